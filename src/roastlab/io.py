@@ -1,0 +1,56 @@
+"""Small file helpers: atomic writes that never leave a partial output behind."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+from .errors import InputError
+
+
+def atomic_write_bytes(path: str | Path, data: bytes) -> None:
+    """Write ``data`` to ``path`` through a temporary file in the same folder and a rename."""
+    path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    if not folder.is_dir():
+        raise InputError("output folder does not exist", path)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
+    except OSError as exc:
+        raise InputError(f"cannot write output ({exc.strerror})", path) from None
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except OSError as exc:
+        Path(tmp).unlink(missing_ok=True)
+        raise InputError(f"cannot write output ({exc.strerror})", path) from None
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def atomic_write_text(path: str | Path, text: str) -> None:
+    atomic_write_bytes(path, text.encode("utf-8"))
+
+
+def check_output_path(out: str | Path, inputs: list[str | Path]) -> Path:
+    """Refuse an output path that is one of the inputs or lies in a missing folder."""
+    out = Path(out)
+    for src in inputs:
+        try:
+            if Path(src).exists() and out.exists() and os.path.samefile(src, out):
+                raise InputError(f"output path is the same file as input {src}; refusing to overwrite an input", out)
+        except OSError:
+            pass
+        if Path(src).resolve() == out.resolve():
+            raise InputError(f"output path is the same file as input {src}; refusing to overwrite an input", out)
+    folder = out.parent if str(out.parent) else Path(".")
+    if not folder.is_dir():
+        raise InputError("output folder does not exist", out)
+    if not os.access(folder, os.W_OK):
+        raise InputError("output folder is not writable", out)
+    return out
