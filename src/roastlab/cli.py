@@ -31,8 +31,9 @@ def _float_arg(name: str):
     return parse
 
 
-def _add_model_options(p: argparse.ArgumentParser, with_theta: bool = True) -> None:
-    p.add_argument("--plant", required=True, help="plant preset (120kg, 360kg) or PLANT.toml path")
+def _add_model_options(p: argparse.ArgumentParser, with_theta: bool = True, plant: bool = True) -> None:
+    if plant:
+        p.add_argument("--plant", required=True, help="plant preset (120kg, 360kg) or PLANT.toml path")
     if with_theta:
         p.add_argument("--theta", metavar="THETA.json", help="identified coefficients (default: the paper's theta*)")
         p.add_argument("--hgm", type=_float_arg("--hgm"), help="gas-metal coefficient [kW/(m2 K)]; overrides --theta")
@@ -134,6 +135,219 @@ def cmd_plant(args) -> int:
     return 0
 
 
+def _parse_assignments(items, option: str, ranged: bool):
+    """Parse ``name=value`` (or ``name=lo:hi`` when ``ranged``) options."""
+    out = {}
+    for item in items or []:
+        name, sep, text = item.partition("=")
+        if not sep or not name:
+            raise InputError(f"{option} expects NAME={'LO:HI' if ranged else 'VALUE'}, got {item!r}", "command line")
+        try:
+            if ranged:
+                lo, sep2, hi = text.partition(":")
+                if not sep2:
+                    raise ValueError
+                value = (float(lo), float(hi))
+            else:
+                value = float(text)
+        except ValueError:
+            raise InputError(
+                f"{option} {name}: cannot read {text!r} as {'LO:HI' if ranged else 'a number'}", "command line"
+            ) from None
+        if ranged and not value[0] < value[1]:
+            raise InputError(
+                f"{option} {name}: inverted or empty bounds {value[0]:g}:{value[1]:g} (need LO < HI)", "command line"
+            )
+        out[name.strip()] = value
+    return out
+
+
+def _load_batches(args, require_Ta=True):
+    from .data import expand_batch_args
+    from .plant import load_plant
+
+    batches, dataset_plant = expand_batch_args(args.batches, require_Ta=require_Ta)
+    plant_spec = args.plant or dataset_plant
+    if plant_spec is None:
+        raise InputError("--plant is required unless a dataset folder names its plant", "command line")
+    return batches, load_plant(plant_spec)
+
+
+def _print_warnings(warnings) -> None:
+    for w in warnings:
+        print(f"warning: {w}", file=sys.stderr)
+
+
+def cmd_identify(args) -> int:
+    import json
+
+    from .identify import build_free_parameters, identify
+    from .io import atomic_write_text, check_output_path
+    from .population import pack_batches
+    from .simulate import InitialState
+    from .theta import THETA_START
+
+    batches, plant = _load_batches(args)
+    out = check_output_path(args.out, [b.source for b in batches if b.source])
+    fix = _parse_assignments(args.fix, "--fix", ranged=False)
+    bounds = _parse_assignments(args.bounds, "--bounds", ranged=True)
+    free, fixed = build_free_parameters(fix, bounds, estimate_tm0=args.estimate_tm0)
+    initial = InitialState(Tb0_C=args.tb0, Tm0_C=args.tm0, X0=args.x0)
+    packed = pack_batches(batches, plant, THETA_START, initial=initial, moisture=args.moisture, hold=args.hold)
+    result = identify(packed, free, fixed, method=args.method, seed=args.seed, n_starts=args.starts)
+    doc = {**result.to_json_dict(), "plant": plant.name}
+    atomic_write_text(out, json.dumps(doc, indent=1) + "\n")
+    th = result.theta
+    print(
+        f"identified on {len(batches)} batch(es), {result.n_residuals} samples, plant {plant.name} [{result.method}, seed {result.seed}]"
+    )
+    print(f"{'parameter':<22}{'value':>12}{'std. error':>12}  bounds")
+    for name, value in ((k, v) for k, v in {**result.fixed, **result.values}.items()):
+        if isinstance(value, list):
+            for bname, v in zip(result.batches, value):
+                lab = f"{name}[{bname}]"
+                lo, hi = result.bounds[lab]
+                print(f"{lab[:22]:<22}{v:>12.4f}{result.stderr[lab]:>12.2g}  [{lo:g}, {hi:g}]")
+            continue
+        if name in result.fixed:
+            print(f"{name:<22}{value:>12.4f}{'fixed':>12}")
+        else:
+            lo, hi = result.bounds[name]
+            print(f"{name:<22}{value:>12.4f}{result.stderr[name]:>12.2g}  [{lo:g}, {hi:g}]")
+    print(f"summed SSR {result.SSR:.4f} °C², {result.nfev} simulations, {result.wall_s:.2f} s -> {out}")
+    _print_warnings(result.warnings)
+    del th
+    return 0
+
+
+def cmd_validate(args) -> int:
+    import json
+
+    from .io import atomic_write_text, check_output_path
+    from .report import plot_fit
+    from .simulate import InitialState
+    from .validate import applicable_values, validate
+
+    batches, plant = _load_batches(args)
+    theta, extra = _theta_from_args(args)
+    inputs = [b.source for b in batches if b.source] + ([args.theta] if args.theta else [])
+    for target in (args.json, args.plot):
+        if target:
+            check_output_path(target, inputs)
+    initial = InitialState(Tb0_C=args.tb0, Tm0_C=args.tm0, X0=args.x0)
+    result = validate(
+        batches,
+        plant,
+        theta,
+        initial=initial,
+        moisture=args.moisture,
+        hold=args.hold,
+        extra_values=applicable_values(extra),
+    )
+    print(
+        result.table(
+            f"validation on plant {plant.name}, theta = hgm {theta.hgm:.4f}, hbm {theta.hbm:.4f}, Pbm {theta.Pbm:.4f}"
+        )
+    )
+    if args.json:
+        atomic_write_text(args.json, json.dumps(result.to_json_dict(), indent=1) + "\n")
+    if args.plot:
+        plot_fit(result, args.plot, title=f"measured vs simulated Ta, plant {plant.name}")
+    return 0
+
+
+def cmd_reproduce(args) -> int:
+    from .reproduce import run, summary_table
+
+    summary = run(args.out, args.data, seed=args.seed)
+    print(summary_table(summary))
+    return 0
+
+
+def cmd_datasets(args) -> int:
+    from .datasets import make_paper
+
+    written = make_paper(args.seed, args.out)
+    print(f"wrote {len(written)} files of SYNTHETIC data under {args.out} (seed {args.seed})")
+    return 0
+
+
+def _add_fit_commands(sub) -> None:
+    from .datasets import PAPER_SEED
+
+    fit_help = "batch CSVs (time_s,Gg_kg_s,Tgi_C,Ta_C) and/or dataset folders with a dataset.toml"
+    p = sub.add_parser(
+        "identify",
+        help="identify theta = (hgm, hbm, Pbm) on batches (eqs. 18-19)",
+        description="Minimise the summed SSR of the probe temperature over the given batches within bounds, "
+        "by a seeded global search (scattered starts polished by bounded least squares) or differential evolution. "
+        "Writes THETA.json with the optimum, standard errors, correlations and warnings.",
+    )
+    p.add_argument("batches", nargs="+", metavar="BATCH", help=fit_help)
+    p.add_argument("--plant", help="plant preset or PLANT.toml (default: the dataset's plant)")
+    p.add_argument("--out", required=True, metavar="THETA.json", help="where to write the result")
+    p.add_argument(
+        "--method", choices=("global", "de"), default="global", help="global search (default) or differential evolution"
+    )
+    p.add_argument("--seed", type=int, default=0, help="random seed of the search (default 0)")
+    p.add_argument("--starts", type=int, default=6, help="local polishes in the global search (default 6)")
+    p.add_argument(
+        "--fix", action="append", metavar="NAME=V", help="hold a parameter fixed, e.g. --fix hgm=0.01 (repeatable)"
+    )
+    p.add_argument(
+        "--bounds", action="append", metavar="NAME=LO:HI", help="change bounds, e.g. --bounds hbm=0.01:0.5 (repeatable)"
+    )
+    p.add_argument(
+        "--estimate-tm0",
+        action="store_true",
+        help="estimate each batch's initial metal temperature as a nuisance parameter",
+    )
+    _add_model_options(p, with_theta=False, plant=False)
+    p.set_defaults(func=cmd_identify)
+
+    p = sub.add_parser(
+        "validate",
+        help="simulate batches with theta and report the paper's metrics",
+        description="Simulate each batch with THETA.json (default: the paper's theta*) and report n, SSR, ||e||, MAE, MPE, MAPE, FIT, rho per batch and on average.",
+    )
+    p.add_argument("batches", nargs="+", metavar="BATCH", help=fit_help)
+    p.add_argument("--plant", help="plant preset or PLANT.toml (default: the dataset's plant)")
+    p.add_argument("--json", metavar="METRICS.json", help="write the metrics as JSON")
+    p.add_argument("--plot", metavar="FIG.png", help="plot measured vs simulated Ta per batch")
+    _add_model_options(p, with_theta=True, plant=False)
+    p.set_defaults(func=cmd_validate)
+
+    p = sub.add_parser(
+        "reproduce",
+        help="the paper end to end: identify on dataset-I, validate on dataset-V",
+        description="Identify on the synthetic dataset-I (120 kg), validate on dataset-V (360 kg) and write "
+        "theta.json, metrics.json, report.md, fig2_profiles.png and fig3_errors.png.",
+    )
+    p.add_argument("--out", default="out/reproduce", metavar="DIR", help="output folder (default out/reproduce)")
+    p.add_argument(
+        "--data", metavar="DIR", help="folder holding dataset-I and dataset-V (default: the shipped synthetic data)"
+    )
+    p.add_argument("--seed", type=int, default=0, help="seed of the identification (default 0)")
+    p.set_defaults(func=cmd_reproduce)
+
+    p = sub.add_parser("datasets", help="generate the synthetic stand-in datasets")
+    dsub = p.add_subparsers(dest="what", metavar="WHAT", parser_class=_Parser)
+    dsub.required = True
+    q = dsub.add_parser(
+        "make-paper",
+        help="write dataset-I and dataset-V (SYNTHETIC) from a seed",
+        description="Generate the synthetic stand-ins of the paper's datasets, byte-identical for a given seed.",
+    )
+    q.add_argument("--seed", type=int, default=PAPER_SEED, help=f"random seed (default {PAPER_SEED}, the shipped data)")
+    q.add_argument(
+        "--out",
+        default="datasets/paper-synthetic",
+        metavar="DIR",
+        help="output folder (default datasets/paper-synthetic)",
+    )
+    q.set_defaults(func=cmd_datasets)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="roastlab",
@@ -168,13 +382,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--x0", type=_float_arg("--x0"), default=0.1, help="moisture used for Mbd and F (default 0.1)")
     p.set_defaults(func=cmd_plant)
 
-    for register in _EXTRA_COMMANDS:
-        register(sub)
+    _add_fit_commands(sub)
     return parser
-
-
-#: Later modules append functions ``register(subparsers)`` here.
-_EXTRA_COMMANDS: list = []
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -164,7 +164,7 @@ def read_table(path: str | Path, required: tuple[str, ...], optional: tuple[str,
         )
     if len(lines) == 1:
         raise InputError("header only, no data rows", path)
-    wanted = [c for c in required + optional if c in header]
+    wanted = list(dict.fromkeys(c for c in required + optional if c in header))
     index = {c: header.index(c) for c in wanted}
     values = {c: [] for c in wanted}
     for line_no, row_text in lines[1:]:

@@ -166,6 +166,19 @@ def _simulate_population(T, GG, TGI, N, batch_of, X0, PP, zoh, h_max, out):
         _integrate_into(T[b], GG[b], TGI[b], N[b], X0[i], PP[i], zoh, h_max, out[i])
 
 
+@njit(cache=True, parallel=True)
+def _ta_population(T, GG, TGI, N, batch_of, X0, PP, zoh, h_max, out_ta):
+    """Like :func:`_simulate_population` but keeps only the probe reading Ta (for fitting)."""
+    nmax = T.shape[1]
+    for i in prange(batch_of.shape[0]):
+        b = batch_of[i]
+        scratch = np.empty((nmax, N_OUT))
+        n = N[b]
+        _integrate_into(T[b], GG[b], TGI[b], n, X0[i], PP[i], zoh, h_max, scratch)
+        for j in range(n):
+            out_ta[i, j] = scratch[j, 4]
+
+
 @njit(cache=True)
 def _step_kernel(x, Gg0, Tgi0, Gg1, Tgi1, dt, p, zoh, h_max, h0):
     t = np.array([0.0, dt])

@@ -1,0 +1,90 @@
+"""identify / validate / reproduce / datasets on the command line."""
+
+import json
+
+from roastlab.reproduce import default_dataset_root
+
+DATA = default_dataset_root()
+
+
+def test_identify_then_validate(cli, tmp_path):
+    theta = tmp_path / "theta.json"
+    code, out, err = cli("identify", "--plant", "120kg", DATA / "dataset-I", "--out", theta, "--seed", "3")
+    assert code == 0, err
+    doc = json.loads(theta.read_text())
+    assert {"hgm", "hbm", "Pbm", "SSR", "stderr", "correlation", "warnings", "evaluations", "wall_s"} <= set(doc)
+    assert "summed SSR" in out
+    metrics = tmp_path / "m.json"
+    code, out, err = cli(
+        "validate",
+        "--plant",
+        "360kg",
+        "--theta",
+        theta,
+        DATA / "dataset-V",
+        "--json",
+        metrics,
+        "--plot",
+        tmp_path / "f.png",
+    )
+    assert code == 0, err
+    m = json.loads(metrics.read_text())
+    assert [b["name"] for b in m["batches"]] == ["batch1", "batch2"]
+    assert set(m["batches"][0]) >= {"name", "n", "SSR", "norm", "MAE", "MPE", "MAPE", "FIT", "rho"}
+    assert set(m["average"]) >= {"SSR", "MAE", "FIT"}
+    assert "average" in out and (tmp_path / "f.png").exists()
+
+
+def test_identify_with_csv_list_fix_and_bounds(cli, tmp_path):
+    files = sorted((DATA / "dataset-I").glob("batch*.csv"))[:2]
+    theta = tmp_path / "t.json"
+    code, out, err = cli(
+        "identify",
+        "--plant",
+        "120kg",
+        *files,
+        "--out",
+        theta,
+        "--fix",
+        "hgm=0.02",
+        "--bounds",
+        "hbm=0.01:0.5",
+        "--method",
+        "de",
+    )
+    assert code == 0, err
+    doc = json.loads(theta.read_text())
+    assert doc["hgm"] == 0.02 and doc["fixed"] == ["hgm"] and doc["method"] == "de"
+
+
+def test_identify_bad_options(cli, tmp_path):
+    base = ["identify", "--plant", "120kg", DATA / "dataset-I", "--out", tmp_path / "t.json"]
+    for extra, needle in (
+        (["--bounds", "hbm=0.3:0.1"], "inverted"),
+        (["--fix", "nope=1"], "unknown parameter"),
+        (["--fix", "hgm"], "NAME=VALUE"),
+    ):
+        code, _, err = cli(*base, *extra)
+        assert code == 2 and needle in err and err.count("\n") == 1, err
+    assert not (tmp_path / "t.json").exists()
+
+
+def test_batch_without_ta_is_refused(cli, tmp_path):
+    f = tmp_path / "noTa.csv"
+    f.write_text("time_s,Gg_kg_s,Tgi_C\n0,0.4,450\n30,0.4,450\n")
+    code, _, err = cli("identify", "--plant", "120kg", f, "--out", tmp_path / "t.json")
+    assert code == 2 and "noTa.csv" in err and "Ta_C" in err
+
+
+def test_reproduce_writes_everything(cli, tmp_path):
+    out = tmp_path / "rep"
+    code, stdout, err = cli("reproduce", "--out", out)
+    assert code == 0, err
+    for name in ("theta.json", "metrics.json", "report.md", "fig2_profiles.png", "fig3_errors.png"):
+        assert (out / name).exists(), name
+    report = (out / "report.md").read_text()
+    assert "SYNTHETIC" in report and "76.861" in report and "Table 1" in report and "Table 4" in report
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["synthetic_data"] is True
+    assert metrics["dataset-V"]["average"]["FIT"] > 50
+    assert "dataset-V" in stdout

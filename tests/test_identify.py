@@ -1,0 +1,111 @@
+"""Identification: recovery on noise-free data, seed-independence on the shipped data."""
+
+import numpy as np
+import pytest
+
+from roastlab.data import Batch, read_dataset
+from roastlab.datasets import _burner_program
+from roastlab.identify import build_free_parameters, identify
+from roastlab.metrics import batch_metrics
+from roastlab.population import pack_batches, predict_ta
+from roastlab.reproduce import default_dataset_root
+from roastlab.simulate import InitialState
+from roastlab.theta import THETA_BOUNDS, THETA_START
+
+DATA = default_dataset_root()
+
+
+def noise_free_batches(seed, plant, theta, count=4):
+    """Batches whose Ta is the model's own output at ``theta`` (no noise, known initial state)."""
+    rng = np.random.default_rng(seed)
+    scale = 1.0 if plant == "120kg" else 3.0
+    batches = []
+    for i in range(count):
+        t = np.arange(int(rng.integers(25, 34))) * 30.0
+        Tgi, _ = _burner_program(rng, t)
+        Gg = scale * rng.uniform(0.30, 0.45) * (1 + 0.01 * rng.standard_normal(len(t)))
+        batches.append(Batch(f"b{i}", t, Gg, Tgi, np.full(len(t), 30.0)))
+    packed = pack_batches(batches, plant, theta, InitialState(Ta0_C=30.0))
+    ta = predict_ta(packed, [], np.zeros((1, len(batches), 0)))[0]
+    for i, b in enumerate(batches):
+        b.Ta_C = ta[i, : b.n].copy()
+    return batches
+
+
+@pytest.mark.parametrize("seed, plant", [(1, "120kg"), (2, "360kg"), (3, "120kg"), (4, "360kg")])
+def test_recovers_noise_free_truth(seed, plant):
+    rng = np.random.default_rng(100 + seed)
+    truth = tuple(rng.uniform(lo, hi) for lo, hi in THETA_BOUNDS.values())
+    batches = noise_free_batches(seed, plant, truth)
+    packed = pack_batches(batches, plant, THETA_START, InitialState(Ta0_C=30.0))
+    free, fixed = build_free_parameters()
+    fit = identify(packed, free, fixed, seed=seed, progress=False)
+    truth_ssr = 0.0  # the data are the model's output at the truth
+    assert fit.SSR <= truth_ssr * (1 + 1e-6) + 1e-6
+    ta = predict_ta(packed, ["hgm", "hbm", "Pbm"], np.array([[list(fit.theta.as_tuple())] * len(batches)]))[0]
+    for i, b in enumerate(batches):
+        assert batch_metrics(b.Ta_C, ta[i, : b.n])["FIT"] >= 99.5
+
+
+def shipped_packed():
+    ds = read_dataset(DATA / "dataset-I")
+    return pack_batches(ds.batches, ds.plant, THETA_START)
+
+
+def test_ten_seeds_reach_the_same_optimum():
+    packed = shipped_packed()
+    free, fixed = build_free_parameters()
+    ssr = [identify(packed, free, fixed, seed=s, progress=False).SSR for s in range(10)]
+    spread = (max(ssr) - min(ssr)) / min(ssr)
+    assert spread < 1e-3, ssr
+
+
+def test_de_agrees_with_global_search():
+    packed = shipped_packed()
+    free, fixed = build_free_parameters()
+    g = identify(packed, free, fixed, seed=0, progress=False)
+    d = identify(packed, free, fixed, method="de", seed=0, progress=False)
+    assert abs(d.SSR - g.SSR) / g.SSR < 1e-3
+
+
+def test_identified_beats_paper_theta_and_reports_uncertainty():
+    packed = shipped_packed()
+    free, fixed = build_free_parameters()
+    fit = identify(packed, free, fixed, seed=0, progress=False)
+    from roastlab.identify import Objective
+
+    obj = Objective(packed, free, fixed)
+    ssr_paper = float(obj.ssr_many(np.array([[0.0100, 0.0254, 0.5793]]))[0])
+    assert fit.SSR <= ssr_paper
+    assert set(fit.stderr) == {"hgm", "hbm", "Pbm"}
+    m = np.array(fit.correlation["matrix"])
+    assert m.shape == (3, 3) and np.allclose(np.diag(m), 1.0, atol=1e-6)
+
+
+def test_fix_bounds_and_bound_warning():
+    packed = shipped_packed()
+    free, fixed = build_free_parameters(fix={"hgm": 0.01}, bounds={"hbm": (0.01, 0.5)})
+    fit = identify(packed, free, fixed, seed=0, progress=False)
+    assert fit.theta.hgm == 0.01 and "hgm" not in fit.stderr
+    assert fit.bounds["hbm"] == [0.01, 0.5]
+    # force an optimum onto a bound: the warning must say so
+    free, fixed = build_free_parameters(bounds={"Pbm": (0.7, 0.8)})
+    fit = identify(packed, free, fixed, seed=0, progress=False)
+    assert any("Pbm" in w and "bound" in w for w in fit.warnings)
+
+
+def test_estimating_initial_metal_temperature_lowers_ssr():
+    packed = shipped_packed()
+    free, fixed = build_free_parameters()
+    plain = identify(packed, free, fixed, seed=0, progress=False)
+    free, fixed = build_free_parameters(estimate_tm0=True)
+    nuis = identify(packed, free, fixed, seed=0, progress=False, n_starts=3)
+    assert nuis.SSR < plain.SSR
+    assert len(nuis.values["Tm0_C"]) == packed.n_batches
+
+
+def test_inverted_bounds_rejected():
+    from roastlab.errors import ParameterError
+
+    with pytest.raises(ParameterError, match="inverted"):
+        build_free_parameters(bounds={"hbm": (0.3, 0.1)})
