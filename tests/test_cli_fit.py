@@ -88,3 +88,13 @@ def test_reproduce_writes_everything(cli, tmp_path):
     assert metrics["synthetic_data"] is True
     assert metrics["dataset-V"]["average"]["FIT"] > 50
     assert "dataset-V" in stdout
+
+
+def test_identify_per_batch(cli, tmp_path):
+    out = tmp_path / "fleet.json"
+    code, stdout, err = cli("identify", DATA / "dataset-I", "--per-batch", "--out", out)
+    assert code == 0, err
+    doc = json.loads(out.read_text())
+    assert doc["mode"] == "per-batch" and len(doc["batches"]) == 5
+    assert {"hgm", "hbm", "Pbm", "SSR", "FIT"} <= set(doc["batches"][0])
+    assert "mean" in stdout

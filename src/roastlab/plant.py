@@ -7,6 +7,7 @@ Presets ``120kg`` and ``360kg`` ship as TOML files in ``roastlab/plants/``.
 
 from __future__ import annotations
 
+import functools
 import math
 import tomllib
 from dataclasses import dataclass, field
@@ -27,10 +28,21 @@ _GEOMETRY_DOC = {
 }
 
 
+@functools.cache
+def _preset_names() -> tuple[str, ...]:
+    folder = resources.files("roastlab") / "plants"
+    return tuple(sorted(p.name.removesuffix(".toml") for p in folder.iterdir() if p.name.endswith(".toml")))
+
+
+@functools.cache
+def _load_preset(name: str) -> Plant:
+    resource = resources.files("roastlab") / "plants" / f"{name}.toml"
+    return plant_from_mapping(tomllib.loads(resource.read_text(encoding="utf-8")), f"preset {name}", name)
+
+
 def preset_names() -> list[str]:
     """Names of the plant presets shipped with roastlab."""
-    folder = resources.files("roastlab") / "plants"
-    return sorted(p.name.removesuffix(".toml") for p in folder.iterdir() if p.name.endswith(".toml"))
+    return list(_preset_names())
 
 
 @dataclass(frozen=True)
@@ -168,10 +180,8 @@ def load_plant(spec: str | Path | Plant) -> Plant:
     if isinstance(spec, Plant):
         return spec
     text = str(spec)
-    if text in preset_names():
-        resource = resources.files("roastlab") / "plants" / f"{text}.toml"
-        data = tomllib.loads(resource.read_text(encoding="utf-8"))
-        return plant_from_mapping(data, f"preset {text}", text)
+    if text in _preset_names():
+        return _load_preset(text)  # presets are immutable data: parse once per process
     path = Path(text)
     if path.suffix.lower() != ".toml" and not path.exists():
         raise InputError(

@@ -12,6 +12,7 @@ theta coefficients, any process constant, the metal mass, and the initial states
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -69,7 +70,12 @@ def pack_batches(
     nb = len(batches)
     if not isinstance(plants, (list, tuple)):
         plants = [plants] * nb
-    plants = [load_plant(p) for p in plants]
+    loaded: dict = {}  # read each distinct plant file once, not once per batch
+    for spec in plants:
+        key = str(spec) if isinstance(spec, (str, Path)) else id(spec)
+        if key not in loaded:
+            loaded[key] = load_plant(spec)
+    plants = [loaded[str(s) if isinstance(s, (str, Path)) else id(s)] for s in plants]
     base = initial or InitialState()
     nmax = max(b.n for b in batches)
     T = np.zeros((nb, nmax))

@@ -88,7 +88,10 @@ def _integrate_into(t, Gg, Tgi, n, x0, p, zoh, h_max, out, h0=5.0):
             dg = (Gg[k + 1] - g0) / dt
             dT = (Tgi[k + 1] - T0) / dt
         s = 0.0
-        _f(x, g0, T0, p, k1)
+        if zoh or k == 0:
+            # a zero-order hold jumps at the sample, so the derivative there is new; a linear
+            # hold is continuous, so the last stage of the previous interval is still valid
+            _f(x, g0, T0, p, k1)
         while s < dt:
             last = False
             h_try = h
