@@ -166,6 +166,17 @@ def _load_batches(args, require_Ta=True):
     from .data import expand_batch_args
     from .plant import load_plant
 
+    if getattr(args, "map", None):
+        from .importers import import_log, load_map
+
+        cmap = load_map(args.map)
+        batches = [import_log(p, cmap) for p in args.batches]
+        for b in batches:
+            for note in b.notes:
+                print(f"warning: {b.source}: {note}", file=sys.stderr)
+        if not args.plant:
+            raise InputError("--plant is required with --map", "command line")
+        return batches, load_plant(args.plant)
     batches, dataset_plant = expand_batch_args(args.batches, require_Ta=require_Ta)
     plant_spec = args.plant or dataset_plant
     if plant_spec is None:
@@ -188,7 +199,18 @@ def cmd_identify(args) -> int:
     from .theta import THETA_START
 
     batches, plant = _load_batches(args)
-    out = check_output_path(args.out, [b.source for b in batches if b.source])
+    out = check_output_path(args.out, [b.source for b in batches if b.source] + [x for x in (args.map, args.spec) if x])
+    if args.baseline:
+        from .baseline import fit_first_order
+
+        doc = {**fit_first_order(batches), "plant": plant.name}
+        atomic_write_text(out, json.dumps(doc, indent=1) + "\n")
+        print(
+            f"first-order baseline on {len(batches)} batch(es): tau {doc['tau_s']:.1f} s, offset {doc['offset_C']:+.2f} degC, SSR {doc['SSR']:.1f} -> {out}"
+        )
+        return 0
+    if args.spec:
+        return _identify_with_spec(args, batches, plant, out)
     fix = _parse_assignments(args.fix, "--fix", ranged=False)
     bounds = _parse_assignments(args.bounds, "--bounds", ranged=True)
     free, fixed = build_free_parameters(fix, bounds, estimate_tm0=args.estimate_tm0)
@@ -199,27 +221,62 @@ def cmd_identify(args) -> int:
     result = identify(packed, free, fixed, method=args.method, seed=args.seed, n_starts=args.starts)
     doc = {**result.to_json_dict(), "plant": plant.name}
     atomic_write_text(out, json.dumps(doc, indent=1) + "\n")
-    th = result.theta
+    _print_fit(result, len(batches), plant.name, out)
+    return 0
+
+
+def _identify_with_spec(args, batches, plant, out) -> int:
+    import json
+
+    from .fitspec import load_fit_spec
+    from .identify import identify
+    from .io import atomic_write_text
+    from .population import pack_batches
+    from .simulate import InitialState
+    from .theta import THETA_START
+
+    spec = load_fit_spec(args.spec)
+    if args.fix or args.bounds or args.estimate_tm0 or args.per_batch:
+        raise InputError(
+            "--spec sets free and fixed parameters itself; drop --fix/--bounds/--estimate-tm0/--per-batch",
+            "command line",
+        )
+    init_values = {"Tb0_C": args.tb0, "Tm0_C": args.tm0, "X0": args.x0, **spec.initial}
+    initial = InitialState(**init_values)
+    packed = pack_batches(batches, plant, THETA_START, initial=initial, moisture=args.moisture, hold=args.hold)
+    result = identify(packed, spec.free, spec.fixed, method=args.method, seed=args.seed, n_starts=args.starts)
+    doc = {
+        **result.to_json_dict(),
+        "plant": plant.name,
+        "initial": init_values,
+        "spec": str(args.spec),
+        "map": str(args.map) if args.map else None,
+        "moisture": args.moisture,
+        "hold": args.hold,
+    }
+    atomic_write_text(out, json.dumps(doc, indent=1) + "\n")
+    _print_fit(result, len(batches), plant.name, out)
+    return 0
+
+
+def _print_fit(result, n_batches, plant_name, out) -> None:
     print(
-        f"identified on {len(batches)} batch(es), {result.n_residuals} samples, plant {plant.name} [{result.method}, seed {result.seed}]"
+        f"identified on {n_batches} batch(es), {result.n_residuals} samples, plant {plant_name} [{result.method}, seed {result.seed}]"
     )
-    print(f"{'parameter':<22}{'value':>12}{'std. error':>12}  bounds")
-    for name, value in ((k, v) for k, v in {**result.fixed, **result.values}.items()):
+    print(f"{'parameter':<26}{'value':>12}{'std. error':>12}  bounds")
+    for name, value in {**result.fixed, **result.values}.items():
         if isinstance(value, list):
             for bname, v in zip(result.batches, value):
                 lab = f"{name}[{bname}]"
                 lo, hi = result.bounds[lab]
-                print(f"{lab[:22]:<22}{v:>12.4f}{result.stderr[lab]:>12.2g}  [{lo:g}, {hi:g}]")
-            continue
-        if name in result.fixed:
-            print(f"{name:<22}{value:>12.4f}{'fixed':>12}")
+                print(f"{lab[:26]:<26}{v:>12.5g}{result.stderr[lab]:>12.2g}  [{lo:g}, {hi:g}]")
+        elif name in result.fixed:
+            print(f"{name:<26}{value:>12.5g}{'fixed':>12}")
         else:
             lo, hi = result.bounds[name]
-            print(f"{name:<22}{value:>12.4f}{result.stderr[name]:>12.2g}  [{lo:g}, {hi:g}]")
+            print(f"{name:<26}{value:>12.5g}{result.stderr[name]:>12.2g}  [{lo:g}, {hi:g}]")
     print(f"summed SSR {result.SSR:.4f} °C², {result.nfev} simulations, {result.wall_s:.2f} s -> {out}")
     _print_warnings(result.warnings)
-    del th
-    return 0
 
 
 def _identify_per_batch(args, packed, plant, fix, bounds, out) -> int:
@@ -259,12 +316,21 @@ def cmd_validate(args) -> int:
     from .validate import applicable_values, validate
 
     batches, plant = _load_batches(args)
-    theta, extra = _theta_from_args(args)
     inputs = [b.source for b in batches if b.source] + ([args.theta] if args.theta else [])
     for target in (args.json, args.plot):
         if target:
             check_output_path(target, inputs)
-    initial = InitialState(Tb0_C=args.tb0, Tm0_C=args.tm0, X0=args.x0)
+    if args.baseline:
+        return _validate_baseline(args, batches, plant)
+    theta, extra = _theta_from_args(args)
+    init_values = {"Tb0_C": args.tb0, "Tm0_C": args.tm0, "X0": args.x0}
+    saved_initial = extra.get("initial")
+    if isinstance(saved_initial, dict):  # the initial state the fit used
+        init_values.update(
+            {k: float(v) for k, v in saved_initial.items() if k in ("Tb0_C", "Tm0_C", "X0", "He0_kJ_kg", "Ta0_C")}
+        )
+    _apply_per_batch_initial(extra, batches)
+    initial = InitialState(**init_values)
     result = validate(
         batches,
         plant,
@@ -283,6 +349,98 @@ def cmd_validate(args) -> int:
         atomic_write_text(args.json, json.dumps(result.to_json_dict(), indent=1) + "\n")
     if args.plot:
         plot_fit(result, args.plot, title=f"measured vs simulated Ta, plant {plant.name}")
+    return 0
+
+
+def _apply_per_batch_initial(theta_json: dict, batches) -> None:
+    """Per-batch identified initial states (e.g. Tm0_C per batch) apply to batches of the same name."""
+    from .population import STATE0
+
+    names = theta_json.get("batches")
+    if not isinstance(names, list):
+        return
+    by_name = {b.name: b for b in batches}
+    for key, values in theta_json.items():
+        if key in STATE0 and isinstance(values, list) and len(values) == len(names):
+            for bname, v in zip(names, values):
+                if bname in by_name and isinstance(v, (int, float)) and not isinstance(v, bool):
+                    by_name[bname].initial[key] = float(v)
+
+
+def _validate_baseline(args, batches, plant) -> int:
+    import json
+
+    from .baseline import validate_first_order
+    from .io import atomic_write_text
+    from .metrics import average_metrics
+    from .validate import ValidationResult
+
+    if not args.theta:
+        raise InputError(
+            "--baseline first-order needs --theta BASELINE.json from 'identify --baseline first-order'", "command line"
+        )
+    params = _read_baseline_json(args.theta)
+    preds, rows = validate_first_order(batches, params)
+    result = ValidationResult(
+        [b.name for b in batches], [b.time_s for b in batches], [b.Ta_C for b in batches], preds, [], rows, plant.name
+    )
+    print(
+        result.table(
+            f"first-order baseline (tau {params['tau_s']:.1f} s, offset {params['offset_C']:+.2f} degC) on plant {plant.name}"
+        )
+    )
+    if args.json:
+        doc = {
+            "baseline": "first-order",
+            "tau_s": params["tau_s"],
+            "offset_C": params["offset_C"],
+            "batches": [{"name": n, **r} for n, r in zip(result.names, rows)],
+            "average": average_metrics(rows),
+        }
+        atomic_write_text(args.json, json.dumps(doc, indent=1) + "\n")
+    if args.plot:
+        from .report import plot_fit
+
+        plot_fit(result, args.plot, title="measured vs first-order baseline")
+    return 0
+
+
+def _read_baseline_json(path) -> dict:
+    import json
+    from pathlib import Path
+
+    try:
+        data = json.loads(Path(path).read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise InputError("file not found", path) from None
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise InputError(f"not valid JSON ({exc})", path) from None
+    if not isinstance(data, dict):
+        raise InputError("expected a JSON object", path)
+    for key in ("tau_s", "offset_C"):
+        v = data.get(key)
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            raise InputError("missing or not a number", path, f"key {key}")
+    if not data["tau_s"] > 0:
+        raise InputError("tau_s must be > 0", path, "key tau_s")
+    return data
+
+
+def cmd_import(args) -> int:
+    from .data import write_batch_csv
+    from .importers import import_log, load_map
+    from .io import check_output_path
+
+    cmap = load_map(args.map) if args.map else None
+    out = check_output_path(args.out, [args.log] + ([args.map] if args.map else []))
+    batch = import_log(args.log, cmap, name=args.name)
+    for note in batch.notes:
+        print(f"warning: {args.log}: {note}", file=sys.stderr)
+    write_batch_csv(out, batch, comment=f"imported by roastlab from {args.log}", decimals=4)
+    mass = f", green batch {batch.Mb_kg * 1000:.0f} g" if batch.Mb_kg else ""
+    print(
+        f"imported {batch.n} samples ({batch.time_s[0]:.0f}..{batch.time_s[-1]:.0f} s){mass}: Ta {batch.Ta_C[0]:.1f} -> {batch.Ta_C[-1]:.1f} degC -> {out}"
+    )
     return 0
 
 
@@ -353,6 +511,21 @@ def _add_fit_commands(sub) -> None:
         action="store_true",
         help="fit a separate theta to every batch (fleet mode: compiled, parallel, linear in the number of batches)",
     )
+    p.add_argument(
+        "--map",
+        metavar="MAP.toml",
+        help="the BATCH arguments are raw logs (Artisan .alog/.csv, CSV, Parquet) read with this column map",
+    )
+    p.add_argument(
+        "--spec",
+        metavar="FIT.toml",
+        help="fit spec: free parameters (theta, process constants, initial states) with bounds",
+    )
+    p.add_argument(
+        "--baseline",
+        choices=("first-order",),
+        help="fit the first-order baseline dBT/dt = (ET + offset - BT)/tau instead",
+    )
     _add_model_options(p, with_theta=False, plant=False)
     p.set_defaults(func=cmd_identify)
 
@@ -365,6 +538,12 @@ def _add_fit_commands(sub) -> None:
     p.add_argument("--plant", help="plant preset or PLANT.toml (default: the dataset's plant)")
     p.add_argument("--json", metavar="METRICS.json", help="write the metrics as JSON")
     p.add_argument("--plot", metavar="FIG.png", help="plot measured vs simulated Ta per batch")
+    p.add_argument("--map", metavar="MAP.toml", help="the BATCH arguments are raw logs read with this column map")
+    p.add_argument(
+        "--baseline",
+        choices=("first-order",),
+        help="validate the first-order baseline (--theta from 'identify --baseline first-order')",
+    )
     _add_model_options(p, with_theta=True, plant=False)
     p.set_defaults(func=cmd_validate)
 
@@ -391,6 +570,18 @@ def _add_fit_commands(sub) -> None:
     p.add_argument("--json", action="store_true", help="print the figures as JSON (progress goes quiet)")
     p.add_argument("--save", metavar="FILE.json", help="also save the JSON to a file")
     p.set_defaults(func=cmd_bench)
+
+    p = sub.add_parser(
+        "import",
+        help="convert a roast log (Artisan .alog/.csv, CSV, Parquet) into a batch CSV",
+        description="Read a log with a column map and write the canonical batch CSV time_s,Gg_kg_s,Tgi_C,Ta_C "
+        "(Artisan logs: time 0 at CHARGE, cut after DROP, °F converted, green weight kept as '# Mb_kg').",
+    )
+    p.add_argument("log", metavar="LOG", help="the roast log")
+    p.add_argument("--map", metavar="MAP.toml", help="column map (default: canonical column names)")
+    p.add_argument("--out", required=True, metavar="BATCH.csv", help="where to write the batch CSV")
+    p.add_argument("--name", help="batch name (default: the log's file name)")
+    p.set_defaults(func=cmd_import)
 
     p = sub.add_parser("datasets", help="generate the synthetic stand-in datasets")
     dsub = p.add_subparsers(dest="what", metavar="WHAT", parser_class=_Parser)

@@ -39,6 +39,8 @@ class Batch:
     Ta_C : (n,) array or None, measured bean-probe temperature [degC]
     source : path it was read from, if any
     initial : per-batch initial-state overrides (e.g. ``{"Tm0_C": 105.0}``)
+    Mb_kg : green batch mass [kg] if it differs from the plant's (read from a
+        ``# Mb_kg = ...`` comment line of a batch CSV, or from an Artisan log's weight)
     """
 
     name: str
@@ -48,6 +50,8 @@ class Batch:
     Ta_C: np.ndarray | None = None
     source: str | None = None
     initial: dict = field(default_factory=dict)
+    Mb_kg: float | None = None
+    notes: list = field(default_factory=list)  # import warnings worth telling the user
 
     @property
     def n(self) -> int:
@@ -187,6 +191,7 @@ def read_batch_csv(path: str | Path, name: str | None = None, require_Ta: bool =
     path = Path(path)
     required = REQUIRED_COLUMNS + (("Ta_C",) if require_Ta else ())
     cols = read_table(path, required, OPTIONAL_COLUMNS)
+    meta = read_comment_metadata(path)
     batch = Batch(
         name=name or path.stem,
         time_s=cols["time_s"],
@@ -194,8 +199,33 @@ def read_batch_csv(path: str | Path, name: str | None = None, require_Ta: bool =
         Tgi_C=cols["Tgi_C"],
         Ta_C=cols.get("Ta_C"),
         source=str(path),
+        Mb_kg=meta.get("Mb_kg"),
     )
     return batch.validate()
+
+
+#: Metadata a batch CSV may carry in ``# key = value`` comment lines, with allowed ranges.
+COMMENT_METADATA = {"Mb_kg": (1e-4, 1e4)}
+
+
+def read_comment_metadata(path: str | Path) -> dict[str, float]:
+    """Parse ``# Mb_kg = 0.2``-style metadata lines at the top of a batch CSV."""
+    path = Path(path)
+    out = {}
+    for line_no, line in enumerate(_read_text(path).splitlines(), start=1):
+        if not line.startswith("#"):
+            if line.strip():
+                break
+            continue
+        key, sep, value = line[1:].partition("=")
+        key = key.strip()
+        if sep and key in COMMENT_METADATA:
+            v = parse_number(value, path, line_no, key)
+            lo, hi = COMMENT_METADATA[key]
+            if not lo <= v <= hi:
+                raise InputError(f"{key} = {v:g} outside {lo:g}..{hi:g}", path, f"line {line_no}")
+            out[key] = v
+    return out
 
 
 def write_batch_csv(path: str | Path, batch: Batch, comment: str | None = None, decimals: int = 4) -> None:
@@ -206,6 +236,8 @@ def write_batch_csv(path: str | Path, batch: Batch, comment: str | None = None, 
     if comment:
         for line in comment.splitlines():
             out.write(f"# {line}\n")
+    if batch.Mb_kg:
+        out.write(f"# Mb_kg = {batch.Mb_kg:.6g}\n")
     cols = ["time_s", "Gg_kg_s", "Tgi_C"] + (["Ta_C"] if batch.Ta_C is not None else [])
     out.write(",".join(cols) + "\n")
     arrays = [batch.time_s, batch.Gg_kg_s, batch.Tgi_C] + ([batch.Ta_C] if batch.Ta_C is not None else [])

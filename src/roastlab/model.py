@@ -46,11 +46,12 @@ PARAM_NAMES = (
     "Kt",
     "lam",  # process constants
     "x_exp",  # exponent of X in the moisture law: 2 (Schwartzberg) or 0 (printed)
+    "Gg_scale",  # factor on the gas-flow input [-], 1 = as given (identifies an unlogged constant Gg)
 )
 P = {name: i for i, name in enumerate(PARAM_NAMES)}
 N_PARAMS = len(PARAM_NAMES)
 I_HGM, I_HBM, I_PBM, I_AGM, I_AB, I_MBD, I_MM = range(7)
-I_A, I_CM, I_CW, I_DB, I_HAR, I_HET, I_K1, I_K2, I_KT, I_LAM, I_XEXP = range(7, 18)
+I_A, I_CM, I_CW, I_DB, I_HAR, I_HET, I_K1, I_K2, I_KT, I_LAM, I_XEXP, I_GGS = range(7, 19)
 
 _A0, _A1, _A2, _A3, _A4, _A5, _A6 = CG_ALPHA_J_KG_K
 KELVIN = 273.15
@@ -82,6 +83,7 @@ def heat_flows(Tb, Tm, X, Gg, Tgi, p):
     Returns ``(Tgo [degC], Qgb, Qgm, Qbm [kW])``:
     Tgi - Tgo from eq. 15e, Qgb eq. 9, Qgm eq. 10, Qbm eq. 11.
     """
+    Gg = Gg * p[I_GGS]  # gas-flow factor (1 unless a constant flow is being identified)
     Pbm = p[I_PBM]
     Agb = p[I_AB] * (1.0 - Pbm)  # section 3.1
     Abm = p[I_AB] * Pbm  # section 3.1
@@ -188,5 +190,6 @@ def pack_params(plant, theta, X0: float = 0.1, moisture: str = "schwartzberg") -
         "Kt": pc.Kt,
         "lam": pc.lam,
         "x_exp": MOISTURE_LAWS[moisture],
+        "Gg_scale": 1.0,
     }
     return np.array([values[name] for name in PARAM_NAMES], dtype=np.float64)

@@ -11,6 +11,7 @@ theta coefficients, any process constant, the metal mass, and the initial states
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -23,6 +24,9 @@ from .simulate import H_MAX_S, N_OUT, InitialState, _check_hold, _simulate_popul
 STATE0 = {"Tb0_C": 0, "Tm0_C": 1, "X0": 2, "He0_kJ_kg": 3, "Ta0_C": 4}
 #: Parameter-vector names usable as free parameters (process constants keep MODEL.md names).
 PARAM_SLOTS = {k: P[k] for k in ("hgm", "hbm", "Pbm", "A", "cm", "cw", "Ha_R", "Het", "k1", "k2", "Kt", "lam", "Mm")}
+#: ``Gg_kg_s`` as a free parameter is the gas-flow factor: the batch's Gg column is then a
+#: placeholder of 1 kg/s (a map with ``[Gg] identify = true``), so the factor is the flow itself.
+PARAM_SLOTS["Gg_kg_s"] = P["Gg_scale"]
 FREE_NAMES = tuple(PARAM_SLOTS) + tuple(STATE0)
 
 
@@ -98,6 +102,8 @@ def pack_batches(
         fields = {**base.__dict__, **b.initial}
         state = InitialState(**fields)
         X0[i] = state.vector(None if b.Ta_C is None else float(b.Ta_C[0]))
+        if getattr(b, "Mb_kg", None):  # the batch's own green weight (e.g. from an Artisan log)
+            plant = dataclasses.replace(plant, Mb_kg=float(b.Mb_kg))
         p = pack_params(plant, theta, state.X0, moisture)
         if PB is None:
             PB = np.zeros((nb, len(p)))

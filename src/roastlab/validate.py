@@ -44,13 +44,14 @@ class ValidationResult:
         }
 
     def table(self, title: str | None = None) -> str:
-        """A readable text table of the metrics."""
-        head = f"{'batch':<16}" + "".join(f"{k:>10}" for k in METRIC_NAMES)
+        """A readable text table of the metrics (columns sized to their contents)."""
+        w = max([len("average")] + [len(n) for n in self.names]) + 2
+        head = f"{'batch':<{w}}" + "".join(f"{k:>11}" for k in METRIC_NAMES)
         lines = ([title] if title else []) + [head, "-" * len(head)]
         for name, row in zip(self.names, self.rows):
-            lines.append(f"{name[:16]:<16}" + "".join(_fmt(k, row[k]) for k in METRIC_NAMES))
+            lines.append(f"{name:<{w}}" + "".join(_fmt(k, row[k]) for k in METRIC_NAMES))
         lines.append("-" * len(head))
-        lines.append(f"{'average':<16}" + "".join(_fmt(k, self.average[k]) for k in METRIC_NAMES))
+        lines.append(f"{'average':<{w}}" + "".join(_fmt(k, self.average[k]) for k in METRIC_NAMES))
         em = self.error_moments
         lines.append(
             f"|e| over {em['samples']} samples: mean {em['mean_abs_error']:.3f} °C, variance {em['var_abs_error']:.3f} °C²"
@@ -60,8 +61,10 @@ class ValidationResult:
 
 def _fmt(key, value) -> str:
     if key == "n":
-        return f"{int(value):>10d}"
-    return f"{value:>10.3f}" if key != "rho" else f"{value:>10.4f}"
+        return f"{int(value):>11d}"
+    if key == "SSR":
+        return f"{value:>11.1f}"
+    return f"{value:>11.3f}" if key != "rho" else f"{value:>11.4f}"
 
 
 def applicable_values(theta_json: dict) -> dict[str, float]:

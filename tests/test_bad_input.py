@@ -1,0 +1,323 @@
+"""Every kind of bad input: one line on stderr naming the file and the problem, exit code 2,
+no traceback, no output file (not even a partial or temporary one)."""
+
+import json
+import os
+
+import pytest
+
+from roastlab.reproduce import default_dataset_root
+
+DATA = default_dataset_root()
+HEADER = "time_s,Gg_kg_s,Tgi_C,Ta_C\n"
+GOOD_ROWS = "".join(f"{t},0.4,450,{30 + t / 10}\n" for t in range(0, 301, 30))
+GOOD_ALOG = repr(
+    {
+        "mode": "C",
+        "timex": [1.5 * i for i in range(40)],
+        "temp1": [150.0 + i for i in range(40)],
+        "temp2": [120.0 + 0.5 * i for i in range(40)],
+        "timeindex": [2, 0, 0, 0, 0, 0, 35, 0],
+        "weight": [200, 0, "g"],
+    }
+)
+SKY_MAP = '[Ta]\ncolumn = "BT"\n[Tgi]\ncolumn = "ET"\n[Gg]\nidentify = true\n'
+
+
+def simulate_with(tmp_path, name, content):
+    f = tmp_path / name
+    f.write_text(content) if isinstance(content, str) else f.write_bytes(content)
+    return ["simulate", "--plant", "120kg", "--inputs", f, "--out", tmp_path / "out.csv"]
+
+
+def import_with(tmp_path, name, content, map_text=SKY_MAP):
+    f = tmp_path / name
+    f.write_text(content) if isinstance(content, str) else f.write_bytes(content)
+    m = tmp_path / "map.toml"
+    m.write_text(map_text)
+    return ["import", f, "--map", m, "--out", tmp_path / "out.csv"]
+
+
+def theta_with(tmp_path, payload):
+    good = tmp_path / "good.csv"
+    good.write_text(HEADER + GOOD_ROWS)
+    t = tmp_path / "theta.json"
+    t.write_text(payload)
+    return ["simulate", "--plant", "120kg", "--inputs", good, "--out", tmp_path / "out.csv", "--theta", t]
+
+
+def plant_with(tmp_path, toml):
+    good = tmp_path / "good.csv"
+    good.write_text(HEADER + GOOD_ROWS)
+    p = tmp_path / "plant.toml"
+    p.write_text(toml)
+    return ["simulate", "--plant", p, "--inputs", good, "--out", tmp_path / "out.csv"]
+
+
+PLANT = "Mb_kg = 120\nDch_m = 1.24\nLch_m = 1.335\nHflap_m = 0.3\nSflap_m = 0.1\nMm_kg = 2000\n"
+
+CASES = {
+    # batch CSVs
+    "empty file": (lambda d: simulate_with(d, "b.csv", ""), "b.csv", "empty file"),
+    "header only": (lambda d: simulate_with(d, "b.csv", HEADER), "b.csv", "header only"),
+    "missing column": (
+        lambda d: simulate_with(d, "b.csv", "time_s,Gg_kg_s\n0,0.4\n"),
+        "b.csv",
+        "missing column(s) Tgi_C",
+    ),
+    "duplicated column": (
+        lambda d: simulate_with(d, "b.csv", "time_s,Gg_kg_s,Tgi_C,Tgi_C\n0,0.4,450,450\n"),
+        "b.csv",
+        "duplicated column 'Tgi_C'",
+    ),
+    "non-numeric cell": (
+        lambda d: simulate_with(d, "b.csv", HEADER + "0,0.4,450,30\n30,0.4,hot,30\n"),
+        "b.csv",
+        "line 3, column Tgi_C: not a number",
+    ),
+    "NaN": (
+        lambda d: simulate_with(d, "b.csv", HEADER + "0,0.4,450,30\n30,NaN,450,30\n"),
+        "b.csv",
+        "line 3, column Gg_kg_s: non-finite",
+    ),
+    "inf": (
+        lambda d: simulate_with(d, "b.csv", HEADER + "0,0.4,inf,30\n30,0.4,450,30\n"),
+        "b.csv",
+        "column Tgi_C: non-finite",
+    ),
+    "empty cell": (
+        lambda d: simulate_with(d, "b.csv", HEADER + "0,0.4,450,30\n30,,450,30\n"),
+        "b.csv",
+        "line 3, column Gg_kg_s: empty cell",
+    ),
+    "time decreasing": (
+        lambda d: simulate_with(d, "b.csv", HEADER + "0,0.4,450,30\n30,0.4,450,30\n20,0.4,450,30\n"),
+        "b.csv",
+        "row 3, column time_s: time not strictly increasing (decreasing",
+    ),
+    "time duplicated": (
+        lambda d: simulate_with(d, "b.csv", HEADER + "0,0.4,450,30\n0,0.4,450,30\n"),
+        "b.csv",
+        "time not strictly increasing (duplicated",
+    ),
+    "negative flow": (
+        lambda d: simulate_with(d, "b.csv", HEADER + "0,0.4,450,30\n30,-0.1,450,30\n"),
+        "b.csv",
+        "row 2, column Gg_kg_s: gas flow must be > 0",
+    ),
+    "zero flow": (
+        lambda d: simulate_with(d, "b.csv", HEADER + "0,0,450,30\n30,0.4,450,30\n"),
+        "b.csv",
+        "gas flow must be > 0",
+    ),
+    "temperature too high": (
+        lambda d: simulate_with(d, "b.csv", HEADER + "0,0.4,1450,30\n30,0.4,450,30\n"),
+        "b.csv",
+        "column Tgi_C: temperature 1450",
+    ),
+    "temperature too low": (
+        lambda d: simulate_with(d, "b.csv", HEADER + "0,0.4,450,-80\n30,0.4,450,30\n"),
+        "b.csv",
+        "column Ta_C: temperature -80",
+    ),
+    "truncated row": (
+        lambda d: simulate_with(d, "b.csv", HEADER + "0,0.4,450,30\n30,0.4"),
+        "b.csv",
+        "line 3: row has 2 cells",
+    ),
+    "binary file": (lambda d: simulate_with(d, "b.csv", b"\x00\x01\x02PK\x03\x04" * 50), "b.csv", "binary file"),
+    "Mb_kg metadata out of range": (
+        lambda d: simulate_with(d, "b.csv", "# Mb_kg = -3\n" + HEADER + GOOD_ROWS),
+        "b.csv",
+        "line 1: Mb_kg = -3 outside",
+    ),
+    # logs and maps
+    "degF data declared as degC": (
+        lambda d: import_with(
+            d,
+            "f.csv",
+            "time_s,Ta_C,Tgi_C\n" + "".join(f"{t},{250 + t / 2},{500}\n" for t in range(0, 601, 30)),
+            "[Gg]\nconstant_kg_s = 0.4\n",
+        ),
+        "f.csv",
+        "at DROP is above 300",
+    ),
+    "truncated alog": (
+        lambda d: import_with(d, "t.alog", GOOD_ALOG[: len(GOOD_ALOG) // 2]),
+        "t.alog",
+        "truncated or malformed",
+    ),
+    "alog containing code": (
+        lambda d: import_with(d, "evil.alog", "{'timex': __import__('os').system('touch /tmp/roastlab_pwned')}"),
+        "evil.alog",
+        "code is never run",
+    ),
+    "alog wrong JSON types": (
+        lambda d: import_with(d, "w.alog", json.dumps({"timex": "0,1,2", "temp1": [1, 2, 3], "temp2": [1, 2, 3]})),
+        "w.alog",
+        "key timex: expected a list of numbers",
+    ),
+    "alog lengths differ": (
+        lambda d: import_with(
+            d, "l.alog", repr({"timex": [0.0, 1.5, 3.0], "temp1": [150.0, 151.0, 152.0], "temp2": [120.0, 121.0]})
+        ),
+        "l.alog",
+        "key temp2: has 2 values but timex has 3",
+    ),
+    "alog not a dict": (lambda d: import_with(d, "n.alog", "[1, 2, 3]"), "n.alog", "not an Artisan profile"),
+    "map unknown key": (
+        lambda d: import_with(d, "g.alog", GOOD_ALOG, "colour = 'red'\n" + SKY_MAP),
+        "map.toml",
+        "unknown key(s) colour",
+    ),
+    "map unknown key in a table": (
+        lambda d: import_with(d, "g.alog", GOOD_ALOG, SKY_MAP + "colour = 'red'\n"),
+        "map.toml",
+        "[Gg]: unknown key(s) colour",
+    ),
+    "map channel missing from log": (
+        lambda d: import_with(d, "g.alog", GOOD_ALOG, SKY_MAP.replace('"ET"', '"Inlet"')),
+        "g.alog",
+        "no channel 'Inlet'",
+    ),
+    "map two flow sources": (
+        lambda d: import_with(d, "g.alog", GOOD_ALOG, SKY_MAP + "constant_kg_s = 0.1\n"),
+        "map.toml",
+        "exactly one of",
+    ),
+    # parameters and plants
+    "unknown plant preset": (
+        lambda d: (
+            simulate_with(d, "b.csv", HEADER + GOOD_ROWS)[:2]
+            + ["999kg"]
+            + simulate_with(d, "b.csv", HEADER + GOOD_ROWS)[3:]
+        ),
+        "999kg",
+        "unknown plant preset",
+    ),
+    "negative geometry": (
+        lambda d: plant_with(d, PLANT.replace("Lch_m = 1.335", "Lch_m = -1.335")),
+        "plant.toml",
+        "Lch_m: chamber length [m] must be > 0",
+    ),
+    "plant missing key": (
+        lambda d: plant_with(d, PLANT.replace("Mm_kg = 2000\n", "")),
+        "plant.toml",
+        "missing key(s) Mm_kg",
+    ),
+    "plant bad TOML": (lambda d: plant_with(d, "Mb_kg = = 3"), "plant.toml", "not valid TOML"),
+    "plant unknown process constant": (
+        lambda d: plant_with(d, PLANT + "[process]\nwarp = 9\n"),
+        "plant.toml",
+        "unknown process constant 'warp'",
+    ),
+    "Pbm outside (0, 1) in THETA.json": (
+        lambda d: theta_with(d, '{"hgm": 0.01, "hbm": 0.02, "Pbm": 1.3}'),
+        "theta.json",
+        "Pbm must be in (0, 1)",
+    ),
+    "missing theta keys": (lambda d: theta_with(d, '{"hgm": 0.01}'), "theta.json", "missing key(s) hbm, Pbm"),
+    "theta wrong JSON type": (
+        lambda d: theta_with(d, '{"hgm": "0.01", "hbm": 0.02, "Pbm": 0.6}'),
+        "theta.json",
+        "key hgm: must be a number",
+    ),
+    "theta not JSON": (lambda d: theta_with(d, "hgm = 0.01"), "theta.json", "not valid JSON"),
+    "Pbm outside (0, 1) on the command line": (
+        lambda d: simulate_with(d, "b.csv", HEADER + GOOD_ROWS) + ["--pbm", "0"],
+        "command line",
+        "Pbm must be in (0, 1)",
+    ),
+    "inverted bounds": (
+        lambda d: [
+            "identify",
+            "--plant",
+            "120kg",
+            DATA / "dataset-I",
+            "--out",
+            d / "out.csv",
+            "--bounds",
+            "hbm=0.3:0.1",
+        ],
+        "command line",
+        "inverted or empty bounds",
+    ),
+    "inverted bounds in a fit spec": (
+        lambda d: _spec(d, "[free]\nhgm = [0.3, 0.1, 0.2]\n"),
+        "fit.toml",
+        "free.hgm: bounds of hgm inverted",
+    ),
+    "fit spec unknown parameter": (
+        lambda d: _spec(d, "[free]\nwarp = [0, 1, 0.5]\n"),
+        "fit.toml",
+        "free.warp: unknown parameter",
+    ),
+    # files and paths
+    "missing input file": (
+        lambda d: ["simulate", "--plant", "120kg", "--inputs", d / "nope.csv", "--out", d / "out.csv"],
+        "nope.csv",
+        "file not found",
+    ),
+    "output path equal to input": (lambda d: _same_path(d), "b.csv", "same file as input"),
+    "missing output folder": (
+        lambda d: simulate_with(d, "b.csv", HEADER + GOOD_ROWS)[:-1] + [d / "no" / "such" / "out.csv"],
+        "out.csv",
+        "output folder does not exist",
+    ),
+    "file over 200 MB": (lambda d: _huge(d), "huge.csv", "over the 200 MB limit"),
+    "huge alog": (lambda d: _huge(d, "huge.alog", import_=True), "huge.alog", "over the 200 MB limit"),
+}
+
+
+def _spec(d, text):
+    spec = d / "fit.toml"
+    spec.write_text(text)
+    return ["identify", "--plant", "120kg", DATA / "dataset-I", "--out", d / "out.csv", "--spec", spec]
+
+
+def _same_path(d):
+    f = d / "b.csv"
+    f.write_text(HEADER + GOOD_ROWS)
+    return ["simulate", "--plant", "120kg", "--inputs", f, "--out", f]
+
+
+def _huge(d, name="huge.csv", import_=False):
+    f = d / name
+    with open(f, "wb") as fh:  # sparse: 201 MB on paper, nothing on disk
+        fh.truncate(201 * 1024 * 1024)
+    if import_:
+        m = d / "map.toml"
+        m.write_text(SKY_MAP)
+        return ["import", f, "--map", m, "--out", d / "out.csv"]
+    return ["simulate", "--plant", "120kg", "--inputs", f, "--out", d / "out.csv"]
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_bad_input(cli, tmp_path, case):
+    build, names, needle = CASES[case]
+    args = build(tmp_path)
+    before = {
+        p: p.read_bytes() if p.stat().st_size < 1e6 else p.stat().st_size for p in tmp_path.rglob("*") if p.is_file()
+    }
+    code, out, err = cli(*args)
+    assert code == 2, (case, code, err)
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    assert names in err and needle in err, err
+    after = {p for p in tmp_path.rglob("*") if p.is_file()}
+    assert after == set(before), f"{case}: files appeared {after - set(before)}"
+    for p, content in before.items():  # inputs never modified
+        assert (p.read_bytes() if isinstance(content, bytes) else p.stat().st_size) == content
+    assert not os.path.exists("/tmp/roastlab_pwned")
+
+
+def test_at_least_25_distinct_cases():
+    assert len(CASES) >= 25
+
+
+def test_unwritable_output_folder(cli, tmp_path):
+    good = tmp_path / "good.csv"
+    good.write_text(HEADER + GOOD_ROWS)
+    target = "/proc/roastlab-out.csv"  # /proc refuses new files even for root
+    code, _, err = cli("simulate", "--plant", "120kg", "--inputs", good, "--out", target)
+    assert code == 2 and "roastlab-out.csv" in err and err.count("\n") == 1, err
+    assert not os.path.exists(target)

@@ -1,0 +1,218 @@
+"""Property-based fuzzing: every loader either returns or raises the project's own error.
+
+Inputs are random bytes, random text and mutations (cut, insert, replace) of valid files, so
+the fuzzer spends its time near the formats rather than on noise alone.
+"""
+
+import json
+import tempfile
+from pathlib import Path
+
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from roastlab.data import read_batch_csv, read_dataset
+from roastlab.errors import RoastlabError
+from roastlab.fitspec import load_fit_spec
+from roastlab.importers import import_log, load_map
+from roastlab.importers.artisan import read_alog, read_artisan_csv
+from roastlab.plant import load_plant
+from roastlab.theta import load_theta_json
+
+VALID = {
+    ".csv": "# Mb_kg = 0.2\ntime_s,Gg_kg_s,Tgi_C,Ta_C\n0,0.4,450,30\n30,0.41,449,40\n60,0.4,447,55\n",
+    ".alog": repr(
+        {
+            "mode": "F",
+            "timex": [0.0, 1.5, 3.0, 4.5],
+            "temp1": [300.0, 301.0, -1, 303.0],
+            "temp2": [250.0, 251.0, 252.0, 253.0],
+            "timeindex": [1, 0, 0, 0, 0, 0, 3, 0],
+            "weight": [200, 0, "g"],
+            "specialevents": [1, 2],
+            "specialeventstype": [3, 0],
+            "specialeventsvalue": [8.0, 5.5],
+            "etypes": ["Air", "Drum", "Damper", "Burner", "--"],
+            "extratimex": [[0.0, 1.5, 3.0, 4.5]],
+            "extraname1": ["Inlet"],
+            "extratemp1": [[600.0, 610.0, 620.0, 630.0]],
+            "extraname2": ["Fan"],
+            "extratemp2": [[1, 2, 3, 4]],
+            "extraNoneTempHint2": [True],
+        }
+    ),
+    ".export.csv": "Date:01.01.2026\tUnit:F\tCHARGE:00:02\tDROP:00:08\nTime1\tTime2\tET\tBT\tEvent\n00:00\t\t300\t250\t\n00:02\t00:00\t301\t240\t\n00:05\t00:03\t302\t245\t\n00:08\t00:06\t303\t250\t\n",
+    ".map.toml": 'format = "auto"\nresample_s = 2\n[time]\ncolumn = "time_s"\nunit = "s"\n[Ta]\ncolumn = "Ta_C"\nunit = "F"\n[Tgi]\ncolumn = "Tgi_C"\noffset_C = 5\n[Gg]\ncolumn = "Gg_kg_s"\nunit = "kg/h"\n',
+    ".plant.toml": 'name = "x"\nMb_kg = 1\nDch_m = 0.3\nLch_m = 0.4\nHflap_m = 0.02\nSflap_m = 0.1\nMm_kg = 20\n[process]\nKt = 0.02\n"Ha/R" = 5000\n',
+    ".json": json.dumps({"hgm": 0.02, "hbm": 0.03, "Pbm": 0.6, "SSR": 1.0, "Tm0_C": [100, 120], "batches": ["a", "b"]}),
+    ".fit.toml": "[free]\nhgm = [0.001, 1.0, 0.02]\nTm0_C = { lower = 60, upper = 300, start = 170, per_batch = true }\n[fixed]\nKt = 0.02\n[initial]\nTb0_C = 22\n",
+}
+
+
+def mutated(kind):
+    base = VALID[kind]
+    return st.tuples(
+        st.integers(0, len(base)),
+        st.integers(0, 40),
+        st.text(max_size=30),
+        st.sampled_from(["cut", "insert", "replace", "truncate"]),
+    ).map(lambda a: _mutate(base, *a))
+
+
+def _mutate(base, i, n, text, how):
+    if how == "cut":
+        return base[:i] + base[i + n :]
+    if how == "insert":
+        return base[:i] + text + base[i:]
+    if how == "replace":
+        return base[:i] + text + base[i + len(text) :]
+    return base[:i]
+
+
+# Structured inputs: well-formed documents with the right keys and values of any type, so the
+# loaders' type and range checks are exercised, not only their parsers.
+SCALARS = st.one_of(st.booleans(), st.integers(-10**6, 10**6), st.floats(allow_nan=True, allow_infinity=True), st.text(max_size=8))
+VALUES = st.recursive(SCALARS, lambda c: st.lists(c, max_size=6) | st.dictionaries(st.text(max_size=6), c, max_size=4), max_leaves=12)
+NUMBER_LISTS = st.lists(st.one_of(st.floats(-1e4, 1e4), st.integers(-5, 500), st.just(-1)), max_size=12)
+
+KEYS = {
+    ".map.toml": {"format": VALUES, "resample_s": VALUES, "keep_after_drop": VALUES,
+                  "time": st.fixed_dictionaries({}, optional={"column": VALUES, "unit": VALUES}),
+                  "Ta": st.fixed_dictionaries({}, optional={"column": VALUES, "unit": VALUES, "offset_C": VALUES}),
+                  "Tgi": st.fixed_dictionaries({}, optional={"column": VALUES, "unit": VALUES, "offset_C": VALUES}),
+                  "Gg": st.fixed_dictionaries({}, optional={"column": VALUES, "unit": VALUES, "density_kg_m3": VALUES, "constant_kg_s": VALUES,
+                                                            "identify": VALUES, "pitot": st.dictionaries(st.sampled_from(["dp_column", "T_column", "section_m2", "rho0_kg_m3", "T_unit"]), VALUES)})},
+    ".plant.toml": {k: st.one_of(VALUES, st.floats(-10, 10)) for k in ("name", "Mb_kg", "Dch_m", "Lch_m", "Hflap_m", "Sflap_m", "Mm_kg")}
+    | {"process": st.dictionaries(st.sampled_from(["A", "cm", "Kt", "Ha/R", "lambda", "warp"]), VALUES, max_size=3)},
+    ".fit.toml": {"free": st.dictionaries(st.sampled_from(["hgm", "Pbm", "Tm0_C", "Gg_kg_s", "warp"]), VALUES, max_size=3),
+                  "fixed": st.dictionaries(st.sampled_from(["Kt", "hbm", "warp"]), VALUES, max_size=2),
+                  "initial": st.dictionaries(st.sampled_from(["Tb0_C", "X0", "warp"]), VALUES, max_size=2)},
+    ".json": {"hgm": VALUES, "hbm": VALUES, "Pbm": st.one_of(VALUES, st.floats(-1, 2)), "SSR": VALUES, "batches": VALUES},
+    ".alog": {"mode": st.one_of(VALUES, st.sampled_from(["C", "F"])), "timex": st.one_of(VALUES, NUMBER_LISTS), "temp1": st.one_of(VALUES, NUMBER_LISTS),
+              "temp2": st.one_of(VALUES, NUMBER_LISTS), "timeindex": st.one_of(VALUES, st.lists(st.integers(-2, 15), max_size=8)),
+              "weight": VALUES, "etypes": VALUES, "specialevents": st.one_of(VALUES, NUMBER_LISTS), "specialeventstype": st.one_of(VALUES, NUMBER_LISTS),
+              "specialeventsvalue": st.one_of(VALUES, NUMBER_LISTS), "extratimex": VALUES, "extraname1": VALUES, "extratemp1": VALUES,
+              "extraNoneTempHint1": VALUES},
+}
+
+
+def _toml_value(v):
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        return "nan" if v != v else ("inf" if v == float("inf") else ("-inf" if v == float("-inf") else repr(v)))
+    if isinstance(v, str):
+        return json.dumps(v)
+    if isinstance(v, list):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    return "{ " + ", ".join(f"{json.dumps(k)} = {_toml_value(x)}" for k, x in v.items()) + " }"
+
+
+def _toml(doc: dict) -> str:
+    return "".join(f"{json.dumps(k)} = {_toml_value(v)}\n" for k, v in doc.items())
+
+
+def structured(kind):
+    doc = st.fixed_dictionaries({}, optional=KEYS[kind])
+    if kind.endswith(".toml"):
+        return doc.map(_toml)
+    if kind == ".json":
+        return doc.map(lambda d: json.dumps(d, allow_nan=True))
+    return st.one_of(doc.map(repr), doc.map(lambda d: json.dumps(d, allow_nan=True)))
+
+
+def content(kind):
+    options = [mutated(kind), mutated(kind), st.text(max_size=400), st.binary(max_size=400)]
+    if kind in KEYS:
+        options += [structured(kind)] * 3
+    return st.one_of(*options)
+
+
+def run_loader(kind, data, loader):
+    with tempfile.TemporaryDirectory() as tmp:
+        suffix = {".export.csv": ".csv", ".map.toml": ".toml", ".plant.toml": ".toml", ".fit.toml": ".toml"}.get(
+            kind, kind
+        )
+        path = Path(tmp) / f"fuzz{suffix}"
+        if isinstance(data, bytes):
+            path.write_bytes(data)
+        else:
+            path.write_text(data, encoding="utf-8", errors="surrogatepass") if _encodable(data) else path.write_bytes(
+                data.encode("utf-8", "replace")
+            )
+        try:
+            loader(path)
+        except RoastlabError:
+            pass
+
+
+def _encodable(text):
+    try:
+        text.encode("utf-8")
+        return True
+    except UnicodeEncodeError:
+        return False
+
+
+FUZZ = settings(max_examples=300, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+
+
+@FUZZ
+@given(content(".csv"))
+def test_fuzz_batch_csv(data):
+    run_loader(".csv", data, read_batch_csv)
+    run_loader(".csv", data, lambda p: import_log(p, None))
+
+
+@FUZZ
+@given(content(".alog"))
+def test_fuzz_alog(data):
+    run_loader(".alog", data, read_alog)
+    run_loader(".alog", data, lambda p: import_log(p, None))
+
+
+@FUZZ
+@given(content(".export.csv"))
+def test_fuzz_artisan_csv(data):
+    run_loader(".export.csv", data, read_artisan_csv)
+
+
+@FUZZ
+@given(content(".map.toml"))
+def test_fuzz_map(data):
+    run_loader(".map.toml", data, load_map)
+
+
+@FUZZ
+@given(content(".plant.toml"))
+def test_fuzz_plant(data):
+    run_loader(".plant.toml", data, load_plant)
+
+
+@FUZZ
+@given(content(".json"))
+def test_fuzz_theta_json(data):
+    run_loader(".json", data, load_theta_json)
+
+
+@FUZZ
+@given(content(".fit.toml"))
+def test_fuzz_fit_spec(data):
+    run_loader(".fit.toml", data, load_fit_spec)
+
+
+@settings(max_examples=60, deadline=None, derandomize=True)
+@given(content(".plant.toml"))
+def test_fuzz_dataset_folder(data):
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        (folder / "dataset.toml").write_text(
+            'plant = "120kg"\n[[batch]]\nfile = "b.csv"\n' if isinstance(data, bytes) else data[:200], errors="replace"
+        )
+        (folder / "b.csv").write_text(VALID[".csv"])
+        try:
+            read_dataset(folder)
+        except RoastlabError:
+            pass

@@ -1,0 +1,195 @@
+"""Importers: the shared real Artisan logs, Artisan CSV, generic CSV/Parquet, Pitot flow."""
+
+import ast
+import json
+
+import numpy as np
+import pytest
+
+from roastlab.importers import gas_flow_pitot_kg_s, import_log, load_map
+from roastlab.importers.artisan import events_internal_to_external, read_alog
+
+SPOT = ["roast_25-09-27_1236_R14.alog", "roast_25-11-16_1235.alog", "roast_26-05-10_1438_R58_brazil_250.alog"]
+
+
+def write_map(tmp_path, text, name="map.toml"):
+    p = tmp_path / name
+    p.write_text(text)
+    return p
+
+
+SKY_MAP = '[Ta]\ncolumn = "BT"\n[Tgi]\ncolumn = "ET"\n[Gg]\nidentify = true\n'
+
+
+def test_all_shared_logs_import(real_data, tmp_path):
+    cmap = load_map(write_map(tmp_path, SKY_MAP))
+    logs = sorted(real_data.glob("*.alog"))
+    assert len(logs) == 16
+    for path in logs:
+        b = import_log(path, cmap)
+        assert b.time_s[0] == 0.0 and b.n > 100
+        assert 0.1 <= b.Mb_kg <= 0.3
+        assert 90 < b.Ta_C.min() and b.Ta_C.max() < 230
+
+
+@pytest.mark.parametrize("name", SPOT)
+def test_charge_and_drop_match_artisan_computed(real_data, name):
+    path = real_data / name
+    computed = ast.literal_eval(path.read_text())["computed"]
+    log = read_alog(path)
+    assert log.time_s[0] == 0.0
+    assert log.events["DROP"] == pytest.approx(computed["DROP_time"], abs=0.05)
+    assert log.time_s[-1] == pytest.approx(computed["DROP_time"], abs=0.05)
+    assert log.channels["BT"][0] == pytest.approx(computed["CHARGE_BT"], abs=0.05)
+    assert log.channels["ET"][0] == pytest.approx(computed["CHARGE_ET"], abs=0.05)
+    assert log.channels["BT"][-1] == pytest.approx(computed["DROP_BT"], abs=0.05)
+    assert log.events["FCs"] == pytest.approx(computed["FCs_time"], abs=0.05)
+    full = read_alog(path, keep_after_drop=True)
+    assert full.time_s[-1] > log.time_s[-1]
+
+
+def test_probe_fault_is_cut_with_a_note(real_data, tmp_path):
+    b = import_log(real_data / "roast_25-10-25_1609.alog", load_map(write_map(tmp_path, SKY_MAP)))
+    assert b.Ta_C.max() < 200
+    assert any("probe fault" in n for n in b.notes)
+
+
+def test_special_events_become_step_signals(real_data):
+    log = read_alog(real_data / "roast_25-11-16_1235.alog")
+    burner = log.channels["Burner"]
+    assert np.nanmax(burner) <= 100 and np.nanmin(burner) >= 0
+    assert len(np.unique(burner[np.isfinite(burner)])) > 2  # steps, not a constant
+    assert events_internal_to_external(8.0) == 70 and events_internal_to_external(11.0) == 100
+    assert events_internal_to_external(0.5) == 0 and events_internal_to_external(1.0) == 0
+
+
+def fake_alog(mode="C", bt=None, et=None, n=120, extra=None, as_json=False):
+    t = [1.5 * i for i in range(n)]
+    bt = bt if bt is not None else [130.0 - 0.2 * i if i < 30 else 124.0 + 0.5 * (i - 30) for i in range(n)]
+    et = et if et is not None else [150.0 + 0.4 * i for i in range(n)]
+    d = {
+        "mode": mode,
+        "timex": t,
+        "temp1": et,
+        "temp2": bt,
+        "timeindex": [5, 0, 0, 0, 0, 0, n - 10, 0],
+        "weight": [200.0, 170.0, "g"],
+    }
+    d.update(extra or {})
+    return json.dumps(d) if as_json else repr(d)
+
+
+def test_fahrenheit_log_converted_but_not_non_temperature_extras(tmp_path):
+    n = 120
+    btF = [266.0 + 0.9 * i for i in range(n)]
+    etF = [300.0 + 0.9 * i for i in range(n)]
+    extra = {
+        "extratimex": [[1.5 * i for i in range(n)]],
+        "extraname1": ["Inlet"],
+        "extratemp1": [[752.0] * n],
+        "extraname2": ["Fan"],
+        "extratemp2": [[40.0] * n],
+        "extraNoneTempHint1": [False],
+        "extraNoneTempHint2": [True],
+    }
+    p = tmp_path / "f.alog"
+    p.write_text(fake_alog("F", btF, etF, n, extra))
+    log = read_alog(p)
+    assert log.channels["BT"][0] == pytest.approx((btF[5] - 32) * 5 / 9)
+    assert log.channels["Inlet"][0] == pytest.approx(400.0)  # a temperature: converted
+    assert log.channels["Fan"][0] == pytest.approx(40.0)  # flagged non-temperature: untouched
+    assert log.weight_in_kg == pytest.approx(0.2)
+
+
+def test_json_alog_and_missing_samples(tmp_path):
+    n = 120
+    bt = [130.0 - 0.2 * i if i < 30 else 124.0 + 0.5 * (i - 30) for i in range(n)]
+    bt[50] = -1
+    p = tmp_path / "j.alog"
+    p.write_text(fake_alog(bt=bt, n=n, as_json=True))
+    b = import_log(p, load_map(write_map(tmp_path, SKY_MAP)))
+    assert b.n == (n - 10) - 5 + 1 - 1  # CHARGE..DROP, one missing sample dropped
+    assert any("incomplete" in note for note in b.notes)
+
+
+def test_artisan_csv_export(tmp_path):
+    rows = [
+        "Date:01.01.2026\tUnit:C\tCHARGE:00:06\tTP:\tDRYe:\tFCs:\tFCe:\tSCs:\tSCe:\tDROP:03:00\tCOOL:",
+        "Time1\tTime2\tET\tBT\tEvent",
+    ]
+    for i in range(0, 200, 2):
+        t2 = "" if i < 6 else f"{(i - 6) // 60:02d}:{(i - 6) % 60:02d}"
+        rows.append(f"{i // 60:02d}:{i % 60:02d}\t{t2}\t{150 + i * 0.2:.1f}\t{120 + i * 0.3:.1f}\t")
+    p = tmp_path / "export.csv"
+    p.write_text("\n".join(rows) + "\n")
+    b = import_log(p, load_map(write_map(tmp_path, SKY_MAP)))
+    assert b.time_s[0] == 0 and b.time_s[-1] == pytest.approx(174.0)
+    assert b.Ta_C[0] == pytest.approx(121.8)
+
+
+def test_generic_csv_with_units_and_pitot(tmp_path):
+    t = np.arange(0, 601, 10.0)
+    lines = ["t_min,bean_F,inlet_K,dp_Pa,pitotT_C"] + [
+        f"{v / 60},{(30 + v * 0.3) * 9 / 5 + 32},{450 + 273.15},{120.0},{200.0}" for v in t
+    ]
+    p = tmp_path / "plant.csv"
+    p.write_text("\n".join(lines) + "\n")
+    m = write_map(
+        tmp_path,
+        '[time]\ncolumn = "t_min"\nunit = "min"\n[Ta]\ncolumn = "bean_F"\nunit = "F"\n[Tgi]\ncolumn = "inlet_K"\nunit = "K"\n'
+        '[Gg.pitot]\ndp_column = "dp_Pa"\nT_column = "pitotT_C"\nsection_m2 = 0.05\n',
+    )
+    b = import_log(p, load_map(m))
+    np.testing.assert_allclose(b.time_s, t)
+    np.testing.assert_allclose(b.Ta_C, 30 + t * 0.3, atol=1e-9)
+    np.testing.assert_allclose(b.Tgi_C, 450.0)
+    np.testing.assert_allclose(b.Gg_kg_s, gas_flow_pitot_kg_s(120.0, 200.0, 0.05))
+
+
+def test_flow_units(tmp_path):
+    p = tmp_path / "f.csv"
+    p.write_text("time_s,Ta_C,Tgi_C,flow\n0,30,450,1440\n30,40,450,1440\n")
+    b = import_log(p, load_map(write_map(tmp_path, '[Gg]\ncolumn = "flow"\nunit = "kg/h"\n')))
+    assert b.Gg_kg_s[0] == pytest.approx(0.4)
+    b = import_log(p, load_map(write_map(tmp_path, '[Gg]\ncolumn = "flow"\nunit = "m3/h"\ndensity_kg_m3 = 1.0\n')))
+    assert b.Gg_kg_s[0] == pytest.approx(0.4)
+
+
+def test_pitot_formula_eq16():
+    # Gg = S sqrt(2 rho0 dp 273.15 / (T + 273.15)); at T = 0 degC: S sqrt(2 rho0 dp)
+    assert gas_flow_pitot_kg_s(100.0, 0.0, 0.05) == pytest.approx(0.05 * np.sqrt(2 * 1.275 * 100.0))
+    hot = gas_flow_pitot_kg_s(100.0, 273.15, 0.05)
+    assert hot == pytest.approx(0.05 * np.sqrt(1.275 * 100.0))  # twice the absolute temperature
+
+
+def test_parquet(tmp_path):
+    pd = pytest.importorskip("pandas")
+    pytest.importorskip("pyarrow")
+    frame = pd.DataFrame(
+        {"time_s": [0.0, 30.0, 60.0], "Gg_kg_s": [0.4] * 3, "Tgi_C": [450.0] * 3, "Ta_C": [30.0, 50.0, 70.0]}
+    )
+    p = tmp_path / "b.parquet"
+    frame.to_parquet(p)
+    b = import_log(p, None)
+    assert b.n == 3 and b.Ta_C[-1] == 70.0
+
+
+def test_import_cli_then_simulate(cli, real_data, tmp_path):
+    m = write_map(tmp_path, SKY_MAP)
+    out = tmp_path / "batch.csv"
+    code, stdout, err = cli("import", real_data / SPOT[1], "--map", m, "--out", out)
+    assert code == 0, err
+    text = out.read_text()
+    assert "# Mb_kg = 0.2" in text and "time_s,Gg_kg_s,Tgi_C,Ta_C" in text
+    from roastlab.data import read_batch_csv
+
+    assert read_batch_csv(out).Mb_kg == pytest.approx(0.2)
+    code, _, err = cli("simulate", "--plant", "120kg", "--inputs", out, "--out", tmp_path / "sim.csv")
+    assert code == 0, err
+
+
+def test_inputs_never_modified(cli, real_data, tmp_path):
+    src = real_data / SPOT[0]
+    before = src.read_bytes()
+    cli("import", src, "--map", write_map(tmp_path, SKY_MAP), "--out", tmp_path / "o.csv")
+    assert src.read_bytes() == before
