@@ -407,14 +407,13 @@ def _validate_baseline(args, batches, plant) -> int:
 
 def _read_baseline_json(path) -> dict:
     import json
-    from pathlib import Path
+
+    from .io import read_input_text
 
     try:
-        data = json.loads(Path(path).read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise InputError("file not found", path) from None
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise InputError(f"not valid JSON ({exc})", path) from None
+        data = json.loads(read_input_text(path))
+    except json.JSONDecodeError as exc:
+        raise InputError(f"not valid JSON ({exc.msg} at line {exc.lineno})", path) from None
     if not isinstance(data, dict):
         raise InputError("expected a JSON object", path)
     for key in ("tau_s", "offset_C"):
@@ -476,10 +475,24 @@ def cmd_bench(args) -> int:
     return 0
 
 
+FIT_HELP = "batch CSVs (time_s,Gg_kg_s,Tgi_C,Ta_C) and/or dataset folders with a dataset.toml; raw logs with --map"
+
+
+def _add_batch_options(p, baseline_help: str) -> None:
+    """Options shared by identify and validate: the batches, their plant, a map, the baseline."""
+    p.add_argument("batches", nargs="+", metavar="BATCH", help=FIT_HELP)
+    p.add_argument("--plant", help="plant preset or PLANT.toml (default: the dataset's plant)")
+    p.add_argument(
+        "--map",
+        metavar="MAP.toml",
+        help="the BATCH arguments are raw logs (Artisan .alog/.csv, CSV, Parquet) read with this column map",
+    )
+    p.add_argument("--baseline", choices=("first-order",), help=baseline_help)
+
+
 def _add_fit_commands(sub) -> None:
     from .datasets import PAPER_SEED
 
-    fit_help = "batch CSVs (time_s,Gg_kg_s,Tgi_C,Ta_C) and/or dataset folders with a dataset.toml"
     p = sub.add_parser(
         "identify",
         help="identify theta = (hgm, hbm, Pbm) on batches (eqs. 18-19)",
@@ -487,8 +500,7 @@ def _add_fit_commands(sub) -> None:
         "by a seeded global search (scattered starts polished by bounded least squares) or differential evolution. "
         "Writes THETA.json with the optimum, standard errors, correlations and warnings.",
     )
-    p.add_argument("batches", nargs="+", metavar="BATCH", help=fit_help)
-    p.add_argument("--plant", help="plant preset or PLANT.toml (default: the dataset's plant)")
+    _add_batch_options(p, "fit the first-order baseline dBT/dt = (ET + offset - BT)/tau instead")
     p.add_argument("--out", required=True, metavar="THETA.json", help="where to write the result")
     p.add_argument(
         "--method", choices=("global", "de"), default="global", help="global search (default) or differential evolution"
@@ -512,19 +524,9 @@ def _add_fit_commands(sub) -> None:
         help="fit a separate theta to every batch (fleet mode: compiled, parallel, linear in the number of batches)",
     )
     p.add_argument(
-        "--map",
-        metavar="MAP.toml",
-        help="the BATCH arguments are raw logs (Artisan .alog/.csv, CSV, Parquet) read with this column map",
-    )
-    p.add_argument(
         "--spec",
         metavar="FIT.toml",
         help="fit spec: free parameters (theta, process constants, initial states) with bounds",
-    )
-    p.add_argument(
-        "--baseline",
-        choices=("first-order",),
-        help="fit the first-order baseline dBT/dt = (ET + offset - BT)/tau instead",
     )
     _add_model_options(p, with_theta=False, plant=False)
     p.set_defaults(func=cmd_identify)
@@ -534,16 +536,9 @@ def _add_fit_commands(sub) -> None:
         help="simulate batches with theta and report the paper's metrics",
         description="Simulate each batch with THETA.json (default: the paper's theta*) and report n, SSR, ||e||, MAE, MPE, MAPE, FIT, rho per batch and on average.",
     )
-    p.add_argument("batches", nargs="+", metavar="BATCH", help=fit_help)
-    p.add_argument("--plant", help="plant preset or PLANT.toml (default: the dataset's plant)")
+    _add_batch_options(p, "validate the first-order baseline (--theta from 'identify --baseline first-order')")
     p.add_argument("--json", metavar="METRICS.json", help="write the metrics as JSON")
     p.add_argument("--plot", metavar="FIG.png", help="plot measured vs simulated Ta per batch")
-    p.add_argument("--map", metavar="MAP.toml", help="the BATCH arguments are raw logs read with this column map")
-    p.add_argument(
-        "--baseline",
-        choices=("first-order",),
-        help="validate the first-order baseline (--theta from 'identify --baseline first-order')",
-    )
     _add_model_options(p, with_theta=True, plant=False)
     p.set_defaults(func=cmd_validate)
 

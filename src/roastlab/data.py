@@ -12,7 +12,6 @@ import csv
 import io
 import math
 import os
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -23,7 +22,6 @@ from .errors import InputError
 REQUIRED_COLUMNS = ("time_s", "Gg_kg_s", "Tgi_C")
 OPTIONAL_COLUMNS = ("Ta_C",)
 TEMPERATURE_RANGE_C = (-50.0, 1000.0)
-MAX_FILE_BYTES = 200 * 1024 * 1024
 
 
 @dataclass
@@ -104,20 +102,9 @@ class Batch:
 
 
 def _read_text(path: Path) -> str:
-    try:
-        size = path.stat().st_size
-    except FileNotFoundError:
-        raise InputError("file not found", path) from None
-    except OSError as exc:
-        raise InputError(f"cannot read ({exc.strerror})", path) from None
-    if path.is_dir():
-        raise InputError("is a directory, expected a file", path)
-    if size > MAX_FILE_BYTES:
-        raise InputError(f"file is {size / 1e6:.0f} MB, over the {MAX_FILE_BYTES // (1024 * 1024)} MB limit", path)
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise InputError(f"cannot read ({exc.strerror})", path) from None
+    from .io import read_input_bytes
+
+    raw = read_input_bytes(path)
     if b"\x00" in raw[:4096]:
         raise InputError("binary file, expected CSV text", path)
     try:
@@ -261,13 +248,12 @@ class Dataset:
 def read_dataset(folder: str | Path) -> Dataset:
     """Read a dataset folder: ``dataset.toml`` with ``plant``, ``[[batch]]`` ``file``/``name``."""
     folder = Path(folder)
+    from .io import read_toml
+
     meta_path = folder / "dataset.toml"
     if not meta_path.is_file():
         raise InputError("not a dataset folder (no dataset.toml)", folder)
-    try:
-        meta = tomllib.loads(meta_path.read_text(encoding="utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise InputError(f"not valid TOML ({exc})", meta_path) from None
+    meta = read_toml(meta_path)
     plant = meta.get("plant")
     if not isinstance(plant, str):
         raise InputError("missing or non-string key 'plant'", meta_path)

@@ -23,12 +23,12 @@ k1, k2, Kt, lam``, the metal mass ``Mm``, the gas flow ``Gg_kg_s``, and initial 
 
 from __future__ import annotations
 
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from .errors import InputError, ParameterError
 from .identify import FreeParameter
+from .io import read_toml
 from .population import FREE_NAMES, STATE0
 from .theta import THETA_NAMES, THETA_PAPER
 
@@ -52,12 +52,7 @@ def _num(v, src, where) -> float:
 
 def load_fit_spec(path: str | Path) -> FitSpec:
     path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise InputError("file not found", path) from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise InputError(f"not valid TOML ({exc})", path) from None
+    data = read_toml(path)
     unknown = sorted(set(data) - {"free", "fixed", "initial", "description", "notes"})
     if unknown:
         raise InputError(f"unknown table(s) {', '.join(unknown)} (allowed: free, fixed, initial)", path)

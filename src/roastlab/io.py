@@ -54,3 +54,45 @@ def check_output_path(out: str | Path, inputs: list[str | Path]) -> Path:
     if not os.access(folder, os.W_OK):
         raise InputError("output folder is not writable", out)
     return out
+
+
+#: Largest input file roastlab reads [bytes]; larger ones are refused before reading.
+MAX_INPUT_BYTES = 200 * 1024 * 1024
+
+
+def read_input_bytes(path: str | Path) -> bytes:
+    """Read a user's input file, refusing missing files, folders and files over 200 MB."""
+    path = Path(path)
+    try:
+        size = path.stat().st_size
+    except FileNotFoundError:
+        raise InputError("file not found", path) from None
+    except OSError as exc:
+        raise InputError(f"cannot read ({exc.strerror})", path) from None
+    if path.is_dir():
+        raise InputError("is a directory, expected a file", path)
+    if size > MAX_INPUT_BYTES:
+        raise InputError(f"file is {size / 1e6:.0f} MB, over the {MAX_INPUT_BYTES // (1024 * 1024)} MB limit", path)
+    try:
+        return path.read_bytes()
+    except OSError as exc:
+        raise InputError(f"cannot read ({exc.strerror})", path) from None
+
+
+def read_input_text(path: str | Path) -> str:
+    """An input file as text: UTF-8 (with or without BOM), else Latin-1 (old loggers)."""
+    raw = read_input_bytes(path)
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        return raw.decode("latin-1")
+
+
+def read_toml(path: str | Path) -> dict:
+    """Parse a user's TOML file; every failure is one InputError naming the file."""
+    import tomllib
+
+    try:
+        return tomllib.loads(read_input_text(path))
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"not valid TOML ({exc})", path) from None

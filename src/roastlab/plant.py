@@ -132,22 +132,6 @@ class Plant:
         return rows
 
 
-def _read_toml(path: Path) -> dict:
-    try:
-        with open(path, "rb") as fh:
-            return tomllib.load(fh)
-    except FileNotFoundError:
-        raise InputError("file not found", path) from None
-    except IsADirectoryError:
-        raise InputError("is a directory, expected a TOML file", path) from None
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"not valid TOML ({exc})", path) from None
-    except UnicodeDecodeError:
-        raise InputError("not a text TOML file", path) from None
-    except OSError as exc:
-        raise InputError(f"cannot read ({exc.strerror})", path) from None
-
-
 def plant_from_mapping(data: dict, source: str | Path, default_name: str) -> Plant:
     """Build a :class:`Plant` from a parsed TOML mapping, naming ``source`` in errors."""
     missing = [k for k in GEOMETRY_KEYS if k not in data]
@@ -187,4 +171,6 @@ def load_plant(spec: str | Path | Plant) -> Plant:
         raise InputError(
             f"unknown plant preset (presets: {', '.join(preset_names())}; or give a PLANT.toml path)", text
         )
-    return plant_from_mapping(_read_toml(path), path, path.stem)
+    from .io import read_toml
+
+    return plant_from_mapping(read_toml(path), path, path.stem)

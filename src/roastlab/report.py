@@ -28,6 +28,16 @@ def save_figure(fig, path) -> None:
     atomic_write_bytes(path, buf.getvalue())
 
 
+def _finish(plt, fig, path, title):
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    if path is not None:
+        save_figure(fig, path)
+        plt.close(fig)
+    return fig
+
+
 def plot_simulation(result, path=None, title=None):
     """Three panels: temperatures (bean, probe, metal, gas in/out), moisture, heat flows."""
     plt = _pyplot()
@@ -54,13 +64,7 @@ def plot_simulation(result, path=None, title=None):
     axes[2].set_xlabel("time [min]")
     axes[2].legend(fontsize=8, ncol=4)
     axes[2].grid(alpha=0.3)
-    if title:
-        fig.suptitle(title)
-    fig.tight_layout()
-    if path is not None:
-        save_figure(fig, path)
-        plt.close(fig)
-    return fig
+    return _finish(plt, fig, path, title)
 
 
 def plot_fit(result, path=None, title=None, max_panels: int = 8):
@@ -75,13 +79,9 @@ def plot_fit(result, path=None, title=None, max_panels: int = 8):
         _profile_panel(ax, result, i)
     for j in range(k, rows * cols):
         axes[j // cols][j % cols].axis("off")
-    if title:
-        fig.suptitle(title)
-    fig.tight_layout()
-    if path is not None:
-        save_figure(fig, path)
-        plt.close(fig)
-    return fig
+    if len(result.names) > k:
+        title = f"{title or ''} (first {k} of {len(result.names)} batches)".strip()
+    return _finish(plt, fig, path, title)
 
 
 def _profile_panel(ax, result, i, label=None):

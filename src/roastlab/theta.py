@@ -75,15 +75,10 @@ def load_theta_json(path: str | Path) -> tuple[Theta, dict]:
 
     Returns the Theta and the whole parsed mapping (extra keys kept for callers).
     """
+    from .io import read_input_text
+
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise InputError("file not found", path) from None
-    except UnicodeDecodeError:
-        raise InputError("not a UTF-8 text file", path) from None
-    except OSError as exc:
-        raise InputError(f"cannot read ({exc.strerror})", path) from None
+    text = read_input_text(path)
     try:
         data = json.loads(text)
     except json.JSONDecodeError as exc:

@@ -22,8 +22,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
+from ..io import read_input_text
 
-MAX_BYTES = 200 * 1024 * 1024
 EVENT_NAMES = ("CHARGE", "DRY", "FCs", "FCe", "SCs", "SCe", "DROP", "COOL")
 WEIGHT_UNITS = {"g": 1e-3, "kg": 1.0, "lb": 0.45359237, "oz": 0.028349523125}
 
@@ -116,21 +116,7 @@ def _numeric_list(data: dict, key: str, path: Path, required: bool = True):
 def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: bool = True) -> ArtisanLog:
     """Parse an Artisan ``.alog`` file into an :class:`ArtisanLog` (see module docstring)."""
     path = Path(path)
-    try:
-        size = path.stat().st_size
-    except FileNotFoundError:
-        raise InputError("file not found", path) from None
-    if size > MAX_BYTES:
-        raise InputError(f"file is {size / 1e6:.0f} MB, over the 200 MB limit", path)
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise InputError(f"cannot read ({exc.strerror})", path) from None
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError:
-        text = raw.decode("latin-1")
-    data = _parse_text(path, text)
+    data = _parse_text(path, read_input_text(path))
     timex = _numeric_list(data, "timex", path)
     et = _numeric_list(data, "temp1", path)
     bt = _numeric_list(data, "temp2", path)

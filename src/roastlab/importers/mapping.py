@@ -34,7 +34,6 @@ types (``Burner``, ``Air``, ...). Every error names the map or log file and the 
 
 from __future__ import annotations
 
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -42,6 +41,7 @@ import numpy as np
 
 from ..data import Batch, read_table
 from ..errors import InputError
+from ..io import read_toml
 from .artisan import read_alog, read_artisan_csv
 from .pitot import gas_flow_pitot_kg_s
 
@@ -116,14 +116,7 @@ def _check_num(table: dict, key: str, src, where: str, positive=False, default=N
 def load_map(path: str | Path) -> ColumnMap:
     """Read and check a column-map TOML file."""
     path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise InputError("file not found", path) from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise InputError(f"not valid TOML ({exc})", path) from None
-    except OSError as exc:
-        raise InputError(f"cannot read ({exc.strerror})", path) from None
+    data = read_toml(path)
     known = {"format", "keep_after_drop", "resample_s", "time", "Ta", "Tgi", "Gg", "name", "description", "notes"}
     unknown = sorted(set(data) - known)
     if unknown:
