@@ -9,7 +9,8 @@ the batches in lock-step so that each iteration is one compiled, parallel popula
    and start each batch from its best one (a one-start GlobalSearch);
 2. projected Levenberg-Marquardt per batch: central-difference Jacobians (6 runs), a damped
    Gauss-Newton step clipped to the bounds, accepted if the batch's SSR falls, damping
-   adapted; it stops when a step gains less than ``gain_tol`` (1e-10) of the SSR.
+   adapted; it stops when a step gains less than ``gain_tol`` (1e-10) of the SSR or moves
+   less than 1e-6 of the bounds' span.
 
 Each batch's whole fit is one compiled routine, and batches run in parallel over the cores
 (numba ``prange``): the work per batch does not depend on how many batches there are, so the
@@ -20,6 +21,7 @@ tests check it against ``scipy.optimize.least_squares`` batch by batch.
 
 from __future__ import annotations
 
+import functools
 import sys
 import time
 from dataclasses import dataclass
@@ -72,11 +74,22 @@ class FleetResult:
         }
 
 
+#: Central-difference step in units of each parameter's bound span: large against the adaptive
+#: integrator's noise (~1e-6 relative), small against the curvature of the residuals.
+FD_STEP = 1e-3
+
+
+@njit(cache=True, inline="always")
+def _set_theta(z, lo, span, p):
+    """Scaled z in [0, 1] -> theta in p[0:3] (model.PARAM_NAMES)."""
+    for j in range(3):
+        p[j] = lo[j] + z[j] * span[j]
+
+
 @njit(cache=True)
 def _ssr_of(z, lo, span, t, Gg, Tgi, n, Ta, x0, p, zoh, h_max, scratch):
     """SSR of the probe reading for scaled parameters z in [0, 1]^3."""
-    for j in range(3):
-        p[j] = lo[j] + z[j] * span[j]  # theta occupies p[0:3] (model.PARAM_NAMES)
+    _set_theta(z, lo, span, p)
     _integrate_into(t, Gg, Tgi, n, x0, p, zoh, h_max, scratch)
     s = 0.0
     for i in range(n):
@@ -89,8 +102,7 @@ def _ssr_of(z, lo, span, t, Gg, Tgi, n, Ta, x0, p, zoh, h_max, scratch):
 
 @njit(cache=True)
 def _residual_vec(z, lo, span, t, Gg, Tgi, n, Ta, x0, p, zoh, h_max, scratch, out):
-    for j in range(3):
-        p[j] = lo[j] + z[j] * span[j]
+    _set_theta(z, lo, span, p)
     _integrate_into(t, Gg, Tgi, n, x0, p, zoh, h_max, scratch)
     for i in range(n):
         out[i] = scratch[i, 4] - Ta[i]
@@ -122,6 +134,8 @@ def _fit_one(t, Gg, Tgi, n, Ta, x0, p_in, lo, span, trial, zoh, h_max, max_iter,
     M = np.empty((3, 3))
     b = np.empty(3)
     zt = np.empty(3)
+    pinned = np.empty(3, dtype=np.bool_)
+    fixed_step = np.empty(3)
     lam = 1e-3
     ssr = best
     need_jac = True
@@ -135,8 +149,8 @@ def _fit_one(t, Gg, Tgi, n, Ta, x0, p_in, lo, span, trial, zoh, h_max, max_iter,
                         J[i, j] = 0.0
                     continue
                 zt[:] = z
-                zp = min(z[j] + 1e-4, 1.0)
-                zm = max(z[j] - 1e-4, 0.0)
+                zp = min(z[j] + FD_STEP, 1.0)
+                zm = max(z[j] - FD_STEP, 0.0)
                 zt[j] = zp
                 _residual_vec(zt, lo, span, t, Gg, Tgi, n, Ta, x0, p, zoh, h_max, scratch, rp)
                 zt[j] = zm
@@ -154,32 +168,56 @@ def _fit_one(t, Gg, Tgi, n, Ta, x0, p_in, lo, span, trial, zoh, h_max, max_iter,
                         acc += J[i, a] * J[i, c]
                     A[a, c] = acc
             need_jac = False
-        # damped normal equations (M = A + lam diag(A)); fixed parameters, and those on a bound
-        # whose gradient pushes outward (the active set), are pinned for this step
+        # damped normal equations (M = A + lam diag(A)). Fixed parameters, those on a bound whose
+        # gradient pushes outward, and those whose step would cross a bound are pinned (the last
+        # at the bound they hit) and the others re-solved given that move: clipping a step
+        # computed as if the bound were not there is what makes projected Gauss-Newton crawl.
         for a in range(3):
-            for c in range(3):
-                M[a, c] = A[a, c]
-            M[a, a] += lam * A[a, a] + 1e-12
-            b[a] = -g[a]
-            active = (z[a] <= 0.0 and g[a] > 0.0) or (z[a] >= 1.0 and g[a] < 0.0)
-            if not free[a] or active:
+            pinned[a] = (not free[a]) or (z[a] <= 0.0 and g[a] > 0.0) or (z[a] >= 1.0 and g[a] < 0.0)
+            fixed_step[a] = 0.0
+        for _pass in range(3):
+            for a in range(3):
                 for c in range(3):
-                    M[a, c] = 0.0
-                    M[c, a] = 0.0
-                M[a, a] = 1.0
-                b[a] = 0.0
-        step = np.linalg.solve(M, b)
+                    M[a, c] = A[a, c]
+                M[a, a] += lam * A[a, a] + 1e-12
+                b[a] = -g[a]
+            for a in range(3):  # move the pinned displacements to the right-hand side
+                if pinned[a]:
+                    for c in range(3):
+                        if not pinned[c]:
+                            b[c] -= M[c, a] * fixed_step[a]
+            for a in range(3):
+                if pinned[a]:
+                    for c in range(3):
+                        M[a, c] = 0.0
+                        M[c, a] = 0.0
+                    M[a, a] = 1.0
+                    b[a] = fixed_step[a]
+            step = np.linalg.solve(M, b)
+            crossed = False
+            for j in range(3):
+                if not pinned[j] and (z[j] + step[j] < 0.0 or z[j] + step[j] > 1.0):
+                    pinned[j] = True
+                    fixed_step[j] = (0.0 if z[j] + step[j] < 0.0 else 1.0) - z[j]
+                    crossed = True
+            if not crossed:
+                break
         for j in range(3):
             zt[j] = min(max(z[j] + step[j], 0.0), 1.0)
         s = _ssr_of(zt, lo, span, t, Gg, Tgi, n, Ta, x0, p, zoh, h_max, scratch)
         sims += 1
         if s < ssr:
             gain = (ssr - s) / max(ssr, 1e-300)
+            moved = 0.0
+            for j in range(3):
+                moved = max(moved, abs(zt[j] - z[j]))
             z[:] = zt
             ssr = s
             lam = max(lam / 3.0, 1e-12)
             need_jac = True
-            if gain < gain_tol:
+            # converged: the SSR barely moves, or the step (in units of the bounds) is tiny,
+            # which ends the slow crawl along a valley of correlated parameters
+            if gain < gain_tol or moved < 1e-6:
                 break
         else:
             lam *= 4.0
@@ -197,6 +235,14 @@ def _fit_population(T, GG, TGI, N, TA, X0, PB, lo, span, trial, zoh, h_max, max_
         )
         SSR[b] = ssr
         SIMS[b] = sims
+
+
+@functools.cache
+def _sobol_points(seed: int, n: int) -> np.ndarray:
+    """Scrambled Sobol points in [0, 1)^3, cached: building the generator costs ~1 ms a call."""
+    pts = qmc.Sobol(3, scramble=True, seed=np.random.default_rng(seed)).random(n)
+    pts.setflags(write=False)
+    return pts
 
 
 def identify_each(
@@ -225,8 +271,8 @@ def identify_each(
 
         raise InputError("per-batch identification needs a measured Ta at every sample")
     # the same trial points for every batch: theta0 and a scrambled Sobol set, in scaled units
-    trial = qmc.Sobol(3, scramble=True, seed=np.random.default_rng(seed)).random(n_trial)
-    start = (np.array(THETA_START.as_tuple()) - lo) / np.where(span > 0, span, 1.0)
+    trial = _sobol_points(seed, n_trial)
+    start = (np.clip(np.array(THETA_START.as_tuple()), lo, hi) - lo) / np.where(span > 0, span, 1.0)
     trial = np.clip(np.vstack([start, trial]), 0.0, 1.0)
     trial[:, span == 0] = 0.0
     Z = np.zeros((nb, 3))

@@ -171,11 +171,12 @@ class Objective:
     def jacobian(self, z: np.ndarray) -> np.ndarray:
         """Central differences, all 2 nz perturbed vectors in one population call.
 
-        The step is 1e-4 of each parameter's range: large against the adaptive integrator's
-        ~1e-7 relative noise, small against the curvature of the residuals.
+        The step is 1e-3 of each parameter's range: large against the adaptive integrator's
+        ~1e-6 relative noise (a smaller step let noise steer the search along flat valleys),
+        small against the curvature of the residuals.
         """
         nz = len(z)
-        step = 1e-4 * (self.upper - self.lower)
+        step = 1e-3 * (self.upper - self.lower)
         Z = np.repeat(z[None, :], 2 * nz, axis=0)
         hi = np.minimum(z + step, self.upper)
         lo = np.maximum(z - step, self.lower)

@@ -8,7 +8,7 @@ Adaptivity matters: over plausible roasts the dynamics are slow (time constants 
 but if beans are driven far past roasting temperatures Schwartzberg's moisture law becomes
 stiff (rate ~6 1/s at 400 degC) and a fixed step would silently lose accuracy.
 
-Against a 1e-10-tolerance SciPy reference the error stays below 1e-4 degC over randomised
+Against a 1e-10-tolerance SciPy reference the error stays below 1e-3 degC over randomised
 inputs and parameters (tests/test_reference.py). The kernels call
 :func:`roastlab.model.derivatives` (compiled inline), are cached on disk (``cache=True``) so a
 second process does not recompile, and the population kernel runs in parallel over cores.
@@ -27,8 +27,10 @@ from .model import STATE_NAMES, derivatives, heat_flows, pack_params, reaction_h
 #: Largest integration step [s].
 H_MAX_S = 30.0
 #: Local error tolerances per state [Tb degC, Tm degC, X kg/kg, He kJ/kg, Ta degC] and relative.
-ATOL = np.array([1e-5, 1e-5, 1e-8, 1e-4, 1e-5])
-RTOL = 1e-7
+#: The temperatures bind: the worst global error against the reference is ~6e-4 degC, 17x
+#: inside the 0.01 degC contract; 10x tighter costs ~25 % more evaluations for no user gain.
+ATOL = np.array([1e-4, 1e-4, 1e-7, 1e-3, 1e-4])
+RTOL = 1e-6
 N_OUT = 6  # five states and Tgo
 
 
