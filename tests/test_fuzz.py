@@ -71,28 +71,69 @@ def _mutate(base, i, n, text, how):
 
 # Structured inputs: well-formed documents with the right keys and values of any type, so the
 # loaders' type and range checks are exercised, not only their parsers.
-SCALARS = st.one_of(st.booleans(), st.integers(-10**6, 10**6), st.floats(allow_nan=True, allow_infinity=True), st.text(max_size=8))
-VALUES = st.recursive(SCALARS, lambda c: st.lists(c, max_size=6) | st.dictionaries(st.text(max_size=6), c, max_size=4), max_leaves=12)
+SCALARS = st.one_of(
+    st.booleans(), st.integers(-(10**6), 10**6), st.floats(allow_nan=True, allow_infinity=True), st.text(max_size=8)
+)
+VALUES = st.recursive(
+    SCALARS, lambda c: st.lists(c, max_size=6) | st.dictionaries(st.text(max_size=6), c, max_size=4), max_leaves=12
+)
 NUMBER_LISTS = st.lists(st.one_of(st.floats(-1e4, 1e4), st.integers(-5, 500), st.just(-1)), max_size=12)
 
 KEYS = {
-    ".map.toml": {"format": VALUES, "resample_s": VALUES, "keep_after_drop": VALUES,
-                  "time": st.fixed_dictionaries({}, optional={"column": VALUES, "unit": VALUES}),
-                  "Ta": st.fixed_dictionaries({}, optional={"column": VALUES, "unit": VALUES, "offset_C": VALUES}),
-                  "Tgi": st.fixed_dictionaries({}, optional={"column": VALUES, "unit": VALUES, "offset_C": VALUES}),
-                  "Gg": st.fixed_dictionaries({}, optional={"column": VALUES, "unit": VALUES, "density_kg_m3": VALUES, "constant_kg_s": VALUES,
-                                                            "identify": VALUES, "pitot": st.dictionaries(st.sampled_from(["dp_column", "T_column", "section_m2", "rho0_kg_m3", "T_unit"]), VALUES)})},
-    ".plant.toml": {k: st.one_of(VALUES, st.floats(-10, 10)) for k in ("name", "Mb_kg", "Dch_m", "Lch_m", "Hflap_m", "Sflap_m", "Mm_kg")}
+    ".map.toml": {
+        "format": VALUES,
+        "resample_s": VALUES,
+        "keep_after_drop": VALUES,
+        "time": st.fixed_dictionaries({}, optional={"column": VALUES, "unit": VALUES}),
+        "Ta": st.fixed_dictionaries({}, optional={"column": VALUES, "unit": VALUES, "offset_C": VALUES}),
+        "Tgi": st.fixed_dictionaries({}, optional={"column": VALUES, "unit": VALUES, "offset_C": VALUES}),
+        "Gg": st.fixed_dictionaries(
+            {},
+            optional={
+                "column": VALUES,
+                "unit": VALUES,
+                "density_kg_m3": VALUES,
+                "constant_kg_s": VALUES,
+                "identify": VALUES,
+                "pitot": st.dictionaries(
+                    st.sampled_from(["dp_column", "T_column", "section_m2", "rho0_kg_m3", "T_unit"]), VALUES
+                ),
+            },
+        ),
+    },
+    ".plant.toml": {
+        k: st.one_of(VALUES, st.floats(-10, 10))
+        for k in ("name", "Mb_kg", "Dch_m", "Lch_m", "Hflap_m", "Sflap_m", "Mm_kg")
+    }
     | {"process": st.dictionaries(st.sampled_from(["A", "cm", "Kt", "Ha/R", "lambda", "warp"]), VALUES, max_size=3)},
-    ".fit.toml": {"free": st.dictionaries(st.sampled_from(["hgm", "Pbm", "Tm0_C", "Gg_kg_s", "warp"]), VALUES, max_size=3),
-                  "fixed": st.dictionaries(st.sampled_from(["Kt", "hbm", "warp"]), VALUES, max_size=2),
-                  "initial": st.dictionaries(st.sampled_from(["Tb0_C", "X0", "warp"]), VALUES, max_size=2)},
-    ".json": {"hgm": VALUES, "hbm": VALUES, "Pbm": st.one_of(VALUES, st.floats(-1, 2)), "SSR": VALUES, "batches": VALUES},
-    ".alog": {"mode": st.one_of(VALUES, st.sampled_from(["C", "F"])), "timex": st.one_of(VALUES, NUMBER_LISTS), "temp1": st.one_of(VALUES, NUMBER_LISTS),
-              "temp2": st.one_of(VALUES, NUMBER_LISTS), "timeindex": st.one_of(VALUES, st.lists(st.integers(-2, 15), max_size=8)),
-              "weight": VALUES, "etypes": VALUES, "specialevents": st.one_of(VALUES, NUMBER_LISTS), "specialeventstype": st.one_of(VALUES, NUMBER_LISTS),
-              "specialeventsvalue": st.one_of(VALUES, NUMBER_LISTS), "extratimex": VALUES, "extraname1": VALUES, "extratemp1": VALUES,
-              "extraNoneTempHint1": VALUES},
+    ".fit.toml": {
+        "free": st.dictionaries(st.sampled_from(["hgm", "Pbm", "Tm0_C", "Gg_kg_s", "warp"]), VALUES, max_size=3),
+        "fixed": st.dictionaries(st.sampled_from(["Kt", "hbm", "warp"]), VALUES, max_size=2),
+        "initial": st.dictionaries(st.sampled_from(["Tb0_C", "X0", "warp"]), VALUES, max_size=2),
+    },
+    ".json": {
+        "hgm": VALUES,
+        "hbm": VALUES,
+        "Pbm": st.one_of(VALUES, st.floats(-1, 2)),
+        "SSR": VALUES,
+        "batches": VALUES,
+    },
+    ".alog": {
+        "mode": st.one_of(VALUES, st.sampled_from(["C", "F"])),
+        "timex": st.one_of(VALUES, NUMBER_LISTS),
+        "temp1": st.one_of(VALUES, NUMBER_LISTS),
+        "temp2": st.one_of(VALUES, NUMBER_LISTS),
+        "timeindex": st.one_of(VALUES, st.lists(st.integers(-2, 15), max_size=8)),
+        "weight": VALUES,
+        "etypes": VALUES,
+        "specialevents": st.one_of(VALUES, NUMBER_LISTS),
+        "specialeventstype": st.one_of(VALUES, NUMBER_LISTS),
+        "specialeventsvalue": st.one_of(VALUES, NUMBER_LISTS),
+        "extratimex": VALUES,
+        "extraname1": VALUES,
+        "extratemp1": VALUES,
+        "extraNoneTempHint1": VALUES,
+    },
 }
 
 

@@ -269,14 +269,19 @@ def _print_fit(result, n_batches, plant_name, out) -> None:
             for bname, v in zip(result.batches, value):
                 lab = f"{name}[{bname}]"
                 lo, hi = result.bounds[lab]
-                print(f"{lab[:26]:<26}{v:>12.5g}{result.stderr[lab]:>12.2g}  [{lo:g}, {hi:g}]")
+                print(f"{lab[:26]:<26}{v:>12.5g}{_se(result.stderr[lab]):>12}  [{lo:g}, {hi:g}]")
         elif name in result.fixed:
             print(f"{name:<26}{value:>12.5g}{'fixed':>12}")
         else:
             lo, hi = result.bounds[name]
-            print(f"{name:<26}{value:>12.5g}{result.stderr[name]:>12.2g}  [{lo:g}, {hi:g}]")
+            print(f"{name:<26}{value:>12.5g}{_se(result.stderr[name]):>12}  [{lo:g}, {hi:g}]")
     print(f"summed SSR {result.SSR:.4f} °C², {result.nfev} simulations, {result.wall_s:.2f} s -> {out}")
     _print_warnings(result.warnings)
+
+
+def _se(value) -> str:
+    """A standard error for the table; None means the parameter is held by a bound."""
+    return "on bound" if value is None else f"{value:.2g}"
 
 
 def _identify_per_batch(args, packed, plant, fix, bounds, out) -> int:

@@ -11,8 +11,9 @@ theta* = argmin sum_j SSR_j(theta) within bounds. Two global strategies:
 
 Any component can be fixed or re-bounded, and each batch's initial metal temperature can be
 estimated as a nuisance parameter. Uncertainty comes from the Jacobian at the optimum:
-cov = s^2 (J'J)^-1 with s^2 = SSR / (n - p). Warnings flag parameters on a bound (where that
-covariance is not meaningful) and pairs correlated above 0.95.
+cov = s^2 (J'J)^-1 with s^2 = SSR / (n - p), over the parameters not on a bound (a parameter
+held by a bound gets no standard error). Warnings flag parameters on a bound and pairs
+correlated above 0.95.
 """
 
 from __future__ import annotations
@@ -251,19 +252,28 @@ def _polish(obj: Objective, z0: np.ndarray):
     return res.x, float(res.fun @ res.fun)
 
 
-def _uncertainty(obj: Objective, z: np.ndarray, ssr: float):
-    J = obj.jacobian(z)
+def _uncertainty(obj: Objective, z: np.ndarray, ssr: float, interior: np.ndarray):
+    """Standard errors and correlations from J at the optimum, over interior parameters only.
+
+    A parameter on a bound is held there by the constraint, not by the data: the linearised
+    covariance says nothing about it, and including it distorts the others. Its standard
+    error and correlations are reported as NaN.
+    """
+    J = obj.jacobian(z)[:, interior]
     n, p = J.shape
-    dof = max(n - p, 1)
-    s2 = ssr / dof
-    try:
-        cov = s2 * np.linalg.pinv(J.T @ J)
-    except np.linalg.LinAlgError:
-        cov = np.full((p, p), np.nan)
+    full_se = np.full(len(z), np.nan)
+    full_corr = np.full((len(z), len(z)), np.nan)
+    if p == 0:
+        return full_se, full_corr
+    s2 = ssr / max(n - p, 1)
+    cov = s2 * np.linalg.pinv(J.T @ J)
     se = np.sqrt(np.clip(np.diag(cov), 0, None))
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov / np.outer(se, se)
-    return se, corr
+    idx = np.flatnonzero(interior)
+    full_se[idx] = se
+    full_corr[np.ix_(idx, idx)] = corr
+    return full_se, full_corr
 
 
 def identify(
@@ -345,7 +355,9 @@ def identify(
     if progress:
         sys.stderr.write("\n")
     z, ssr = best
-    se, corr = _uncertainty(obj, z, ssr)
+    span_all = obj.upper - obj.lower
+    on_bound = (z - obj.lower <= 1e-4 * span_all) | (obj.upper - z <= 1e-4 * span_all)
+    se, corr = _uncertainty(obj, z, ssr, ~on_bound)
     labels = [free[j].name if b < 0 else f"{free[j].name}[{packed.names[b]}]" for j, b in obj.layout]
     values: dict = {}
     for k, (j, b) in enumerate(obj.layout):
@@ -359,15 +371,15 @@ def identify(
         span = obj.upper[k] - obj.lower[k]
         if z[k] - obj.lower[k] <= 1e-4 * span:
             warnings.append(
-                f"{lab} = {z[k]:.6g} is on its lower bound {obj.lower[k]:g}: the optimum may lie outside; its standard error is not meaningful"
+                f"{lab} = {z[k]:.6g} is on its lower bound {obj.lower[k]:g}: the optimum may lie outside; no standard error (held by the bound, not the data)"
             )
         elif obj.upper[k] - z[k] <= 1e-4 * span:
             warnings.append(
-                f"{lab} = {z[k]:.6g} is on its upper bound {obj.upper[k]:g}: the optimum may lie outside; its standard error is not meaningful"
+                f"{lab} = {z[k]:.6g} is on its upper bound {obj.upper[k]:g}: the optimum may lie outside; no standard error (held by the bound, not the data)"
             )
     for a in range(nz):
         for b in range(a + 1, nz):
-            if abs(corr[a, b]) > CORRELATION_WARN:
+            if np.isfinite(corr[a, b]) and abs(corr[a, b]) > CORRELATION_WARN:
                 warnings.append(
                     f"{labels[a]} and {labels[b]} are correlated ({corr[a, b]:+.3f}): the data pin down a combination of them, not each"
                 )
@@ -375,8 +387,12 @@ def identify(
         values=values,
         fixed=fixed,
         SSR=ssr,
-        stderr={lab: float(v) for lab, v in zip(labels, se)},
-        correlation={"names": labels, "matrix": [[float(round(c, 6)) for c in row] for row in corr]},
+        stderr={lab: (float(v) if np.isfinite(v) else None) for lab, v in zip(labels, se)},
+        correlation={
+            "names": labels,
+            "matrix": [[None if not np.isfinite(c) else float(round(c, 6)) for c in row] for row in corr],
+            "note": "over parameters not on a bound; null for those on a bound",
+        },
         warnings=warnings,
         n_residuals=obj.n_residuals,
         nfev=obj.nfev,

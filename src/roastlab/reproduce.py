@@ -165,12 +165,12 @@ def _report(fit, res_i, res_v, synthetic, identify_s, root) -> str:
         se = fit.stderr.get(name)
         t1.append(
             f"| {name} | {THETA_UNITS[name]} | {lo:g} | {hi:g} | {THETA_START.as_dict()[name]:g} | {th[name]:.4f} | "
-            f"{'' if se is None else f'{se:.2g}'} | {THETA_PAPER.as_dict()[name]:.4f} |"
+            f"{'on bound' if se is None else f'{se:.2g}'} | {THETA_PAPER.as_dict()[name]:.4f} |"
         )
     corr = fit.correlation
     corr_lines = ["| | " + " | ".join(corr["names"]) + " |", "|---|" + "---|" * len(corr["names"])]
     for name, row in zip(corr["names"], corr["matrix"]):
-        corr_lines.append(f"| {name} | " + " | ".join(f"{v:+.3f}" for v in row) + " |")
+        corr_lines.append(f"| {name} | " + " | ".join("—" if v is None else f"{v:+.3f}" for v in row) + " |")
     em_i, em_v = res_i.error_moments, res_v.error_moments
     warn = "\n".join(f"- {w}" for w in fit.warnings) or "- none"
     return f"""# Reproduction of "A scalable model of a coffee roasting chamber"
@@ -185,7 +185,8 @@ Identification: {len(res_i.names)} batches of `{root / "dataset-I"}` on the {res
 
 {chr(10).join(t1)}
 
-Summed SSR {fit.SSR:.3f} °C² over {fit.n_residuals} samples. Correlation of the estimates (from the Jacobian at the optimum):
+Summed SSR {fit.SSR:.3f} °C² over {fit.n_residuals} samples. Correlation of the estimates (from the Jacobian at the optimum,
+over the parameters not held by a bound; — for those that are):
 
 {chr(10).join(corr_lines)}
 
