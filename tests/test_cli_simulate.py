@@ -178,3 +178,17 @@ def test_simulation_result_frame_and_plot(tmp_path):
     assert {"Qgb_kW", "Qgm_kW", "Qbm_kW", "Qr_kW"} <= set(frame.columns)
     r.plot(tmp_path / "f.png")
     assert (tmp_path / "f.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_batch_green_weight_overrides_plant(cli, tmp_path, check_inputs):
+    """A '# Mb_kg' line (written by roastlab import) sets the batch mass for that batch."""
+    plain, heavy, explicit = tmp_path / "a.csv", tmp_path / "b.csv", tmp_path / "c.csv"
+    cli("simulate", "--plant", "120kg", "--inputs", check_inputs, "--out", plain)
+    half = tmp_path / "half.csv"
+    half.write_text("# Mb_kg = 60\n" + check_inputs.read_text())
+    cli("simulate", "--plant", "120kg", "--inputs", half, "--out", heavy)
+    plant = tmp_path / "p.toml"
+    plant.write_text("Mb_kg = 60\nDch_m = 1.24\nLch_m = 1.335\nHflap_m = 0.3\nSflap_m = 0.1\nMm_kg = 2000\n")
+    cli("simulate", "--plant", plant, "--inputs", check_inputs, "--out", explicit)
+    assert heavy.read_text() != plain.read_text()
+    assert heavy.read_text() == explicit.read_text()

@@ -92,6 +92,10 @@ def cmd_simulate(args) -> int:
     plant = load_plant(args.plant)
     theta, _ = _theta_from_args(args)
     batch = read_batch_csv(args.inputs)
+    if batch.Mb_kg:  # the batch's own green weight (e.g. imported from an Artisan log)
+        import dataclasses
+
+        plant = dataclasses.replace(plant, Mb_kg=batch.Mb_kg)
     out = check_output_path(args.out, [args.inputs] + ([args.theta] if args.theta else []))
     result = simulate(
         plant,
