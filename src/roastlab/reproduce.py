@@ -147,6 +147,13 @@ def summary_table(summary: dict) -> str:
 
 
 def _report(fit, res_i, res_v, synthetic, identify_s, root) -> str:
+    import os
+
+    try:  # readable and portable: relative to where the command ran, when that is shorter
+        rel = Path(os.path.relpath(root))
+        root = rel if len(str(rel)) < len(str(root)) else root
+    except ValueError:  # another drive on Windows
+        pass
     th = fit.theta.as_dict()
     banner = (
         "> **SYNTHETIC DATA.** The paper's measurements are private. These results come from the synthetic\n"
