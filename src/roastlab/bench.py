@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import json
 import os
-import resource
 import subprocess
 import sys
 import tempfile
@@ -274,7 +273,3 @@ def table(res: dict) -> str:
         )
     w = max(len(r[0]) for r in rows)
     return "\n".join(f"{a:<{w}}  {b:>16}  {c}" for a, b, c in rows)
-
-
-def peak_rss_mb() -> float:
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0

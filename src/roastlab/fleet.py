@@ -320,21 +320,3 @@ def identify_each(
     err = np.sqrt(np.where(mask, (y - np.where(mask, ta, 0.0)) ** 2, 0.0).sum(axis=1))
     fits = 100.0 * (1.0 - err / spread)
     return FleetResult(list(packed.names), theta, SSR, fits, max_iter, int(SIMS.sum()) + nb, time.perf_counter() - t0)
-
-
-def _subset(packed: PackedBatches, idx: np.ndarray) -> PackedBatches:
-    if idx.size == packed.n_batches:
-        return packed
-    return PackedBatches(
-        packed.T[idx],
-        packed.GG[idx],
-        packed.TGI[idx],
-        packed.N[idx],
-        packed.TA[idx],
-        packed.X0[idx],
-        packed.PB[idx],
-        packed.Mb[idx],
-        [packed.names[i] for i in idx],
-        packed.zoh,
-        packed.h_max_s,
-    )
