@@ -87,25 +87,24 @@ def _set_theta(z, lo, span, p):
 
 
 @njit(cache=True)
-def _ssr_of(z, lo, span, t, Gg, Tgi, n, Ta, x0, p, zoh, h_max, scratch):
-    """SSR of the probe reading for scaled parameters z in [0, 1]^3."""
+def _residual_vec(z, lo, span, t, Gg, Tgi, n, Ta, x0, p, zoh, h_max, scratch, out):
+    """Residuals T^a - Ta for scaled parameters z in [0, 1]^3, into out[:n]."""
     _set_theta(z, lo, span, p)
-    _integrate_into(t, Gg, Tgi, n, x0, p, zoh, h_max, scratch)
-    s = 0.0
+    _integrate_into(t, Gg, Tgi, n, x0, p, zoh, h_max, scratch, 5.0, False)
     for i in range(n):
-        e = scratch[i, 4] - Ta[i]
-        s += e * e
-    if not (s == s):
-        return 1e300
-    return s
+        out[i] = scratch[i, 4] - Ta[i]
 
 
 @njit(cache=True)
-def _residual_vec(z, lo, span, t, Gg, Tgi, n, Ta, x0, p, zoh, h_max, scratch, out):
-    _set_theta(z, lo, span, p)
-    _integrate_into(t, Gg, Tgi, n, x0, p, zoh, h_max, scratch)
+def _ssr_of(z, lo, span, t, Gg, Tgi, n, Ta, x0, p, zoh, h_max, scratch, r):
+    """SSR of the probe reading (a failed simulation counts as 1e300); r is a work buffer."""
+    _residual_vec(z, lo, span, t, Gg, Tgi, n, Ta, x0, p, zoh, h_max, scratch, r)
+    s = 0.0
     for i in range(n):
-        out[i] = scratch[i, 4] - Ta[i]
+        s += r[i] * r[i]
+    if not (s == s):
+        return 1e300
+    return s
 
 
 @njit(cache=True)
@@ -113,11 +112,12 @@ def _fit_one(t, Gg, Tgi, n, Ta, x0, p_in, lo, span, trial, zoh, h_max, max_iter,
     """Score the trial points, then projected Levenberg-Marquardt from the best; returns (SSR, sims)."""
     p = p_in.copy()
     scratch = np.empty((t.shape[0], 6))
+    rs = np.empty(n)
     best = 1e300
     z = np.empty(3)
     sims = 0
     for k in range(trial.shape[0]):
-        s = _ssr_of(trial[k], lo, span, t, Gg, Tgi, n, Ta, x0, p, zoh, h_max, scratch)
+        s = _ssr_of(trial[k], lo, span, t, Gg, Tgi, n, Ta, x0, p, zoh, h_max, scratch, rs)
         sims += 1
         if s < best:
             best = s
@@ -204,7 +204,7 @@ def _fit_one(t, Gg, Tgi, n, Ta, x0, p_in, lo, span, trial, zoh, h_max, max_iter,
                 break
         for j in range(3):
             zt[j] = min(max(z[j] + step[j], 0.0), 1.0)
-        s = _ssr_of(zt, lo, span, t, Gg, Tgi, n, Ta, x0, p, zoh, h_max, scratch)
+        s = _ssr_of(zt, lo, span, t, Gg, Tgi, n, Ta, x0, p, zoh, h_max, scratch, rs)
         sims += 1
         if s < ssr:
             gain = (ssr - s) / max(ssr, 1e-300)

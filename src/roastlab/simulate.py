@@ -56,18 +56,20 @@ def _f(x, g, T, p, out):
 
 
 @njit(cache=True)
-def _integrate_into(t, Gg, Tgi, n, x0, p, zoh, h_max, out, h0=5.0):
+def _integrate_into(t, Gg, Tgi, n, x0, p, zoh, h_max, out, h0=5.0, with_tgo=True):
     """Integrate one batch over samples t[0..n-1]; write states and Tgo to out[:n, :6].
 
     Adaptive Dormand-Prince 5(4) inside each sample interval (input kinks are always step
     boundaries). Local error per step is kept below ATOL + RTOL |x| per state. ``h0`` is the
-    first trial step; the step size the next call should start from is returned.
+    first trial step; the step size the next call should start from is returned. Fitting
+    needs only Ta, so ``with_tgo=False`` skips the outlet-gas output (column 5 is left as is).
     """
     x = np.empty(5)
     for i in range(5):
         x[i] = x0[i]
         out[0, i] = x0[i]
-    out[0, 5] = heat_flows(x[0], x[1], x[2], Gg[0], Tgi[0], p)[0]
+    if with_tgo:
+        out[0, 5] = heat_flows(x[0], x[1], x[2], Gg[0], Tgi[0], p)[0]
     k1 = np.empty(5)
     k2 = np.empty(5)
     k3 = np.empty(5)
@@ -145,9 +147,10 @@ def _integrate_into(t, Gg, Tgi, n, x0, p, zoh, h_max, out, h0=5.0):
                 h = h * max(0.2, 0.9 * err**-0.2)
         for i in range(5):
             out[k + 1, i] = x[i]
-        gk = Gg[k] if zoh else Gg[k + 1]
-        Tk = Tgi[k] if zoh else Tgi[k + 1]
-        out[k + 1, 5] = heat_flows(x[0], x[1], x[2], gk, Tk, p)[0]
+        if with_tgo:
+            gk = Gg[k] if zoh else Gg[k + 1]
+            Tk = Tgi[k] if zoh else Tgi[k + 1]
+            out[k + 1, 5] = heat_flows(x[0], x[1], x[2], gk, Tk, p)[0]
     return h
 
 
@@ -179,7 +182,7 @@ def _ta_population(T, GG, TGI, N, batch_of, X0, PP, zoh, h_max, out_ta):
         b = batch_of[i]
         scratch = np.empty((nmax, N_OUT))
         n = N[b]
-        _integrate_into(T[b], GG[b], TGI[b], n, X0[i], PP[i], zoh, h_max, scratch)
+        _integrate_into(T[b], GG[b], TGI[b], n, X0[i], PP[i], zoh, h_max, scratch, 5.0, False)
         for j in range(n):
             out_ta[i, j] = scratch[j, 4]
 
