@@ -126,14 +126,16 @@ def parse_number(cell: str, path, line: int, column: str) -> float:
     return value
 
 
-def read_table(path: str | Path, required: tuple[str, ...], optional: tuple[str, ...] = ()) -> dict[str, np.ndarray]:
+def read_table(
+    path: str | Path, required: tuple[str, ...], optional: tuple[str, ...] = (), text: str | None = None
+) -> dict[str, np.ndarray]:
     """Read named numeric columns from a CSV with a header row, strictly.
 
     Lines starting with ``#`` are comments. Returns ``{column: array}`` for the required
     columns and those optional ones present.
     """
     path = Path(path)
-    text = _read_text(path)
+    text = _read_text(path) if text is None else text  # callers that already read it pass it
     lines = [(i + 1, ln) for i, ln in enumerate(text.splitlines()) if ln.strip() and not ln.lstrip().startswith("#")]
     if not lines:
         raise InputError("empty file (no header row)", path)
@@ -177,8 +179,9 @@ def read_batch_csv(path: str | Path, name: str | None = None, require_Ta: bool =
     """Read and validate a canonical batch CSV (``time_s, Gg_kg_s, Tgi_C[, Ta_C]``)."""
     path = Path(path)
     required = REQUIRED_COLUMNS + (("Ta_C",) if require_Ta else ())
-    cols = read_table(path, required, OPTIONAL_COLUMNS)
-    meta = read_comment_metadata(path)
+    text = _read_text(path)  # once: the table and the '# Mb_kg' metadata come from the same text
+    cols = read_table(path, required, OPTIONAL_COLUMNS, text=text)
+    meta = read_comment_metadata(path, text=text)
     batch = Batch(
         name=name or path.stem,
         time_s=cols["time_s"],
@@ -195,11 +198,12 @@ def read_batch_csv(path: str | Path, name: str | None = None, require_Ta: bool =
 COMMENT_METADATA = {"Mb_kg": (1e-4, 1e4)}
 
 
-def read_comment_metadata(path: str | Path) -> dict[str, float]:
+def read_comment_metadata(path: str | Path, text: str | None = None) -> dict[str, float]:
     """Parse ``# Mb_kg = 0.2``-style metadata lines at the top of a batch CSV."""
     path = Path(path)
     out = {}
-    for line_no, line in enumerate(_read_text(path).splitlines(), start=1):
+    text = _read_text(path) if text is None else text
+    for line_no, line in enumerate(text.splitlines(), start=1):
         if not line.startswith("#"):
             if line.strip():
                 break
