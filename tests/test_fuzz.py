@@ -8,6 +8,7 @@ import json
 import tempfile
 from pathlib import Path
 
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -200,48 +201,28 @@ def _encodable(text):
 FUZZ = settings(max_examples=300, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
 
 
-@FUZZ
-@given(content(".csv"))
-def test_fuzz_batch_csv(data):
-    run_loader(".csv", data, read_batch_csv)
-    run_loader(".csv", data, lambda p: import_log(p, None))
+LOADERS = {
+    ".csv": [read_batch_csv, lambda p: import_log(p, None)],
+    ".alog": [read_alog, lambda p: import_log(p, None)],
+    ".export.csv": [read_artisan_csv],
+    ".map.toml": [load_map],
+    ".plant.toml": [load_plant],
+    ".json": [load_theta_json],
+    ".fit.toml": [load_fit_spec],
+}
 
 
-@FUZZ
-@given(content(".alog"))
-def test_fuzz_alog(data):
-    run_loader(".alog", data, read_alog)
-    run_loader(".alog", data, lambda p: import_log(p, None))
+@pytest.mark.parametrize("kind", sorted(LOADERS))
+def test_fuzz_loader(kind):
+    """Each loader, on 300 generated files of its format, returns or raises RoastlabError."""
 
+    @FUZZ
+    @given(content(kind))
+    def check(data):
+        for loader in LOADERS[kind]:
+            run_loader(kind, data, loader)
 
-@FUZZ
-@given(content(".export.csv"))
-def test_fuzz_artisan_csv(data):
-    run_loader(".export.csv", data, read_artisan_csv)
-
-
-@FUZZ
-@given(content(".map.toml"))
-def test_fuzz_map(data):
-    run_loader(".map.toml", data, load_map)
-
-
-@FUZZ
-@given(content(".plant.toml"))
-def test_fuzz_plant(data):
-    run_loader(".plant.toml", data, load_plant)
-
-
-@FUZZ
-@given(content(".json"))
-def test_fuzz_theta_json(data):
-    run_loader(".json", data, load_theta_json)
-
-
-@FUZZ
-@given(content(".fit.toml"))
-def test_fuzz_fit_spec(data):
-    run_loader(".fit.toml", data, load_fit_spec)
+    check()
 
 
 @settings(max_examples=60, deadline=None, derandomize=True)
