@@ -6,7 +6,7 @@ import os
 
 import pytest
 
-from roastlab.reproduce import default_dataset_root
+from roastlab.workflows.reproduce import default_dataset_root
 
 DATA = default_dataset_root()
 HEADER = "time_s,Gg_kg_s,Tgi_C,Ta_C\n"
@@ -220,7 +220,7 @@ CASES = {
     "theta wrong JSON type": (
         lambda d: theta_with(d, '{"hgm": "0.01", "hbm": 0.02, "Pbm": 0.6}'),
         "theta.json",
-        "key hgm: must be a number",
+        "parameters.hgm: must be a number",
     ),
     "theta not JSON": (lambda d: theta_with(d, "hgm = 0.01"), "theta.json", "not valid JSON"),
     "Pbm outside (0, 1) on the command line": (
@@ -258,7 +258,7 @@ CASES = {
         "nope.csv",
         "file not found",
     ),
-    "output path equal to input": (lambda d: _same_path(d), "b.csv", "same file as input"),
+    "output path equal to input": (lambda d: _same_path(d), "b.csv", "is an input of this run"),
     "missing output folder": (
         lambda d: simulate_with(d, "b.csv", HEADER + GOOD_ROWS)[:-1] + [d / "no" / "such" / "out.csv"],
         "out.csv",

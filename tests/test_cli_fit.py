@@ -2,7 +2,7 @@
 
 import json
 
-from roastlab.reproduce import default_dataset_root
+from roastlab.workflows.reproduce import default_dataset_root
 
 DATA = default_dataset_root()
 
@@ -12,14 +12,19 @@ def test_identify_then_validate(cli, tmp_path):
     code, out, err = cli("identify", "--plant", "120kg", DATA / "dataset-I", "--out", theta, "--seed", "3")
     assert code == 0, err
     doc = json.loads(theta.read_text())
-    assert {"hgm", "hbm", "Pbm", "SSR", "stderr", "correlation", "warnings", "evaluations", "wall_s"} <= set(doc)
+    assert doc["format"] == "roastlab-model/1"
+    assert {"plant", "parameters", "initial", "fit", "metrics", "provenance"} <= set(doc)
+    assert {"SSR", "correlation", "warnings", "evaluations", "wall_s"} <= set(doc["fit"])
+    assert doc["plant"]["Mb_kg"] == 120.0 and doc["parameters"]["hbm"]["stderr"] > 0
+    hashes = {i["path"]: i["sha256"] for i in doc["provenance"]["inputs"]}
+    assert len(hashes) == 5 and all(len(h) == 64 for h in hashes.values())
     assert "summed SSR" in out
     metrics = tmp_path / "m.json"
     code, out, err = cli(
         "validate",
         "--plant",
         "360kg",
-        "--theta",
+        "--model",
         theta,
         DATA / "dataset-V",
         "--json",
@@ -54,7 +59,9 @@ def test_identify_with_csv_list_fix_and_bounds(cli, tmp_path):
     )
     assert code == 0, err
     doc = json.loads(theta.read_text())
-    assert doc["hgm"] == 0.02 and doc["fixed"] == ["hgm"] and doc["method"] == "de"
+    hgm = doc["parameters"]["hgm"]
+    assert hgm["value"] == 0.02 and hgm["how"] == "fixed" and doc["fit"]["method"] == "de"
+    assert doc["parameters"]["hbm"]["bounds"] == [0.01, 0.5]
 
 
 def test_identify_bad_options(cli, tmp_path):
@@ -80,7 +87,7 @@ def test_reproduce_writes_everything(cli, tmp_path):
     out = tmp_path / "rep"
     code, stdout, err = cli("reproduce", "--out", out)
     assert code == 0, err
-    for name in ("theta.json", "metrics.json", "report.md", "fig2_profiles.png", "fig3_errors.png"):
+    for name in ("model.json", "metrics.json", "report.md", "fig2_profiles.png", "fig3_errors.png"):
         assert (out / name).exists(), name
     report = (out / "report.md").read_text()
     assert "SYNTHETIC" in report and "76.861" in report and "Table 1" in report and "Table 4" in report
@@ -92,9 +99,10 @@ def test_reproduce_writes_everything(cli, tmp_path):
 
 def test_identify_per_batch(cli, tmp_path):
     out = tmp_path / "fleet.json"
-    code, stdout, err = cli("identify", DATA / "dataset-I", "--per-batch", "--out", out)
+    code, stdout, err = cli("identify", DATA / "dataset-I", "--per-batch", "--fix", "hgm=0.01", "--out", out)
     assert code == 0, err
     doc = json.loads(out.read_text())
     assert doc["mode"] == "per-batch" and len(doc["batches"]) == 5
     assert {"hgm", "hbm", "Pbm", "SSR", "FIT"} <= set(doc["batches"][0])
+    assert all(b["hgm"] == 0.01 for b in doc["batches"])  # --fix with --per-batch (was refused)
     assert "mean" in stdout

@@ -138,8 +138,8 @@ def test_negative_geometry(cli, tmp_path, check_inputs):
 def test_second_cli_process_uses_disk_cache(tmp_path, check_inputs):
     """The compiled kernel is loaded from numba's on-disk cache in a fresh process."""
     code = (
-        "import sys; from roastlab.cli import main; main(sys.argv[1:]);"
-        "from roastlab.simulate import _simulate_one as f; print('HITS', sum(f.stats.cache_hits.values()), 'MISSES', sum(f.stats.cache_misses.values()))"
+        "import sys; from roastlab.apps.cli import main; main(sys.argv[1:]);"
+        "from roastlab.sim.kernels import simulate_population_kernel as f; print('HITS', sum(f.stats.cache_hits.values()), 'MISSES', sum(f.stats.cache_misses.values()))"
     )
     args = [
         sys.executable,
@@ -162,7 +162,17 @@ def test_doctests():
     import doctest
     import importlib
 
-    for name in ("roastlab.model", "roastlab.plant", "roastlab.simulate"):
+    for name in (
+        "roastlab.model.rhs",
+        "roastlab.model.plant",
+        "roastlab.model.limits",
+        "roastlab.io.plants",
+        "roastlab.io.files",
+        "roastlab.sim.simulate",
+        "roastlab.sim.population",
+        "roastlab.evaluate.metrics",
+        "roastlab.workflows.model",
+    ):
         mod = importlib.import_module(name)
         failures, tried = doctest.testmod(mod)
         assert failures == 0 and tried > 0, mod.__name__

@@ -2,9 +2,9 @@
 
 import json
 
-from roastlab.data import read_dataset
-from roastlab.datasets import PAPER_SEED, make_paper
-from roastlab.reproduce import default_dataset_root
+from roastlab.io.batch import read_dataset
+from roastlab.workflows.datasets import PAPER_SEED, make_paper
+from roastlab.workflows.reproduce import default_dataset_root
 
 SHIPPED = default_dataset_root()
 

@@ -12,13 +12,13 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from roastlab.data import read_batch_csv, read_dataset
 from roastlab.errors import RoastlabError
-from roastlab.fitspec import load_fit_spec
-from roastlab.importers import import_log, load_map
-from roastlab.importers.artisan import read_alog, read_artisan_csv
-from roastlab.plant import load_plant
-from roastlab.theta import load_theta_json
+from roastlab.io.batch import read_batch_csv, read_dataset
+from roastlab.io.fitspec import load_fit_spec
+from roastlab.io.importers import import_log, load_map
+from roastlab.io.importers.artisan import read_alog, read_artisan_csv
+from roastlab.io.modelfile import read_model_document
+from roastlab.io.plants import load_plant
 
 VALID = {
     ".csv": "# Mb_kg = 0.2\ntime_s,Gg_kg_s,Tgi_C,Ta_C\n0,0.4,450,30\n30,0.41,449,40\n60,0.4,447,55\n",
@@ -207,7 +207,7 @@ LOADERS = {
     ".export.csv": [read_artisan_csv],
     ".map.toml": [load_map],
     ".plant.toml": [load_plant],
-    ".json": [load_theta_json],
+    ".json": [read_model_document],
     ".fit.toml": [load_fit_spec],
 }
 

@@ -3,14 +3,14 @@
 import numpy as np
 import pytest
 
-from roastlab.data import Batch, read_dataset
-from roastlab.datasets import _burner_program
-from roastlab.identify import build_free_parameters, identify
-from roastlab.metrics import batch_metrics
-from roastlab.population import pack_batches, predict_ta
-from roastlab.reproduce import default_dataset_root
-from roastlab.simulate import InitialState
-from roastlab.theta import THETA_BOUNDS, THETA_START
+from roastlab.evaluate.metrics import batch_metrics
+from roastlab.fit.identify import build_free_parameters, identify
+from roastlab.io.batch import Batch, read_dataset
+from roastlab.model.parameters import THETA_BOUNDS, THETA_START
+from roastlab.sim.population import pack_batches, predict_ta
+from roastlab.sim.simulate import InitialState
+from roastlab.workflows.datasets import _burner_program
+from roastlab.workflows.reproduce import default_dataset_root
 
 DATA = default_dataset_root()
 
@@ -39,7 +39,7 @@ def test_recovers_noise_free_truth(seed, plant):
     batches = noise_free_batches(seed, plant, truth)
     packed = pack_batches(batches, plant, THETA_START, InitialState(Ta0_C=30.0))
     free, fixed = build_free_parameters()
-    fit = identify(packed, free, fixed, seed=seed, progress=False)
+    fit = identify(packed, free, fixed, seed=seed)
     truth_ssr = 0.0  # the data are the model's output at the truth
     assert fit.SSR <= truth_ssr * (1 + 1e-6) + 1e-6
     ta = predict_ta(packed, ["hgm", "hbm", "Pbm"], np.array([[list(fit.theta.as_tuple())] * len(batches)]))[0]
@@ -55,7 +55,7 @@ def shipped_packed():
 def test_ten_seeds_reach_the_same_optimum():
     packed = shipped_packed()
     free, fixed = build_free_parameters()
-    ssr = [identify(packed, free, fixed, seed=s, progress=False).SSR for s in range(10)]
+    ssr = [identify(packed, free, fixed, seed=s).SSR for s in range(10)]
     spread = (max(ssr) - min(ssr)) / min(ssr)
     assert spread < 1e-3, ssr
 
@@ -63,16 +63,16 @@ def test_ten_seeds_reach_the_same_optimum():
 def test_de_agrees_with_global_search():
     packed = shipped_packed()
     free, fixed = build_free_parameters()
-    g = identify(packed, free, fixed, seed=0, progress=False)
-    d = identify(packed, free, fixed, method="de", seed=0, progress=False)
+    g = identify(packed, free, fixed, seed=0)
+    d = identify(packed, free, fixed, method="de", seed=0)
     assert abs(d.SSR - g.SSR) / g.SSR < 1e-3
 
 
 def test_identified_beats_paper_theta_and_reports_uncertainty():
     packed = shipped_packed()
     free, fixed = build_free_parameters()
-    fit = identify(packed, free, fixed, seed=0, progress=False)
-    from roastlab.identify import Objective
+    fit = identify(packed, free, fixed, seed=0)
+    from roastlab.fit.identify import Objective
 
     obj = Objective(packed, free, fixed)
     ssr_paper = float(obj.ssr_many(np.array([[0.0100, 0.0254, 0.5793]]))[0])
@@ -92,21 +92,21 @@ def test_identified_beats_paper_theta_and_reports_uncertainty():
 def test_fix_bounds_and_bound_warning():
     packed = shipped_packed()
     free, fixed = build_free_parameters(fix={"hgm": 0.01}, bounds={"hbm": (0.01, 0.5)})
-    fit = identify(packed, free, fixed, seed=0, progress=False)
+    fit = identify(packed, free, fixed, seed=0)
     assert fit.theta.hgm == 0.01 and "hgm" not in fit.stderr
     assert fit.bounds["hbm"] == [0.01, 0.5]
     # force an optimum onto a bound: the warning must say so
     free, fixed = build_free_parameters(bounds={"Pbm": (0.7, 0.8)})
-    fit = identify(packed, free, fixed, seed=0, progress=False)
+    fit = identify(packed, free, fixed, seed=0)
     assert any("Pbm" in w and "bound" in w for w in fit.warnings)
 
 
 def test_estimating_initial_metal_temperature_lowers_ssr():
     packed = shipped_packed()
     free, fixed = build_free_parameters()
-    plain = identify(packed, free, fixed, seed=0, progress=False)
+    plain = identify(packed, free, fixed, seed=0)
     free, fixed = build_free_parameters(estimate_tm0=True)
-    nuis = identify(packed, free, fixed, seed=0, progress=False, n_starts=3)
+    nuis = identify(packed, free, fixed, seed=0, n_starts=3)
     assert nuis.SSR < plain.SSR
     assert len(nuis.values["Tm0_C"]) == packed.n_batches
 

@@ -2,12 +2,13 @@
 
 import ast
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from roastlab.importers import gas_flow_pitot_kg_s, import_log, load_map
-from roastlab.importers.artisan import events_internal_to_external, read_alog
+from roastlab.io.importers import gas_flow_pitot_kg_s, import_log, load_map
+from roastlab.io.importers.artisan import events_internal_to_external, read_alog
 
 SPOT = ["roast_25-09-27_1236_R14.alog", "roast_25-11-16_1235.alog", "roast_26-05-10_1438_R58_brazil_250.alog"]
 
@@ -181,11 +182,15 @@ def test_import_cli_then_simulate(cli, real_data, tmp_path):
     assert code == 0, err
     text = out.read_text()
     assert "# Mb_kg = 0.2" in text and "time_s,Gg_kg_s,Tgi_C,Ta_C" in text
-    from roastlab.data import read_batch_csv
+    from roastlab.io.batch import read_batch_csv
 
     assert read_batch_csv(out).Mb_kg == pytest.approx(0.2)
-    code, _, err = cli("simulate", "--plant", "120kg", "--inputs", out, "--out", tmp_path / "sim.csv")
+    plant = Path(__file__).parents[1] / "examples" / "skywalker" / "plant.toml"
+    code, _, err = cli("simulate", "--plant", plant, "--inputs", out, "--out", tmp_path / "sim.csv")
     assert code == 0, err
+    # a 200 g log on the 120 kg plant is a mismatch worth an error, not a silent answer
+    code, _, err = cli("simulate", "--plant", "120kg", "--inputs", out, "--out", tmp_path / "sim2.csv")
+    assert code == 2 and "wrong plant" in err
 
 
 def test_inputs_never_modified(cli, real_data, tmp_path):

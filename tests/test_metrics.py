@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from roastlab.metrics import absolute_error_moments, average_metrics, batch_metrics
+from roastlab.evaluate.metrics import absolute_error_moments, average_metrics, batch_metrics
 
 # Y = [100, 200, 300], Yhat = [110, 190, 300]: e = [-10, 10, 0]
 Y = [100.0, 200.0, 300.0]

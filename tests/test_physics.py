@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from roastlab import InitialState, Simulator, load_plant, pack_params, rhs, simulate
-from roastlab.model import gas_heat_capacity_kJ_kgK
-from roastlab.simulate import _simulate_one
+from roastlab.model.rhs import gas_heat_capacity_kJ_kgK
+from roastlab.sim.kernels import simulate_one
 
 T = np.arange(0.0, 961.0, 30.0)
 
@@ -74,7 +74,7 @@ def test_rhs_is_pure_and_matches_kernel_step():
     assert np.all(x == [30.0, 121.0, 0.1, 0.0, 30.0])
     # the compiled integrator over a tiny step moves the state by h * rhs (Euler), to O(h^2)
     h = 1e-3
-    out = _simulate_one(np.array([0.0, h]), np.array([0.4, 0.4]), np.array([450.0, 450.0]), x, p, False, 30.0)
+    out = simulate_one(np.array([0.0, h]), np.array([0.4, 0.4]), np.array([450.0, 450.0]), x, p, False, 30.0)
     np.testing.assert_allclose(out[1, :5], x + h * d1, rtol=0, atol=1e-4 * h * np.abs(d1).max())
     assert d1[0] > 0 and d1[2] <= 0 and d1[3] > 0
 

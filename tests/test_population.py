@@ -4,12 +4,12 @@ import numpy as np
 import pytest
 
 from roastlab import InitialState, simulate
-from roastlab.data import read_dataset
-from roastlab.fleet import identify_each
-from roastlab.identify import build_free_parameters, identify
-from roastlab.population import pack_batches, predict_ta, simulate_population
-from roastlab.reproduce import default_dataset_root
-from roastlab.theta import THETA_PAPER, THETA_START
+from roastlab.fit.fleet import identify_each
+from roastlab.fit.identify import build_free_parameters, identify
+from roastlab.io.batch import read_dataset
+from roastlab.model.parameters import THETA_PAPER, THETA_START
+from roastlab.sim.population import pack_batches, predict_ta, simulate_population
+from roastlab.workflows.reproduce import default_dataset_root
 
 DATA = default_dataset_root()
 
@@ -51,8 +51,8 @@ def test_fleet_fit_matches_scipy_least_squares(index):
     ds = read_dataset(DATA / "dataset-I")
     one = pack_batches([ds.batches[index]], "120kg", THETA_START)
     free, fixed = build_free_parameters()
-    ref = identify(one, free, fixed, seed=0, progress=False)
-    fleet = identify_each(pack_batches(ds.batches, "120kg", THETA_START), progress=False)
+    ref = identify(one, free, fixed, seed=0)
+    fleet = identify_each(pack_batches(ds.batches, "120kg", THETA_START))
     assert fleet.SSR[index] <= ref.SSR * (1 + 1e-4)
     assert fleet.FIT[index] > 80
 
@@ -66,6 +66,6 @@ def test_fleet_fit_recovers_per_batch_truth():
     ta = predict_ta(packed, ["hgm", "hbm", "Pbm"], truths[None])[0]
     for b, batch in enumerate(batches):
         batch.Ta_C = ta[b, : batch.n].copy()
-    fleet = identify_each(pack_batches(batches, "120kg", THETA_START), progress=False)
+    fleet = identify_each(pack_batches(batches, "120kg", THETA_START))
     assert np.all(fleet.SSR < 1e-6)
     assert np.all(fleet.FIT > 99.9)

@@ -6,8 +6,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from roastlab.baseline import first_order_response, fit_first_order
-from roastlab.data import Batch
+from roastlab.fit.baseline import first_order_response, fit_first_order
+from roastlab.io.batch import Batch
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "skywalker"
 
@@ -42,22 +42,27 @@ def test_skywalker_fit_and_validate(cli, real_data, tmp_path):
     )
     assert code == 0, err
     doc = json.loads(theta.read_text())
-    for key in ("hgm", "hbm", "Pbm", "Gg_kg_s", "Tm0_C", "Kt", "SSR", "initial"):
-        assert key in doc, key
+    for key in ("hgm", "hbm", "Pbm", "Gg_kg_s", "Kt"):
+        assert doc["parameters"][key]["how"] == "fitted", key
+    assert doc["initial"]["Tm0_C"]["how"] == "fitted" and doc["map"]["Gg"] == {"identify": True}
     metrics = tmp_path / "m.json"
-    code, out, err = cli("validate", *common, "--theta", theta, *val_logs, "--json", metrics)
+    code, out, err = cli("validate", *common, "--model", theta, *val_logs, "--json", metrics)
     assert code == 0, err
     m = json.loads(metrics.read_text())
     assert len(m["batches"]) == 2 and m["average"]["MAE"] < 25
-    # validate applies every identified value: dropping Gg_kg_s from THETA.json changes the result
-    doc.pop("Gg_kg_s")
+    # the model carries its map: the raw logs need no --map, and give the same metrics
+    code, _, err = cli("validate", "--model", theta, *val_logs, "--json", tmp_path / "m1.json")
+    assert code == 0, err
+    assert json.loads((tmp_path / "m1.json").read_text())["average"] == m["average"]
+    # a model without its fitted flow cannot be applied to placeholder-flow logs: an error, not a guess
+    doc["parameters"].pop("Gg_kg_s")
     stripped = tmp_path / "stripped.json"
     stripped.write_text(json.dumps(doc))
-    code, _, _ = cli("validate", *common, "--theta", stripped, *val_logs, "--json", tmp_path / "m2.json")
-    assert json.loads((tmp_path / "m2.json").read_text())["average"]["MAE"] != m["average"]["MAE"]
+    code, _, err = cli("validate", *common, "--model", stripped, *val_logs, "--json", tmp_path / "m2.json")
+    assert code == 2 and "placeholder" in err and not (tmp_path / "m2.json").exists()
     # the first-order baseline through the same commands
     base = tmp_path / "base.json"
     code, _, err = cli("identify", *common, "--baseline", "first-order", *fit_logs, "--out", base)
     assert code == 0, err
-    code, out, err = cli("validate", *common, "--baseline", "first-order", "--theta", base, *val_logs)
+    code, out, err = cli("validate", *common, "--baseline", "first-order", "--model", base, *val_logs)
     assert code == 0 and "first-order baseline" in out, err

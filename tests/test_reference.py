@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from reference_model import reference_simulate
 from roastlab import InitialState, simulate
-from roastlab.theta import THETA_BOUNDS
+from roastlab.model.parameters import THETA_BOUNDS
 
 TOL_C = 0.01
 TOL_X = 1e-5

@@ -2,24 +2,44 @@
 
 Implements "A scalable model of a coffee roasting chamber" (Procedia Computer Science,
 2021, doi:10.1016/j.procs.2021.01.362) as read by MODEL.md: the model, a fast simulator,
-identification of (hgm, hbm, Pbm) and validation across plant sizes.
+identification and validation across plant sizes, applied through one fitted-model object.
+
+Layout (imports point one way: apps -> workflows -> fit -> evaluate -> sim -> report -> io -> model):
+
+* :mod:`roastlab.model`: constants, plant geometry, the right-hand side, the parameter registry;
+* :mod:`roastlab.io`: input/output guards, batch files, plants, model files, fit specs, importers;
+* :mod:`roastlab.report`: figures;
+* :mod:`roastlab.sim`: compiled kernels, :func:`simulate`, :class:`Simulator`, populations;
+* :mod:`roastlab.evaluate`: metrics and validation scores;
+* :mod:`roastlab.fit`: the objective, global search, per-batch fleet fits, the baseline;
+* :mod:`roastlab.workflows`: :class:`FittedModel`, :func:`fit`, reproduction, synthetic datasets;
+* :mod:`roastlab.apps`: the command line and the benchmark.
 """
 
-from .errors import InputError, ParameterError, RoastlabError
-from .model import INPUT_NAMES, PARAM_NAMES, STATE_NAMES, pack_params, rhs
-from .plant import Plant, load_plant, preset_names
-from .simulate import InitialState, SimulationResult, Simulator, simulate
-from .theta import THETA_BOUNDS, THETA_PAPER, THETA_START, Theta
+__version__ = "0.2.0"
 
-__version__ = "0.1.0"
+from .errors import InputError, ParameterError, RoastlabError  # noqa: E402
+from .io.batch import Batch, read_batch_csv, read_dataset  # noqa: E402
+from .io.plants import load_plant  # noqa: E402
+from .model.parameters import REGISTRY, THETA_BOUNDS, THETA_PAPER, THETA_START, Theta  # noqa: E402
+from .model.plant import Plant, preset_names  # noqa: E402
+from .model.rhs import INPUT_NAMES, PARAM_NAMES, STATE_NAMES, pack_params, rhs  # noqa: E402
+from .sim.simulate import InitialState, SimulationResult, Simulator, simulate  # noqa: E402
+from .workflows.fitting import FitResult, fit  # noqa: E402
+from .workflows.model import FittedModel, load_log, load_model  # noqa: E402
+from .workflows.reproduce import default_dataset_root  # noqa: E402
 
 __all__ = [
     "INPUT_NAMES",
     "PARAM_NAMES",
+    "REGISTRY",
     "STATE_NAMES",
     "THETA_BOUNDS",
     "THETA_PAPER",
     "THETA_START",
+    "Batch",
+    "FitResult",
+    "FittedModel",
     "InitialState",
     "InputError",
     "ParameterError",
@@ -28,9 +48,15 @@ __all__ = [
     "SimulationResult",
     "Simulator",
     "Theta",
+    "default_dataset_root",
+    "fit",
+    "load_log",
+    "load_model",
     "load_plant",
     "pack_params",
     "preset_names",
+    "read_batch_csv",
+    "read_dataset",
     "rhs",
     "simulate",
 ]

@@ -1,0 +1,275 @@
+"""``roastlab bench``: speed measured as ratios against a baseline in the same run.
+
+Baseline: what a Python user writes first, ``scipy.integrate.solve_ivp(method="LSODA",
+rtol=1e-8, atol=1e-8)`` on the same right-hand side (:func:`roastlab.model.rhs`, run as
+plain Python/NumPy) with inputs linearly interpolated by ``np.interp``.
+
+Figures (medians of repeated runs):
+
+* ``single_speedup``: batches/s of :func:`roastlab.simulate` over the baseline, one batch at
+  a time (dataset-I batch 1 inputs, 120 kg plant, theta*);
+* ``population_speedup``: the same per-batch ratio with 1,000 parameter sets (uniform in the
+  Table 1 bounds) in one population call; the baseline is timed on a sample of those same
+  sets, since corners of the box are stiffer than theta* for both integrators;
+* ``max_abs_dev_C``: largest temperature difference project vs baseline over those runs;
+* ``identify_paper_s``: identification on dataset-I in-process, compile cache warm;
+* ``identify_scaling``: fleet identification (a theta per batch) of 10, 100 and 1,000
+  synthetic 120 kg batches generated as dataset-I. Batches differ in difficulty (73 to 518
+  simulations each), so every size processes the same 1,000-batch fleet, in 100 calls of 10,
+  10 calls of 100 or one call of 1,000, three times over: ``wall_s`` is the median call,
+  ``s_per_batch`` the median over the three passes of (pass time / 1,000 batches), so only
+  per-call overhead differs between sizes and VM noise is damped. Peak memory
+  of the 1,000-batch call is measured in a fresh process;
+* ``cli_cold_s``: wall time of ``roastlab simulate`` on one batch as a fresh process.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from ..model.rhs import rhs
+
+TARGETS = {
+    "single_speedup": (">=", 100.0),
+    "population_speedup": (">=", 500.0),
+    "max_abs_dev_C": ("<=", 0.01),
+    "identify_paper_s": ("<=", 1.0),
+    "identify_1000_s": ("<=", 60.0),
+    "scaling_spread": ("<=", 0.20),
+    "peak_memory_MB": ("<=", 500.0),
+    "cli_cold_s": ("<=", 3.0),
+}
+
+
+def baseline_simulate(t, Gg, Tgi, x0, p):
+    """The baseline: solve_ivp LSODA on the plain-Python right-hand side; (n, 5) states."""
+
+    def f(s, x):
+        u = np.array([np.interp(s, t, Gg), np.interp(s, t, Tgi)])
+        return rhs(s, x, u, p)
+
+    sol = solve_ivp(f, (t[0], t[-1]), x0, method="LSODA", t_eval=t, rtol=1e-8, atol=1e-8)
+    return sol.y.T
+
+
+def _median_time(fn, repeats: int) -> float:
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return float(np.median(times))
+
+
+def _log(msg: str, quiet: bool) -> None:
+    if not quiet:
+        print(msg, file=sys.stderr, flush=True)
+
+
+def _fleet_batches(count: int, seed: int = 7):
+    from ..workflows.datasets import make_batch
+
+    rng = np.random.default_rng(seed)
+    return [make_batch(rng, "120kg", i + 1, cold_first=(i % 5 == 0))[0] for i in range(count)]
+
+
+def _peak_memory_child(count: int) -> dict:
+    """Run the largest fleet identification in a fresh process and read its peak RSS."""
+    code = (
+        "import json, resource, time, sys\n"
+        "from roastlab.bench import _fleet_batches\n"
+        "from roastlab.fleet import identify_each\n"
+        "from roastlab.population import pack_batches\n"
+        "from roastlab.theta import THETA_START\n"
+        f"b = _fleet_batches({count})\n"
+        "t0 = time.perf_counter(); r = identify_each(pack_batches(b, '120kg', THETA_START), progress=False); dt = time.perf_counter() - t0\n"
+        "print(json.dumps({'wall_s': dt, 'peak_MB': resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, 'mean_FIT': float(r.FIT.mean())}))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def run(quiet: bool = False, baseline_repeats: int = 5) -> dict:
+    from ..fit.fleet import identify_each
+    from ..fit.identify import build_free_parameters, identify
+    from ..io.batch import read_dataset
+    from ..io.plants import load_plant
+    from ..model.parameters import THETA_PAPER, THETA_START
+    from ..sim.population import pack_batches, simulate_population
+    from ..sim.simulate import InitialState, simulate
+    from ..workflows.reproduce import default_dataset_root
+
+    root = default_dataset_root()
+    ds = read_dataset(root / "dataset-I")
+    batch = ds.batches[0]
+    plant = load_plant("120kg")
+    t, Gg, Tgi = batch.time_s, batch.Gg_kg_s, batch.Tgi_C
+    init = InitialState()
+    x0 = init.vector(float(batch.Ta_C[0]))
+    res = {
+        "machine": {"cpus": os.cpu_count(), "python": sys.version.split()[0]},
+        "batch": {"name": f"dataset-I/{batch.name}", "duration_s": float(t[-1]), "samples": int(batch.n)},
+    }
+
+    # --- single batch: project vs baseline -------------------------------------------------
+    _log("warming up the compiled kernels ...", quiet)
+    sim = lambda: simulate(plant, t, Gg, Tgi, theta=THETA_PAPER, initial=init, Ta_measured_C=batch.Ta_C)  # noqa: E731
+    fast = sim()
+    p = fast.params
+    _log(f"baseline: solve_ivp LSODA x{baseline_repeats} ...", quiet)
+    base_states = baseline_simulate(t, Gg, Tgi, x0, p)
+    base_s = _median_time(lambda: baseline_simulate(t, Gg, Tgi, x0, p), baseline_repeats)
+    n_fast = 2000
+    t0 = time.perf_counter()
+    for _ in range(n_fast):
+        sim()
+    fast_s = _median_time(sim, 200)
+    fast_s = min(fast_s, (time.perf_counter() - t0) / n_fast)
+    dev = float(np.max(np.abs(fast.states[:, [0, 1, 4]] - base_states[:, [0, 1, 4]])))
+
+    # --- population: 1,000 parameter sets in one call -------------------------------------
+    _log("population: 1,000 parameter sets ...", quiet)
+    rng = np.random.default_rng(1)
+    thetas = np.column_stack(
+        [rng.uniform(0.01, 0.35, 1000), rng.uniform(0.01, 0.35, 1000), rng.uniform(0.5, 0.8, 1000)]
+    )
+    packed = pack_batches([batch], plant, THETA_PAPER, initial=init)
+    values = thetas[:, None, :]
+    pop = simulate_population(packed, ["hgm", "hbm", "Pbm"], values)
+    pop_s = _median_time(lambda: simulate_population(packed, ["hgm", "hbm", "Pbm"], values), 5) / 1000
+    # the baseline on a sample of the same parameter sets: the population spans the whole
+    # box, where some corners are stiffer (more steps) than theta*, for both integrators
+    base_pop = []
+    for k in np.linspace(0, 999, baseline_repeats).astype(int):
+        pk = p.copy()
+        pk[0:3] = thetas[k]
+        t0 = time.perf_counter()
+        ref = baseline_simulate(t, Gg, Tgi, x0, pk)
+        base_pop.append(time.perf_counter() - t0)
+        dev = max(dev, float(np.max(np.abs(pop[k, 0, : batch.n][:, [0, 1, 4]] - ref[:, [0, 1, 4]]))))
+    base_pop_s = float(np.median(base_pop))
+    res["baseline_s_per_batch"] = base_s
+    res["project_s_per_batch"] = fast_s
+    res["population_s_per_batch"] = pop_s
+    res["single_speedup"] = base_s / fast_s
+    res["baseline_population_sets_s_per_batch"] = base_pop_s
+    res["population_speedup"] = base_pop_s / pop_s
+    res["max_abs_dev_C"] = dev
+
+    # --- identification on dataset-I -------------------------------------------------------
+    _log("identify on dataset-I ...", quiet)
+    free, fixed = build_free_parameters()
+    pk_i = pack_batches(ds.batches, ds.plant, THETA_START)
+    identify(pk_i, free, fixed, seed=0, progress=False)
+    res["identify_paper_s"] = _median_time(
+        lambda: identify(pack_batches(ds.batches, ds.plant, THETA_START), free, fixed, seed=0, progress=False), 5
+    )
+
+    # --- fleet identification scaling ------------------------------------------------------
+    _log("fleet identification: 10, 100, 1,000 batches ...", quiet)
+    fleet = _fleet_batches(1000)
+    identify_each(pack_batches(fleet[:10], "120kg", THETA_START), progress=False)
+    scaling = {}
+    for size in (10, 100, 1000):
+        passes = []  # three passes over the whole fleet: VM noise is not scaling
+        walls = []
+        for _ in range(3):
+            pass_walls = []
+            for k in range(len(fleet) // size):  # the whole fleet, in calls of `size` batches
+                part = fleet[k * size : (k + 1) * size]
+                t0 = time.perf_counter()
+                identify_each(pack_batches(part, "120kg", THETA_START), progress=False)
+                pass_walls.append(time.perf_counter() - t0)
+            passes.append(float(np.sum(pass_walls)) / len(fleet))
+            walls += pass_walls
+        scaling[str(size)] = {
+            "wall_s": float(np.median(walls)),
+            "s_per_batch": float(np.median(passes)),
+            "calls": len(walls),
+            "passes": 3,
+        }
+        _log(
+            f"  {size:>5} batches per call: {np.median(walls):.3f} s per call, {np.median(passes) * 1e3:.2f} ms per batch (median of 3 passes)",
+            quiet,
+        )
+    per = [v["s_per_batch"] for v in scaling.values()]
+    scaling["spread"] = (max(per) - min(per)) / min(per)
+    _log("  peak memory of the 1,000-batch run (fresh process) ...", quiet)
+    child = _peak_memory_child(1000)
+    scaling["peak_memory_MB_1000"] = child["peak_MB"]
+    scaling["fresh_process_wall_s_1000"] = child["wall_s"]
+    scaling["mean_FIT_1000"] = child["mean_FIT"]
+    res["identify_scaling"] = scaling
+
+    # --- the CLI as a fresh process -------------------------------------------------------
+    _log("cold CLI ...", quiet)
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "out.csv"
+        exe = [
+            sys.executable,
+            "-m",
+            "roastlab",
+            "simulate",
+            "--plant",
+            "120kg",
+            "--inputs",
+            str(batch.source),
+            "--out",
+            str(out),
+        ]
+        subprocess.run(exe, check=True, capture_output=True)  # fills the on-disk cache if needed
+        res["cli_cold_s"] = _median_time(lambda: subprocess.run(exe, check=True, capture_output=True), 5)
+    res["checks"] = check_targets(res)
+    return res
+
+
+def check_targets(res: dict) -> dict:
+    values = {
+        "single_speedup": res["single_speedup"],
+        "population_speedup": res["population_speedup"],
+        "max_abs_dev_C": res["max_abs_dev_C"],
+        "identify_paper_s": res["identify_paper_s"],
+        "identify_1000_s": res["identify_scaling"]["1000"]["wall_s"],
+        "scaling_spread": res["identify_scaling"]["spread"],
+        "peak_memory_MB": res["identify_scaling"]["peak_memory_MB_1000"],
+        "cli_cold_s": res["cli_cold_s"],
+    }
+    out = {}
+    for key, (op, target) in TARGETS.items():
+        v = values[key]
+        ok = v >= target if op == ">=" else v <= target
+        out[key] = {"value": v, "target": f"{op} {target:g}", "met": bool(ok)}
+    return out
+
+
+def table(res: dict) -> str:
+    sc = res["identify_scaling"]
+    rows = [
+        ("baseline (solve_ivp LSODA)", f"{res['baseline_s_per_batch'] * 1e3:.1f} ms/batch", ""),
+        ("project, one batch", f"{res['project_s_per_batch'] * 1e6:.1f} µs/batch", ""),
+        ("baseline on the population's sets", f"{res['baseline_population_sets_s_per_batch'] * 1e3:.1f} ms/batch", ""),
+        ("project, population of 1,000", f"{res['population_s_per_batch'] * 1e6:.1f} µs/batch", ""),
+    ]
+    for key, chk in res["checks"].items():
+        v = chk["value"]
+        txt = f"{v:.4g}"
+        rows.append((key, txt, f"{chk['target']}  {'ok' if chk['met'] else 'MISSED'}"))
+    for size in ("10", "100", "1000"):
+        rows.append(
+            (
+                f"fleet identify, {size} batches",
+                f"{sc[size]['wall_s']:.3f} s",
+                f"{sc[size]['s_per_batch'] * 1e3:.2f} ms/batch",
+            )
+        )
+    w = max(len(r[0]) for r in rows)
+    return "\n".join(f"{a:<{w}}  {b:>16}  {c}" for a, b, c in rows)

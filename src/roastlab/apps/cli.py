@@ -1,0 +1,754 @@
+"""The ``roastlab`` command line: a thin layer that parses, calls the library, formats.
+
+Every :class:`~roastlab.errors.RoastlabError` becomes one line on stderr and exit code 2.
+Every command plans its outputs first (:class:`roastlab.io.files.Outputs`): an output that is
+one of the run's inputs, a folder or a special file is refused before any work, and the
+outputs are written together at the end or not at all.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from pathlib import Path
+
+from ..errors import InputError, RoastlabError
+
+MODEL_HELP = "fitted model file from 'roastlab identify' (roastlab-model/1; a THETA.json of roastlab 0.1 also loads)"
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors (exit 2) instead of a usage block."""
+
+    def error(self, message: str):  # noqa: D102
+        self.exit(2, f"{self.prog}: error: {message} (see --help)\n")
+
+
+def _float_arg(name: str):
+    def parse(text: str) -> float:
+        try:
+            v = float(text)
+        except (ValueError, OverflowError):
+            raise argparse.ArgumentTypeError(f"{name} must be a number, got {text[:40]!r}") from None
+        if not math.isfinite(v):
+            raise argparse.ArgumentTypeError(f"{name} must be finite, got {text[:40]!r}")
+        return v
+
+    return parse
+
+
+def _seed_arg(text: str) -> int:
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"--seed must be an integer, got {text[:40]!r}") from None
+    if not 0 <= v < 2**32:
+        raise argparse.ArgumentTypeError(f"--seed must be in 0..{2**32 - 1}, got {text[:40]}")
+    return v
+
+
+def _count_arg(name: str, lo: int, hi: int):
+    def parse(text: str) -> int:
+        try:
+            v = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} must be an integer, got {text[:40]!r}") from None
+        if not lo <= v <= hi:
+            raise argparse.ArgumentTypeError(f"{name} must be in {lo}..{hi}, got {v}")
+        return v
+
+    return parse
+
+
+def _progress(desc: str):
+    """A progress callback drawing a tqdm bar on a terminal, shown only for work over ~2 s."""
+    from tqdm import tqdm
+
+    state: dict = {}
+
+    def update(done: int, total: int, text: str = "") -> None:
+        bar = state.get("bar")
+        if bar is None:
+            bar = state["bar"] = tqdm(total=total, desc=desc, file=sys.stderr, delay=2.0, disable=None, leave=False)
+        bar.set_postfix_str(text[:60], refresh=False)
+        bar.update(done - bar.n)
+        if done >= total:
+            bar.close()
+
+    return update
+
+
+def _say(notes) -> None:
+    for note in notes:
+        print(f"note: {note}", file=sys.stderr)
+
+
+# ----------------------------------------------------------------------------- shared options
+def _add_model_options(p: argparse.ArgumentParser, with_model: bool = True) -> None:
+    if with_model:
+        p.add_argument("--model", "--theta", dest="model", metavar="MODEL.json", help=MODEL_HELP)
+        p.add_argument("--hgm", type=_float_arg("--hgm"), help="gas-metal coefficient [kW/(m2 K)]; overrides the model")
+        p.add_argument(
+            "--hbm", type=_float_arg("--hbm"), help="metal-bean coefficient [kW/(m2 K)]; overrides the model"
+        )
+        p.add_argument(
+            "--pbm", type=_float_arg("--pbm"), help="bean-metal contact fraction in (0, 1); overrides the model"
+        )
+    p.add_argument(
+        "--tb0", type=_float_arg("--tb0"), help="initial bean temperature [degC] (default: the model's, else 30)"
+    )
+    p.add_argument(
+        "--tm0", type=_float_arg("--tm0"), help="initial drum metal temperature [degC] (default: the model's, else 121)"
+    )
+    p.add_argument(
+        "--x0", type=_float_arg("--x0"), help="initial moisture [kg/kg dry] (default: the model's, else 0.1)"
+    )
+    p.add_argument(
+        "--moisture",
+        choices=("schwartzberg", "printed"),
+        help="moisture law, eq. 13 (default: the model's, else schwartzberg)",
+    )
+    p.add_argument(
+        "--hold", choices=("linear", "zoh"), help="input hold between samples (default: the model's, else linear)"
+    )
+
+
+def _initial_changes(args) -> dict:
+    from ..model.limits import check_value
+
+    changes = {}
+    for opt, name in (("tb0", "Tb0_C"), ("tm0", "Tm0_C"), ("x0", "X0")):
+        v = getattr(args, opt, None)
+        if v is not None:
+            changes[name] = check_value(name, v, f"--{opt}")
+    return changes
+
+
+def _model_from_args(args, plant_spec):
+    """The model of a command: --model (or the paper's theta*), with --hgm/--hbm/--pbm and variants applied."""
+    from ..workflows.model import FittedModel, load_model
+
+    if getattr(args, "model", None):
+        model = load_model(args.model)
+    else:
+        if plant_spec is None:
+            raise InputError("--plant is required without --model", "command line")
+        model = FittedModel.paper(plant_spec)
+    overrides = {
+        k: getattr(args, o)
+        for k, o in (("hgm", "hgm"), ("hbm", "hbm"), ("Pbm", "pbm"))
+        if getattr(args, o, None) is not None
+    }
+    if overrides:
+        model = model.with_values(**overrides)
+        try:
+            model.theta  # noqa: B018 - validates the overridden theta
+        except RoastlabError as exc:
+            raise InputError(str(exc), "command line") from None
+    for key in ("moisture", "hold"):
+        if getattr(args, key, None):
+            model.doc[key] = getattr(args, key)
+            setattr(model, key, getattr(args, key))
+    return model
+
+
+def _read_inputs(path, map_path, model):
+    """A batch CSV, or a raw log read with --map or with the map the model was fitted with."""
+    from ..workflows.model import load_log
+
+    if map_path:
+        return load_log(path, map_path)
+    if (
+        model is not None
+        and model.column_map is not None
+        and Path(path).suffix.lower() in (".alog", ".json", ".parquet", ".pq")
+    ):
+        return load_log(path, model.column_map)
+    return load_log(path)
+
+
+# ----------------------------------------------------------------------------- commands
+def cmd_simulate(args) -> int:
+    from ..io.files import Outputs
+    from ..report.figures import check_figure_path, plot_simulation
+
+    out_plan = Outputs([args.inputs, args.model, args.map, args.plant])
+    out_plan.check(args.out)
+    if args.plot:
+        check_figure_path(out_plan.check(args.plot))
+    model = _model_from_args(args, args.plant)
+    batch = _read_inputs(args.inputs, args.map, model)
+    changes = _initial_changes(args)
+    if args.tgi_offset is not None:
+        changes["Tgi_offset_C"] = args.tgi_offset
+    result = model.predict(batch, plant=args.plant, **changes)
+    _say(result.meta.get("notes", []))
+    with out_plan as out:
+        if Path(args.out).suffix.lower() == ".json":
+            out.write_text(args.out, result.to_json_text(heat_flows=args.heat_flows))
+        else:
+            out.write_text(args.out, result.to_csv_text(heat_flows=args.heat_flows))
+        if args.plot:
+            plot_simulation(result, args.plot, f"{batch.name} on {result.meta['plant']} (simulated)", outputs=out)
+    last = result.states[-1]
+    print(
+        f"simulated {batch.name}: {len(result.time_s)} samples, {result.time_s[-1] - result.time_s[0]:.0f} s on plant {result.meta['plant']}; "
+        f"final BT {last[4]:.2f} degC (bean core Tb {last[0]:.2f}), X {last[2]:.4f}, Tgo {result.Tgo_C[-1]:.1f} degC -> {args.out}"
+    )
+    return 0
+
+
+def cmd_plant(args) -> int:
+    from ..io.plants import load_plant
+    from ..model.parameters import THETA_PAPER
+
+    plant = load_plant(args.plant)
+    th = THETA_PAPER
+    print(f"plant {plant.name}")
+    print(f"{'symbol':<8}{'value':>12}  {'unit':<6} meaning")
+    for symbol, value, unit, meaning in plant.describe(th.hgm, th.hbm, th.Pbm, args.x0):
+        print(f"{symbol:<8}{value:>12.4g}  {unit:<6} {meaning}")
+    pc = plant.process.as_dict()
+    print("process constants: " + ", ".join(f"{k}={v:g}" for k, v in pc.items()))
+    return 0
+
+
+def _parse_assignments(items, option: str, ranged: bool):
+    """Parse ``name=value`` (or ``name=lo:hi`` when ``ranged``) options."""
+    out = {}
+    for item in items or []:
+        name, sep, text = item.partition("=")
+        if not sep or not name:
+            raise InputError(
+                f"{option} expects NAME={'LO:HI' if ranged else 'VALUE'}, got {item[:60]!r}", "command line"
+            )
+        try:
+            if ranged:
+                lo, sep2, hi = text.partition(":")
+                if not sep2:
+                    raise ValueError
+                value = (float(lo), float(hi))
+            else:
+                value = (float(text),)
+        except (ValueError, OverflowError):
+            raise InputError(
+                f"{option} {name[:30]}: cannot read {text[:40]!r} as {'LO:HI' if ranged else 'a number'}",
+                "command line",
+            ) from None
+        if not all(math.isfinite(v) for v in value):
+            raise InputError(f"{option} {name[:30]}: values must be finite", "command line")
+        if ranged and not value[0] < value[1]:
+            raise InputError(
+                f"{option} {name}: inverted or empty bounds {value[0]:g}:{value[1]:g} (need LO < HI)", "command line"
+            )
+        out[name.strip()] = value if ranged else value[0]
+    return out
+
+
+def _load_batches(args, model=None):
+    """The BATCH arguments as batches, and the plant spec to use (--plant, else the dataset's)."""
+    from ..io.batch import expand_batch_args
+    from ..workflows.model import load_log
+
+    if getattr(args, "map", None) or (
+        model is not None and model.column_map is not None and not any(Path(p).is_dir() for p in args.batches)
+    ):
+        cmap = args.map if args.map else model.column_map
+        if all(Path(p).suffix.lower() == ".csv" for p in args.batches) and not args.map:
+            batches, dataset_plant = expand_batch_args(args.batches, require_Ta=True)
+        else:
+            batches, dataset_plant = [load_log(p, cmap) for p in args.batches], None
+        for b in batches:
+            for note in b.notes:
+                print(f"warning: {b.source}: {note}", file=sys.stderr)
+    else:
+        batches, dataset_plant = expand_batch_args(args.batches, require_Ta=True)
+    return batches, args.plant or dataset_plant
+
+
+def _fit_inputs(args) -> list:
+    return [*args.batches, args.map, getattr(args, "spec", None), args.plant, getattr(args, "model", None)]
+
+
+def cmd_identify(args) -> int:
+    from ..io.files import Outputs
+
+    outputs = Outputs(_fit_inputs(args))
+    outputs.check(args.out)
+    batches, plant_spec = _load_batches(args)
+    if plant_spec is None:
+        raise InputError("--plant is required unless a dataset folder names its plant", "command line")
+    if args.baseline:
+        from ..fit.baseline import fit_first_order
+
+        doc = {**fit_first_order(batches), "plant": str(plant_spec)}
+        with outputs as out:
+            out.write_text(args.out, json.dumps(doc, indent=1, allow_nan=False) + "\n")
+        print(
+            f"first-order baseline on {len(batches)} batch(es): tau {doc['tau_s']:.1f} s, offset {doc['offset_C']:+.2f} degC, SSR {doc['SSR']:.1f} -> {args.out}"
+        )
+        return 0
+    fix = _parse_assignments(args.fix, "--fix", ranged=False)
+    bounds = _parse_assignments(args.bounds, "--bounds", ranged=True)
+    if args.per_batch:
+        return _identify_per_batch(args, batches, plant_spec, fix, bounds, outputs)
+    from ..io.importers import load_map
+    from ..workflows.fitting import fit
+
+    initial = _initial_changes(args)
+    result = fit(
+        batches,
+        plant_spec,
+        args.spec,
+        fix=fix,
+        bounds=bounds,
+        estimate_tm0=args.estimate_tm0,
+        initial=initial,
+        moisture=args.moisture or "schwartzberg",
+        hold=args.hold or "linear",
+        method=args.method,
+        seed=args.seed,
+        starts=args.starts,
+        column_map=load_map(args.map) if args.map else None,
+        progress=_progress("identify"),
+    )
+    from ..io.modelfile import model_document_text
+
+    with outputs as out:
+        out.write_text(args.out, model_document_text(result.model.to_document()))
+    print(result.report())
+    print(f"-> {args.out}")
+    return 0
+
+
+def _identify_per_batch(args, batches, plant_spec, fix, bounds, outputs) -> int:
+    from ..fit.fleet import identify_each
+    from ..model.parameters import THETA_NAMES, THETA_START
+    from ..sim.population import pack_batches
+    from ..sim.simulate import InitialState
+    from ..workflows.model import PAPER_INITIAL
+
+    unknown = sorted((set(fix) | set(bounds)) - set(THETA_NAMES))
+    if unknown or args.estimate_tm0 or args.spec:
+        raise InputError(
+            "--per-batch fits hgm, hbm, Pbm only (no --spec, no --estimate-tm0, no other parameters)", "command line"
+        )
+    init = InitialState(**{**PAPER_INITIAL, **_initial_changes(args)})
+    packed = pack_batches(
+        batches, plant_spec, THETA_START, init, args.moisture or "schwartzberg", args.hold or "linear"
+    )
+    result = identify_each(packed, bounds=bounds, fix=fix, seed=args.seed, progress=_progress("fit per batch"))
+    doc = {**result.to_json_dict(), "plant": str(plant_spec), "fixed": sorted(fix)}
+    with outputs as out:
+        out.write_text(args.out, json.dumps(doc, indent=1, allow_nan=False) + "\n")
+    print(
+        f"identified theta per batch for {packed.n_batches} batch(es) on plant {plant_spec} in {result.wall_s:.2f} s ({result.simulations} simulations)"
+    )
+    if packed.n_batches <= 20:
+        print(f"{'batch':<20}{'hgm':>9}{'hbm':>9}{'Pbm':>9}{'SSR':>12}{'FIT %':>9}")
+        for name, th, ssr, fit in zip(result.names, result.theta, result.SSR, result.FIT):
+            print(f"{name[:20]:<20}{th[0]:>9.4f}{th[1]:>9.4f}{th[2]:>9.4f}{ssr:>12.3f}{fit:>9.2f}")
+    summ = result.summary()
+    for name in THETA_NAMES:
+        v = summ[name]
+        print(f"{name}: mean {v['mean']:.4f}, std {v['std']:.4f}, range [{v['min']:.4f}, {v['max']:.4f}]")
+    print(f"FIT: mean {summ['FIT']['mean']:.2f} %, worst {summ['FIT']['min']:.2f} % -> {args.out}")
+    return 0
+
+
+def cmd_validate(args) -> int:
+    from ..io.files import Outputs
+    from ..report.figures import check_figure_path, plot_fit
+
+    outputs = Outputs(_fit_inputs(args))
+    for target in (args.json, args.plot):
+        if target:
+            outputs.check(target)
+    if args.plot:
+        check_figure_path(args.plot)
+    if args.predictions and not Path(args.predictions).is_dir():
+        raise InputError("not an existing folder (create it first)", args.predictions)
+    if args.baseline:
+        return _validate_baseline(args, outputs)
+    model = _model_from_args(args, args.plant)
+    batches, plant_spec = _load_batches(args, model)
+    changes = _initial_changes(args)
+    if args.tgi_offset is not None:
+        changes["Tgi_offset_C"] = args.tgi_offset
+    result = model.validate(batches, plant=plant_spec, **changes)
+    _say(result.notes)
+    th = model.theta
+    print(
+        result.table(
+            f"validation on plant {result.plant}, theta = hgm {th.hgm:.4f}, hbm {th.hbm:.4f}, Pbm {th.Pbm:.4f}"
+        )
+    )
+    with outputs as out:
+        if args.json:
+            out.write_text(args.json, json.dumps(_finite_json(result.to_json_dict()), indent=1, allow_nan=False) + "\n")
+        if args.plot:
+            plot_fit(result, args.plot, title=f"measured vs predicted BT, plant {result.plant}", outputs=out)
+        if args.predictions:
+            written = set()
+            for name, frame in result.frames().items():
+                stem = _safe_stem(name, written)
+                out.write_text(
+                    Path(args.predictions) / f"{stem}.csv",
+                    frame.to_csv(index=False, float_format="%.6f", lineterminator="\n"),
+                )
+    if args.predictions:
+        print(f"wrote {len(result.names)} prediction CSV(s) to {args.predictions}")
+    return 0
+
+
+def _safe_stem(name: str, taken: set) -> str:
+    """A file stem from a batch name: no path separators or control characters, unique."""
+    stem = "".join(c if (c.isalnum() or c in "-_.") else "_" for c in name)[:80].strip(".") or "batch"
+    base, k = stem, 2
+    while stem in taken:
+        stem, k = f"{base}-{k}", k + 1
+    taken.add(stem)
+    return stem
+
+
+def _finite_json(value):
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {k: _finite_json(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_finite_json(v) for v in value]
+    return value
+
+
+def _validate_baseline(args, outputs) -> int:
+    from ..evaluate.metrics import average_metrics
+    from ..evaluate.validate import ValidationResult
+    from ..fit.baseline import validate_first_order
+    from ..report.figures import plot_fit
+
+    if not args.model:
+        raise InputError(
+            "--baseline first-order needs --model BASELINE.json from 'identify --baseline first-order'", "command line"
+        )
+    params = _read_baseline_json(args.model)
+    batches, plant_spec = _load_batches(args)
+    preds, rows = validate_first_order(batches, params)
+    result = ValidationResult(
+        [b.name for b in batches],
+        [b.time_s for b in batches],
+        [b.Ta_C for b in batches],
+        preds,
+        [],
+        rows,
+        str(plant_spec),
+    )
+    print(result.table(f"first-order baseline (tau {params['tau_s']:.1f} s, offset {params['offset_C']:+.2f} degC)"))
+    with outputs as out:
+        if args.json:
+            doc = {
+                "baseline": "first-order",
+                "tau_s": params["tau_s"],
+                "offset_C": params["offset_C"],
+                "batches": [{"name": n, **r} for n, r in zip(result.names, rows)],
+                "average": average_metrics(rows),
+            }
+            out.write_text(args.json, json.dumps(_finite_json(doc), indent=1, allow_nan=False) + "\n")
+        if args.plot:
+            plot_fit(result, args.plot, title="measured vs first-order baseline", outputs=out)
+    return 0
+
+
+def _read_baseline_json(path) -> dict:
+    from ..io.files import read_input_text
+    from ..io.modelfile import parse_json_document
+
+    data = parse_json_document(read_input_text(path, "JSON"), path)
+    if not isinstance(data, dict):
+        raise InputError("expected a JSON object", path)
+    if data.get("baseline") != "first-order":
+        raise InputError("not a first-order baseline file (from 'identify --baseline first-order')", path)
+    for key in ("tau_s", "offset_C"):
+        v = data.get(key)
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+            raise InputError("missing or not a finite number", path, f"key {key}")
+    if not data["tau_s"] > 0:
+        raise InputError("tau_s must be > 0", path, "key tau_s")
+    return data
+
+
+def cmd_import(args) -> int:
+    from ..io.batch import write_batch_csv_text
+    from ..io.files import Outputs
+    from ..io.importers import import_log, load_map
+
+    outputs = Outputs([args.log, args.map])
+    outputs.check(args.out)
+    cmap = load_map(args.map) if args.map else None
+    batch = import_log(args.log, cmap, name=args.name)
+    for note in batch.notes:
+        print(f"warning: {args.log}: {note}", file=sys.stderr)
+    with outputs as out:
+        out.write_text(args.out, write_batch_csv_text(batch, comment=f"imported by roastlab from {args.log}"))
+    mass = f", green batch {batch.Mb_kg * 1000:.0f} g" if batch.Mb_kg else ""
+    print(
+        f"imported {batch.n} samples ({batch.time_s[0]:.0f}..{batch.time_s[-1]:.0f} s){mass}: BT {batch.Ta_C[0]:.1f} -> {batch.Ta_C[-1]:.1f} degC -> {args.out}"
+    )
+    return 0
+
+
+def cmd_reproduce(args) -> int:
+    from ..workflows.reproduce import run, summary_table
+
+    summary = run(args.out, args.data, seed=args.seed, progress=_progress("identify"))
+    print(summary_table(summary))
+    return 0
+
+
+def cmd_datasets(args) -> int:
+    from ..workflows.datasets import make_paper
+
+    written = make_paper(args.seed, args.out)
+    print(f"wrote {len(written)} files of SYNTHETIC data under {args.out} (seed {args.seed})")
+    return 0
+
+
+def cmd_bench(args) -> int:
+    from ..apps.bench import run, table
+    from ..io.files import Outputs
+
+    outputs = Outputs()
+    if args.save:
+        outputs.check(args.save)
+    res = run(quiet=args.json)
+    if args.json:
+        print(json.dumps(res, indent=1))
+    else:
+        print(table(res))
+    if args.save:
+        with outputs as out:
+            out.write_text(args.save, json.dumps(res, indent=1) + "\n")
+    return 0
+
+
+FIT_HELP = "batch CSVs (time_s,Gg_kg_s,Tgi_C,Ta_C) and/or dataset folders with a dataset.toml; raw logs with --map"
+
+
+def _add_batch_options(p, baseline_help: str) -> None:
+    """Options shared by identify and validate: the batches, their plant, a map, the baseline."""
+    p.add_argument("batches", nargs="+", metavar="BATCH", help=FIT_HELP)
+    p.add_argument("--plant", help="plant preset or PLANT.toml (default: the model's plant, else the dataset's)")
+    p.add_argument(
+        "--map",
+        metavar="MAP.toml",
+        help="the BATCH arguments are raw logs (Artisan .alog/.csv, CSV, Parquet) read with this column map",
+    )
+    p.add_argument("--baseline", choices=("first-order",), help=baseline_help)
+
+
+def _add_fit_commands(sub) -> None:
+    from ..workflows.datasets import PAPER_SEED
+
+    p = sub.add_parser(
+        "identify",
+        help="fit a model on batches (eqs. 18-19) and write MODEL.json",
+        description="Minimise the summed SSR of the probe temperature over the given batches within bounds, "
+        "by a seeded global search (scattered starts polished by bounded least squares) or differential evolution. "
+        "Writes the fitted model file (roastlab-model/1): plant, theta and every other fitted or held value with "
+        "standard errors and bounds, the initial states, the column map, fit-set metrics and provenance.",
+        epilog="example: roastlab identify --plant 120kg dataset-I/ --out model.json",
+    )
+    _add_batch_options(p, "fit the first-order baseline dBT/dt = (ET + offset - BT)/tau instead")
+    p.add_argument("--out", required=True, metavar="MODEL.json", help="where to write the model file")
+    p.add_argument(
+        "--method", choices=("global", "de"), default="global", help="global search (default) or differential evolution"
+    )
+    p.add_argument("--seed", type=_seed_arg, default=0, help="random seed of the search (default 0)")
+    p.add_argument("--starts", type=_count_arg("--starts", 1, 100), default=6, help="local polishes (default 6)")
+    p.add_argument(
+        "--fix", action="append", metavar="NAME=V", help="hold a parameter fixed, e.g. --fix hgm=0.01 (repeatable)"
+    )
+    p.add_argument(
+        "--bounds", action="append", metavar="NAME=LO:HI", help="change bounds, e.g. --bounds hbm=0.01:0.5 (repeatable)"
+    )
+    p.add_argument(
+        "--estimate-tm0",
+        action="store_true",
+        help="estimate each batch's initial metal temperature as a nuisance parameter",
+    )
+    p.add_argument(
+        "--per-batch",
+        action="store_true",
+        help="fit a separate theta to every batch (fleet mode; writes a per-batch table, not a model file)",
+    )
+    p.add_argument(
+        "--spec",
+        metavar="FIT.toml",
+        help="fit spec: free parameters (theta, process constants, initial states) with bounds",
+    )
+    _add_model_options(p, with_model=False)
+    p.set_defaults(func=cmd_identify)
+
+    p = sub.add_parser(
+        "validate",
+        help="apply a model file to batches and report the paper's metrics",
+        description="Apply MODEL.json (all of it: theta, fitted flow and constants, initial states; default: the "
+        "paper's theta*) to each batch and report n, SSR, ||e||, MAE, MPE, MAPE, FIT, rho per batch and on average.",
+        epilog="example: roastlab validate --model model.json --plant 360kg dataset-V/ --predictions pred/",
+    )
+    _add_batch_options(
+        p, "validate the first-order baseline (--model BASELINE.json from 'identify --baseline first-order')"
+    )
+    p.add_argument("--json", metavar="METRICS.json", help="write the metrics as JSON")
+    p.add_argument("--plot", metavar="FIG.png", help="plot measured vs predicted BT with residuals (.png/.svg/.pdf)")
+    p.add_argument(
+        "--predictions",
+        metavar="DIR",
+        help="write one CSV per batch: time_s, measured Ta_C, Ta_pred_C, predicted states, inputs as applied",
+    )
+    p.add_argument(
+        "--tgi-offset", type=_float_arg("--tgi-offset"), help="what-if: add this to the inlet gas / ET [degC]"
+    )
+    _add_model_options(p)
+    p.set_defaults(func=cmd_validate)
+
+    p = sub.add_parser(
+        "reproduce",
+        help="the paper end to end: identify on dataset-I, validate on dataset-V",
+        description="Identify on the synthetic dataset-I (120 kg), validate on dataset-V (360 kg) and write "
+        "model.json, metrics.json, report.md, fig2_profiles.png and fig3_errors.png (all or none).",
+    )
+    p.add_argument("--out", default="out/reproduce", metavar="DIR", help="output folder (default out/reproduce)")
+    p.add_argument(
+        "--data", metavar="DIR", help="folder holding dataset-I and dataset-V (default: the shipped synthetic data)"
+    )
+    p.add_argument("--seed", type=_seed_arg, default=0, help="seed of the identification (default 0)")
+    p.set_defaults(func=cmd_reproduce)
+
+    p = sub.add_parser(
+        "bench",
+        help="measure speed against a solve_ivp baseline in one run",
+        description="Measure single-batch and population simulation speed-ups over solve_ivp(LSODA), "
+        "identification time on dataset-I, fleet identification scaling (10/100/1,000 batches) and the cold CLI. "
+        "Takes a few minutes on 2 cores.",
+    )
+    p.add_argument("--json", action="store_true", help="print the figures as JSON (progress goes quiet)")
+    p.add_argument("--save", metavar="FILE.json", help="also save the JSON to a file")
+    p.set_defaults(func=cmd_bench)
+
+    p = sub.add_parser(
+        "import",
+        help="convert a roast log (Artisan .alog/.csv, CSV, Parquet) into a batch CSV",
+        description="Read a log with a column map and write the canonical batch CSV time_s,Gg_kg_s,Tgi_C,Ta_C "
+        "(Artisan logs: time 0 at CHARGE, cut after DROP, °F converted, green weight kept as '# Mb_kg').",
+        epilog="example: roastlab import roast.alog --map examples/skywalker/map.toml --out batch.csv",
+    )
+    p.add_argument("log", metavar="LOG", help="the roast log")
+    p.add_argument("--map", metavar="MAP.toml", help="column map (default: canonical column names)")
+    p.add_argument("--out", required=True, metavar="BATCH.csv", help="where to write the batch CSV")
+    p.add_argument("--name", help="batch name (default: the log's file name)")
+    p.set_defaults(func=cmd_import)
+
+    p = sub.add_parser("datasets", help="generate the synthetic stand-in datasets")
+    dsub = p.add_subparsers(dest="what", metavar="WHAT", parser_class=_Parser)
+    dsub.required = True
+    q = dsub.add_parser(
+        "make-paper",
+        help="write dataset-I and dataset-V (SYNTHETIC) from a seed",
+        description="Generate the synthetic stand-ins of the paper's datasets, byte-identical for a given seed.",
+    )
+    q.add_argument(
+        "--seed", type=_seed_arg, default=PAPER_SEED, help=f"random seed (default {PAPER_SEED}, the shipped data)"
+    )
+    q.add_argument("--out", default="paper-synthetic", metavar="DIR", help="output folder (default paper-synthetic)")
+    q.set_defaults(func=cmd_datasets)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    from .. import __version__
+
+    parser = _Parser(
+        prog="roastlab",
+        description="Simulate, identify and validate the scalable coffee-roasting-chamber model "
+        "(Procedia Computer Science 2021) on plants of any size. A fit is one model file (MODEL.json, "
+        "from 'identify'); simulate and validate take it with --model and apply all of it the same way.",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog="examples:\n"
+        "  roastlab reproduce                       the paper end to end on the shipped SYNTHETIC data\n"
+        "  roastlab simulate --plant 120kg --inputs in.csv --out out.csv --plot out.png\n"
+        "  roastlab identify --plant 120kg dataset-I/ --out model.json\n"
+        "  roastlab validate --model model.json --plant 360kg dataset-V/\n"
+        "  roastlab simulate --model model.json --inputs batch.csv --out pred.csv --tgi-offset 20\n"
+        "  roastlab import roast.alog --map map.toml --out batch.csv\n"
+        "  roastlab bench                           speed against solve_ivp (about a minute)\n\n"
+        "Every command: bad input gives one line naming the file and the problem, exit code 2.",
+    )
+    parser.add_argument("--version", action="version", version=f"roastlab {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    sub.required = True
+
+    p = sub.add_parser(
+        "simulate",
+        help="simulate one batch with a model file (default: the paper's theta*)",
+        description="Simulate one batch with MODEL.json (all of it, as validate applies it). INPUTS is a batch CSV "
+        "(time_s,Gg_kg_s,Tgi_C[,Ta_C]) or a raw log read with --map or with the model's own map. OUT.csv gets "
+        "time_s,Tb_C,Tm_C,X_kg_kg,He_kJ_kg,Ta_C,Tgo_C (OUT.json: the same as JSON).",
+        epilog="example: roastlab simulate --model model.json --inputs batch.csv --out pred.csv --tgi-offset 20",
+    )
+    _add_model_options(p)
+    p.add_argument("--plant", help="plant preset (120kg, 360kg) or PLANT.toml (default: the model's plant)")
+    p.add_argument(
+        "--inputs", required=True, metavar="INPUTS.csv", help="input samples (time_s,Gg_kg_s,Tgi_C[,Ta_C]) or a log"
+    )
+    p.add_argument("--map", metavar="MAP.toml", help="INPUTS is a raw log read with this column map")
+    p.add_argument(
+        "--out", required=True, metavar="OUT.csv", help="where to write the simulated states (.csv or .json)"
+    )
+    p.add_argument(
+        "--tgi-offset", type=_float_arg("--tgi-offset"), help="what-if: add this to the inlet gas / ET [degC]"
+    )
+    p.add_argument("--heat-flows", action="store_true", help="also write Qgb, Qgm, Qbm, Qr [kW]")
+    p.add_argument("--plot", metavar="FIG.png", help="also save a figure of the simulation (.png/.svg/.pdf)")
+    p.set_defaults(func=cmd_simulate)
+
+    p = sub.add_parser(
+        "plant",
+        help="print a plant's geometry and derived quantities",
+        description="Print geometry (Table 5) and derived quantities (eq. 6-7) of a plant.",
+    )
+    p.add_argument("plant", help="plant preset (120kg, 360kg) or PLANT.toml path")
+    p.add_argument("--x0", type=_float_arg("--x0"), default=0.1, help="moisture used for Mbd and F (default 0.1)")
+    p.set_defaults(func=cmd_plant)
+
+    _add_fit_commands(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    from ..io.files import begin_run
+
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    begin_run()
+    try:
+        return int(args.func(args) or 0)
+    except RoastlabError as exc:
+        print(f"roastlab {args.command}: error: {_one_line(str(exc))}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("roastlab: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        return 0
+
+
+def _one_line(text: str, limit: int = 300) -> str:
+    """An error message as one printable line of at most ``limit`` characters."""
+    flat = "".join(c if c.isprintable() else "?" for c in text.replace("\n", " "))
+    return flat if len(flat) <= limit else flat[: limit - 1] + "…"
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

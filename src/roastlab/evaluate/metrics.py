@@ -1,0 +1,74 @@
+"""Performance indexes of a fit (paper Table 2, eq. 18; MODEL.md).
+
+With measured Y, predicted Yhat and e = Y - Yhat over n samples:
+
+* SSR = sum(e^2) (eq. 18) and norm = ||e||_2 = sqrt(SSR). The paper's Tables 3-4 column
+  headed SSR matches ``norm``, not sum(e^2); both are reported, clearly named.
+* MAE = mean|e|; MPE = 100/n sum(e/Y) (signed, as printed in Table 2);
+  MAPE = 100/n sum|e/Y| (the paper's tabulated "MPE" values match MAPE).
+* FIT = 100 (1 - ||e|| / ||Y - mean(Y)||); rho = Pearson correlation of Y and Yhat.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+METRIC_NAMES = ("n", "SSR", "norm", "MAE", "MPE", "MAPE", "FIT", "rho")
+METRIC_UNITS = {"n": "", "SSR": "°C²", "norm": "°C", "MAE": "°C", "MPE": "%", "MAPE": "%", "FIT": "%", "rho": ""}
+
+
+def fit_percent(measured, predicted) -> float:
+    """FIT = 100 (1 - ||Y - Yhat|| / ||Y - mean(Y)||) [%] (Table 2); NaN for a flat Y.
+
+    >>> round(fit_percent([100.0, 200.0, 300.0], [110.0, 190.0, 300.0]), 3)
+    90.0
+    """
+    y = np.asarray(measured, dtype=float)
+    e = y - np.asarray(predicted, dtype=float)
+    spread = float(np.linalg.norm(y - y.mean()))
+    return float(100.0 * (1.0 - np.linalg.norm(e) / spread)) if spread > 0 else float("nan")
+
+
+def batch_metrics(measured, predicted) -> dict[str, float]:
+    """All indexes of one batch as a dict keyed by :data:`METRIC_NAMES`.
+
+    >>> m = batch_metrics([100.0, 200.0, 300.0], [110.0, 190.0, 300.0])
+    >>> m["SSR"], m["MAE"], round(m["FIT"], 3)
+    (200.0, 6.666666666666667, 90.0)
+    """
+    y = np.asarray(measured, dtype=float)
+    yhat = np.asarray(predicted, dtype=float)
+    e = y - yhat
+    n = len(y)
+    ssr = float(e @ e)
+    sy, sp = y.std(), yhat.std()
+    rho = float(np.corrcoef(y, yhat)[0, 1]) if sy > 0 and sp > 0 else float("nan")
+    return {
+        "n": n,
+        "SSR": ssr,
+        "norm": float(np.sqrt(ssr)),
+        "MAE": float(np.mean(np.abs(e))),
+        "MPE": float(100.0 / n * np.sum(e / y)),
+        "MAPE": float(100.0 / n * np.sum(np.abs(e / y))),
+        "FIT": fit_percent(y, yhat),
+        "rho": rho,
+    }
+
+
+def average_metrics(rows: list[dict]) -> dict[str, float]:
+    """Mean of each index over batches (n is summed), as the paper's 'Average' rows."""
+    out = {}
+    for key in METRIC_NAMES:
+        vals = [r[key] for r in rows]
+        out[key] = int(sum(vals)) if key == "n" else float(np.mean(vals))
+    return out
+
+
+def absolute_error_moments(errors: list[np.ndarray]) -> dict[str, float]:
+    """Mean and (sample) variance of |e| pooled over a dataset's batches (section 6.2)."""
+    a = np.abs(np.concatenate([np.asarray(e, dtype=float) for e in errors]))
+    return {
+        "mean_abs_error": float(a.mean()),
+        "var_abs_error": float(a.var(ddof=1)) if a.size > 1 else 0.0,
+        "samples": int(a.size),
+    }

@@ -1,0 +1,119 @@
+"""Score predictions against measurements (Table 2 metrics, section 6.2).
+
+Predictions come from :meth:`roastlab.workflows.model.FittedModel.validate`, the one path
+that applies a model to batches; this module only compares and tabulates.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .metrics import METRIC_NAMES, absolute_error_moments, average_metrics, batch_metrics
+
+#: Predicted states written beside measured and predicted Ta (Ta itself is Ta_pred_C).
+PREDICTED_STATES = ("Tb_C", "Tm_C", "X_kg_kg", "He_kJ_kg")
+
+
+@dataclass
+class ValidationResult:
+    """Per-batch predictions and metrics of one dataset."""
+
+    names: list[str]
+    time_s: list[np.ndarray]
+    measured: list[np.ndarray]
+    predicted: list[np.ndarray]
+    states: list[np.ndarray]
+    rows: list[dict]
+    plant: str
+    notes: list[str] = field(default_factory=list)
+    results: list = field(default_factory=list)  # the SimulationResult of each batch, when known
+
+    def __repr__(self) -> str:
+        a = self.average
+        return f"<ValidationResult {len(self.names)} batch(es) on {self.plant}: FIT {a['FIT']:.2f} %, MAE {a['MAE']:.3f} °C>"
+
+    def to_frame(self):
+        """Metrics per batch as a pandas DataFrame (one row a batch)."""
+        import pandas as pd
+
+        return pd.DataFrame(self.rows, index=pd.Index(self.names, name="batch"))
+
+    def frames(self) -> dict:
+        """Per batch, a DataFrame of time, measured and predicted Ta, states and inputs as applied."""
+        import pandas as pd
+
+        out = {}
+        for r in self.results:
+            cols = {"time_s": r.time_s, "Ta_C": r.Ta_measured_C, "Ta_pred_C": r.Ta_C}
+            cols.update({k: r.states[:, j] for j, k in enumerate(PREDICTED_STATES)})
+            cols.update({"Tgo_C": r.Tgo_C, "Gg_kg_s": r.Gg_kg_s, "Tgi_C": r.Tgi_C})
+            out[r.name] = pd.DataFrame(cols)
+        return out
+
+    def _repr_html_(self) -> str:
+        return f"<p>{repr(self)[1:-1]}</p>" + self.to_frame().to_html(float_format=lambda v: f"{v:.3f}")
+
+    def plot(self, path=None, title=None):
+        """Measured vs predicted BT per batch with residuals; returns the Figure."""
+        from ..report.figures import plot_fit
+
+        return plot_fit(self, path, title)
+
+    @property
+    def average(self) -> dict:
+        return average_metrics(self.rows)
+
+    @property
+    def errors(self) -> list[np.ndarray]:
+        return [m - p for m, p in zip(self.measured, self.predicted)]
+
+    @property
+    def error_moments(self) -> dict:
+        return absolute_error_moments(self.errors)
+
+    def to_json_dict(self) -> dict:
+        return {
+            "plant": self.plant,
+            "batches": [{"name": name, **row} for name, row in zip(self.names, self.rows)],
+            "average": self.average,
+            "absolute_error": self.error_moments,
+        }
+
+    def table(self, title: str | None = None) -> str:
+        """A readable text table of the metrics (columns sized to their contents)."""
+        w = max([len("average")] + [len(n) for n in self.names]) + 2
+        head = f"{'batch':<{w}}" + "".join(f"{k:>11}" for k in METRIC_NAMES)
+        lines = ([title] if title else []) + [head, "-" * len(head)]
+        for name, row in zip(self.names, self.rows):
+            lines.append(f"{name:<{w}}" + "".join(_fmt(k, row[k]) for k in METRIC_NAMES))
+        lines.append("-" * len(head))
+        lines.append(f"{'average':<{w}}" + "".join(_fmt(k, self.average[k]) for k in METRIC_NAMES))
+        em = self.error_moments
+        lines.append(
+            f"|e| over {em['samples']} samples: mean {em['mean_abs_error']:.3f} °C, variance {em['var_abs_error']:.3f} °C²"
+        )
+        return "\n".join(lines)
+
+
+def _fmt(key, value) -> str:
+    if key == "n":
+        return f"{int(value):>11d}"
+    if key == "SSR":
+        return f"{value:>11.1f}"
+    return f"{value:>11.3f}" if key != "rho" else f"{value:>11.4f}"
+
+
+def score(results, plant_name: str) -> ValidationResult:
+    """Score simulated batches (:class:`~roastlab.sim.simulate.SimulationResult` with a measured Ta)."""
+    rows, meas, pred, times, states = [], [], [], [], []
+    for r in results:
+        rows.append(batch_metrics(r.Ta_measured_C, r.Ta_C))
+        meas.append(np.asarray(r.Ta_measured_C))
+        pred.append(r.Ta_C.copy())
+        times.append(r.time_s)
+        states.append(np.column_stack([r.states, r.Tgo_C]))
+    out = ValidationResult([r.name for r in results], times, meas, pred, states, rows, str(plant_name))
+    out.results = list(results)
+    return out

@@ -1,0 +1,307 @@
+"""Batch files: the canonical input CSV, validation, and dataset folders.
+
+A batch CSV has a header row and columns ``time_s, Gg_kg_s, Tgi_C`` and optionally ``Ta_C``
+(the measured probe reading); other columns are ignored. Time must increase strictly, every
+value must be a finite number, Gg > 0 and temperatures within -50..1000 degC. Each problem is
+reported as an :class:`~roastlab.errors.InputError` naming the file, line and column.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from .files import atomic_write_text, read_input_text, read_toml
+
+REQUIRED_COLUMNS = ("time_s", "Gg_kg_s", "Tgi_C")
+OPTIONAL_COLUMNS = ("Ta_C",)
+TEMPERATURE_RANGE_C = (-50.0, 1000.0)
+
+
+@dataclass
+class Batch:
+    """One roast: sampled inputs and (optionally) the measured probe temperature.
+
+    Attributes
+    ----------
+    name : str
+    time_s : (n,) array, strictly increasing [s]
+    Gg_kg_s : (n,) array, inlet gas mass flow [kg/s]
+    Tgi_C : (n,) array, inlet gas temperature [degC]
+    Ta_C : (n,) array or None, measured bean-probe temperature [degC]
+    source : path it was read from, if any
+    initial : per-batch initial-state overrides (e.g. ``{"Tm0_C": 105.0}``)
+    Mb_kg : green batch mass [kg] if it differs from the plant's (read from a
+        ``# Mb_kg = ...`` comment line of a batch CSV, or from an Artisan log's weight)
+    """
+
+    name: str
+    time_s: np.ndarray
+    Gg_kg_s: np.ndarray
+    Tgi_C: np.ndarray
+    Ta_C: np.ndarray | None = None
+    source: str | None = None
+    initial: dict = field(default_factory=dict)
+    Mb_kg: float | None = None
+    notes: list = field(default_factory=list)  # import warnings worth telling the user
+
+    @property
+    def n(self) -> int:
+        return len(self.time_s)
+
+    def validate(self) -> Batch:
+        """Check the physical sanity of the arrays; raise InputError naming the source."""
+        src = self.source or self.name
+        cols = {"time_s": self.time_s, "Gg_kg_s": self.Gg_kg_s, "Tgi_C": self.Tgi_C}
+        if self.Ta_C is not None:
+            cols["Ta_C"] = self.Ta_C
+        n = len(self.time_s)
+        if n < 2:
+            raise InputError(f"needs at least 2 samples, got {n}", src)
+        for name, arr in cols.items():
+            if len(arr) != n:
+                raise InputError(f"column {name} has {len(arr)} values, time has {n}", src)
+            bad = np.flatnonzero(~np.isfinite(arr))
+            if bad.size:
+                raise InputError(
+                    f"non-finite value {arr[bad[0]]} (NaN or inf)", src, f"row {bad[0] + 1}, column {name}"
+                )
+        dt = np.diff(self.time_s)
+        bad = np.flatnonzero(dt <= 0)
+        if bad.size:
+            i = bad[0] + 1
+            kind = "duplicated" if dt[bad[0]] == 0 else "decreasing"
+            raise InputError(
+                f"time not strictly increasing ({kind}: {self.time_s[i - 1]:g} then {self.time_s[i]:g} s)",
+                src,
+                f"row {i + 1}, column time_s",
+            )
+        bad = np.flatnonzero(self.Gg_kg_s <= 0)
+        if bad.size:
+            raise InputError(
+                f"gas flow must be > 0 kg/s, got {self.Gg_kg_s[bad[0]]:g}", src, f"row {bad[0] + 1}, column Gg_kg_s"
+            )
+        lo, hi = TEMPERATURE_RANGE_C
+        for name in ("Tgi_C", "Ta_C"):
+            if name in cols:
+                arr = cols[name]
+                bad = np.flatnonzero((arr < lo) | (arr > hi))
+                if bad.size:
+                    raise InputError(
+                        f"temperature {arr[bad[0]]:g} degC outside {lo:g}..{hi:g} degC (wrong units?)",
+                        src,
+                        f"row {bad[0] + 1}, column {name}",
+                    )
+        return self
+
+
+def read_text(path: Path) -> str:
+    """A batch CSV's text, read through the input guard."""
+    return read_input_text(path, "CSV text")
+
+
+def parse_number(cell: str, path, line: int, column: str) -> float:
+    text = cell.strip()
+    if text == "":
+        raise InputError("empty cell", path, f"line {line}, column {column}")
+    try:
+        value = float(text)
+    except ValueError:
+        raise InputError(f"not a number: {text[:40]!r}", path, f"line {line}, column {column}") from None
+    if not math.isfinite(value):
+        raise InputError(f"non-finite value {text!r} (NaN or inf)", path, f"line {line}, column {column}")
+    return value
+
+
+def read_table(
+    path: str | Path, required: tuple[str, ...], optional: tuple[str, ...] = (), text: str | None = None
+) -> dict[str, np.ndarray]:
+    """Read named numeric columns from a CSV with a header row, strictly.
+
+    Lines starting with ``#`` are comments. Returns ``{column: array}`` for the required
+    columns and those optional ones present.
+    """
+    path = Path(path)
+    text = read_text(path) if text is None else text  # callers that already read it pass it
+    lines = [(i + 1, ln) for i, ln in enumerate(text.splitlines()) if ln.strip() and not ln.lstrip().startswith("#")]
+    if not lines:
+        raise InputError("empty file (no header row)", path)
+    header_line, header_text = lines[0]
+    try:
+        header = next(csv.reader(io.StringIO(header_text)))
+    except csv.Error as exc:
+        raise InputError(f"unreadable header ({exc})", path, f"line {header_line}") from None
+    header = [h.strip() for h in header]
+    seen = set()
+    for h in header:
+        if h in seen and h in required + optional:
+            raise InputError(f"duplicated column {h!r}", path, f"line {header_line}")
+        seen.add(h)
+    missing = [c for c in required if c not in header]
+    if missing:
+        raise InputError(
+            f"missing column(s) {', '.join(missing)} (header has: {', '.join(header)})", path, f"line {header_line}"
+        )
+    if len(lines) == 1:
+        raise InputError("header only, no data rows", path)
+    wanted = list(dict.fromkeys(c for c in required + optional if c in header))
+    index = {c: header.index(c) for c in wanted}
+    values = {c: [] for c in wanted}
+    for line_no, row_text in lines[1:]:
+        try:
+            row = next(csv.reader(io.StringIO(row_text)))
+        except csv.Error as exc:
+            raise InputError(f"unreadable row ({exc})", path, f"line {line_no}") from None
+        for c in wanted:
+            j = index[c]
+            if j >= len(row):
+                raise InputError(
+                    f"row has {len(row)} cells, column {c} missing (truncated file?)", path, f"line {line_no}"
+                )
+            values[c].append(parse_number(row[j], path, line_no, c))
+    return {c: np.asarray(v, dtype=np.float64) for c, v in values.items()}
+
+
+def read_batch_csv(path: str | Path, name: str | None = None, require_Ta: bool = False) -> Batch:
+    """Read and validate a canonical batch CSV (``time_s, Gg_kg_s, Tgi_C[, Ta_C]``)."""
+    path = Path(path)
+    required = REQUIRED_COLUMNS + (("Ta_C",) if require_Ta else ())
+    text = read_text(path)  # once: the table and the '# Mb_kg' metadata come from the same text
+    cols = read_table(path, required, OPTIONAL_COLUMNS, text=text)
+    meta = read_comment_metadata(path, text=text)
+    batch = Batch(
+        name=name or path.stem,
+        time_s=cols["time_s"],
+        Gg_kg_s=cols["Gg_kg_s"],
+        Tgi_C=cols["Tgi_C"],
+        Ta_C=cols.get("Ta_C"),
+        source=str(path),
+        Mb_kg=meta.get("Mb_kg"),
+    )
+    return batch.validate()
+
+
+#: Metadata a batch CSV may carry in ``# key = value`` comment lines, with allowed ranges.
+COMMENT_METADATA = {"Mb_kg": (1e-4, 1e4)}
+
+
+def read_comment_metadata(path: str | Path, text: str | None = None) -> dict[str, float]:
+    """Parse ``# Mb_kg = 0.2``-style metadata lines at the top of a batch CSV."""
+    path = Path(path)
+    out = {}
+    text = read_text(path) if text is None else text
+    for line_no, line in enumerate(text.splitlines(), start=1):
+        if not line.startswith("#"):
+            if line.strip():
+                break
+            continue
+        key, sep, value = line[1:].partition("=")
+        key = key.strip()
+        if sep and key in COMMENT_METADATA:
+            v = parse_number(value, path, line_no, key)
+            lo, hi = COMMENT_METADATA[key]
+            if not lo <= v <= hi:
+                raise InputError(f"{key} = {v:g} outside {lo:g}..{hi:g}", path, f"line {line_no}")
+            out[key] = v
+    return out
+
+
+def write_batch_csv_text(batch: Batch, comment: str | None = None, decimals: int = 4) -> str:
+    """A canonical batch CSV as text (optional ``#`` comment lines first).
+
+    Comment lines start with ``##``, which the metadata reader never obeys, and are made
+    printable: text from a log's file name or fields (a newline, a ``Mb_kg = ...``) cannot
+    become a line a reader acts on.
+    """
+    out = io.StringIO()
+    for line in (comment or "").splitlines():
+        out.write("## " + "".join(c if c.isprintable() else "?" for c in line) + "\n")
+    if batch.Mb_kg:
+        out.write(f"# Mb_kg = {batch.Mb_kg:.6g}\n")
+    cols = ["time_s", "Gg_kg_s", "Tgi_C"] + (["Ta_C"] if batch.Ta_C is not None else [])
+    out.write(",".join(cols) + "\n")
+    arrays = [batch.time_s, batch.Gg_kg_s, batch.Tgi_C] + ([batch.Ta_C] if batch.Ta_C is not None else [])
+    for row in zip(*arrays):
+        out.write(",".join(f"{v:.{decimals}f}" for v in row) + "\n")
+    return out.getvalue()
+
+
+def write_batch_csv(path: str | Path, batch: Batch, comment: str | None = None, decimals: int = 4) -> None:
+    """Write a canonical batch CSV atomically (see :func:`write_batch_csv_text`)."""
+    atomic_write_text(path, write_batch_csv_text(batch, comment, decimals))
+
+
+@dataclass
+class Dataset:
+    """A folder of batch CSVs with a ``dataset.toml`` naming the plant and the batches."""
+
+    name: str
+    plant: str
+    batches: list[Batch]
+    folder: str
+    synthetic: bool = False
+    description: str = ""
+
+
+def read_dataset(folder: str | Path) -> Dataset:
+    """Read a dataset folder: ``dataset.toml`` with ``plant``, ``[[batch]]`` ``file``/``name``."""
+    folder = Path(folder)
+    meta_path = folder / "dataset.toml"
+    if not meta_path.is_file():
+        raise InputError("not a dataset folder (no dataset.toml)", folder)
+    meta = read_toml(meta_path)
+    plant = meta.get("plant")
+    if not isinstance(plant, str):
+        raise InputError("missing or non-string key 'plant'", meta_path)
+    entries = meta.get("batch")
+    if not isinstance(entries, list) or not entries:
+        raise InputError("no [[batch]] entries", meta_path)
+    batches = []
+    for k, entry in enumerate(entries):
+        if not isinstance(entry, dict) or not isinstance(entry.get("file"), str):
+            raise InputError(f"[[batch]] entry {k + 1} needs a string 'file'", meta_path)
+        rel = entry["file"]
+        if os.path.isabs(rel) or ".." in Path(rel).parts:
+            raise InputError(f"[[batch]] entry {k + 1}: file must be inside the dataset folder", meta_path)
+        b = read_batch_csv(folder / rel, name=str(entry.get("name", Path(rel).stem)))
+        batches.append(b)
+    plant_ref = plant
+    if plant.endswith(".toml"):
+        plant_ref = str(folder / plant)
+    return Dataset(
+        name=str(meta.get("name", folder.name)),
+        plant=plant_ref,
+        batches=batches,
+        folder=str(folder),
+        synthetic=bool(meta.get("synthetic", False)),
+        description=str(meta.get("description", "")),
+    )
+
+
+def expand_batch_args(paths: list[str | Path], require_Ta: bool = True) -> tuple[list[Batch], str | None]:
+    """Turn CLI arguments (batch CSVs and/or dataset folders) into batches.
+
+    Returns the batches and the plant named by a dataset folder (or None).
+    """
+    batches: list[Batch] = []
+    plant = None
+    for p in paths:
+        p = Path(p)
+        if p.is_dir():
+            ds = read_dataset(p)
+            plant = plant or ds.plant
+            batches.extend(ds.batches)
+        else:
+            batches.append(read_batch_csv(p, require_Ta=require_Ta))
+    if require_Ta:
+        for b in batches:
+            if b.Ta_C is None:
+                raise InputError("no measured Ta_C column: needed to identify or validate", b.source or b.name)
+    return batches, plant

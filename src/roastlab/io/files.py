@@ -1,0 +1,238 @@
+"""The two guards every file passes through: bounded input reads and transactional outputs.
+
+Inputs: :func:`read_input_bytes` opens without blocking, checks with ``fstat`` on the open
+descriptor (not a racy ``stat`` of the name) that it is a regular file, and reads at most
+:data:`MAX_INPUT_BYTES` + 1 bytes whatever the file claims, so a pipe, a device such as
+``/dev/zero`` or a growing file can neither hang a run nor fill memory. Every file read is
+remembered for the run (:func:`inputs_read`) so no output can overwrite it.
+
+Outputs: :class:`Outputs` plans every output of a command before anything is written,
+refuses one that is an input of the run, an existing non-regular file (a FIFO, a device) or
+a folder, writes each to a temporary file in its own folder, and renames them all into
+place only when every one was produced. A failure at any point leaves nothing behind.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import stat
+import tempfile
+from pathlib import Path
+
+from ..errors import InputError
+
+#: Largest input file roastlab reads [bytes]; a larger one is refused without reading it all.
+MAX_INPUT_BYTES = 200 * 1024 * 1024
+
+_READ: dict[tuple[int, int], str] = {}  # (device, inode) -> path of every input read in this run
+_RUN = {"active": False}
+_DIGESTS: dict[str, str] = {}  # path as given -> SHA-256 of the bytes read (model-file provenance)
+
+
+def input_digest(path: str | Path) -> str | None:
+    """SHA-256 (hex) of the bytes last read from ``path`` by :func:`read_input_bytes`, if any."""
+    return _DIGESTS.get(str(path))
+
+
+def inputs_read() -> list[str]:
+    """Paths of every input file read since :func:`begin_run` (empty outside a run)."""
+    return list(_READ.values()) if _RUN["active"] else []
+
+
+def begin_run() -> None:
+    """Start a command: from now on no output may replace any file it reads (the CLI calls it)."""
+    _READ.clear()
+    _RUN["active"] = True
+
+
+def read_input_bytes(path: str | Path, limit: int = MAX_INPUT_BYTES) -> bytes:
+    """Read a user's input file in bounded memory and time.
+
+    Refuses missing files, folders, anything that is not a regular file (pipes, devices,
+    sockets) and files over ``limit`` bytes (counted while reading, not taken from stat).
+    """
+    path = Path(path)
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0))
+    except FileNotFoundError:
+        raise InputError("file not found", path) from None
+    except IsADirectoryError:
+        raise InputError("is a directory, expected a file", path) from None
+    except OSError as exc:
+        raise InputError(f"cannot read ({exc.strerror})", path) from None
+    try:
+        st = os.fstat(fd)
+        if stat.S_ISDIR(st.st_mode):
+            raise InputError("is a directory, expected a file", path)
+        if not stat.S_ISREG(st.st_mode):
+            raise InputError("not a regular file (a pipe, device or socket); give a file", path)
+        if st.st_size > limit:  # a regular file's size is a lower bound: refuse early, without reading
+            raise InputError(f"file is {st.st_size / 1e6:.0f} MB, over the {limit // (1024 * 1024)} MB limit", path)
+        chunks, total = [], 0
+        while True:
+            chunk = os.read(fd, min(1 << 20, limit + 1 - total))
+            if not chunk:
+                break
+            chunks.append(chunk)
+            total += len(chunk)
+            if total > limit:
+                raise InputError(f"file grew over the {limit // (1024 * 1024)} MB limit while being read", path)
+        _READ[(st.st_dev, st.st_ino)] = str(path)
+        data = b"".join(chunks)
+        _DIGESTS[str(path)] = hashlib.sha256(data).hexdigest()
+        return data
+    except OSError as exc:
+        raise InputError(f"cannot read ({exc.strerror})", path) from None
+    finally:
+        os.close(fd)
+
+
+def decode_text(raw: bytes, path: str | Path, what: str = "text") -> str:
+    """Bytes of an input file as text: UTF-8 (with or without BOM), else Latin-1 (old loggers).
+
+    A NUL byte in the first 4 KiB means a binary file given where text is expected.
+    """
+    if b"\x00" in raw[:4096]:
+        raise InputError(f"binary file, expected {what}", path)
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        return raw.decode("latin-1")
+
+
+def read_input_text(path: str | Path, what: str = "text") -> str:
+    """An input file as text (see :func:`read_input_bytes` and :func:`decode_text`)."""
+    return decode_text(read_input_bytes(path), path, what)
+
+
+def read_toml(path: str | Path) -> dict:
+    """Parse a user's TOML file; every failure is one InputError naming the file."""
+    import tomllib
+
+    try:
+        return tomllib.loads(read_input_text(path, "TOML text"))
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"not valid TOML ({str(exc)[:120]})", path) from None
+    except (RecursionError, MemoryError, OverflowError, ValueError):
+        raise InputError("TOML nested too deeply or with numbers out of range", path) from None
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    try:
+        if os.path.samefile(a, b):
+            return True
+    except OSError:
+        pass
+    return a.resolve() == b.resolve()
+
+
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+class Outputs:
+    """The outputs of one command, written all together or not at all.
+
+    >>> import tempfile, pathlib
+    >>> d = pathlib.Path(tempfile.mkdtemp())
+    >>> with Outputs() as out:
+    ...     _ = out.write_text(d / "a.csv", "x\\n")
+    ...     _ = out.write_text(d / "b.json", "{}\\n")
+    >>> sorted(p.name for p in d.iterdir())
+    ['a.csv', 'b.json']
+    """
+
+    def __init__(self, inputs: list[str | Path] | None = None):
+        self.inputs = [Path(p) for p in (inputs or []) if p]
+        self._pending: list[tuple[Path, str]] = []  # (final path, temporary path)
+
+    def check(self, path: str | Path) -> Path:
+        """Refuse an output that is an input, a folder or a special file, or sits in a missing folder."""
+        out = Path(path)
+        if str(out) == "" or out.name in ("", ".", ".."):
+            raise InputError("not a file name", out)
+        for src in self.inputs + [Path(p) for p in inputs_read()]:
+            if src.exists() and _same_file(src, out):
+                raise InputError(f"is an input of this run ({src}); refusing to overwrite an input", out)
+        if out.is_dir():
+            raise InputError("is a directory; give a file name", out)
+        if out.exists() or out.is_symlink():
+            try:
+                mode = os.stat(out).st_mode
+            except OSError:
+                mode = stat.S_IFREG  # a dangling symlink: replaced by the rename
+            if not stat.S_ISREG(mode):
+                raise InputError("exists and is not a regular file (a pipe or device); refusing to replace it", out)
+        folder = out.parent if str(out.parent) else Path(".")
+        if not folder.is_dir():
+            raise InputError("output folder does not exist", out)
+        if not os.access(folder, os.W_OK):
+            raise InputError("output folder is not writable", out)
+        return out
+
+    def write_bytes(self, path: str | Path, data: bytes) -> Path:
+        """Write ``data`` to a temporary file beside ``path``; it becomes ``path`` on commit."""
+        out = self.check(path)
+        folder = out.parent if str(out.parent) else Path(".")
+        try:
+            fd, tmp = tempfile.mkstemp(prefix=f".{out.name[:60]}.", suffix=".tmp", dir=folder)
+        except OSError as exc:
+            raise InputError(f"cannot write output ({exc.strerror})", out) from None
+        self._pending.append((out, tmp))
+        try:
+            with os.fdopen(fd, "wb") as fh:
+                fh.write(data)
+                fh.flush()
+                os.fsync(fh.fileno())
+            os.chmod(tmp, 0o666 & ~_umask())
+        except OSError as exc:
+            raise InputError(f"cannot write output ({exc.strerror})", out) from None
+        return out
+
+    def write_text(self, path: str | Path, text: str) -> Path:
+        return self.write_bytes(path, text.encode("utf-8"))
+
+    def commit(self) -> None:
+        """Re-check every output against the inputs read meanwhile, then rename all into place."""
+        try:
+            for out, _ in self._pending:
+                self.check(out)
+            for out, tmp in self._pending:
+                os.replace(tmp, out)
+        except OSError as exc:
+            raise InputError(f"cannot write output ({exc.strerror})", self._pending[0][0]) from None
+        finally:
+            self.discard()
+
+    def discard(self) -> None:
+        """Remove every temporary file not yet renamed into place."""
+        for _, tmp in self._pending:
+            Path(tmp).unlink(missing_ok=True)
+        self._pending = []
+
+    def __enter__(self) -> Outputs:
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        if exc_type is None:
+            self.commit()
+        else:
+            self.discard()
+
+
+def atomic_write_bytes(path: str | Path, data: bytes) -> None:
+    """Write one output through the output guard (temporary file, then rename)."""
+    with Outputs() as out:
+        out.write_bytes(path, data)
+
+
+def atomic_write_text(path: str | Path, text: str) -> None:
+    atomic_write_bytes(path, text.encode("utf-8"))
+
+
+def check_output_path(out: str | Path, inputs: list[str | Path]) -> Path:
+    """Refuse an output path that is one of ``inputs`` (or any input read), a folder or a special file."""
+    return Outputs(inputs).check(out)

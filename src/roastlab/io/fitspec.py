@@ -1,0 +1,103 @@
+"""Fit specifications: which quantities an identification may move, within which bounds.
+
+A fit spec is a TOML file::
+
+    [free]                      # name = [lower, upper, start]  or a table with per_batch
+    hgm = [0.001, 2.0, 0.05]
+    hbm = [0.001, 2.0, 0.05]
+    Pbm = [0.05, 0.95, 0.5]
+    Gg_kg_s = [0.001, 0.2, 0.02]               # needs a map with [Gg] identify = true
+    Tm0_C = { lower = 60, upper = 260, start = 160, per_batch = true }
+
+    [fixed]                     # held values (theta components not free default to theta*)
+    Kt = 0.02
+
+    [initial]                   # initial-state defaults for every batch
+    Tb0_C = 22.0
+    X0 = 0.11
+
+Names: the theta coefficients ``hgm, hbm, Pbm``, process constants ``A, cm, cw, Ha_R, Het,
+k1, k2, Kt, lam``, the metal mass ``Mm``, the gas flow ``Gg_kg_s``, and initial states
+``Tb0_C, Tm0_C, X0, He0_kJ_kg, Ta0_C``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..errors import InputError, ParameterError
+from ..model.parameters import FREE_NAMES, STATE0, THETA_NAMES, THETA_PAPER, FreeParameter
+from .files import read_toml
+
+ALLOWED = FREE_NAMES
+INITIAL_NAMES = tuple(STATE0)
+
+
+@dataclass
+class FitSpec:
+    free: list[FreeParameter]
+    fixed: dict[str, float]
+    initial: dict[str, float] = field(default_factory=dict)
+    source: str = ""
+
+
+def _num(v, src, where) -> float:
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or v != v:
+        raise InputError(f"must be a number, got {v!r}", src, where)
+    return float(v)
+
+
+def load_fit_spec(path: str | Path) -> FitSpec:
+    path = Path(path)
+    data = read_toml(path)
+    unknown = sorted(set(data) - {"free", "fixed", "initial", "description", "notes"})
+    if unknown:
+        raise InputError(f"unknown table(s) {', '.join(unknown)} (allowed: free, fixed, initial)", path)
+    free = []
+    for name, spec in (data.get("free") or {}).items():
+        where = f"free.{name}"
+        if name not in ALLOWED:
+            raise InputError(f"unknown parameter (allowed: {', '.join(ALLOWED)})", path, where)
+        per_batch = False
+        if isinstance(spec, list):
+            if len(spec) != 3:
+                raise InputError("expected [lower, upper, start]", path, where)
+            lo, hi, start = (_num(v, path, where) for v in spec)
+        elif isinstance(spec, dict):
+            missing = [k for k in ("lower", "upper") if k not in spec]
+            if missing:
+                raise InputError(f"missing {', '.join(missing)}", path, where)
+            lo, hi = _num(spec["lower"], path, where), _num(spec["upper"], path, where)
+            start = _num(spec.get("start", 0.5 * (lo + hi)), path, where)
+            per_batch = spec.get("per_batch", False)
+            if not isinstance(per_batch, bool):
+                raise InputError("per_batch must be true or false", path, where)
+        else:
+            raise InputError("expected [lower, upper, start] or a table", path, where)
+        if name == "Pbm" and not (0 < lo and hi < 1):
+            raise InputError(f"Pbm bounds must lie inside (0, 1), got {lo:g}:{hi:g}", path, where)
+        try:
+            free.append(FreeParameter(name, lo, hi, start, per_batch))
+        except ParameterError as exc:
+            raise InputError(str(exc), path, where) from None
+    if not free:
+        raise InputError("no [free] parameters: nothing to identify", path)
+    fixed = {}
+    for name, v in (data.get("fixed") or {}).items():
+        if name not in ALLOWED:
+            raise InputError(f"unknown parameter (allowed: {', '.join(ALLOWED)})", path, f"fixed.{name}")
+        fixed[name] = _num(v, path, f"fixed.{name}")
+    names_free = {f.name for f in free}
+    both = names_free & set(fixed)
+    if both:
+        raise InputError(f"{', '.join(sorted(both))} both free and fixed", path)
+    for name in THETA_NAMES:  # theta components not free are held at the paper's theta*
+        if name not in names_free and name not in fixed:
+            fixed[name] = THETA_PAPER.as_dict()[name]
+    initial = {}
+    for name, v in (data.get("initial") or {}).items():
+        if name not in INITIAL_NAMES:
+            raise InputError(f"unknown initial state (allowed: {', '.join(INITIAL_NAMES)})", path, f"initial.{name}")
+        initial[name] = _num(v, path, f"initial.{name}")
+    return FitSpec(free, fixed, initial, str(path))

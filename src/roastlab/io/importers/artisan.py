@@ -1,0 +1,310 @@
+"""Artisan roast logs: ``.alog`` (Python-literal or JSON dict) and the Artisan CSV export.
+
+Fields used: ``timex`` [s], ``temp1`` = ET, ``temp2`` = BT, ``mode`` ('C' or 'F'), ``-1`` =
+missing sample, ``timeindex`` = sample indices of [CHARGE, DRY, FCs, FCe, SCs, SCe, DROP, COOL]
+(0 = not set, except CHARGE whose 0 is a real index only when set explicitly; -1 = unset in
+newer files), ``weight`` = [green, roasted, unit], extra devices (``extratimex``,
+``extratemp1/2``, ``extraname1/2``, ``extraNoneTempHint1/2`` marking non-temperature channels),
+and special events (``specialevents`` sample indices, ``specialeventstype`` indices into
+``etypes``, ``specialeventsvalue`` in Artisan's internal encoding).
+
+The file is parsed as data only: JSON when it is JSON, otherwise ``ast.literal_eval``; a
+file holding code (a call, a name) is refused, never run.
+"""
+
+from __future__ import annotations
+
+import ast
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ...errors import InputError
+from ..files import read_input_text
+
+EVENT_NAMES = ("CHARGE", "DRY", "FCs", "FCe", "SCs", "SCe", "DROP", "COOL")
+WEIGHT_UNITS = {"g": 1e-3, "kg": 1.0, "lb": 0.45359237, "oz": 0.028349523125}
+
+
+def f_to_c(values):
+    return (np.asarray(values, dtype=float) - 32.0) * 5.0 / 9.0
+
+
+def events_internal_to_external(v: float) -> float:
+    """Artisan's event-value encoding: internal v in [-11, 11] -> external in [-100, 100].
+
+    Artisan stores slider/button event values as v = 1 + external/10 (so 0 % is 1.0 and
+    100 % is 11.0); values with |v| <= 1 mean 0.
+    """
+    if v is None or -1.0 <= v <= 1.0:
+        return 0.0
+    if v < -1.0:
+        return -(round(abs(v) * 10) - 10)
+    return float(round(v * 10) - 10)
+
+
+@dataclass
+class ArtisanLog:
+    """A parsed Artisan profile, in degC, time aligned so that CHARGE is t = 0.
+
+    channels : name -> array over ``time_s`` (``BT``, ``ET``, extra device names, and one step
+    signal per special-event type, e.g. ``Burner``, ``Air``, in Artisan's external units).
+    """
+
+    path: str
+    time_s: np.ndarray
+    channels: dict[str, np.ndarray]
+    temperature_channels: set
+    mode: str
+    charge_index: int
+    drop_index: int | None
+    events: dict[str, float] = field(default_factory=dict)  # event name -> time after CHARGE [s]
+    weight_in_kg: float | None = None
+    weight_out_kg: float | None = None
+    title: str = ""
+
+
+def _parse_text(path: Path, text: str) -> dict:
+    stripped = text.strip()
+    if not stripped:
+        raise InputError("empty file", path)
+    if stripped[0] != "{":
+        raise InputError("not an Artisan profile (expected a dict starting with '{')", path)
+    try:
+        data = json.loads(stripped)
+    except (json.JSONDecodeError, RecursionError):
+        try:
+            data = ast.literal_eval(stripped)
+        except (ValueError, TypeError) as exc:
+            raise InputError(
+                f"not a data-only Artisan profile ({str(exc).splitlines()[0][:80]}); code is never run", path
+            ) from None
+        except SyntaxError as exc:
+            raise InputError(
+                f"truncated or malformed Artisan profile (syntax error at line {exc.lineno})", path
+            ) from None
+        except (MemoryError, RecursionError):
+            raise InputError("Artisan profile nested too deeply to parse", path) from None
+    if not isinstance(data, dict):
+        raise InputError(f"expected a dict at the top level, got {type(data).__name__}", path)
+    return data
+
+
+def _as_list(value) -> list:
+    """A field that should be a list, or [] when the file has anything else there."""
+    return value if isinstance(value, list) else []
+
+
+def _numeric_list(data: dict, key: str, path: Path, required: bool = True):
+    if key not in data:
+        if required:
+            raise InputError("missing key", path, f"key {key}")
+        return None
+    value = data[key]
+    if not isinstance(value, (list, tuple)):
+        raise InputError(f"expected a list of numbers, got {type(value).__name__}", path, f"key {key}")
+    out = np.empty(len(value))
+    for i, v in enumerate(value):
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            raise InputError(f"expected numbers, found {type(v).__name__} at position {i}", path, f"key {key}")
+        out[i] = v
+    return out
+
+
+def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: bool = True) -> ArtisanLog:
+    """Parse an Artisan ``.alog`` file into an :class:`ArtisanLog` (see module docstring)."""
+    path = Path(path)
+    data = _parse_text(path, read_input_text(path))
+    timex = _numeric_list(data, "timex", path)
+    et = _numeric_list(data, "temp1", path)
+    bt = _numeric_list(data, "temp2", path)
+    n = len(timex)
+    if n < 2:
+        raise InputError(f"needs at least 2 samples, timex has {n}", path, "key timex")
+    for key, arr in (("temp1", et), ("temp2", bt)):
+        if len(arr) != n:
+            raise InputError(f"has {len(arr)} values but timex has {n} (truncated file?)", path, f"key {key}")
+    mode = data.get("mode", "C")
+    if mode not in ("C", "F"):
+        raise InputError(f"mode must be 'C' or 'F', got {mode!r}", path, "key mode")
+    if not np.all(np.isfinite(timex)) or np.any(np.diff(timex) <= 0):
+        bad = int(np.flatnonzero(~(np.diff(timex) > 0))[0]) + 1 if np.any(~(np.diff(timex) > 0)) else 0
+        raise InputError(f"time not strictly increasing at sample {bad}", path, "key timex")
+
+    channels = {"ET": et.copy(), "BT": bt.copy()}
+    temps = {"ET", "BT"}
+    # extra devices: each has a time base and two channels with names
+    extratimex = _as_list(data.get("extratimex"))
+    if extratimex:
+        for d, tx in enumerate(extratimex):
+            for k in (1, 2):
+                names = _as_list(data.get(f"extraname{k}"))
+                values = _as_list(data.get(f"extratemp{k}"))
+                hints = _as_list(data.get(f"extraNoneTempHint{k}"))
+                if d >= len(names) or d >= len(values):
+                    continue
+                name = names[d]
+                if not isinstance(name, str) or not name or name in channels:
+                    continue
+                arr = _numeric_list({"v": values[d]}, "v", path)
+                txa = _numeric_list({"v": tx}, "v", path)
+                if len(arr) != len(txa) or len(arr) == 0:
+                    continue
+                arr = np.where(arr == -1, np.nan, arr)
+                channels[name] = np.interp(timex, txa, arr, left=np.nan, right=np.nan) if len(txa) != n else arr
+                is_temp = not (d < len(hints) and bool(hints[d]))
+                if is_temp:
+                    temps.add(name)
+    # -1 marks a missing sample
+    for name in list(channels):
+        arr = channels[name]
+        channels[name] = np.where(arr == -1, np.nan, arr)
+    if mode == "F":
+        for name in temps:
+            channels[name] = f_to_c(channels[name])
+
+    # special events -> step signals in external units, one per event type
+    etypes = _as_list(data.get("etypes")) or ["Air", "Drum", "Damper", "Burner", "--"]
+    idx, types, vals = (data.get(k, []) for k in ("specialevents", "specialeventstype", "specialeventsvalue"))
+    if not (isinstance(idx, list) and isinstance(types, list) and isinstance(vals, list)):
+        raise InputError("special events must be lists", path, "key specialevents")
+    if not (len(idx) == len(types) == len(vals)):
+        raise InputError(
+            f"specialevents/type/value lengths differ ({len(idx)}, {len(types)}, {len(vals)})",
+            path,
+            "key specialevents",
+        )
+    for i, ty, v in zip(idx, types, vals):
+        if not all(isinstance(q, (int, float)) and not isinstance(q, bool) for q in (i, ty, v)):
+            raise InputError("special events must be numbers", path, "key specialevents")
+        ty, i = int(ty), int(i)
+        if not 0 <= ty < len(etypes) or not 0 <= i < n:
+            continue
+        name = str(etypes[ty])
+        if name == "--":
+            continue
+        sig = channels.setdefault(name, np.full(n, np.nan))
+        sig[i:] = events_internal_to_external(float(v))
+
+    # CHARGE alignment and DROP cut
+    ti = data.get("timeindex", [0] * 8)
+    if not isinstance(ti, list) or not all(isinstance(q, int) and not isinstance(q, bool) for q in ti):
+        raise InputError("timeindex must be a list of integers", path, "key timeindex")
+    ti = (ti + [0] * 8)[:8]
+    charge = ti[0] if 0 <= ti[0] < n else 0
+    drop = ti[6] if 0 < ti[6] < n else None
+    events = {}
+    for name, k in zip(EVENT_NAMES, ti):
+        if (k > 0 or name == "CHARGE") and k < n:
+            events[name] = float(timex[k] - timex[charge])
+    t0 = timex[charge] if align_charge else 0.0
+    end = n if (keep_after_drop or drop is None) else drop + 1
+    start = charge if align_charge else 0
+    time_s = timex[start:end] - t0
+    for name in channels:
+        channels[name] = channels[name][start:end]
+    weight_in = weight_out = None
+    w = data.get("weight")
+    if isinstance(w, list) and len(w) >= 3 and isinstance(w[2], str):
+        factor = WEIGHT_UNITS.get(w[2].lower())
+        if factor is not None:
+            if isinstance(w[0], (int, float)) and w[0] > 0:
+                weight_in = float(w[0]) * factor
+            if isinstance(w[1], (int, float)) and w[1] > 0:
+                weight_out = float(w[1]) * factor
+    return ArtisanLog(
+        str(path),
+        time_s,
+        channels,
+        temps,
+        mode,
+        charge,
+        drop,
+        events,
+        weight_in,
+        weight_out,
+        str(data.get("title", "")),
+    )
+
+
+def _mmss(text: str) -> float:
+    text = text.strip()
+    if not text:
+        return float("nan")
+    parts = text.split(":")
+    try:
+        if len(parts) == 2:
+            return int(parts[0]) * 60 + float(parts[1])
+        return float(text)
+    except ValueError:
+        raise ValueError(text) from None
+
+
+def read_artisan_csv(path: str | Path, keep_after_drop: bool = False) -> ArtisanLog:
+    """Parse Artisan's CSV export: a first line with ``Unit:C``/``Unit:F`` and the event clock
+    times (CHARGE, DROP, ... on the Time1 axis), a header ``Time1, Time2, ET, BT, Event`` (tab-
+    or comma-separated), rows with mm:ss times (Time2 counts from CHARGE, empty before it)."""
+    path = Path(path)
+    from ..batch import read_text
+
+    text = read_text(path)
+    lines = [ln for ln in text.splitlines() if ln.strip()]
+    if len(lines) < 3:
+        raise InputError("too short for an Artisan CSV export (meta line, header, data)", path)
+    sep = "\t" if "\t" in lines[1] else ","
+    meta = {}
+    for item in lines[0].split(sep):
+        k, _, v = item.partition(":")
+        meta[k.strip()] = v.strip()
+    mode = meta.get("Unit", "C")
+    if mode not in ("C", "F"):
+        raise InputError(f"Unit must be C or F, got {mode!r}", path, "line 1")
+    header = [h.strip() for h in lines[1].split(sep)]
+    for col in ("Time1", "ET", "BT"):
+        if col not in header:
+            raise InputError(f"missing column {col} (header has: {', '.join(header)})", path, "line 2")
+    rows = []
+    for line_no, ln in enumerate(lines[2:], start=3):
+        cells = ln.split(sep)
+        if len(cells) < len(header) - 1:
+            raise InputError(
+                f"row has {len(cells)} cells, header {len(header)} (truncated file?)", path, f"line {line_no}"
+            )
+        rows.append((line_no, cells))
+    idx = {c: header.index(c) for c in header}
+    t1, t2, et, bt = [], [], [], []
+    for line_no, cells in rows:
+        try:
+            t1.append(_mmss(cells[idx["Time1"]]))
+            t2.append(_mmss(cells[idx["Time2"]]) if "Time2" in idx and idx["Time2"] < len(cells) else float("nan"))
+        except ValueError as exc:
+            raise InputError(f"not a mm:ss time: {str(exc)[:20]!r}", path, f"line {line_no}, column Time1") from None
+        for col, dest in (("ET", et), ("BT", bt)):
+            cell = cells[idx[col]].strip() if idx[col] < len(cells) else ""
+            try:
+                v = float(cell) if cell else float("nan")
+            except ValueError:
+                raise InputError(f"not a number: {cell[:20]!r}", path, f"line {line_no}, column {col}") from None
+            dest.append(float("nan") if v == -1 else v)
+    t1, t2 = np.array(t1), np.array(t2)
+    et, bt = np.array(et), np.array(bt)
+    if mode == "F":
+        et, bt = f_to_c(et), f_to_c(bt)
+    charged = np.flatnonzero(np.isfinite(t2))
+    charge = int(charged[0]) if charged.size else 0
+    time_s = t1 - t1[charge]
+    drop = None
+    if meta.get("DROP"):
+        # the meta line's event times are clock times on the Time1 axis, like CHARGE's
+        try:
+            drop = int(np.argmin(np.abs(t1 - _mmss(meta["DROP"]))))
+        except ValueError:
+            raise InputError(f"DROP time {meta['DROP'][:20]!r} is not mm:ss", path, "line 1") from None
+    end = len(time_s) if (keep_after_drop or drop is None) else drop + 1
+    sl = slice(charge, end)
+    events = {"CHARGE": 0.0}
+    if drop is not None:
+        events["DROP"] = float(time_s[drop])
+    return ArtisanLog(str(path), time_s[sl], {"ET": et[sl], "BT": bt[sl]}, {"ET", "BT"}, mode, charge, drop, events)

@@ -1,0 +1,381 @@
+"""Column maps: which channel of a log is time, Ta (BT), Tgi and Gg, and in which units.
+
+A map is a TOML file::
+
+    format = "auto"            # auto | alog | artisan-csv | csv | parquet
+    keep_after_drop = false    # Artisan logs: keep samples after DROP
+    resample_s = 0             # > 0: resample onto a uniform grid of this step [s]
+
+    [time]                     # generic tables only; Artisan time is aligned to CHARGE
+    column = "time"
+    unit = "s"                 # s | min | ms
+
+    [Ta]                       # the measured bean probe
+    column = "BT"
+    unit = "C"                 # C | F | K
+
+    [Tgi]                      # inlet gas temperature: a column, or an Artisan ET / extra channel
+    column = "ET"
+    unit = "C"
+    offset_C = 0.0
+
+    [Gg]                       # exactly one of: column, constant_kg_s, identify, [Gg.pitot]
+    column = "flow"
+    unit = "kg/h"              # kg/s | kg/h | g/s | m3/h (with density_kg_m3)
+    density_kg_m3 = 1.2
+    # constant_kg_s = 0.02
+    # identify = true          # Gg unknown: write 1 kg/s and free Gg_kg_s in the fit spec
+    # [Gg.pitot]               # eq. 16
+    # dp_column = "dp_Pa"; T_column = "T_pitot_C"; section_m2 = 0.03; rho0_kg_m3 = 1.275
+
+Artisan channel names are ``BT``, ``ET``, the extra devices' names and the special-event
+types (``Burner``, ``Air``, ...). Every error names the map or log file and the key.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ...errors import InputError
+from ...model.pitot import gas_flow_pitot_kg_s
+from ..batch import Batch, read_table
+from ..files import read_toml
+from .artisan import read_alog, read_artisan_csv
+
+FORMATS = ("auto", "alog", "artisan-csv", "csv", "parquet")
+TIME_UNITS = {"s": 1.0, "min": 60.0, "ms": 1e-3}
+TEMP_UNITS = ("C", "F", "K")
+FLOW_UNITS = {"kg/s": 1.0, "kg/h": 1.0 / 3600.0, "g/s": 1e-3, "m3/h": None}
+DROP_BT_LIMIT_C = 300.0
+#: Smallest resampling step [s] and most samples a log may have after resampling.
+MIN_RESAMPLE_S = 0.1
+MAX_SAMPLES = 1_000_000
+#: A bean probe cannot move this much between two samples: a larger step is a sensor fault.
+MAX_JUMP_C = 40.0
+
+
+@dataclass
+class ColumnMap:
+    """A parsed column map (see module docstring)."""
+
+    source: str
+    format: str = "auto"
+    keep_after_drop: bool = False
+    resample_s: float = 0.0
+    time: dict = field(default_factory=lambda: {"column": "time_s", "unit": "s"})
+    Ta: dict = field(default_factory=lambda: {"column": "Ta_C", "unit": "C"})
+    Tgi: dict = field(default_factory=lambda: {"column": "Tgi_C", "unit": "C"})
+    Gg: dict = field(default_factory=lambda: {"column": "Gg_kg_s", "unit": "kg/s"})
+
+    def to_mapping(self) -> dict:
+        """The map as the TOML-shaped mapping :func:`map_from_mapping` reads (for model files)."""
+
+        def clean(d: dict) -> dict:
+            return {k: (clean(v) if isinstance(v, dict) else v) for k, v in d.items() if v is not None}
+
+        return clean(
+            {
+                "format": self.format,
+                "keep_after_drop": self.keep_after_drop,
+                "resample_s": self.resample_s,
+                "time": self.time,
+                "Ta": self.Ta,
+                "Tgi": self.Tgi,
+                "Gg": self.Gg,
+            }
+        )
+
+    @property
+    def identifies_flow(self) -> bool:
+        """True if the map writes a 1 kg/s placeholder flow for the fit to scale (``[Gg] identify``)."""
+        return bool(self.Gg.get("identify"))
+
+
+#: Keys each map table may hold; anything else is a typo worth reporting.
+TABLE_KEYS = {
+    "time": {"column", "unit"},
+    "Ta": {"column", "unit", "offset_C"},
+    "Tgi": {"column", "unit", "offset_C"},
+    "Gg": {"column", "unit", "density_kg_m3", "constant_kg_s", "identify", "pitot"},
+    "pitot": {"dp_column", "T_column", "section_m2", "rho0_kg_m3", "T_unit"},
+}
+
+
+def _table(data: dict, key: str, src) -> dict:
+    value = data.get(key, {})
+    if not isinstance(value, dict):
+        raise InputError(f"[{key}] must be a table", src, f"key {key}")
+    unknown = sorted(set(value) - TABLE_KEYS.get(key, set(value)))
+    if unknown:
+        allowed = ", ".join(sorted(TABLE_KEYS[key]))
+        raise InputError(f"unknown key(s) {', '.join(unknown)} (allowed: {allowed})", src, f"[{key}]")
+    return value
+
+
+def _check_str(table: dict, key: str, src, where: str, required: bool = True, choices=None):
+    v = table.get(key)
+    if v is None:
+        if required:
+            raise InputError("missing key", src, f"{where}.{key}")
+        return None
+    if not isinstance(v, str) or not v:
+        raise InputError(f"must be a non-empty string, got {v!r}", src, f"{where}.{key}")
+    if choices is not None and v not in choices:
+        raise InputError(f"must be one of {', '.join(choices)}, got {v!r}", src, f"{where}.{key}")
+    return v
+
+
+def _check_num(table: dict, key: str, src, where: str, positive=False, default=None):
+    v = table.get(key, default)
+    if v is None:
+        return None
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or v != v:
+        raise InputError(f"must be a number, got {v!r}", src, f"{where}.{key}")
+    if positive and not v > 0:
+        raise InputError(f"must be > 0, got {v!r}", src, f"{where}.{key}")
+    return float(v)
+
+
+def load_map(path: str | Path) -> ColumnMap:
+    """Read and check a column-map TOML file."""
+    return map_from_mapping(read_toml(path), path)
+
+
+def map_from_mapping(data: dict, path: str | Path) -> ColumnMap:
+    """Check a parsed map (a TOML file, or the copy a model file keeps) and build a ColumnMap."""
+    if not isinstance(data, dict):
+        raise InputError("a column map must be a table", path)
+    known = {"format", "keep_after_drop", "resample_s", "time", "Ta", "Tgi", "Gg", "name", "description", "notes"}
+    unknown = sorted(set(data) - known)
+    if unknown:
+        raise InputError(f"unknown key(s) {', '.join(unknown)} (allowed: {', '.join(sorted(known))})", path)
+    m = ColumnMap(source=str(path))
+    m.format = _check_str(data, "format", path, "map", required=False, choices=FORMATS) or "auto"
+    kad = data.get("keep_after_drop", False)
+    if not isinstance(kad, bool):
+        raise InputError(f"must be true or false, got {kad!r}", path, "keep_after_drop")
+    m.keep_after_drop = kad
+    m.resample_s = _check_num(data, "resample_s", path, "map", default=0.0) or 0.0
+    if m.resample_s != 0 and not MIN_RESAMPLE_S <= m.resample_s <= 600:
+        raise InputError(f"must be 0 (off) or {MIN_RESAMPLE_S:g}..600 s, got {m.resample_s:g}", path, "resample_s")
+    if "time" in data:
+        t = _table(data, "time", path)
+        m.time = {
+            "column": _check_str(t, "column", path, "time", required=False) or "time_s",
+            "unit": _check_str(t, "unit", path, "time", required=False, choices=tuple(TIME_UNITS)) or "s",
+        }
+    for key in ("Ta", "Tgi"):
+        if key in data:
+            t = _table(data, key, path)
+            m_t = {
+                "column": _check_str(t, "column", path, key),
+                "unit": _check_str(t, "unit", path, key, required=False, choices=TEMP_UNITS) or "C",
+                "offset_C": _check_num(t, "offset_C", path, key, default=0.0),
+            }
+            setattr(m, key, m_t)
+    if "Gg" in data:
+        g = _table(data, "Gg", path)
+        ways = [k for k in ("column", "constant_kg_s", "identify", "pitot") if k in g]
+        if len(ways) != 1:
+            raise InputError(
+                f"[Gg] needs exactly one of column, constant_kg_s, identify, [Gg.pitot]; got {', '.join(ways) or 'none'}",
+                path,
+                "Gg",
+            )
+        way = ways[0]
+        if way == "column":
+            unit = _check_str(g, "unit", path, "Gg", required=False, choices=tuple(FLOW_UNITS)) or "kg/s"
+            dens = _check_num(g, "density_kg_m3", path, "Gg", positive=True)
+            if unit == "m3/h" and dens is None:
+                raise InputError("unit m3/h needs density_kg_m3", path, "Gg.density_kg_m3")
+            m.Gg = {"column": _check_str(g, "column", path, "Gg"), "unit": unit, "density_kg_m3": dens}
+        elif way == "constant_kg_s":
+            m.Gg = {"constant_kg_s": _check_num(g, "constant_kg_s", path, "Gg", positive=True)}
+        elif way == "identify":
+            if g["identify"] is not True:
+                raise InputError("identify must be true (or leave it out)", path, "Gg.identify")
+            m.Gg = {"identify": True}
+        else:
+            p = _table(g, "pitot", path)
+            m.Gg = {
+                "pitot": {
+                    "dp_column": _check_str(p, "dp_column", path, "Gg.pitot"),
+                    "T_column": _check_str(p, "T_column", path, "Gg.pitot"),
+                    "section_m2": _check_num(p, "section_m2", path, "Gg.pitot", positive=True)
+                    or _missing(path, "Gg.pitot.section_m2"),
+                    "rho0_kg_m3": _check_num(p, "rho0_kg_m3", path, "Gg.pitot", positive=True, default=1.275),
+                    "T_unit": _check_str(p, "T_unit", path, "Gg.pitot", required=False, choices=TEMP_UNITS) or "C",
+                }
+            }
+    return m
+
+
+def _missing(path, key):
+    raise InputError("missing key", path, key)
+
+
+def to_celsius(values: np.ndarray, unit: str) -> np.ndarray:
+    if unit == "F":
+        return (values - 32.0) * 5.0 / 9.0
+    if unit == "K":
+        return values - 273.15
+    return values
+
+
+def _detect_format(path: Path, fmt: str) -> str:
+    if fmt != "auto":
+        return fmt
+    suffix = path.suffix.lower()
+    if suffix == ".alog":
+        return "alog"
+    if suffix in (".parquet", ".pq"):
+        return "parquet"
+    if suffix in (".csv", ".txt", ".tsv"):
+        try:
+            with open(path, encoding="utf-8", errors="replace") as fh:
+                first = fh.readline()
+        except OSError:
+            first = ""
+        return "artisan-csv" if "Unit:" in first else "csv"
+    raise InputError(f"cannot tell the log format from suffix {suffix!r}; set format in the map", path)
+
+
+def _read_parquet(path: Path, columns: list[str]) -> dict[str, np.ndarray]:
+    try:
+        import pandas as pd
+
+        frame = pd.read_parquet(path)
+    except ImportError:
+        raise InputError("reading Parquet needs pyarrow (pip install 'roastlab[parquet]')", path) from None
+    except Exception as exc:  # pyarrow raises many types for a bad file
+        raise InputError(f"not a readable Parquet file ({type(exc).__name__})", path) from None
+    out = {}
+    for c in columns:
+        if c not in frame.columns:
+            raise InputError(f"missing column {c!r} (columns: {', '.join(map(str, frame.columns))})", path)
+        try:
+            out[c] = frame[c].to_numpy(dtype=float)
+        except (TypeError, ValueError):
+            raise InputError("not numeric", path, f"column {c}") from None
+    return out
+
+
+def _resample(time_s: np.ndarray, columns: dict[str, np.ndarray], step: float, path):
+    if (time_s[-1] - time_s[0]) / step > MAX_SAMPLES:
+        raise InputError(
+            f"resampling {time_s[-1] - time_s[0]:.0f} s every {step:g} s gives over {MAX_SAMPLES} samples", path
+        )
+    grid = np.arange(time_s[0], time_s[-1] + 1e-9, step)
+    return grid, {k: np.interp(grid, time_s, v) for k, v in columns.items()}
+
+
+def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None) -> Batch:
+    """Read any supported log with a column map into a validated canonical :class:`Batch`."""
+    path = Path(path)
+    cmap = cmap or ColumnMap(source="default map")
+    if not path.exists():
+        raise InputError("file not found", path)
+    fmt = _detect_format(path, cmap.format)
+    gg = cmap.Gg
+    Mb = None
+    if fmt in ("alog", "artisan-csv"):
+        log = (
+            read_alog(path, keep_after_drop=cmap.keep_after_drop)
+            if fmt == "alog"
+            else read_artisan_csv(path, cmap.keep_after_drop)
+        )
+        time_s = log.time_s
+        available = log.channels
+
+        def channel(spec: dict, what: str) -> np.ndarray:
+            col = spec["column"]
+            if col not in available:
+                raise InputError(f"{what}: no channel {col!r} in the log (has: {', '.join(sorted(available))})", path)
+            return np.array(available[col], dtype=float)  # Artisan temperatures already in degC
+
+        Ta = channel(cmap.Ta, "Ta") + (cmap.Ta.get("offset_C") or 0.0)
+        Tgi = channel(cmap.Tgi, "Tgi") + (cmap.Tgi.get("offset_C") or 0.0)
+        extra = {}
+        if "column" in gg:
+            extra["Gg"] = channel(gg, "Gg")
+        elif "pitot" in gg:
+            extra["dp"] = channel({"column": gg["pitot"]["dp_column"]}, "Gg.pitot.dp_column")
+            extra["Tp"] = channel({"column": gg["pitot"]["T_column"]}, "Gg.pitot.T_column")
+        Mb = log.weight_in_kg
+        drop_known = log.drop_index is not None
+    else:
+        needed = [cmap.time["column"], cmap.Ta["column"], cmap.Tgi["column"]]
+        if "column" in gg:
+            needed.append(gg["column"])
+        elif "pitot" in gg:
+            needed += [gg["pitot"]["dp_column"], gg["pitot"]["T_column"]]
+        needed = list(dict.fromkeys(needed))
+        cols = _read_parquet(path, needed) if fmt == "parquet" else read_table(path, tuple(needed))
+        time_s = cols[cmap.time["column"]] * TIME_UNITS[cmap.time["unit"]]
+        Ta = to_celsius(cols[cmap.Ta["column"]], cmap.Ta["unit"]) + (cmap.Ta.get("offset_C") or 0.0)
+        Tgi = to_celsius(cols[cmap.Tgi["column"]], cmap.Tgi["unit"]) + (cmap.Tgi.get("offset_C") or 0.0)
+        extra = {}
+        if "column" in gg:
+            extra["Gg"] = cols[gg["column"]]
+        elif "pitot" in gg:
+            extra["dp"] = cols[gg["pitot"]["dp_column"]]
+            extra["Tp"] = to_celsius(cols[gg["pitot"]["T_column"]], gg["pitot"]["T_unit"])
+        drop_known = True
+
+    # Gg in kg/s
+    if "column" in gg:
+        factor = FLOW_UNITS[gg["unit"]]
+        Gg = extra["Gg"] * (gg["density_kg_m3"] / 3600.0 if factor is None else factor)
+    elif "pitot" in gg:
+        if np.any(extra["dp"][np.isfinite(extra["dp"])] < 0):
+            raise InputError("negative Pitot pressure difference", path, f"column {gg['pitot']['dp_column']}")
+        Gg = gas_flow_pitot_kg_s(extra["dp"], extra["Tp"], gg["pitot"]["section_m2"], gg["pitot"]["rho0_kg_m3"])
+    elif "constant_kg_s" in gg:
+        Gg = np.full(len(time_s), gg["constant_kg_s"])
+    else:  # identify: a 1 kg/s placeholder scaled by the identified Gg_kg_s
+        Gg = np.ones(len(time_s))
+
+    # missing samples (Artisan -1, empty cells) are dropped rather than invented
+    ok = np.isfinite(time_s) & np.isfinite(Ta) & np.isfinite(Tgi) & np.isfinite(Gg)
+    if ok.sum() < 2:
+        raise InputError("fewer than 2 complete samples after dropping missing values", path)
+    time_s, Ta, Tgi, Gg = time_s[ok], Ta[ok], Tgi[ok], Gg[ok]
+    notes = []
+    if ok.sum() < ok.size:
+        notes.append(f"dropped {ok.size - ok.sum()} incomplete sample(s) (missing values)")
+    jumps = np.flatnonzero(np.abs(np.diff(Ta)) > MAX_JUMP_C)
+    if jumps.size:
+        # a probe fault: keep what came before it rather than fit a physically impossible step
+        j = int(jumps[0])
+        if j + 1 < max(2, 0.5 * len(Ta)):
+            raise InputError(
+                f"bean temperature jumps {Ta[j]:.0f} -> {Ta[j + 1]:.0f} degC at t = {time_s[j + 1]:.0f} s, early in the log: sensor fault?",
+                path,
+            )
+        notes.append(
+            f"bean temperature jumps {Ta[j]:.0f} -> {Ta[j + 1]:.0f} degC at t = {time_s[j + 1]:.0f} s (probe fault): log cut there"
+        )
+        time_s, Ta, Tgi, Gg = time_s[: j + 1], Ta[: j + 1], Tgi[: j + 1], Gg[: j + 1]
+    if drop_known and Ta[-1] > DROP_BT_LIMIT_C:
+        raise InputError(
+            f"bean temperature {Ta[-1]:.0f} degC at DROP is above {DROP_BT_LIMIT_C:.0f}: °F data declared as °C?", path
+        )
+    if cmap.resample_s > 0:
+        if np.any(np.diff(time_s) <= 0):
+            raise InputError("time not strictly increasing", path)
+        time_s, cols = _resample(time_s, {"Ta": Ta, "Tgi": Tgi, "Gg": Gg}, cmap.resample_s, path)
+        Ta, Tgi, Gg = cols["Ta"], cols["Tgi"], cols["Gg"]
+    batch = Batch(
+        name or path.stem,
+        np.asarray(time_s, float),
+        np.asarray(Gg, float),
+        np.asarray(Tgi, float),
+        np.asarray(Ta, float),
+        source=str(path),
+        Mb_kg=Mb,
+    )
+    batch.notes = notes
+    return batch.validate()

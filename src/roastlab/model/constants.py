@@ -1,0 +1,124 @@
+"""Fixed process constants of the roasting model (paper Table 5, left; MODEL.md).
+
+Units follow MODEL.md: kJ, kW (= kJ/s), kg, m, s, degC; kelvin only inside the Arrhenius
+terms and the gas heat-capacity polynomial.
+
+Departures from the printed paper (see MODEL.md):
+
+* ``A`` is a rate, kJ/(kg s); Table 5 prints kJ/kg.
+* ``k1`` = 4320 m^2/s with an X^2 factor (Schwartzberg's law, which the paper cites); the
+  printed eq. 13 with k1 = 4.32e-9 and no X factor barely moves moisture in a whole roast.
+  It stays available as the ``"printed"`` moisture law (:data:`K1_PRINTED`).
+
+References
+----------
+.. [1] "A scalable model of a coffee roasting chamber", Procedia Computer Science (2021),
+   doi:10.1016/j.procs.2021.01.362
+.. [2] Schwartzberg, H. G. "Modeling bean heating during batch roasting of coffee beans",
+   in Engineering and Food for the 21st Century (2002).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+from ..errors import ParameterError
+
+#: eq. 2 coefficients alpha_0..alpha_6 of cg(T) in J/(kg K), T in kelvin.
+CG_ALPHA_J_KG_K = (
+    1.0839e3,
+    -7.2075e-1,
+    2.1034e-3,
+    -2.3267e-6,
+    1.3621e-9,
+    -4.1550e-13,
+    5.3091e-17,
+)
+
+#: eq. 13 as printed: k1 = 4.32e-9 with no X factor (the ``"printed"`` moisture law).
+K1_PRINTED = 4.32e-9
+
+#: Moisture laws (eq. 13 / 15c): name -> exponent of X in dX/dt.
+MOISTURE_LAWS = {"schwartzberg": 2.0, "printed": 0.0}
+
+#: Input hold between samples: first-order (linear) or zero-order.
+INPUT_HOLDS = ("linear", "zoh")
+
+#: Air density of the Pitot formula, eq. 16 [kg/m^3].
+RHO0_KG_M3 = 1.275
+
+
+@dataclass(frozen=True)
+class ProcessConstants:
+    """Fixed process constants (Table 5, left), overridable per plant file.
+
+    Attributes
+    ----------
+    A : float
+        Arrhenius pre-factor of the exothermic reaction [kJ/(kg s)] (eq. 14).
+    cm : float
+        Specific heat capacity of the drum metal [kJ/(kg K)] (eq. 12).
+    cw : float
+        Partial heat capacity of water in the bean [kJ/(kg K)] (eq. 8).
+    Db : float
+        Bean diameter [m] (eq. 13, area of beans).
+    Ha_R : float
+        Activation energy over the gas constant [K] (eq. 14).
+    Het : float
+        Total reaction heat [kJ/kg dry] (eq. 14).
+    k1 : float
+        Schwartzberg pre-factor [m^2/s] (eq. 13).
+    k2 : float
+        Schwartzberg activation temperature [K] (eq. 13).
+    Kt : float
+        Inverse time constant of the bean probe [1/s] (eq. 17).
+    mb : float
+        Mass of one bean [kg] (area of beans, section 3.1).
+    lam : float
+        Latent heat of vaporisation of bean moisture [kJ/kg] (eq. 8).
+    """
+
+    A: float = 116200.0
+    cm: float = 0.418
+    cw: float = 5.0
+    Db: float = 7.65e-3
+    Ha_R: float = 5500.0
+    Het: float = 232.0
+    k1: float = 4320.0
+    k2: float = 9889.0
+    Kt: float = 0.01
+    mb: float = 1.5e-4
+    lam: float = 2790.0
+
+    def __post_init__(self) -> None:
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            if not isinstance(value, (int, float)) or isinstance(value, bool):
+                raise ParameterError(f"process constant {f.name} must be a number, got {value!r}")
+            if not (value > 0 and value < float("inf")):
+                raise ParameterError(f"process constant {f.name} must be > 0 and finite, got {value!r}")
+
+    #: Names accepted in a plant file's ``[process]`` table, mapped to field names.
+    ALIASES = {"Ha/R": "Ha_R", "lambda": "lam"}
+
+    @classmethod
+    def from_mapping(cls, values: dict, source: str | None = None) -> ProcessConstants:
+        """Build from a ``{name: value}`` mapping of overrides (MODEL.md names)."""
+        known = {f.name for f in dataclasses.fields(cls)}
+        kwargs = {}
+        for key, value in values.items():
+            name = cls.ALIASES.get(key, key)
+            if name not in known:
+                allowed = ", ".join(sorted(known))
+                raise ParameterError(f"unknown process constant {key!r} (allowed: {allowed})", source, "[process]")
+            if not isinstance(value, (int, float)) or isinstance(value, bool):
+                raise ParameterError(f"process constant {key} must be a number, got {value!r}", source, "[process]")
+            kwargs[name] = float(value)
+        try:
+            return cls(**kwargs)
+        except ParameterError as exc:
+            raise ParameterError(exc.problem, source, "[process]") from None
+
+    def as_dict(self) -> dict[str, float]:
+        return dataclasses.asdict(self)

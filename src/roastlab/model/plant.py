@@ -1,0 +1,172 @@
+"""Plant geometry and the quantities derived from it (paper eq. 7 and section 3.1).
+
+A plant is a data file: six measured dimensions and, optionally, overrides of the fixed
+process constants. Everything else (areas, dry mass, F) is computed here, never stored.
+Presets ``120kg`` and ``360kg`` ship as TOML files in ``roastlab/plants/``.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+import tomllib
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+
+from ..errors import InputError, ParameterError
+from .constants import ProcessConstants
+from .rhs import bean_areas_m2, bean_heat_transfer_coefficient_kW_m2K, conductance_ratio_F, dry_mass_kg
+
+GEOMETRY_KEYS = ("Mb_kg", "Dch_m", "Lch_m", "Hflap_m", "Sflap_m", "Mm_kg")
+_GEOMETRY_DOC = {
+    "Mb_kg": "green batch mass [kg]",
+    "Dch_m": "chamber diameter [m]",
+    "Lch_m": "chamber length [m]",
+    "Hflap_m": "flap height [m]",
+    "Sflap_m": "flap step [m]",
+    "Mm_kg": "metal mass [kg]",
+}
+
+
+@functools.cache
+def _preset_names() -> tuple[str, ...]:
+    folder = resources.files("roastlab.model") / "plants"
+    return tuple(sorted(p.name.removesuffix(".toml") for p in folder.iterdir() if p.name.endswith(".toml")))
+
+
+@functools.cache
+def _load_preset(name: str) -> Plant:
+    resource = resources.files("roastlab.model") / "plants" / f"{name}.toml"
+    return plant_from_mapping(tomllib.loads(resource.read_text(encoding="utf-8")), f"preset {name}", name)
+
+
+def preset_names() -> list[str]:
+    """Names of the plant presets shipped with roastlab."""
+    return list(_preset_names())
+
+
+@dataclass(frozen=True)
+class Plant:
+    """A drum roaster described by its geometry (Table 5, right).
+
+    Attributes
+    ----------
+    name : str
+    Mb_kg, Dch_m, Lch_m, Hflap_m, Sflap_m, Mm_kg : float
+        Green batch mass [kg], chamber diameter [m], chamber length [m], flap height [m],
+        flap step [m] and metal mass [kg].
+    process : ProcessConstants
+        Fixed process constants (Table 5, left), possibly overridden by the plant file.
+
+    Examples
+    --------
+    >>> p = as_plant("120kg")
+    >>> round(p.Agm_m2, 1), round(p.Ab_m2)
+    (23.2, 147)
+    """
+
+    name: str
+    Mb_kg: float
+    Dch_m: float
+    Lch_m: float
+    Hflap_m: float
+    Sflap_m: float
+    Mm_kg: float
+    process: ProcessConstants = field(default_factory=ProcessConstants)
+
+    def __post_init__(self) -> None:
+        for key in GEOMETRY_KEYS:
+            value = getattr(self, key)
+            if not (isinstance(value, (int, float)) and not isinstance(value, bool)):
+                raise ParameterError(f"{key} must be a number, got {value!r}")
+            if not (value > 0 and math.isfinite(value)):
+                raise ParameterError(f"{key} ({_GEOMETRY_DOC[key]}) must be > 0 and finite, got {value!r}")
+
+    # --- derived geometry (eq. 7, section 3.1) ------------------------------------
+    @property
+    def Agm_m2(self) -> float:
+        """Gas-to-metal area: drum wall, flaps and end discs [m^2] (eq. 7)."""
+        return math.pi * self.Dch_m * (self.Lch_m + self.Hflap_m * self.Lch_m / self.Sflap_m + self.Dch_m / 2)
+
+    @property
+    def Ab_m2(self) -> float:
+        """Total bean surface, (Mb/mb) * pi * Db^2 [m^2] (section 3.1)."""
+        return self.Mb_kg / self.process.mb * math.pi * self.process.Db**2
+
+    def Agb_m2(self, Pbm: float) -> float:
+        """Gas-to-bean area Ab (1 - Pbm) [m^2] (section 3.1)."""
+        return bean_areas_m2(self.Ab_m2, Pbm)[0]
+
+    def Abm_m2(self, Pbm: float) -> float:
+        """Metal-to-bean area Ab Pbm [m^2] (section 3.1)."""
+        return bean_areas_m2(self.Ab_m2, Pbm)[1]
+
+    def Mbd_kg(self, X0: float) -> float:
+        """Dry batch mass Mb / (1 + X(0)) [kg], fixed for the batch (section 3.6)."""
+        return dry_mass_kg(self.Mb_kg, X0)
+
+    def F(self, hgm: float, Pbm: float, X: float) -> float:
+        """Ratio of gas-metal to gas-bean conductances, hgm Agm / (he Agb) [-] (eq. 6)."""
+        he = bean_heat_transfer_coefficient_kW_m2K(X)
+        return conductance_ratio_F(hgm, self.Agm_m2, he, self.Agb_m2(Pbm))
+
+    def geometry(self) -> dict[str, float]:
+        return {key: float(getattr(self, key)) for key in GEOMETRY_KEYS}
+
+    def describe(self, hgm: float, hbm: float, Pbm: float, X0: float = 0.1) -> list[tuple[str, float, str, str]]:
+        """Rows (symbol, value, unit, meaning) of geometry and derived quantities."""
+        rows = []
+        for key in GEOMETRY_KEYS:
+            symbol, unit = key.rsplit("_", 1)
+            rows.append((symbol, float(getattr(self, key)), unit, _GEOMETRY_DOC[key].split(" [")[0]))
+        rows += [
+            ("Agm", self.Agm_m2, "m2", "gas-metal area, eq. 7"),
+            ("Ab", self.Ab_m2, "m2", "total bean area"),
+            ("Agb", self.Agb_m2(Pbm), "m2", f"gas-bean area at Pbm={Pbm:g}"),
+            ("Abm", self.Abm_m2(Pbm), "m2", f"metal-bean area at Pbm={Pbm:g}"),
+            ("Mbd", self.Mbd_kg(X0), "kg", f"dry batch mass at X0={X0:g}"),
+            ("F", self.F(hgm, Pbm, X0), "-", f"eq. 6 at hgm={hgm:g}, X={X0:g}"),
+            ("Mm*cm", self.Mm_kg * self.process.cm, "kJ/K", "metal heat capacity"),
+        ]
+        return rows
+
+
+def plant_from_mapping(data: dict, source: str | Path, default_name: str) -> Plant:
+    """Build a :class:`Plant` from a parsed TOML mapping, naming ``source`` in errors."""
+    missing = [k for k in GEOMETRY_KEYS if k not in data]
+    if missing:
+        raise InputError(f"missing key(s) {', '.join(missing)} (a plant needs {', '.join(GEOMETRY_KEYS)})", source)
+    allowed = set(GEOMETRY_KEYS) | {"name", "process", "description", "source", "sources", "notes"}
+    unknown = sorted(set(data) - allowed)
+    if unknown:
+        raise InputError(f"unknown key(s) {', '.join(unknown)}", source)
+    process_table = data.get("process", {})
+    if not isinstance(process_table, dict):
+        raise InputError("[process] must be a table", source)
+    process = ProcessConstants.from_mapping(process_table, str(source))
+    name = data.get("name", default_name)
+    if not isinstance(name, str):
+        raise InputError(f"name must be a string, got {name!r}", source, "name")
+    geometry = {}
+    for key in GEOMETRY_KEYS:
+        value = data[key]
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ParameterError(f"must be a number, got {value!r}", source, key)
+        if not (value > 0 and math.isfinite(value)):
+            raise ParameterError(f"{_GEOMETRY_DOC[key]} must be > 0, got {value!r}", source, key)
+        geometry[key] = float(value)
+    return Plant(name=name, process=process, **geometry)
+
+
+def as_plant(spec: str | Plant) -> Plant:
+    """A :class:`Plant` or a preset name (``"120kg"``, ``"360kg"``) as a Plant.
+
+    Plant files are user input and are read through :func:`roastlab.io.plants.load_plant`.
+    """
+    if isinstance(spec, Plant):
+        return spec
+    text = str(spec)
+    if text in _preset_names():
+        return _load_preset(text)  # presets are immutable data: parse once per process
+    raise InputError(f"unknown plant preset (presets: {', '.join(preset_names())}; or give a PLANT.toml path)", text)

@@ -1,0 +1,212 @@
+"""The roasting-chamber model: one pure right-hand side (paper eqs. 2-17, MODEL.md).
+
+States ``x = [Tb, Tm, X, He, Ta]`` (see :data:`STATE_NAMES`), inputs ``u = [Gg, Tgi]``
+(:data:`INPUT_NAMES`), parameters a flat float64 vector ``p`` built by :func:`pack_params`
+(:data:`PARAM_NAMES`). The functions here are plain Python when called from Python (the
+slow reference path and the benchmark baseline) and are compiled inline into the
+integrators of :mod:`roastlab.sim.kernels` through ``numba.extending.register_jitable``: one
+source, never copied.
+
+Departures from the printed paper, each a reading fixed by MODEL.md:
+
+* eq. 15e gives the temperature *drop* Tgi - Tgo, with the (1 + F) factor inside NTU;
+* eq. 13/15c: Schwartzberg's law dX/dt = -k1 X^2 / Db^2 exp(-k2/T) by default; the printed
+  law (no X factor, k1 = 4.32e-9) is the ``"printed"`` variant (exponent 0);
+* heat-transfer coefficients are in kW/(m^2 K), not W/(m^2 K).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba.extending import register_jitable
+
+from ..errors import ParameterError
+from .constants import CG_ALPHA_J_KG_K, K1_PRINTED, MOISTURE_LAWS
+
+STATE_NAMES = ("Tb_C", "Tm_C", "X_kg_kg", "He_kJ_kg", "Ta_C")
+INPUT_NAMES = ("Gg_kg_s", "Tgi_C")
+#: Layout of the parameter vector ``p``.
+PARAM_NAMES = (
+    "hgm",
+    "hbm",
+    "Pbm",  # identified theta [kW/(m2 K)], [kW/(m2 K)], [-]
+    "Agm",
+    "Ab",
+    "Mbd",
+    "Mm",  # plant-derived [m2], [m2], [kg], [kg]
+    "A",
+    "cm",
+    "cw",
+    "Db",
+    "Ha_R",
+    "Het",
+    "k1",
+    "k2",
+    "Kt",
+    "lam",  # process constants
+    "x_exp",  # exponent of X in the moisture law: 2 (Schwartzberg) or 0 (printed)
+    "Gg_scale",  # factor on the gas-flow input [-], 1 = as given (identifies an unlogged constant Gg)
+)
+P = {name: i for i, name in enumerate(PARAM_NAMES)}
+N_PARAMS = len(PARAM_NAMES)
+# indices derived from the names (compile-time constants for the kernels)
+I_HGM, I_HBM, I_PBM, I_AGM, I_AB, I_MBD, I_MM = (P[k] for k in ("hgm", "hbm", "Pbm", "Agm", "Ab", "Mbd", "Mm"))
+I_A, I_CM, I_CW, I_DB, I_HAR, I_HET = (P[k] for k in ("A", "cm", "cw", "Db", "Ha_R", "Het"))
+I_K1, I_K2, I_KT, I_LAM, I_XEXP, I_GGS = (P[k] for k in ("k1", "k2", "Kt", "lam", "x_exp", "Gg_scale"))
+
+_A0, _A1, _A2, _A3, _A4, _A5, _A6 = CG_ALPHA_J_KG_K
+KELVIN = 273.15
+
+
+@register_jitable
+def gas_heat_capacity_kJ_kgK(Tgi_C):
+    """Specific heat of the drying air cg [kJ/(kg K)] at inlet temperature [degC] (eq. 2).
+
+    The polynomial of eq. 2 is in J/(kg K) of the absolute temperature; divided by 1000.
+
+    >>> round(gas_heat_capacity_kJ_kgK(450.0), 4)
+    1.0807
+    """
+    T = Tgi_C + KELVIN
+    return (_A0 + T * (_A1 + T * (_A2 + T * (_A3 + T * (_A4 + T * (_A5 + T * _A6)))))) / 1000.0
+
+
+@register_jitable
+def bean_heat_transfer_coefficient_kW_m2K(X):
+    """Gas-to-bean coefficient he [kW/(m^2 K)] at moisture X [kg/kg dry] (eq. 3)."""
+    return 0.49 - 0.443 * math.exp(-0.206 * X)
+
+
+@register_jitable
+def bean_areas_m2(Ab_m2, Pbm):
+    """Gas-to-bean and metal-to-bean areas (Agb, Abm) = (Ab (1 - Pbm), Ab Pbm) [m^2] (section 3.1)."""
+    return Ab_m2 * (1.0 - Pbm), Ab_m2 * Pbm
+
+
+@register_jitable
+def conductance_ratio_F(hgm, Agm_m2, he, Agb_m2):
+    """F = hgm Agm / (he Agb) [-], gas-metal over gas-bean conductance (eq. 6)."""
+    return hgm * Agm_m2 / (he * Agb_m2)
+
+
+@register_jitable
+def dry_mass_kg(Mb_kg, X0):
+    """Dry batch mass Mbd = Mb / (1 + X(0)) [kg], fixed for the batch (section 3.6)."""
+    return Mb_kg / (1.0 + X0)
+
+
+@register_jitable
+def heat_flows(Tb, Tm, X, Gg, Tgi, p):
+    """Outlet gas temperature and heat flows at one instant.
+
+    Returns ``(Tgo [degC], Qgb, Qgm, Qbm [kW])``:
+    Tgi - Tgo from eq. 15e, Qgb eq. 9, Qgm eq. 10, Qbm eq. 11.
+    """
+    Gg = Gg * p[I_GGS]  # gas-flow factor (1 unless a constant flow is being identified)
+    Agb, Abm = bean_areas_m2(p[I_AB], p[I_PBM])  # section 3.1
+    he = bean_heat_transfer_coefficient_kW_m2K(X)  # eq. 3
+    cg = gas_heat_capacity_kJ_kgK(Tgi)  # eq. 2
+    F = conductance_ratio_F(p[I_HGM], p[I_AGM], he, Agb)  # eq. 6
+    T_star = (Tb + F * Tm) / (1.0 + F)  # eq. 5/15e: mean sink temperature
+    NTU = he * Agb * (1.0 + F) / (Gg * cg)  # eq. 15e
+    drop = (Tgi - T_star) * (1.0 - math.exp(-NTU))  # eq. 15e: Tgi - Tgo
+    Qgb = Gg * cg * drop  # eq. 9
+    Qgm = F * (he * Agb * (Tb - Tm) + Qgb) / (1.0 + F)  # eq. 10
+    Qbm = p[I_HBM] * Abm * (Tm - Tb)  # eq. 11
+    return Tgi - drop, Qgb, Qgm, Qbm
+
+
+@register_jitable
+def moisture_rate_1_s(Tb, X, p):
+    """dX/dt [1/s] (eqs. 13, 15c); zero once X reaches 0 so X never goes negative."""
+    if X <= 0.0:
+        return 0.0
+    Xn = X * X if p[I_XEXP] == 2.0 else X ** p[I_XEXP]
+    return -p[I_K1] * Xn / (p[I_DB] * p[I_DB]) * math.exp(-p[I_K2] / (Tb + KELVIN))
+
+
+@register_jitable
+def reaction_heat_rate_kW_kg(Tb, He, p):
+    """Exothermic heat production Qr = dHe/dt [kW/kg dry] (eqs. 14, 15d)."""
+    Het = p[I_HET]
+    return p[I_A] * (Het - He) / Het * math.exp(-p[I_HAR] / (Tb + KELVIN))
+
+
+@register_jitable
+def derivatives(Tb, Tm, X, He, Ta, Gg, Tgi, p):
+    """Time derivatives of the five states (eqs. 15a-15d, 17) as a tuple."""
+    Tgo, Qgb, Qgm, Qbm = heat_flows(Tb, Tm, X, Gg, Tgi, p)
+    dX = moisture_rate_1_s(Tb, X, p)  # eq. 15c
+    Qr = reaction_heat_rate_kW_kg(Tb, He, p)  # eq. 15d
+    Mbd = p[I_MBD]
+    cs = 1.099 + 0.007 * Tb  # partial heat capacity of bean solids, section 3.2
+    dTb = (Qgb - Qgm + Qbm + Mbd * (Qr + p[I_LAM] * dX)) / (Mbd * (cs + p[I_CW] * X))  # eq. 15a
+    dTm = (Qgm - Qbm) / (p[I_MM] * p[I_CM])  # eq. 15b, Qe = 0
+    dTa = p[I_KT] * (Tb - Ta)  # eq. 17
+    return dTb, dTm, dX, Qr, dTa
+
+
+@register_jitable
+def rhs(t, x, u, p):
+    """The model's right-hand side f(t, x, u, p) -> dx/dt as a length-5 array.
+
+    Parameters
+    ----------
+    t : float
+        Time [s]; the model is autonomous, so ``t`` is unused but kept for the ODE form.
+    x : array of 5 floats
+        ``[Tb degC, Tm degC, X kg/kg dry, He kJ/kg dry, Ta degC]``.
+    u : array of 2 floats
+        ``[Gg kg/s, Tgi degC]``.
+    p : array
+        Parameter vector from :func:`pack_params`.
+    """
+    d = derivatives(x[0], x[1], x[2], x[3], x[4], u[0], u[1], p)
+    out = np.empty(5)
+    for i in range(5):
+        out[i] = d[i]
+    return out
+
+
+def pack_params(plant, theta, X0: float = 0.1, moisture: str = "schwartzberg") -> np.ndarray:
+    """Build the parameter vector ``p`` for a plant, theta and initial moisture.
+
+    Parameters
+    ----------
+    plant : roastlab.plant.Plant
+    theta : sequence (hgm [kW/(m2 K)], hbm [kW/(m2 K)], Pbm [-]) or mapping with those keys
+    X0 : float
+        Initial moisture [kg/kg dry]; fixes the dry batch mass Mbd = Mb / (1 + X0).
+    moisture : {"schwartzberg", "printed"}
+    """
+    from .parameters import as_theta
+
+    th = as_theta(theta)
+    if moisture not in MOISTURE_LAWS:
+        raise ParameterError(f"unknown moisture law {moisture!r} (allowed: {', '.join(MOISTURE_LAWS)})")
+    pc = plant.process
+    k1 = pc.k1 if moisture == "schwartzberg" else K1_PRINTED
+    values = {
+        "hgm": th.hgm,
+        "hbm": th.hbm,
+        "Pbm": th.Pbm,
+        "Agm": plant.Agm_m2,
+        "Ab": plant.Ab_m2,
+        "Mbd": plant.Mbd_kg(X0),
+        "Mm": plant.Mm_kg,
+        "A": pc.A,
+        "cm": pc.cm,
+        "cw": pc.cw,
+        "Db": pc.Db,
+        "Ha_R": pc.Ha_R,
+        "Het": pc.Het,
+        "k1": k1,
+        "k2": pc.k2,
+        "Kt": pc.Kt,
+        "lam": pc.lam,
+        "x_exp": MOISTURE_LAWS[moisture],
+        "Gg_scale": 1.0,
+    }
+    return np.array([values[name] for name in PARAM_NAMES], dtype=np.float64)

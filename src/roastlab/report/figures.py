@@ -1,0 +1,200 @@
+"""Figures in a roaster's words: BT/ET curves (model names beside), rate of rise, residuals.
+
+Figures are plain :class:`matplotlib.figure.Figure` objects, never registered with pyplot,
+so a notebook shows each once. Saving goes through the output guard (:mod:`roastlab.io.files`).
+"""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from ..io.files import Outputs
+
+#: Image formats a figure may be saved as (by the file suffix).
+FIGURE_FORMATS = ("png", "svg", "pdf")
+#: Window of the rate-of-rise estimate [s] (Artisan's default delta span is 15 s).
+ROR_SPAN_S = 30.0
+
+
+def check_figure_path(path) -> Path:
+    """Refuse a figure path whose suffix is not an image format we write (before any output)."""
+    path = Path(path)
+    fmt = path.suffix.lstrip(".").lower()
+    if fmt not in FIGURE_FORMATS:
+        raise InputError(f"unknown figure format {path.suffix or '(none)'!r} (use .png, .svg or .pdf)", path)
+    return path
+
+
+def new_figure(**kwargs):
+    """A Figure not registered with pyplot (no double display in Jupyter)."""
+    from matplotlib.figure import Figure
+
+    return Figure(**kwargs)
+
+
+def figure_bytes(fig, path) -> bytes:
+    buf = io.BytesIO()
+    fig.savefig(buf, format=check_figure_path(path).suffix.lstrip(".").lower(), dpi=120, bbox_inches="tight")
+    return buf.getvalue()
+
+
+def save_figure(fig, path, outputs: Outputs | None = None) -> None:
+    """Save a figure by suffix (PNG/SVG/PDF), into ``outputs`` if given, else atomically now."""
+    data = figure_bytes(fig, path)
+    if outputs is not None:
+        outputs.write_bytes(path, data)
+    else:
+        with Outputs() as out:
+            out.write_bytes(path, data)
+
+
+def _finish(fig, path, title, outputs=None):
+    if title:
+        fig.suptitle(title)
+    if path is not None:
+        save_figure(fig, path, outputs)
+    return fig
+
+
+def rate_of_rise_C_per_min(time_s, temp_C, span_s: float = ROR_SPAN_S) -> np.ndarray:
+    """Rate of rise [degC/min]: slope of a least-squares line over the last ``span_s`` seconds."""
+    t = np.asarray(time_s, dtype=float)
+    y = np.asarray(temp_C, dtype=float)
+    out = np.full(t.shape, np.nan)
+    for i in range(len(t)):
+        j = np.searchsorted(t, t[i] - span_s)
+        if i - j >= 1:
+            tt, yy = t[j : i + 1], y[j : i + 1]
+            dt = tt - tt.mean()
+            out[i] = 60.0 * float(dt @ (yy - yy.mean()) / (dt @ dt))
+    return out
+
+
+def _events(ax, events: dict | None) -> None:
+    for name, t in (events or {}).items():
+        if t is None or not np.isfinite(t):
+            continue
+        ax.axvline(t / 60.0, color="0.6", lw=0.8, ls=":")
+        ax.annotate(name, (t / 60.0, 1.0), xycoords=("data", "axes fraction"), fontsize=7, rotation=90, va="top")
+
+
+def plot_simulation(result, path=None, title=None, outputs=None, events=None):
+    """Four panels: temperatures (BT/ET and the model's states), rate of rise, moisture, heat flows."""
+    fig = new_figure(figsize=(8.5, 10), layout="constrained")
+    axes = fig.subplots(4, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1.3, 1.1, 1.4]})
+    t_min = result.time_s / 60.0
+    ax = axes[0]
+    ax.plot(t_min, result.Ta_C, label="BT predicted (model Ta, probe)", color="tab:orange", lw=2)
+    if result.Ta_measured_C is not None:
+        ax.plot(t_min, result.Ta_measured_C, "k.", ms=3, label="BT measured (log)")
+    ax.plot(t_min, result.Tb_C, label="bean core (model Tb)", color="tab:brown")
+    ax.plot(t_min, result.Tm_C, label="drum metal (model Tm)", color="tab:gray")
+    ax.plot(t_min, result.Tgi_C, "--", label="ET / inlet gas as applied (model Tgi)", color="tab:red")
+    ax.plot(t_min, result.Tgo_C, ":", label="outlet gas (model Tgo)", color="tab:red")
+    ax.set_ylabel("temperature [°C]")
+    ax.legend(fontsize=7, ncol=2, loc="lower right")
+    ax.grid(alpha=0.3)
+    _events(ax, events)
+    ror = axes[1]
+    ror.plot(t_min, rate_of_rise_C_per_min(result.time_s, result.Ta_C), color="tab:orange", label="RoR predicted")
+    if result.Ta_measured_C is not None:
+        ror.plot(t_min, rate_of_rise_C_per_min(result.time_s, result.Ta_measured_C), "k-", lw=0.8, label="RoR measured")
+    ror.set_ylabel(f"BT rate of rise\n[°C/min, {ROR_SPAN_S:g} s]")
+    ror.legend(fontsize=7)
+    ror.grid(alpha=0.3)
+    axes[2].plot(t_min, result.X_kg_kg, color="tab:blue")
+    axes[2].set_ylabel("moisture X\n[kg/kg dry]")
+    axes[2].grid(alpha=0.3)
+    q = result.heat_flows()
+    labels = {
+        "Qgb_kW": "Qgb gas→beans+drum",
+        "Qgm_kW": "Qgm gas→drum",
+        "Qbm_kW": "Qbm drum→beans",
+        "Qr_kW": "Qr roast reaction",
+    }
+    for key, style in (("Qgb_kW", "-"), ("Qgm_kW", "--"), ("Qbm_kW", "-."), ("Qr_kW", ":")):
+        axes[3].plot(t_min, q[key], style, label=labels[key])
+    axes[3].set_ylabel("heat flow [kW]")
+    axes[3].set_xlabel("time since CHARGE [min]")
+    axes[3].legend(fontsize=7, ncol=2)
+    axes[3].grid(alpha=0.3)
+    return _finish(fig, path, title, outputs)
+
+
+def plot_fit(result, path=None, title=None, max_panels: int = 8, outputs=None):
+    """Measured vs predicted BT per batch of a ValidationResult, each with its residual below."""
+    k = min(len(result.names), max_panels)
+    cols = 2 if k > 1 else 1
+    rows = (k + cols - 1) // cols
+    fig = new_figure(figsize=(6.5 * cols, 4.6 * rows), layout="constrained")
+    grid = fig.add_gridspec(rows * 2, cols, height_ratios=[3, 1] * rows)
+    for i in range(k):
+        r, c = divmod(i, cols)
+        ax = fig.add_subplot(grid[2 * r, c])
+        res = fig.add_subplot(grid[2 * r + 1, c], sharex=ax)
+        _profile_panel(ax, result, i)
+        t = result.time_s[i] / 60.0
+        res.plot(t, result.measured[i] - result.predicted[i], color="tab:purple", lw=1)
+        res.axhline(0.0, color="k", lw=0.6)
+        res.set_ylabel("residual\nBT meas − pred [°C]", fontsize=8)
+        res.set_xlabel("time since CHARGE [min]")
+        res.grid(alpha=0.3)
+    if len(result.names) > k:
+        title = f"{title or ''} (first {k} of {len(result.names)} batches)".strip()
+    return _finish(fig, path, title, outputs)
+
+
+def _profile_panel(ax, result, i, label=None):
+    t = result.time_s[i] / 60.0
+    row = result.rows[i]
+    ax.plot(t, result.predicted[i], color="tab:green", lw=2, label="BT predicted (model Ta)")
+    ax.plot(t, result.measured[i], "--", color="tab:pink", lw=2, label="BT measured (Ta)")
+    ax.set_title(f"{label or result.names[i]}: FIT {row['FIT']:.1f} %, MAE {row['MAE']:.2f} °C", fontsize=10)
+    ax.set_ylabel("BT [°C]")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+
+
+def plot_fig2(ident, valid, path, note="synthetic data", outputs=None):
+    """Paper Fig. 2: worst (left) and best (right) batch by FIT of each dataset."""
+    fig = new_figure(figsize=(12, 7.5), layout="constrained")
+    axes = fig.subplots(2, 2)
+    for r, (res, label) in enumerate(((ident, "dataset-I"), (valid, "dataset-V"))):
+        fits = [row["FIT"] for row in res.rows]
+        worst, best = int(np.argmin(fits)), int(np.argmax(fits))
+        left, right = ("a", "b") if r == 0 else ("c", "d")
+        _profile_panel(axes[r][0], res, worst, f"{left}) {label} {res.names[worst]} (worst)")
+        _profile_panel(axes[r][1], res, best, f"{right}) {label} {res.names[best]} (best)")
+        for ax in axes[r]:
+            ax.set_xlabel("time [min]")
+    return _finish(fig, path, f"Temperature profiles, measured vs simulated ({note})", outputs)
+
+
+def plot_fig3(ident, valid, path, note="synthetic data", outputs=None):
+    """Paper Fig. 3: distribution of the absolute prediction error per dataset."""
+    from matplotlib.lines import Line2D
+
+    fig = new_figure(figsize=(7.5, 4.8), layout="constrained")
+    ax = fig.subplots()
+    data = [np.abs(np.concatenate(ident.errors)), np.abs(np.concatenate(valid.errors))]
+    parts = ax.violinplot(data, showmeans=True, showextrema=True)
+    for body in parts["bodies"]:
+        body.set_alpha(0.4)
+    ax.boxplot(data, widths=0.12)
+    ax.set_xticks([1, 2], [f"identification\n(dataset-I, {ident.plant})", f"validation\n(dataset-V, {valid.plant})"])
+    ax.set_ylabel("absolute error |Ta − T̂a| [°C]")
+    for x, d in zip((1, 2), data):
+        ax.annotate(f"mean {d.mean():.2f}\nvar {d.var(ddof=1):.2f}", (x + 0.18, d.mean()), fontsize=8)
+    handles = [
+        Line2D([], [], color="tab:blue", alpha=0.6, lw=6, label="distribution (violin), whiskers: min/max"),
+        Line2D([], [], color="tab:blue", lw=1.5, label="mean (violin's middle bar)"),
+        Line2D([], [], color="tab:orange", lw=1.5, label="median (box's orange line), box: quartiles"),
+    ]
+    ax.legend(handles=handles, fontsize=7, loc="upper right")
+    ax.set_title(f"Absolute error distribution ({note})")
+    ax.grid(alpha=0.3, axis="y")
+    return _finish(fig, path, None, outputs)

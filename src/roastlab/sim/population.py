@@ -1,0 +1,172 @@
+"""Many simulations in one compiled, parallel call: parameter sets x batches.
+
+Batches of different lengths are packed into padded arrays (:class:`PackedBatches`); every
+run pairs one batch with one parameter vector and one initial state. Results are identical
+to one-at-a-time :func:`roastlab.simulate` (same kernel, same arithmetic).
+
+Parameters that vary between runs are addressed by name (:func:`param_columns`): the three
+theta coefficients, any process constant, the metal mass, and the initial states
+``Tb0_C, Tm0_C, X0, He0_kJ_kg, Ta0_C`` (X0 also updates the dry mass Mbd = Mb/(1+X0)).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..model.parameters import REGISTRY, STATE0
+from ..model.rhs import P, dry_mass_kg, pack_params
+from .kernels import H_MAX_S, N_OUT, simulate_population_kernel, ta_population_kernel
+from .simulate import InitialState, check_hold
+
+#: Registry names that set a parameter-vector entry, and its index. ``Gg_kg_s`` sets the
+#: gas-flow factor: the batch's Gg column is then a 1 kg/s placeholder (a map with
+#: ``[Gg] identify = true``), so the factor is the flow itself.
+PARAM_SLOTS = {name: P[q.slot] for name, q in REGISTRY.items() if q.slot in P}
+
+
+@dataclass
+class PackedBatches:
+    """Batches packed for the population kernels.
+
+    T, GG, TGI : (nb, nmax) padded inputs [s], [kg/s], [degC]; N : (nb,) valid lengths;
+    TA : (nb, nmax) measured Ta, NaN-padded (NaN everywhere if not measured);
+    X0 : (nb, 5) initial states; PB : (nb, n_params) parameter vectors at the start theta;
+    Mb : (nb,) green batch mass of each batch's plant [kg] (for Mbd when X0 varies).
+    """
+
+    T: np.ndarray
+    GG: np.ndarray
+    TGI: np.ndarray
+    N: np.ndarray
+    TA: np.ndarray
+    X0: np.ndarray
+    PB: np.ndarray
+    Mb: np.ndarray
+    names: list[str]
+    zoh: bool
+    h_max_s: float = H_MAX_S
+
+    @property
+    def n_batches(self) -> int:
+        return len(self.N)
+
+    def mask(self) -> np.ndarray:
+        """(nb, nmax) True where a sample is valid."""
+        return np.arange(self.T.shape[1])[None, :] < self.N[:, None]
+
+
+def pack_batches(
+    batches, plants, theta, initial=None, moisture="schwartzberg", hold="linear", h_max_s=H_MAX_S
+) -> PackedBatches:
+    """Pack :class:`roastlab.io.batch.Batch` objects with their plants (one per batch or one for all).
+
+    ``initial`` is an :class:`InitialState` for all batches; each batch's ``initial`` dict
+    (e.g. ``{"Tm0_C": 105}``) overrides it, and Ta(0) defaults to the batch's first measured Ta.
+    """
+    from ..io.plants import load_plant
+
+    nb = len(batches)
+    if not isinstance(plants, (list, tuple)):
+        plants = [plants] * nb
+    loaded: dict = {}  # read each distinct plant file once, not once per batch
+    for spec in plants:
+        key = str(spec) if isinstance(spec, (str, Path)) else id(spec)
+        if key not in loaded:
+            loaded[key] = load_plant(spec)
+    plants = [loaded[str(s) if isinstance(s, (str, Path)) else id(s)] for s in plants]
+    base = initial or InitialState()
+    nmax = max(b.n for b in batches)
+    T = np.zeros((nb, nmax))
+    GG = np.ones((nb, nmax))
+    TGI = np.zeros((nb, nmax))
+    TA = np.full((nb, nmax), np.nan)
+    X0 = np.zeros((nb, 5))
+    N = np.zeros(nb, dtype=np.int64)
+    PB = None
+    Mb = np.zeros(nb)
+    for i, (b, plant) in enumerate(zip(batches, plants)):
+        n = b.n
+        N[i] = n
+        T[i, :n], GG[i, :n], TGI[i, :n] = b.time_s, b.Gg_kg_s, b.Tgi_C
+        # padding repeats the last sample so the arrays stay physically sane
+        T[i, n:] = b.time_s[-1] + np.arange(1, nmax - n + 1)
+        GG[i, n:], TGI[i, n:] = b.Gg_kg_s[-1], b.Tgi_C[-1]
+        if b.Ta_C is not None:
+            TA[i, :n] = b.Ta_C
+        fields = {**base.__dict__, **b.initial}
+        state = InitialState(**fields)
+        X0[i] = state.vector(None if b.Ta_C is None else float(b.Ta_C[0]))
+        if getattr(b, "Mb_kg", None):  # the batch's own green weight (e.g. from an Artisan log)
+            plant = dataclasses.replace(plant, Mb_kg=float(b.Mb_kg))
+        p = pack_params(plant, theta, state.X0, moisture)
+        if PB is None:
+            PB = np.zeros((nb, len(p)))
+        PB[i] = p
+        Mb[i] = plant.Mb_kg
+    return PackedBatches(T, GG, TGI, N, TA, X0, PB, Mb, [b.name for b in batches], check_hold(hold), float(h_max_s))
+
+
+def run_arrays(packed: PackedBatches, names: list[str], values: np.ndarray):
+    """Build per-run (batch_of, X0, PP) for ``m`` value sets over all batches.
+
+    ``values`` has shape (m, nb, len(names)): the value of each named parameter for each
+    run. Returns arrays for m * nb runs ordered (set, batch).
+    """
+    m, nb = values.shape[0], packed.n_batches
+    X0 = np.repeat(packed.X0[None, :, :], m, axis=0).copy()
+    PP = np.repeat(packed.PB[None, :, :], m, axis=0).copy()
+    for j, name in enumerate(names):
+        v = values[:, :, j]
+        if name in PARAM_SLOTS:
+            PP[:, :, PARAM_SLOTS[name]] = v
+        elif name in STATE0:
+            X0[:, :, STATE0[name]] = v
+            if name == "X0":
+                PP[:, :, P["Mbd"]] = dry_mass_kg(packed.Mb[None, :], v)
+        else:
+            raise KeyError(name)
+    batch_of = np.tile(np.arange(nb, dtype=np.int64), m)
+    return batch_of, X0.reshape(m * nb, 5), PP.reshape(m * nb, -1)
+
+
+def predict_ta(packed: PackedBatches, names: list[str], values: np.ndarray) -> np.ndarray:
+    """Simulated probe reading for every (value set, batch): shape (m, nb, nmax), NaN-padded."""
+    m, nb = values.shape[0], packed.n_batches
+    batch_of, X0, PP = run_arrays(packed, names, values)
+    out = np.full((m * nb, packed.T.shape[1]), np.nan)
+    ta_population_kernel(packed.T, packed.GG, packed.TGI, packed.N, batch_of, X0, PP, packed.zoh, packed.h_max_s, out)
+    return out.reshape(m, nb, -1)
+
+
+def simulate_population(packed: PackedBatches, names: list[str] = (), values: np.ndarray | None = None) -> np.ndarray:
+    """All states and Tgo for every (value set, batch): shape (m, nb, nmax, 6), NaN-padded.
+
+    With no ``names``, simulates each batch once at its packed parameters.
+
+    >>> import numpy as np
+    >>> from roastlab.io.batch import Batch
+    >>> t = np.arange(0, 901, 30.0)
+    >>> b = Batch("check", t, np.full_like(t, 0.4), np.full_like(t, 450.0))
+    >>> pk = pack_batches([b], "120kg", (0.01, 0.0254, 0.5793))
+    >>> hbm = np.array([[[0.0254]], [[0.05]]])           # two parameter sets, one batch
+    >>> out = simulate_population(pk, ["hbm"], hbm)
+    >>> round(float(out[0, 0, -1, 0]), 2), bool(out[1, 0, -1, 0] != out[0, 0, -1, 0])
+    (218.31, True)
+    """
+    names = list(names)
+    if values is None:
+        values = np.zeros((1, packed.n_batches, 0))
+    m, nb = values.shape[0], packed.n_batches
+    batch_of, X0, PP = run_arrays(packed, names, values)
+    out = np.full((m * nb, packed.T.shape[1], N_OUT), np.nan)
+    simulate_population_kernel(
+        packed.T, packed.GG, packed.TGI, packed.N, batch_of, X0, PP, packed.zoh, packed.h_max_s, out
+    )
+    mask = packed.mask()
+    out = out.reshape(m, nb, packed.T.shape[1], N_OUT)
+    out[:, ~mask, :] = np.nan
+    return out

@@ -1,0 +1,222 @@
+"""Fit a model to batches: identification (eqs. 18-19) -> a :class:`FittedModel` and its report.
+
+>>> import roastlab
+>>> ds = roastlab.read_dataset(roastlab.default_dataset_root() / "dataset-I")   # SYNTHETIC data
+>>> result = roastlab.fit(ds.batches, plant="120kg", seed=0)
+>>> result.model                                                                # doctest: +ELLIPSIS
+<FittedModel 120kg: hgm=0.04..., hbm=0.02..., Pbm=0.5>
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import html
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from ..evaluate.validate import ValidationResult
+from ..fit.identify import IdentificationResult, build_free_parameters, identify
+from ..io.batch import Batch
+from ..io.fitspec import FitSpec, load_fit_spec
+from ..io.importers.mapping import ColumnMap
+from ..io.plants import load_plant
+from ..model.parameters import REGISTRY, STATE0, THETA_NAMES, THETA_START
+from ..sim.population import pack_batches
+from ..sim.simulate import InitialState
+from .model import PAPER_INITIAL, PLACEHOLDER_GG_KG_S, FittedModel, provenance
+
+
+@dataclasses.dataclass
+class FitResult:
+    """What :func:`fit` returns: the model, the identification behind it, its fit-set validation."""
+
+    model: FittedModel
+    identification: IdentificationResult
+    validation: ValidationResult
+
+    @property
+    def stderr(self) -> dict:
+        return self.identification.stderr
+
+    @property
+    def correlation(self) -> dict:
+        return self.identification.correlation
+
+    @property
+    def warnings(self) -> list[str]:
+        return self.identification.warnings
+
+    def report(self) -> str:
+        """Text report in the spirit of lmfit's ``fit_report``: values, errors, fit figures, warnings."""
+        ident = self.identification
+        head = (
+            f"fit on {len(self.validation.names)} batch(es), {ident.n_residuals} samples "
+            f"[{ident.method}, seed {ident.seed}]: {ident.nfev} simulations in {ident.wall_s:.2f} s"
+        )
+        corr = ident.correlation
+        lines = [head, self.model.report(), "correlations (|r| > 0.5):"]
+        names = corr["names"]
+        for a in range(len(names)):
+            for b in range(a + 1, len(names)):
+                c = corr["matrix"][a][b]
+                if c is not None and abs(c) > 0.5:
+                    lines.append(f"  {names[a]}, {names[b]}: {c:+.3f}")
+        return "\n".join(lines)
+
+    def to_frame(self):
+        """The model's values as a DataFrame (name, value, std. error, unit, how)."""
+        import pandas as pd
+
+        return pd.DataFrame(self.model.table(), columns=["name", "value", "stderr", "unit", "how"]).set_index("name")
+
+    def plot(self, path=None, title=None):
+        return self.validation.plot(path, title or "fit set: measured vs predicted BT")
+
+    def __repr__(self) -> str:
+        a = self.validation.average
+        return f"<FitResult {self.model!r}, fit-set FIT {a['FIT']:.2f} %, MAE {a['MAE']:.3f} °C>"
+
+    def _repr_html_(self) -> str:
+        return self.model._repr_html_() + f"<pre>{html.escape(self.report())}</pre>"
+
+
+def _spec_parts(spec, fix, bounds, estimate_tm0):
+    if spec is None:
+        free, fixed = build_free_parameters(fix, bounds, estimate_tm0=estimate_tm0)
+        return free, fixed, {}, None
+    spec = spec if isinstance(spec, FitSpec) else load_fit_spec(spec)
+    if fix or bounds or estimate_tm0:
+        raise InputError("a fit spec sets free and fixed parameters itself; drop fix/bounds/estimate_tm0", spec.source)
+    return spec.free, dict(spec.fixed), dict(spec.initial), spec.source
+
+
+def fit(
+    batches: list[Batch],
+    plant,
+    spec=None,
+    *,
+    fix: dict | None = None,
+    bounds: dict | None = None,
+    estimate_tm0: bool = False,
+    initial: dict | None = None,
+    moisture: str = "schwartzberg",
+    hold: str = "linear",
+    method: str = "global",
+    seed: int = 0,
+    starts: int = 6,
+    column_map: ColumnMap | None = None,
+    progress=None,
+) -> FitResult:
+    """Identify a model on batches with measured Ta and return a :class:`FitResult`.
+
+    Parameters
+    ----------
+    batches : list of Batch (from :func:`roastlab.load_log` or :func:`roastlab.read_dataset`)
+    plant : Plant, preset name or PLANT.toml path
+    spec : FitSpec or FIT.toml path: free parameters with bounds, fixed values, initial states
+    fix, bounds, estimate_tm0 : without a spec: hold values (``{"hgm": 0.01}``), change bounds
+        (``{"hbm": (0.01, 0.5)}``), fit each batch's initial metal temperature
+    initial : initial-state defaults by name (``Tb0_C``, ``Tm0_C``, ``X0`` ...); default section 5.1
+    moisture, hold : model variants (``"schwartzberg"``/``"printed"``, ``"linear"``/``"zoh"``)
+    method, seed, starts : search (``"global"`` or ``"de"``), its seed, local polishes
+    column_map : the map the logs were read with; kept in the model so it reads new logs alike
+    progress : callable ``progress(done, total, text)`` or None
+    """
+    batches = list(batches)
+    if not batches:
+        raise InputError("no batches to fit")
+    for b in batches:
+        if b.Ta_C is None:
+            raise InputError("no measured Ta_C column: needed to identify", b.source or b.name)
+    plant_file = str(plant) if isinstance(plant, (str, Path)) and str(plant).lower().endswith(".toml") else None
+    plant = load_plant(plant)
+    free, fixed, spec_initial, spec_source = _spec_parts(spec, fix, bounds, estimate_tm0)
+    names_moved = {f.name for f in free} | set(fixed)
+    if "Gg_kg_s" not in names_moved and all(np.all(b.Gg_kg_s == PLACEHOLDER_GG_KG_S) for b in batches):
+        raise InputError(
+            "every batch's gas flow is the 1 kg/s placeholder of a map with [Gg] identify = true, and nothing "
+            "fits it: free Gg_kg_s in a fit spec (--spec FIT.toml), e.g. Gg_kg_s = [0.0005, 0.05, 0.005]",
+            batches[0].source or batches[0].name,
+        )
+    init = {**PAPER_INITIAL, **(initial or {}), **spec_initial}
+    packed = pack_batches(batches, plant, THETA_START, InitialState(**init), moisture, hold)
+    ident = identify(packed, free, fixed, method=method, seed=seed, n_starts=starts, progress=progress)
+    doc = _document(ident, free, fixed, init, plant, moisture, hold, column_map)
+    model = FittedModel(doc)
+    validation = model.validate(batches)
+    doc["metrics"] = {
+        "batches": [{"name": n, **r} for n, r in zip(validation.names, validation.rows)],
+        "average": validation.average,
+    }
+    doc["provenance"] = provenance(
+        {
+            "batch": [b.source for b in batches],
+            "map": [column_map.source] if column_map is not None else [],
+            "spec": [spec_source],
+            "plant": [plant_file],
+        }
+    )
+    return FitResult(model, ident, validation)
+
+
+def _document(ident, free, fixed, init, plant, moisture, hold, column_map) -> dict:
+    params, initial = {}, {}
+    by_name = {f.name: f for f in free}
+    values = {**ident.fixed, **ident.values}
+    for name in list(THETA_NAMES) + [k for k in values if k not in THETA_NAMES]:
+        if name in STATE0:
+            continue
+        unit = REGISTRY[name].unit
+        if name in by_name:
+            params[name] = {
+                "value": values[name],
+                "unit": unit,
+                "how": "fitted",
+                "stderr": ident.stderr.get(name),
+                "bounds": ident.bounds.get(name),
+            }
+        else:
+            params[name] = {"value": float(fixed.get(name, values.get(name))), "unit": unit, "how": "fixed"}
+    for name in STATE0:
+        if name in by_name and by_name[name].per_batch:
+            labels = [f"{name}[{b}]" for b in ident.batches]
+            initial[name] = {
+                "how": "fitted per batch",
+                "per_batch": dict(zip(ident.batches, values[name])),
+                "stderr": {b: ident.stderr.get(lab) for b, lab in zip(ident.batches, labels)},
+                "bounds": [by_name[name].lower, by_name[name].upper],
+            }
+        elif name in by_name:
+            initial[name] = {
+                "how": "fitted",
+                "value": values[name],
+                "stderr": ident.stderr.get(name),
+                "bounds": ident.bounds.get(name),
+            }
+        elif name in fixed:
+            initial[name] = {"how": "fixed", "value": float(fixed[name])}
+        elif name in init:
+            initial[name] = {"how": "fixed", "value": float(init[name])}
+        else:
+            initial[name] = {"how": "from log"}
+    return {
+        "plant": plant,
+        "parameters": params,
+        "initial": initial,
+        "moisture": moisture,
+        "hold": hold,
+        "map": None if column_map is None else column_map.to_mapping(),
+        "fit": {
+            "SSR": ident.SSR,
+            "n_residuals": ident.n_residuals,
+            "evaluations": ident.nfev,
+            "wall_s": round(ident.wall_s, 3),
+            "method": ident.method,
+            "seed": ident.seed,
+            "batches": ident.batches,
+            "correlation": ident.correlation,
+            "warnings": ident.warnings,
+        },
+    }

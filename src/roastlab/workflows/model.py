@@ -1,0 +1,394 @@
+"""A fitted model as one object: what a fit found, applied the same way by every command.
+
+:class:`FittedModel` holds a plant, theta, every other identified or held value (process
+constants, a gas flow, the metal mass), how the initial states are set (fixed, fitted, fitted
+per batch, or from the log), the column map the fit read its logs with, the metrics on its
+fit set and provenance. :meth:`FittedModel.apply` is the only place a model meets batches:
+``simulate``, ``validate``, ``predict`` and later commands all go through it, so the same log
+and model give the same prediction whichever way they are asked.
+
+>>> import numpy as np, roastlab
+>>> m = roastlab.FittedModel.paper("120kg")           # the paper's theta*, section 5.1 start
+>>> t = np.arange(0, 901, 30.0)
+>>> r = m.predict({"time_s": t, "Gg_kg_s": np.full_like(t, 0.4), "Tgi_C": np.full_like(t, 450.0)}, Ta0_C=30.0)
+>>> round(float(r.Tb_C[-1]), 2)
+218.31
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import datetime
+import html
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError, ParameterError
+from ..evaluate.validate import ValidationResult, score
+from ..io.batch import Batch
+from ..io.files import Outputs, input_digest
+from ..io.importers.mapping import ColumnMap, map_from_mapping
+from ..io.modelfile import model_document_text, read_model_document
+from ..io.plants import load_plant
+from ..model.parameters import REGISTRY, STATE0, THETA_NAMES, THETA_PAPER, THETA_UNITS, Theta
+from ..model.plant import Plant
+from ..model.rhs import P
+from ..sim.population import pack_batches, run_arrays, simulate_population
+from ..sim.simulate import InitialState, SimulationResult
+
+#: Initial state of the paper's section 5.1 (Ta0 from the log's first reading).
+PAPER_INITIAL = {"Tb0_C": 30.0, "Tm0_C": 121.0, "X0": 0.1, "He0_kJ_kg": 0.0}
+#: Gas flow written by a map with ``[Gg] identify = true`` and scaled by a fitted Gg_kg_s [kg/s].
+PLACEHOLDER_GG_KG_S = 1.0
+
+
+def _version() -> str:
+    from .. import __version__
+
+    return __version__
+
+
+def as_batch(data, name: str = "inputs") -> Batch:
+    """A :class:`Batch` from a Batch, or a mapping/DataFrame with ``time_s, Gg_kg_s, Tgi_C[, Ta_C]``."""
+    if isinstance(data, Batch):
+        return data
+    try:
+        cols = {k: np.array(data[k], dtype=np.float64) for k in ("time_s", "Gg_kg_s", "Tgi_C")}
+    except (KeyError, TypeError, ValueError) as exc:
+        raise InputError(f"inputs need time_s, Gg_kg_s and Tgi_C as numeric arrays ({exc})", name) from None
+    ta = None
+    try:
+        if "Ta_C" in data:
+            ta = np.array(data["Ta_C"], dtype=np.float64)
+    except TypeError:
+        pass
+    return Batch(name, cols["time_s"], cols["Gg_kg_s"], cols["Tgi_C"], ta).validate()
+
+
+def _plant_specific_initial(name: str, entry: dict) -> bool:
+    """An initial state fitted on the model's own plant (e.g. its drum start temperature)."""
+    return not REGISTRY[name].carries_over and entry.get("how", "").startswith("fitted")
+
+
+@dataclasses.dataclass
+class Applied:
+    """Batches with a model applied: the packed runs, the named values and what was noted."""
+
+    batches: list[Batch]
+    packed: object
+    names: list[str]
+    values: np.ndarray
+    plant: Plant
+    notes: list[str]
+
+
+class FittedModel:
+    """A fitted model (see module docstring). Build with :func:`load_model`, :func:`fit` or
+    :meth:`paper`; apply with :meth:`predict` / :meth:`validate`; store with :meth:`save`."""
+
+    def __init__(self, doc: dict):
+        self.doc = doc
+        plant = doc.get("plant")
+        self.plant: Plant | None = plant if isinstance(plant, Plant) else None
+        if isinstance(plant, str):  # an old THETA.json names its plant; presets resolve
+            try:
+                self.plant = load_plant(plant)
+            except InputError:
+                self.plant = None
+        self.parameters: dict = doc["parameters"]
+        self.initial: dict = doc.get("initial") or {}
+        self.moisture: str = doc.get("moisture", "schwartzberg")
+        self.hold: str = doc.get("hold", "linear")
+        m = doc.get("map")
+        self.column_map: ColumnMap | None = None if m is None else map_from_mapping(copy.deepcopy(m), "model file map")
+        self.source: str | None = doc.get("_source")
+
+    # ------------------------------------------------------------------ construction
+    @classmethod
+    def paper(cls, plant="120kg", theta=None) -> FittedModel:
+        """The paper's model: theta* (Table 1) and the initial state of section 5.1."""
+        th = THETA_PAPER if theta is None else (theta if isinstance(theta, Theta) else Theta(*theta))
+        return cls(
+            {
+                "plant": load_plant(plant),
+                "parameters": {
+                    k: {"value": v, "how": "fixed", "unit": THETA_UNITS[k]} for k, v in th.as_dict().items()
+                },
+                "initial": {k: {"how": "fixed", "value": v} for k, v in PAPER_INITIAL.items()}
+                | {"Ta0_C": {"how": "from log"}},
+                "provenance": {"roastlab": _version(), "note": "the paper's theta*; nothing fitted"},
+            }
+        )
+
+    @property
+    def theta(self) -> Theta:
+        return Theta(*(self.parameters[k]["value"] for k in THETA_NAMES))
+
+    @property
+    def values(self) -> dict[str, float]:
+        """Every parameter value the model applies (theta and the rest), by registry name."""
+        return {k: e["value"] for k, e in self.parameters.items()}
+
+    def with_values(self, **values) -> FittedModel:
+        """A copy with some values changed (registry names, e.g. ``hgm=0.02``, ``Tm0_C=150``)."""
+        doc = copy.deepcopy(self.doc)
+        for name, v in values.items():
+            if name in STATE0:
+                doc.setdefault("initial", {})[name] = {"how": "fixed", "value": float(v)}
+            elif name in REGISTRY:
+                doc["parameters"][name] = {**doc["parameters"].get(name, {}), "value": float(v), "how": "fixed"}
+            else:
+                raise ParameterError(f"unknown value {name!r} (allowed: {', '.join(REGISTRY)})")
+        return FittedModel(doc)
+
+    # ------------------------------------------------------------------ application
+    def _target_plant(self, plant) -> tuple[Plant, list[str]]:
+        if plant is None:
+            if self.plant is None:
+                raise InputError("the model file names no plant geometry: give the plant (--plant)", self.source)
+            return self.plant, []
+        target = load_plant(plant)
+        if self.plant is None or target == self.plant:
+            return target, []
+        kept = [k for k in self.parameters if REGISTRY[k].carries_over]
+        dropped = [k for k in self.parameters if not REGISTRY[k].carries_over]
+        dropped += [k for k, e in self.initial.items() if _plant_specific_initial(k, e)]
+        note = f"model fitted on plant {self.plant.name} applied to {target.name}: carried over {', '.join(kept)}"
+        note += f"; dropped plant-specific {', '.join(dropped)} (defaults used)" if dropped else ""
+        return target, [note]
+
+    def apply(self, batches, plant=None, **changes) -> Applied:
+        """Apply the model to batches: the one place where values meet data.
+
+        ``plant`` (a Plant, preset or PLANT.toml) moves the model to another plant: values
+        that carry over (theta, process constants) stay, plant-specific ones (a fitted gas
+        flow, metal mass, drum start temperature) are dropped and named in ``notes``.
+        ``changes`` override by name: any registry quantity (``hgm``, ``Kt``, ``Tm0_C`` ...),
+        ``Tgi_offset_C`` (added to the inlet temperature [degC]), ``Tgi_C`` / ``Gg_kg_s``
+        (replace an input by a value or an array) and ``batch_kg`` (green batch mass [kg]).
+        """
+        batches = [as_batch(b) for b in (batches if isinstance(batches, (list, tuple)) else [batches])]
+        if not batches:
+            raise InputError("no batches to apply the model to")
+        target, notes = self._target_plant(plant)
+        transfer = bool(notes)
+        params = {k: e["value"] for k, e in self.parameters.items() if not (transfer and not REGISTRY[k].carries_over)}
+        initial = {k: e for k, e in self.initial.items() if not (transfer and _plant_specific_initial(k, e))}
+        allowed = set(REGISTRY) | {"Tgi_offset_C", "Tgi_C", "Gg_kg_s", "batch_kg"}
+        unknown = sorted(set(changes) - allowed)
+        if unknown:
+            raise ParameterError(f"unknown change(s) {', '.join(unknown)} (allowed: {', '.join(sorted(allowed))})")
+        base = dict(PAPER_INITIAL)
+        per_batch: dict[str, dict[str, float]] = {}
+        for name, e in initial.items():
+            if e["how"] == "fitted per batch":
+                per_batch[name] = e["per_batch"]
+                base[name] = float(np.median(list(e["per_batch"].values())))
+            elif e.get("value") is not None:
+                base[name] = e["value"]
+        ready = []
+        for b in batches:
+            b = dataclasses.replace(b, initial=dict(b.initial))
+            for name, vals in per_batch.items():
+                if b.name in vals:
+                    b.initial[name] = vals[b.name]
+                elif name not in changes:
+                    notes.append(
+                        f"{b.name}: not in the fit set, {name} = {base[name]:.4g} (median of the fitted batches)"
+                    )
+            self._check_batch(b, params, target)
+            b = self._changed_inputs(b, changes)
+            ready.append(b)
+        for name in STATE0:
+            if name in changes:
+                for b in ready:
+                    b.initial[name] = float(changes[name])
+        for name in REGISTRY:
+            if name in changes and name not in STATE0:
+                params[name] = float(changes[name])
+        theta = Theta(*(params.pop(k) for k in THETA_NAMES))
+        fields = {k: base[k] for k in PAPER_INITIAL}
+        if "Ta0_C" in base:
+            fields["Ta0_C"] = base["Ta0_C"]
+        packed = pack_batches(ready, target, theta, InitialState(**fields), self.moisture, self.hold)
+        names = list(params)
+        values = np.array([[[params[k] for k in names]] * len(ready)]) if names else np.zeros((1, len(ready), 0))
+        return Applied(ready, packed, names, values, target, notes)
+
+    def _check_batch(self, b: Batch, params: dict, plant: Plant) -> None:
+        src = b.source or b.name
+        placeholder = bool(np.all(b.Gg_kg_s == PLACEHOLDER_GG_KG_S))
+        if "Gg_kg_s" in params and not placeholder:
+            raise InputError(
+                "the model fitted a constant gas flow (its map writes a 1 kg/s placeholder) but this batch has a "
+                f"logged Gg (first value {b.Gg_kg_s[0]:g} kg/s): read the log with the model's map",
+                src,
+            )
+        if "Gg_kg_s" not in params and placeholder and self.column_map is not None and self.column_map.identifies_flow:
+            raise InputError("the batch's gas flow is a 1 kg/s placeholder and the model has no fitted flow", src)
+        if b.Mb_kg and not plant.Mb_kg / 20 <= b.Mb_kg <= 5 * plant.Mb_kg:
+            raise InputError(
+                f"batch of {b.Mb_kg:g} kg on plant {plant.name} (nominal {plant.Mb_kg:g} kg): wrong plant for this log?",
+                src,
+            )
+
+    @staticmethod
+    def _changed_inputs(b: Batch, changes: dict) -> Batch:
+        n = b.n
+
+        def column(name, current):
+            v = np.asarray(changes[name], dtype=np.float64)
+            if v.ndim == 0:
+                return np.full(n, float(v))
+            if v.shape != (n,):
+                raise ParameterError(f"{name} has {v.size} values, the batch has {n} samples")
+            return v.copy()
+
+        Gg = column("Gg_kg_s", b.Gg_kg_s) if "Gg_kg_s" in changes else b.Gg_kg_s
+        Tgi = column("Tgi_C", b.Tgi_C) if "Tgi_C" in changes else b.Tgi_C
+        if "Tgi_offset_C" in changes:
+            Tgi = Tgi + float(changes["Tgi_offset_C"])
+        Mb = float(changes["batch_kg"]) if "batch_kg" in changes else b.Mb_kg
+        return dataclasses.replace(b, Gg_kg_s=Gg, Tgi_C=Tgi, Mb_kg=Mb).validate()
+
+    def simulate(self, applied: Applied) -> list[SimulationResult]:
+        """Run applied batches in one compiled population call; one result per batch."""
+        out = simulate_population(applied.packed, applied.names, applied.values)[0]
+        _, _, PP = run_arrays(applied.packed, applied.names, applied.values)
+        results = []
+        for i, b in enumerate(applied.batches):
+            n = b.n
+            p = PP[i].copy()
+            Gg = b.Gg_kg_s * p[P["Gg_scale"]]  # the flow as applied; the result's params then carry 1
+            p[P["Gg_scale"]] = 1.0
+            meta = {"notes": list(applied.notes), "plant": applied.plant.name}
+            res = SimulationResult(b.time_s.copy(), out[i, :n, :5].copy(), out[i, :n, 5].copy(), Gg, b.Tgi_C.copy(), p)
+            res.name, res.meta = b.name, meta
+            res.Ta_measured_C = None if b.Ta_C is None else b.Ta_C.copy()
+            bad = ~np.isfinite(res.states)
+            if bad.any():
+                i0 = int(np.argwhere(bad)[0][0])
+                raise InputError(
+                    f"the model could not be simulated past t = {b.time_s[max(i0 - 1, 0)]:g} s "
+                    "(non-finite state): check the inputs, initial state and values",
+                    b.source or b.name,
+                )
+            results.append(res)
+        return results
+
+    def predict(self, batch_or_inputs, plant=None, **changes) -> SimulationResult:
+        """Predict one batch (a Batch, a log path read with the model's map, or a mapping of arrays).
+
+        ``changes`` as in :meth:`apply`, e.g. ``predict(batch, Tgi_offset_C=20)`` for +20 degC.
+        """
+        if isinstance(batch_or_inputs, (str, Path)):
+            batch_or_inputs = load_log(batch_or_inputs, self.column_map)
+        return self.simulate(self.apply([batch_or_inputs], plant, **changes))[0]
+
+    def predict_many(self, batches, plant=None, **changes) -> list[SimulationResult]:
+        return self.simulate(self.apply(list(batches), plant, **changes))
+
+    def validate(self, batches, plant=None, **changes) -> ValidationResult:
+        """Predict batches with a measured Ta and score them (Table 2 metrics)."""
+        applied = self.apply(list(batches), plant, **changes)
+        for b in applied.batches:
+            if b.Ta_C is None:
+                raise InputError("no measured Ta_C: needed to validate", b.source or b.name)
+        results = self.simulate(applied)
+        out = score(results, applied.plant.name)
+        out.notes = applied.notes
+        return out
+
+    # ------------------------------------------------------------------ files and display
+    def to_document(self) -> dict:
+        doc = {k: v for k, v in self.doc.items() if not k.startswith("_")}
+        doc["plant"] = self.plant
+        return doc
+
+    def save(self, path) -> Path:
+        """Write the model file (``roastlab-model/1``) atomically."""
+        with Outputs() as out:
+            out.write_text(path, model_document_text(self.to_document()))
+        return Path(path)
+
+    def table(self) -> list[tuple[str, str, str, str, str]]:
+        """Rows (name, value, std. error, unit, how) of every value the model applies."""
+        rows = []
+        for name, e in self.parameters.items():
+            se = e.get("stderr")
+            rows.append(
+                (name, f"{e['value']:.5g}", "" if se is None else f"{se:.2g}", REGISTRY[name].unit, e.get("how", ""))
+            )
+        for name, e in self.initial.items():
+            if e["how"] == "fitted per batch":
+                vals = list(e["per_batch"].values())
+                value = f"{min(vals):.4g}..{max(vals):.4g}"
+            else:
+                value = "" if e.get("value") is None else f"{e['value']:.5g}"
+            rows.append((name, value, "", REGISTRY[name].unit, e["how"]))
+        return rows
+
+    def report(self) -> str:
+        """A text report of the model: plant, values with standard errors, fit figures, warnings."""
+        lines = [f"roastlab model on plant {self.plant.name if self.plant else '(none)'}"]
+        lines.append(f"{'name':<12}{'value':>14}{'std. error':>12}  {'unit':<11}how")
+        for r in self.table():
+            lines.append(f"{r[0]:<12}{r[1]:>14}{r[2]:>12}  {r[3]:<11}{r[4]}")
+        fit = self.doc.get("fit") or {}
+        if "SSR" in fit:
+            lines.append(f"summed SSR {fit['SSR']:.4g} °C² over {fit.get('n_residuals', '?')} samples")
+        avg = (self.doc.get("metrics") or {}).get("average")
+        if avg:
+            lines.append(f"fit set: FIT {avg['FIT']:.2f} %, MAE {avg['MAE']:.3f} °C, MAPE {avg['MAPE']:.3f} %")
+        lines += [f"warning: {w}" for w in fit.get("warnings", [])]
+        return "\n".join(lines)
+
+    def __repr__(self) -> str:
+        th = self.theta
+        name = self.plant.name if self.plant else "no plant"
+        extra = [k for k in self.parameters if k not in THETA_NAMES]
+        more = f", +{', '.join(extra)}" if extra else ""
+        return f"<FittedModel {name}: hgm={th.hgm:.4g}, hbm={th.hbm:.4g}, Pbm={th.Pbm:.4g}{more}>"
+
+    def _repr_html_(self) -> str:
+        head = "".join(f"<th>{h}</th>" for h in ("name", "value", "std. error", "unit", "how"))
+        body = "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in r) + "</tr>" for r in self.table())
+        title = html.escape(repr(self))
+        return f"<p>{title}</p><table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+
+
+def load_model(path) -> FittedModel:
+    """Read a model file (or a THETA.json of roastlab 0.1)."""
+    doc = read_model_document(path)
+    doc["_source"] = str(path)
+    return FittedModel(doc)
+
+
+def load_log(path, map=None, name: str | None = None) -> Batch:  # noqa: A002 - the user-facing word
+    """Read a roast log into a batch: a batch CSV as is, anything else through a column map.
+
+    ``map`` is a MAP.toml path, a :class:`~roastlab.io.importers.mapping.ColumnMap` or None.
+    """
+    from ..io.batch import read_batch_csv
+    from ..io.importers import import_log, load_map
+
+    if map is None:
+        return read_batch_csv(path, name=name)
+    cmap = map if isinstance(map, ColumnMap) else load_map(map)
+    return import_log(path, cmap, name=name)
+
+
+def provenance(roles: dict[str, list]) -> dict:
+    """Provenance of a fit: version, date and every input file with its SHA-256."""
+    inputs = []
+    for role, paths in roles.items():
+        for p in paths:
+            if p:
+                inputs.append({"role": role, "path": str(p), "sha256": input_digest(p)})
+    return {
+        "roastlab": _version(),
+        "created": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
+        "inputs": inputs,
+    }
