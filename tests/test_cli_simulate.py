@@ -100,7 +100,7 @@ def test_plant_command_prints_derived(cli):
         (HEADER + "0,0.4,450,30\n30,abc,450,30\n", "line 3, column Gg_kg_s: not a number"),
         (HEADER + "0,0.4,450,30\n30,nan,450,30\n", "NaN"),
         (HEADER + "0,0.4,450,30\n0,0.4,450,30\n", "time not strictly increasing"),
-        (HEADER + "0,0.4,450,30\n30,0,450,30\n", "gas flow must be > 0"),
+        (HEADER + "0,0.4,450,30\n30,0,450,30\n", "Gg_kg_s (inlet gas mass flow) = 0 kg/s outside"),
         (HEADER + "0,0.4,450,30\n30,0.4\n", "truncated"),
     ],
 )

@@ -42,6 +42,9 @@ def test_recovers_noise_free_truth(seed, plant):
     fit = identify(packed, free, fixed, seed=seed)
     truth_ssr = 0.0  # the data are the model's output at the truth
     assert fit.SSR <= truth_ssr * (1 + 1e-6) + 1e-6
+    # and the identified values are the truth (to the integrator's noise)
+    for name, true_value in zip(("hgm", "hbm", "Pbm"), truth):
+        assert fit.values[name] == pytest.approx(true_value, rel=2e-3), name
     ta = predict_ta(packed, ["hgm", "hbm", "Pbm"], np.array([[list(fit.theta.as_tuple())] * len(batches)]))[0]
     for i, b in enumerate(batches):
         assert batch_metrics(b.Ta_C, ta[i, : b.n])["FIT"] >= 99.5
@@ -116,3 +119,22 @@ def test_inverted_bounds_rejected():
 
     with pytest.raises(ParameterError, match="inverted"):
         build_free_parameters(bounds={"hbm": (0.3, 0.1)})
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2, 3])
+def test_standard_errors_cover_the_truth(seed):
+    """As lmfit's NIST tests: noisy data from a known theta; the estimate lies within 3 reported
+    standard errors of the truth for every parameter (3 sigma: a linearised error that is too
+    small by half fails this on these seeds; measured |z| <= 1.8)."""
+    truth = (0.03, 0.05, 0.65)
+    batches = noise_free_batches(seed, "120kg", truth, count=5)
+    rng = np.random.default_rng(seed)
+    for b in batches:
+        b.Ta_C = b.Ta_C + rng.normal(0.0, 1.0, b.n)  # a 1 degC probe noise
+    packed = pack_batches(batches, "120kg", THETA_START, InitialState(Ta0_C=30.0))
+    free, fixed = build_free_parameters()
+    fit = identify(packed, free, fixed, seed=0)
+    for name, true_value in zip(("hgm", "hbm", "Pbm"), truth):
+        se = fit.stderr[name]
+        assert se is not None and se > 0, name
+        assert abs(fit.values[name] - true_value) <= 3.0 * se, (name, fit.values[name], true_value, se)

@@ -9,9 +9,12 @@ from pathlib import Path
 README = Path(__file__).resolve().parents[1] / "README.md"
 
 
+def _blocks():
+    return re.findall(r"```python\n(.*?)```", README.read_text(), re.S)
+
+
 def test_readme_python_example(tmp_path):
-    text = README.read_text()
-    block = re.search(r"```python\n(.*?)```", text, re.S).group(1)
+    block = _blocks()[0]
     assert len([ln for ln in block.splitlines() if ln.strip()]) <= 6
     out = io.StringIO()
     cwd = os.getcwd()
@@ -26,6 +29,19 @@ def test_readme_python_example(tmp_path):
     assert (tmp_path / "batch.png").exists()
 
 
-def test_readme_names_both_setup_commands():
-    text = README.read_text()
-    assert "make reproduce" in text and "make test" in text
+def test_readme_api_example(tmp_path):
+    """The fit / save / load / predict / validate example runs and its what-if moves BT up."""
+    block = _blocks()[1]
+    out = io.StringIO()
+    cwd = os.getcwd()
+    os.chdir(tmp_path)  # the example saves model.json
+    try:
+        with contextlib.redirect_stdout(out):
+            exec(compile(block, "README.md", "exec"), {})  # our own README, not user input
+    finally:
+        os.chdir(cwd)
+    lines = out.getvalue().splitlines()
+    assert (tmp_path / "model.json").exists() and "std. error" in out.getvalue()
+    delta = float(lines[-2])
+    assert 0.0 < delta < 20.0  # a hotter ET heats the beans, by less than the ET change
+    assert lines[-1].startswith("<ValidationResult 2 batch(es) on 360kg")

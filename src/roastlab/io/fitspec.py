@@ -23,11 +23,13 @@ k1, k2, Kt, lam``, the metal mass ``Mm``, the gas flow ``Gg_kg_s``, and initial 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import InputError, ParameterError
-from ..model.parameters import FREE_NAMES, STATE0, THETA_NAMES, THETA_PAPER, FreeParameter
+from ..model.limits import LIMITS, check_value
+from ..model.parameters import FREE_NAMES, REGISTRY, STATE0, THETA_NAMES, THETA_PAPER, FreeParameter
 from .files import read_toml
 
 ALLOWED = FREE_NAMES
@@ -43,12 +45,31 @@ class FitSpec:
 
 
 def _num(v, src, where) -> float:
-    if isinstance(v, bool) or not isinstance(v, (int, float)) or v != v:
-        raise InputError(f"must be a number, got {v!r}", src, where)
-    return float(v)
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        raise InputError(f"must be a number, got {str(v)[:40]!r}", src, where)
+    try:
+        x = float(v)
+    except OverflowError:
+        raise InputError("number out of range", src, where) from None
+    if not math.isfinite(x):
+        raise InputError(f"must be finite, got {x}", src, where)
+    return x
+
+
+def _checked(name: str, value: float, path, where) -> float:
+    """A fixed or initial value inside its plausible range (process constants: > 0)."""
+    if name in LIMITS:
+        try:
+            return check_value(name, value)
+        except ParameterError as exc:
+            raise ParameterError(exc.problem, path, where) from None
+    if REGISTRY[name].kind != "theta" and not value > 0:
+        raise ParameterError(f"must be > 0 {REGISTRY[name].unit}, got {value:g}", path, where)
+    return value
 
 
 def load_fit_spec(path: str | Path) -> FitSpec:
+    """Read and check the fit spec at ``path`` (see the module docstring for the format)."""
     path = Path(path)
     data = read_toml(path)
     unknown = sorted(set(data) - {"free", "fixed", "initial", "description", "notes"})
@@ -87,7 +108,7 @@ def load_fit_spec(path: str | Path) -> FitSpec:
     for name, v in (data.get("fixed") or {}).items():
         if name not in ALLOWED:
             raise InputError(f"unknown parameter (allowed: {', '.join(ALLOWED)})", path, f"fixed.{name}")
-        fixed[name] = _num(v, path, f"fixed.{name}")
+        fixed[name] = _checked(name, _num(v, path, f"fixed.{name}"), path, f"fixed.{name}")
     names_free = {f.name for f in free}
     both = names_free & set(fixed)
     if both:
@@ -99,5 +120,5 @@ def load_fit_spec(path: str | Path) -> FitSpec:
     for name, v in (data.get("initial") or {}).items():
         if name not in INITIAL_NAMES:
             raise InputError(f"unknown initial state (allowed: {', '.join(INITIAL_NAMES)})", path, f"initial.{name}")
-        initial[name] = _num(v, path, f"initial.{name}")
+        initial[name] = _checked(name, _num(v, path, f"initial.{name}"), path, f"initial.{name}")
     return FitSpec(free, fixed, initial, str(path))

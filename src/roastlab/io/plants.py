@@ -9,7 +9,7 @@ from .files import read_toml
 
 
 def load_plant(spec: str | Path | Plant) -> Plant:
-    """Load a plant by preset name (``"120kg"``, ``"360kg"``) or from a TOML path.
+    """Load a plant: ``spec`` is a preset name (``"120kg"``, ``"360kg"``), a TOML path or a Plant.
 
     >>> round(load_plant("360kg").Agm_m2, 1)
     54.4

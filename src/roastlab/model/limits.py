@@ -69,5 +69,5 @@ def check_array(name: str, values, source: str | None = None, where: str | None 
         raise ParameterError(
             f"{name} ({meaning}) = {a[i]:g} {unit} outside the plausible range {lo:g}..{hi:g} {unit}",
             source,
-            where or f"row {i + 1}",
+            where or f"row {i + 1}, column {name}",
         )

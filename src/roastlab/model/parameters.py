@@ -168,5 +168,12 @@ class FreeParameter:
             raise ParameterError(f"bounds of {self.name} must be finite: {self.lower:g}:{self.upper:g}")
         if not self.lower < self.upper:
             raise ParameterError(f"bounds of {self.name} inverted or empty: {self.lower:g}:{self.upper:g}")
+        from .limits import LIMITS, check_value
+
+        if self.name in LIMITS:
+            check_value(self.name, self.lower)
+            check_value(self.name, self.upper)
+        elif REGISTRY[self.name].kind != "theta" and not self.lower > 0:
+            raise ParameterError(f"{self.name} must stay > 0 {REGISTRY[self.name].unit}: lower bound {self.lower:g}")
         if not self.lower <= self.start <= self.upper:
             self.start = min(max(self.start, self.lower), self.upper)

@@ -103,11 +103,11 @@ class Plant:
         return bean_areas_m2(self.Ab_m2, Pbm)[1]
 
     def Mbd_kg(self, X0: float) -> float:
-        """Dry batch mass Mb / (1 + X(0)) [kg], fixed for the batch (section 3.6)."""
+        """Dry batch mass Mb / (1 + X0) [kg] at initial moisture ``X0`` [kg/kg] (section 3.6)."""
         return dry_mass_kg(self.Mb_kg, X0)
 
     def F(self, hgm: float, Pbm: float, X: float) -> float:
-        """Ratio of gas-metal to gas-bean conductances, hgm Agm / (he Agb) [-] (eq. 6)."""
+        """F = hgm Agm / (he(X) Agb(Pbm)) [-] (eq. 6) for ``hgm`` [kW/(m2 K)], ``Pbm`` [-], moisture ``X``."""
         he = bean_heat_transfer_coefficient_kW_m2K(X)
         return conductance_ratio_F(hgm, self.Agm_m2, he, self.Agb_m2(Pbm))
 
@@ -115,7 +115,10 @@ class Plant:
         return {key: float(getattr(self, key)) for key in GEOMETRY_KEYS}
 
     def describe(self, hgm: float, hbm: float, Pbm: float, X0: float = 0.1) -> list[tuple[str, float, str, str]]:
-        """Rows (symbol, value, unit, meaning) of geometry and derived quantities."""
+        """Rows (symbol, value, unit, meaning) of geometry and derived quantities.
+
+        F uses ``hgm``, ``Pbm`` and moisture ``X0``; ``hbm`` is accepted for symmetry with theta.
+        """
         rows = []
         for key in GEOMETRY_KEYS:
             symbol, unit = key.rsplit("_", 1)

@@ -10,6 +10,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..errors import ParameterError
+from ..model.limits import check_array, check_value
 from ..model.rhs import STATE_NAMES, heat_flows, pack_params, reaction_heat_rate_kW_kg
 from .kernels import H_MAX_S, simulate_one, step_kernel
 
@@ -30,12 +32,12 @@ class InitialState:
     Ta0_C: float | None = None
 
     def vector(self, Ta_measured0: float | None = None) -> np.ndarray:
+        """The state vector [Tb, Tm, X, He, Ta]; Ta from ``Ta_measured0`` (the log's first reading) if set."""
         Ta0 = self.Ta0_C if self.Ta0_C is not None else (Ta_measured0 if Ta_measured0 is not None else self.Tb0_C)
         return np.array([self.Tb0_C, self.Tm0_C, self.X0, self.He0_kJ_kg, Ta0], dtype=np.float64)
 
 
 def check_hold(hold: str) -> bool:
-    from ..errors import ParameterError
     from ..model.constants import INPUT_HOLDS
 
     if hold not in INPUT_HOLDS:
@@ -99,7 +101,7 @@ class SimulationResult:
         return {"Qgb_kW": q[:, 0], "Qgm_kW": q[:, 1], "Qbm_kW": q[:, 2], "Qr_kW": q[:, 3]}
 
     def to_frame(self, heat_flows: bool = False):
-        """A pandas DataFrame with time, states, Tgo (and heat flows on request)."""
+        """A pandas DataFrame with time, states, Tgo (and the heat flows if ``heat_flows``)."""
         import pandas as pd
 
         data = {"time_s": self.time_s}
@@ -111,11 +113,11 @@ class SimulationResult:
         return pd.DataFrame(data)
 
     def to_csv_text(self, heat_flows: bool = False) -> str:
-        """The CSV of the CLI contract as text (6 decimals)."""
+        """The CSV of the CLI contract as text (6 decimals); ``heat_flows`` adds Qgb, Qgm, Qbm, Qr."""
         return self.to_frame(heat_flows=heat_flows).to_csv(index=False, float_format="%.6f", lineterminator="\n")
 
     def to_json_text(self, heat_flows: bool = False) -> str:
-        """A JSON object of column arrays as text."""
+        """A JSON object of column arrays as text; ``heat_flows`` adds the heat flows."""
         import json
 
         frame = self.to_frame(heat_flows=heat_flows)
@@ -123,19 +125,19 @@ class SimulationResult:
         return json.dumps(payload, indent=1, allow_nan=False) + "\n"
 
     def to_csv(self, path, heat_flows: bool = False) -> None:
-        """Write the CSV of the CLI contract (atomically)."""
+        """Write the CSV of the CLI contract to ``path`` atomically (``heat_flows`` as in :meth:`to_csv_text`)."""
         from ..io.files import atomic_write_text
 
         atomic_write_text(path, self.to_csv_text(heat_flows))
 
     def to_json(self, path, heat_flows: bool = False) -> None:
-        """Write a JSON object of column arrays (atomically)."""
+        """Write a JSON object of column arrays to ``path`` atomically (``heat_flows`` adds the heat flows)."""
         from ..io.files import atomic_write_text
 
         atomic_write_text(path, self.to_json_text(heat_flows))
 
     def plot(self, path=None, title: str | None = None):
-        """Figure of temperatures, moisture and heat flows; saved to ``path`` if given."""
+        """Figure of BT/ET, rate of rise, moisture and heat flows, titled ``title``; saved to ``path`` if given."""
         from ..report.figures import plot_simulation
 
         return plot_simulation(self, path=path, title=title)
@@ -182,14 +184,49 @@ def simulate(
     theta = THETA_PAPER if theta is None else theta
     initial = initial or InitialState()
     zoh = check_hold(hold)
-    t = np.ascontiguousarray(time_s, dtype=np.float64)
-    g = np.ascontiguousarray(Gg_kg_s, dtype=np.float64)
-    T = np.ascontiguousarray(Tgi_C, dtype=np.float64)
-    Ta_meas = None if Ta_measured_C is None else np.asarray(Ta_measured_C, dtype=np.float64)
+    t, g, T = (_input_array(n, v) for n, v in (("time_s", time_s), ("Gg_kg_s", Gg_kg_s), ("Tgi_C", Tgi_C)))
+    Ta_meas = None if Ta_measured_C is None else _input_array("Ta_C", Ta_measured_C)
+    for label, arr in (("Gg_kg_s", g), ("Tgi_C", T)) + ((("Ta_C", Ta_meas),) if Ta_meas is not None else ()):
+        if arr.shape != t.shape:
+            raise ParameterError(
+                f"{label} has {arr.size} values, time_s has {t.size}: inputs must have one value per time"
+            )
+    if t.size < 2:
+        raise ParameterError(f"need at least 2 time samples, got {t.size}")
+    check_array("dt_s", np.diff(t), "simulate()", "time_s")
+    check_value_h = check_value("dt_s", h_max_s, "h_max_s")
     x0 = initial.vector(None if Ta_meas is None else float(Ta_meas[0]))
+    _check_initial(x0)
     p = pack_params(plant, theta, initial.X0, moisture)
-    out = simulate_one(t, g, T, x0, p, zoh, float(h_max_s))
+    out = simulate_one(t, g, T, x0, p, zoh, check_value_h)
+    _check_finite(out, t)
     return SimulationResult(t, out[:, :5].copy(), out[:, 5].copy(), g, T, p, name, Ta_meas)
+
+
+def _input_array(name: str, values) -> np.ndarray:
+    """A private float64 copy of an input, every value finite and plausible (LIMITS)."""
+    try:
+        a = np.array(values, dtype=np.float64).reshape(-1) if np.ndim(values) <= 1 else None
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name} must be numbers") from None
+    if a is None:
+        raise ParameterError(f"{name} must be one-dimensional")
+    check_array(name, a, "simulate()", name)
+    return a
+
+
+def _check_initial(x0: np.ndarray) -> None:
+    for name, v in zip(("Tb0_C", "Tm0_C", "X0", "He0_kJ_kg", "Ta0_C"), x0):
+        check_value(name, v, "initial state")
+
+
+def _check_finite(out: np.ndarray, t: np.ndarray) -> None:
+    bad = ~np.isfinite(out[:, :5])
+    if bad.any():
+        i = int(np.argwhere(bad)[0][0])
+        raise ParameterError(
+            f"the simulation went non-finite after t = {t[max(i - 1, 0)]:g} s: inputs, initial state or values out of the model's range"
+        )
 
 
 class Simulator:
@@ -225,6 +262,7 @@ class Simulator:
         self.zoh = check_hold(hold)
         self.h_max_s = float(h_max_s)
         self.x = self.initial.vector()
+        _check_initial(self.x)
         self.t_s = 0.0
         self.Tgo_C = float("nan")
         self._h = 5.0  # the integrator's step size carries over, so stepping equals a batch run
@@ -237,10 +275,16 @@ class Simulator:
 
     def step(self, dt_s: float, Gg_kg_s: float, Tgi_C: float) -> np.ndarray:
         """Advance by ``dt_s`` seconds; return the new state vector."""
+        dt_s = check_value("dt_s", dt_s, "Simulator.step")
+        Gg_kg_s = check_value("Gg_kg_s", Gg_kg_s, "Simulator.step")
+        Tgi_C = check_value("Tgi_C", Tgi_C, "Simulator.step")
         g0, T0 = self._u_prev if (self._u_prev and not self.zoh) else (Gg_kg_s, Tgi_C)
-        self.x, self.Tgo_C, self._h = step_kernel(
-            self.x, g0, T0, Gg_kg_s, Tgi_C, float(dt_s), self.params, self.zoh, self.h_max_s, self._h
-        )
+        x, Tgo, h = step_kernel(self.x, g0, T0, Gg_kg_s, Tgi_C, dt_s, self.params, self.zoh, self.h_max_s, self._h)
+        if not np.all(np.isfinite(x)):
+            raise ParameterError(
+                f"the simulation went non-finite at t = {self.t_s + dt_s:g} s (state kept at {self.t_s:g} s)"
+            )
+        self.x, self.Tgo_C, self._h = x, Tgo, h
         self._u_prev = (Gg_kg_s, Tgi_C)
         self.t_s += dt_s
         return self.x.copy()

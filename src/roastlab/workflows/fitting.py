@@ -72,6 +72,7 @@ class FitResult:
         return pd.DataFrame(self.model.table(), columns=["name", "value", "stderr", "unit", "how"]).set_index("name")
 
     def plot(self, path=None, title=None):
+        """Fit-set figure (measured vs predicted BT, residuals); saved to ``path`` if given, titled ``title``."""
         return self.validation.plot(path, title or "fit set: measured vs predicted BT")
 
     def __repr__(self) -> str:

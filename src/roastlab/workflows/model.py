@@ -86,7 +86,13 @@ class Applied:
 
 class FittedModel:
     """A fitted model (see module docstring). Build with :func:`load_model`, :func:`fit` or
-    :meth:`paper`; apply with :meth:`predict` / :meth:`validate`; store with :meth:`save`."""
+    :meth:`paper`; apply with :meth:`predict` / :meth:`validate`; store with :meth:`save`.
+
+    Parameters
+    ----------
+    doc : dict
+        A checked ``roastlab-model/1`` mapping (:func:`roastlab.io.modelfile.read_model_document`).
+    """
 
     def __init__(self, doc: dict):
         self.doc = doc
@@ -279,19 +285,26 @@ class FittedModel:
         return results
 
     def predict(self, batch_or_inputs, plant=None, **changes) -> SimulationResult:
-        """Predict one batch (a Batch, a log path read with the model's map, or a mapping of arrays).
+        """Predict one batch.
 
-        ``changes`` as in :meth:`apply`, e.g. ``predict(batch, Tgi_offset_C=20)`` for +20 degC.
+        ``batch_or_inputs`` is a Batch, a log path (read with the model's map) or a mapping of
+        arrays ``time_s, Gg_kg_s, Tgi_C[, Ta_C]``; ``plant`` moves the model to another plant
+        and ``changes`` are as in :meth:`apply`, e.g. ``predict(batch, Tgi_offset_C=20)``.
         """
         if isinstance(batch_or_inputs, (str, Path)):
             batch_or_inputs = load_log(batch_or_inputs, self.column_map)
         return self.simulate(self.apply([batch_or_inputs], plant, **changes))[0]
 
     def predict_many(self, batches, plant=None, **changes) -> list[SimulationResult]:
+        """Predict several ``batches`` in one compiled call (``plant``, ``changes`` as in :meth:`apply`)."""
         return self.simulate(self.apply(list(batches), plant, **changes))
 
     def validate(self, batches, plant=None, **changes) -> ValidationResult:
-        """Predict batches with a measured Ta and score them (Table 2 metrics)."""
+        """Predict ``batches`` with a measured Ta and score them (Table 2 metrics).
+
+        ``plant`` and ``changes`` as in :meth:`apply` (the paper's validation moves a 120 kg
+        model to the 360 kg plant with ``plant="360kg"``).
+        """
         applied = self.apply(list(batches), plant, **changes)
         for b in applied.batches:
             if b.Ta_C is None:
@@ -308,7 +321,7 @@ class FittedModel:
         return doc
 
     def save(self, path) -> Path:
-        """Write the model file (``roastlab-model/1``) atomically."""
+        """Write the model file (``roastlab-model/1``) to ``path`` atomically."""
         with Outputs() as out:
             out.write_text(path, model_document_text(self.to_document()))
         return Path(path)
@@ -360,7 +373,7 @@ class FittedModel:
 
 
 def load_model(path) -> FittedModel:
-    """Read a model file (or a THETA.json of roastlab 0.1)."""
+    """Read the model file at ``path`` (or a THETA.json of roastlab 0.1)."""
     doc = read_model_document(path)
     doc["_source"] = str(path)
     return FittedModel(doc)
@@ -369,7 +382,8 @@ def load_model(path) -> FittedModel:
 def load_log(path, map=None, name: str | None = None) -> Batch:  # noqa: A002 - the user-facing word
     """Read a roast log into a batch: a batch CSV as is, anything else through a column map.
 
-    ``map`` is a MAP.toml path, a :class:`~roastlab.io.importers.mapping.ColumnMap` or None.
+    ``path`` is the log, ``map`` a MAP.toml path, a :class:`~roastlab.io.importers.mapping.ColumnMap`
+    or None (a batch CSV), ``name`` the batch name (default: the file name).
     """
     from ..io.batch import read_batch_csv
     from ..io.importers import import_log, load_map

@@ -1,0 +1,157 @@
+"""The fitted-model object and file: one application path for every command and the Python API."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import roastlab
+from roastlab.io.batch import Batch
+
+EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "skywalker"
+DATA = roastlab.default_dataset_root()
+
+
+@pytest.fixture(scope="module")
+def sky_model(tmp_path_factory):
+    """A model fitted on two Skywalker logs with the example's map and spec (what a user runs)."""
+    from conftest import REAL_DATA
+
+    folder = REAL_DATA / "skywalker"
+    if not folder.is_dir():
+        pytest.skip("../shared/data/real is absent")
+    logs = sorted(folder.glob("*.alog"))
+    batches = [roastlab.load_log(p, EXAMPLE / "map.toml") for p in logs[0:4:2]]
+    from roastlab.io.importers import load_map
+
+    result = roastlab.fit(
+        batches, EXAMPLE / "plant.toml", EXAMPLE / "fit.toml", column_map=load_map(EXAMPLE / "map.toml"), starts=2
+    )
+    path = tmp_path_factory.mktemp("model") / "sky.json"
+    result.model.save(path)
+    return path, logs[1]
+
+
+def test_whatif_is_the_same_through_every_path(cli, sky_model, tmp_path):
+    """simulate --model, validate --model --predictions and model.predict agree to 1e-6 degC."""
+    model_path, log = sky_model
+    batch_csv = tmp_path / "b.csv"
+    assert cli("import", log, "--map", EXAMPLE / "map.toml", "--out", batch_csv)[0] == 0
+    model = roastlab.load_model(model_path)
+    batch = roastlab.load_log(batch_csv)
+    for offset in (0.0, 20.0):
+        sim_out, pred_dir = tmp_path / f"sim{offset:g}.csv", tmp_path / f"pred{offset:g}"
+        pred_dir.mkdir()
+        args = ("--model", model_path, "--tgi-offset", offset)
+        assert cli("simulate", *args, "--inputs", batch_csv, "--out", sim_out)[0] == 0
+        code, _, err = cli("validate", *args, batch_csv, "--predictions", pred_dir)
+        assert code == 0, err
+        api = model.predict(batch, Tgi_offset_C=offset).Ta_C
+        via_sim = pd.read_csv(sim_out)["Ta_C"].to_numpy()
+        via_val = pd.read_csv(pred_dir / "b.csv")["Ta_pred_C"].to_numpy()
+        # the CSVs carry 6 decimals: 5e-7 of rounding is the whole allowed difference
+        assert np.max(np.abs(via_sim - api)) <= 1e-6 and np.max(np.abs(via_val - api)) <= 1e-6
+    # the raw log through the model's own map gives the same curve as its imported CSV (4 decimals)
+    raw = model.predict(log).Ta_C
+    assert np.max(np.abs(raw - model.predict(batch).Ta_C)) < 1e-3
+
+
+def test_fit_prediction_equals_identification(sky_model):
+    """The model file, applied by FittedModel, reproduces the identification's own SSR."""
+    model_path, _ = sky_model
+    model = roastlab.load_model(model_path)
+    doc = json.loads(model_path.read_text())
+    logs = [Path(i["path"]) for i in doc["provenance"]["inputs"] if i["role"] == "batch"]
+    val = model.validate([roastlab.load_log(p, model.column_map) for p in logs])
+    ssr = sum(r["SSR"] for r in val.rows)
+    assert ssr == pytest.approx(doc["fit"]["SSR"], rel=1e-9)
+
+
+def test_model_file_round_trip_and_contents(tmp_path):
+    ds = roastlab.read_dataset(DATA / "dataset-I")
+    result = roastlab.fit(ds.batches[:2], "120kg", estimate_tm0=True, seed=1, starts=2)
+    path = result.model.save(tmp_path / "m.json")
+    doc = json.loads(path.read_text())
+    assert doc["format"] == "roastlab-model/1" and doc["plant"]["Dch_m"] == 1.24
+    assert doc["initial"]["Tm0_C"]["how"] == "fitted per batch" and set(doc["initial"]["Tm0_C"]["per_batch"]) == {
+        "batch1",
+        "batch2",
+    }
+    again = roastlab.load_model(path)
+    a = result.model.predict(ds.batches[0]).Ta_C
+    assert np.array_equal(a, again.predict(ds.batches[0]).Ta_C)
+    # a batch not in the fit set takes the median fitted Tm0 and says so
+    r = again.predict(ds.batches[3])
+    assert any("not in the fit set" in n for n in r.meta["notes"])
+
+
+def test_legacy_theta_json_loads(tmp_path):
+    old = tmp_path / "theta.json"
+    old.write_text(json.dumps({"hgm": 0.02, "hbm": 0.03, "Pbm": 0.6, "SSR": 1.0, "plant": "120kg"}))
+    m = roastlab.load_model(old)
+    assert m.theta.as_tuple() == (0.02, 0.03, 0.6) and m.plant.name == "120kg"
+
+
+@pytest.mark.parametrize(
+    "content, needle",
+    [
+        ({"baseline": "first-order", "tau_s": 100.0, "offset_C": 0.0}, "--baseline first-order"),
+        ({"mode": "per-batch", "batches": []}, "not a model"),
+        ({"format": "roastlab-model/9"}, "unknown model format"),
+    ],
+)
+def test_wrong_kind_of_file_says_what_it_is(tmp_path, content, needle):
+    f = tmp_path / "x.json"
+    f.write_text(json.dumps(content))
+    with pytest.raises(roastlab.InputError, match=needle.replace("-", r"\-")):
+        roastlab.load_model(f)
+
+
+def test_transfer_to_another_plant_names_what_carried_over():
+    ds = roastlab.read_dataset(DATA / "dataset-I")
+    result = roastlab.fit(ds.batches[:2], "120kg", estimate_tm0=True, seed=0, starts=2)
+    v = result.model.validate(roastlab.read_dataset(DATA / "dataset-V").batches, plant="360kg")
+    (note,) = [n for n in v.notes if "applied to 360kg" in n]
+    assert "carried over hgm, hbm, Pbm" in note and "dropped plant-specific Tm0_C" in note
+
+
+def test_results_display_and_plot_without_pyplot():
+    import matplotlib.pyplot as plt
+
+    ds = roastlab.read_dataset(DATA / "dataset-I")
+    result = roastlab.fit(ds.batches[:2], "120kg", seed=0, starts=2)
+    assert repr(result).startswith("<FitResult <FittedModel 120kg") and "<table>" in result._repr_html_()
+    assert "hgm" in result.report() and "std. error" in result.report()
+    before = plt.get_fignums()
+    fig = result.plot()
+    sim_fig = result.model.predict(ds.batches[0]).plot()
+    assert plt.get_fignums() == before  # not registered: Jupyter shows it once
+    assert len(fig.axes) == 4 and len(sim_fig.axes) == 4
+    frame = result.validation.to_frame()
+    assert list(frame.index) == ["batch1", "batch2"] and "FIT" in frame
+
+
+def test_progress_is_a_callback_and_the_library_never_prints(capsys):
+    ds = roastlab.read_dataset(DATA / "dataset-I")
+    calls = []
+    roastlab.fit(ds.batches[:1], "120kg", seed=0, starts=2, progress=lambda *a: calls.append(a))
+    assert calls and calls[-1][0] == calls[-1][1]
+    out = capsys.readouterr()
+    assert out.out == "" and out.err == ""
+
+
+def test_unknown_change_is_refused():
+    m = roastlab.FittedModel.paper("120kg")
+    t = np.arange(0, 301, 30.0)
+    b = Batch("b", t, np.full_like(t, 0.4), np.full_like(t, 450.0))
+    with pytest.raises(roastlab.ParameterError, match="unknown change"):
+        m.predict(b, heater=3)
+
+
+def test_placeholder_flow_without_a_spec_is_refused():
+    t = np.arange(0, 301, 30.0)
+    b = Batch("b", t, np.ones_like(t), np.full_like(t, 450.0), np.linspace(30, 150, len(t)))
+    with pytest.raises(roastlab.InputError, match="placeholder"):
+        roastlab.fit([b], "120kg")

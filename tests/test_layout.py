@@ -1,0 +1,128 @@
+"""The architecture as a test: imports point one way, privates stay home, arguments are documented.
+
+Layers, lowest first: errors -> model -> io -> report -> sim -> evaluate -> fit -> workflows -> apps.
+A module may import from its own subpackage and from lower layers only, and never a private
+(underscore) name from another subpackage. Imports inside functions count too.
+"""
+
+import ast
+import inspect
+import re
+from pathlib import Path
+
+import pytest
+
+import roastlab
+
+SRC = Path(roastlab.__file__).parent
+LAYERS = ["errors", "model", "io", "report", "sim", "evaluate", "fit", "workflows", "apps"]
+RANK = {name: i for i, name in enumerate(LAYERS)}
+
+
+def _modules():
+    for path in sorted(SRC.rglob("*.py")):
+        rel = path.relative_to(SRC)
+        if rel.parts[0] in ("__init__.py", "__main__.py"):
+            continue
+        yield path, rel.parts[0].removesuffix(".py")
+
+
+def _imports(path: Path):
+    """(line, target subpackage, imported names) for every roastlab import in a file."""
+    tree = ast.parse(path.read_text())
+    pkg_parts = ("roastlab",) + path.relative_to(SRC).parent.parts
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = pkg_parts[: len(pkg_parts) - node.level + 1]
+                full = list(base) + (node.module.split(".") if node.module else [])
+            elif node.module and node.module.startswith("roastlab"):
+                full = node.module.split(".")
+            else:
+                continue
+            target = full[1] if len(full) > 1 else None
+            names = [a.name for a in node.names]
+            if target is None:  # "from .. import x": x is the subpackage
+                for n in names:
+                    yield node.lineno, n, []
+            else:
+                yield node.lineno, target, names
+        elif isinstance(node, ast.Import):
+            for a in node.names:
+                parts = a.name.split(".")
+                if parts[0] == "roastlab" and len(parts) > 1:
+                    yield node.lineno, parts[1], []
+
+
+def violations():
+    out = []
+    for path, layer in _modules():
+        for line, target, names in _imports(path):
+            if target == "__version__" or target == layer:
+                continue
+            if target not in RANK:
+                out.append(f"{path.relative_to(SRC)}:{line} imports unknown roastlab.{target}")
+            elif RANK[target] > RANK[layer]:
+                out.append(f"{path.relative_to(SRC)}:{line}: {layer} imports upward from {target}")
+            for n in names:
+                if n.startswith("_"):
+                    out.append(f"{path.relative_to(SRC)}:{line}: private {n} imported from {target}")
+    return out
+
+
+def test_imports_point_one_way_and_privates_stay_home():
+    assert violations() == []
+
+
+def test_the_checker_catches_a_violation(tmp_path, monkeypatch):
+    """The layout test itself can fail: an upward import and a private import are both found."""
+    bad = SRC / "model" / "_layout_probe.py"
+    bad.write_text("from ..sim.kernels import integrate_into\nfrom ..io.files import _READ\n")
+    try:
+        found = violations()
+    finally:
+        bad.unlink()
+    assert any("model imports upward from sim" in v for v in found)
+    assert any("private _READ" in v for v in found)
+
+
+def _public_functions():
+    for name in roastlab.__all__:
+        obj = getattr(roastlab, name)
+        if inspect.isfunction(obj):
+            yield name, obj
+        elif inspect.isclass(obj) and obj.__module__.startswith("roastlab"):
+            for meth_name, meth in vars(obj).items():
+                if inspect.isfunction(meth) and not meth_name.startswith("_"):
+                    yield f"{name}.{meth_name}", meth
+    yield "FittedModel.__init__", roastlab.FittedModel.__init__
+
+
+def undocumented(fn) -> list[str]:
+    """Arguments of ``fn`` that its docstring (or its class's) does not mention by name."""
+    doc = inspect.getdoc(fn) or ""
+    owner = getattr(inspect.getmodule(fn), fn.__qualname__.split(".")[0], None)
+    if inspect.isclass(owner):
+        doc += "\n" + (inspect.getdoc(owner) or "")
+    missing = []
+    for p in inspect.signature(fn).parameters.values():
+        if p.name in ("self", "cls") or p.kind in (p.VAR_POSITIONAL,):
+            continue
+        if not re.search(rf"(?<![A-Za-z0-9_]){re.escape(p.name)}(?![A-Za-z0-9_])", doc):
+            missing.append(p.name)
+    return missing
+
+
+PUBLIC = dict(_public_functions())
+
+
+@pytest.mark.parametrize("name", sorted(PUBLIC))
+def test_public_arguments_are_documented(name):
+    assert undocumented(PUBLIC[name]) == [], f"{name}: document these arguments in its docstring"
+
+
+def test_the_documentation_check_can_fail():
+    def f(a, b):
+        """Uses a only."""
+
+    assert undocumented(f) == ["b"]
