@@ -5,7 +5,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: test reproduce bench lint clean
+.PHONY: test reproduce bench lint clean wheel-check
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -29,3 +29,9 @@ lint: $(STAMP)
 clean:
 	rm -rf $(VENV) out .pytest_cache
 	find src tests -name __pycache__ -type d -exec rm -rf {} +
+
+# The wheel (not an editable install) in a fresh venv runs the main job from outside the repository.
+wheel-check:
+	rm -rf /tmp/roastlab-wheel && $(PYTHON) -m venv /tmp/roastlab-wheel/venv
+	/tmp/roastlab-wheel/venv/bin/python -m pip install --quiet .
+	cd /tmp/roastlab-wheel && venv/bin/roastlab reproduce --out X && test -s X/model.json && test -s X/fig2_profiles.png

@@ -202,3 +202,16 @@ def test_batch_green_weight_overrides_plant(cli, tmp_path, check_inputs):
     cli("simulate", "--plant", plant, "--inputs", check_inputs, "--out", explicit)
     assert heavy.read_text() != plain.read_text()
     assert heavy.read_text() == explicit.read_text()
+
+
+def test_every_subcommand_help_names_the_model_file():
+    from roastlab.apps.cli import build_parser
+
+    parser = build_parser()
+    assert "MODEL.json" in parser.format_help()
+    sub = next(a for a in parser._actions if a.dest == "command")
+    for name, p in sub.choices.items():
+        text = p.format_help()
+        for inner in (a for a in p._actions if a.dest == "what"):
+            text += "".join(q.format_help() for q in inner.choices.values())
+        assert "MODEL.json" in text, name

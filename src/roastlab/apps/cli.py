@@ -618,7 +618,7 @@ def _add_fit_commands(sub) -> None:
         "reproduce",
         help="the paper end to end: identify on dataset-I, validate on dataset-V",
         description="Identify on the synthetic dataset-I (120 kg), validate on dataset-V (360 kg) and write "
-        "model.json, metrics.json, report.md, fig2_profiles.png and fig3_errors.png (all or none).",
+        "the fitted MODEL.json (as model.json), metrics.json, report.md, fig2_profiles.png and fig3_errors.png (all or none).",
     )
     p.add_argument("--out", default="out/reproduce", metavar="DIR", help="output folder (default out/reproduce)")
     p.add_argument(
@@ -632,7 +632,7 @@ def _add_fit_commands(sub) -> None:
         help="measure speed against a solve_ivp baseline in one run",
         description="Measure single-batch and population simulation speed-ups over solve_ivp(LSODA), "
         "identification time on dataset-I, fleet identification scaling (10/100/1,000 batches) and the cold CLI. "
-        "Takes a few minutes on 2 cores.",
+        "Takes a few minutes on 2 cores. Needs no MODEL.json: it times the paper's model.",
     )
     p.add_argument("--json", action="store_true", help="print the figures as JSON (progress goes quiet)")
     p.add_argument("--save", metavar="FILE.json", help="also save the JSON to a file")
@@ -643,7 +643,9 @@ def _add_fit_commands(sub) -> None:
         help="convert a roast log (Artisan .alog/.csv, CSV, Parquet) into a batch CSV",
         description="Read a log with a column map and write the canonical batch CSV time_s,Gg_kg_s,Tgi_C,Ta_C "
         "(Artisan logs: time 0 at CHARGE, cut after DROP, °F converted, green weight kept as '# Mb_kg').",
-        epilog="example: roastlab import roast.alog --map examples/skywalker/map.toml --out batch.csv",
+        epilog="example: roastlab import roast.alog --map examples/skywalker/map.toml --out batch.csv\n"
+        "then: roastlab simulate --model MODEL.json --inputs batch.csv --out pred.csv (a model fitted with a map also "
+        "reads the raw log itself)",
     )
     p.add_argument("log", metavar="LOG", help="the roast log")
     p.add_argument("--map", metavar="MAP.toml", help="column map (default: canonical column names)")
@@ -651,13 +653,18 @@ def _add_fit_commands(sub) -> None:
     p.add_argument("--name", help="batch name (default: the log's file name)")
     p.set_defaults(func=cmd_import)
 
-    p = sub.add_parser("datasets", help="generate the synthetic stand-in datasets")
+    p = sub.add_parser(
+        "datasets",
+        help="generate the synthetic stand-in datasets",
+        description="Generate SYNTHETIC stand-in datasets to fit with 'roastlab identify ... --out MODEL.json'.",
+    )
     dsub = p.add_subparsers(dest="what", metavar="WHAT", parser_class=_Parser)
     dsub.required = True
     q = dsub.add_parser(
         "make-paper",
         help="write dataset-I and dataset-V (SYNTHETIC) from a seed",
-        description="Generate the synthetic stand-ins of the paper's datasets, byte-identical for a given seed.",
+        description="Generate the synthetic stand-ins of the paper's datasets, byte-identical for a given seed "
+        "(fit them with 'roastlab identify ... --out MODEL.json').",
     )
     q.add_argument(
         "--seed", type=_seed_arg, default=PAPER_SEED, help=f"random seed (default {PAPER_SEED}, the shipped data)"
@@ -716,7 +723,8 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser(
         "plant",
         help="print a plant's geometry and derived quantities",
-        description="Print geometry (Table 5) and derived quantities (eq. 6-7) of a plant.",
+        description="Print geometry (Table 5) and derived quantities (eq. 6-7) of a plant (the plant a MODEL.json "
+        "stores in full, or a preset or PLANT.toml).",
     )
     p.add_argument("plant", help="plant preset (120kg, 360kg) or PLANT.toml path")
     p.add_argument("--x0", type=_float_arg("--x0"), default=0.1, help="moisture used for Mbd and F (default 0.1)")
