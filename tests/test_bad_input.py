@@ -4,6 +4,7 @@ no traceback, no output file (not even a partial or temporary one)."""
 import json
 import os
 
+import numpy as np
 import pytest
 
 from roastlab.workflows.reproduce import default_dataset_root
@@ -461,3 +462,54 @@ def test_unwritable_output_folder(cli, tmp_path):
     code, _, err = cli("simulate", "--plant", "120kg", "--inputs", good, "--out", target)
     assert code == 2 and "roastlab-out.csv" in err and err.count("\n") == 1, err
     assert not os.path.exists(target)
+
+
+@pytest.mark.parametrize(
+    "kwargs, needle",
+    [
+        ({"Gg_kg_s": np.full(5, 0.4)}, "Gg_kg_s has 5 values, time_s has 31"),
+        ({"time_s": np.array([]), "Gg_kg_s": np.array([]), "Tgi_C": np.array([])}, "at least 2 time samples"),
+        ({"Tgi_C": np.full((31, 2), 450.0)}, "one-dimensional"),
+        ({"Gg_kg_s": np.full(31, np.nan)}, "outside the plausible range"),
+    ],
+)
+def test_python_simulate_checks_shapes_before_the_kernel(kwargs, needle):
+    import roastlab
+
+    t = np.arange(0, 901, 30.0)
+    args = {"time_s": t, "Gg_kg_s": np.full_like(t, 0.4), "Tgi_C": np.full_like(t, 450.0), **kwargs}
+    with pytest.raises(roastlab.ParameterError, match=needle):
+        roastlab.simulate("120kg", **args)
+
+
+def test_python_simulate_returns_copies():
+    import roastlab
+
+    t = np.arange(0, 301, 30.0)
+    g = np.full_like(t, 0.4)
+    r = roastlab.simulate("120kg", t, g, np.full_like(t, 450.0))
+    r.Gg_kg_s[:] = 9.0
+    assert np.all(g == 0.4)
+
+
+@pytest.mark.parametrize("dt", [0.0, -5.0, float("nan")])
+def test_simulator_step_refuses_bad_dt(dt):
+    import roastlab
+
+    sim = roastlab.Simulator("120kg")
+    with pytest.raises(roastlab.ParameterError, match="dt_s"):
+        sim.step(dt, 0.4, 450.0)
+    assert sim.t_s == 0.0
+
+
+def test_newline_in_a_log_name_stays_a_comment(cli, tmp_path):
+    """A log named 'x\\nMb_kg = 5.csv' must not write a metadata line the reader obeys."""
+    log = tmp_path / "x\nMb_kg = 5.csv"
+    log.write_text(HEADER + GOOD_ROWS)
+    out = tmp_path / "o.csv"
+    code, _, err = cli("import", log, "--out", out)
+    assert code == 0, err
+    from roastlab.io.batch import read_batch_csv
+
+    assert read_batch_csv(out).Mb_kg is None
+    assert all(line.startswith(("##", "time_s")) or line[0].isdigit() for line in out.read_text().splitlines())
