@@ -360,6 +360,7 @@ def _identify_per_batch(args, batches, plant_spec, fix, bounds, outputs) -> int:
 
 def cmd_validate(args) -> int:
     from ..io.files import Outputs
+    from ..io.modelfile import jsonable
     from ..report.figures import check_figure_path, plot_fit
 
     outputs = Outputs(_fit_inputs(args))
@@ -387,7 +388,7 @@ def cmd_validate(args) -> int:
     )
     with outputs as out:
         if args.json:
-            out.write_text(args.json, json.dumps(_finite_json(result.to_json_dict()), indent=1, allow_nan=False) + "\n")
+            out.write_text(args.json, json.dumps(jsonable(result.to_json_dict()), indent=1, allow_nan=False) + "\n")
         if args.plot:
             plot_fit(result, args.plot, title=f"measured vs predicted BT, plant {result.plant}", outputs=out)
         if args.predictions:
@@ -413,20 +414,11 @@ def _safe_stem(name: str, taken: set) -> str:
     return stem
 
 
-def _finite_json(value):
-    if isinstance(value, float):
-        return value if math.isfinite(value) else None
-    if isinstance(value, dict):
-        return {k: _finite_json(v) for k, v in value.items()}
-    if isinstance(value, list):
-        return [_finite_json(v) for v in value]
-    return value
-
-
 def _validate_baseline(args, outputs) -> int:
     from ..evaluate.metrics import average_metrics
     from ..evaluate.validate import ValidationResult
     from ..fit.baseline import validate_first_order
+    from ..io.modelfile import jsonable
     from ..report.figures import plot_fit
 
     if not args.model:
@@ -455,7 +447,7 @@ def _validate_baseline(args, outputs) -> int:
                 "batches": [{"name": n, **r} for n, r in zip(result.names, rows)],
                 "average": average_metrics(rows),
             }
-            out.write_text(args.json, json.dumps(_finite_json(doc), indent=1, allow_nan=False) + "\n")
+            out.write_text(args.json, json.dumps(jsonable(doc), indent=1, allow_nan=False) + "\n")
         if args.plot:
             plot_fit(result, args.plot, title="measured vs first-order baseline", outputs=out)
     return 0

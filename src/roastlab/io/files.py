@@ -15,6 +15,7 @@ place only when every one was produced. A failure at any point leaves nothing be
 from __future__ import annotations
 
 import hashlib
+import math
 import os
 import stat
 import tempfile
@@ -104,6 +105,19 @@ def decode_text(raw: bytes, path: str | Path, what: str = "text") -> str:
 def read_input_text(path: str | Path, what: str = "text") -> str:
     """An input file as text (see :func:`read_input_bytes` and :func:`decode_text`)."""
     return decode_text(read_input_bytes(path), path, what)
+
+
+def finite_number(v, path, where: str) -> float:
+    """A parsed value (JSON, TOML) as a finite float; else one InputError naming file and key."""
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        raise InputError(f"must be a number, got {str(v)[:40]!r}", path, where)
+    try:
+        x = float(v)
+    except OverflowError:
+        raise InputError("number out of range", path, where) from None
+    if not math.isfinite(x):
+        raise InputError(f"must be finite, got {v}", path, where)
+    return x
 
 
 def read_toml(path: str | Path) -> dict:

@@ -23,14 +23,13 @@ k1, k2, Kt, lam``, the metal mass ``Mm``, the gas flow ``Gg_kg_s``, and initial 
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import InputError, ParameterError
 from ..model.limits import LIMITS, check_value
 from ..model.parameters import FREE_NAMES, REGISTRY, STATE0, THETA_NAMES, THETA_PAPER, FreeParameter
-from .files import read_toml
+from .files import finite_number, read_toml
 
 ALLOWED = FREE_NAMES
 INITIAL_NAMES = tuple(STATE0)
@@ -42,18 +41,6 @@ class FitSpec:
     fixed: dict[str, float]
     initial: dict[str, float] = field(default_factory=dict)
     source: str = ""
-
-
-def _num(v, src, where) -> float:
-    if isinstance(v, bool) or not isinstance(v, (int, float)):
-        raise InputError(f"must be a number, got {str(v)[:40]!r}", src, where)
-    try:
-        x = float(v)
-    except OverflowError:
-        raise InputError("number out of range", src, where) from None
-    if not math.isfinite(x):
-        raise InputError(f"must be finite, got {x}", src, where)
-    return x
 
 
 def _checked(name: str, value: float, path, where) -> float:
@@ -84,13 +71,13 @@ def load_fit_spec(path: str | Path) -> FitSpec:
         if isinstance(spec, list):
             if len(spec) != 3:
                 raise InputError("expected [lower, upper, start]", path, where)
-            lo, hi, start = (_num(v, path, where) for v in spec)
+            lo, hi, start = (finite_number(v, path, where) for v in spec)
         elif isinstance(spec, dict):
             missing = [k for k in ("lower", "upper") if k not in spec]
             if missing:
                 raise InputError(f"missing {', '.join(missing)}", path, where)
-            lo, hi = _num(spec["lower"], path, where), _num(spec["upper"], path, where)
-            start = _num(spec.get("start", 0.5 * (lo + hi)), path, where)
+            lo, hi = finite_number(spec["lower"], path, where), finite_number(spec["upper"], path, where)
+            start = finite_number(spec.get("start", 0.5 * (lo + hi)), path, where)
             per_batch = spec.get("per_batch", False)
             if not isinstance(per_batch, bool):
                 raise InputError("per_batch must be true or false", path, where)
@@ -108,7 +95,7 @@ def load_fit_spec(path: str | Path) -> FitSpec:
     for name, v in (data.get("fixed") or {}).items():
         if name not in ALLOWED:
             raise InputError(f"unknown parameter (allowed: {', '.join(ALLOWED)})", path, f"fixed.{name}")
-        fixed[name] = _checked(name, _num(v, path, f"fixed.{name}"), path, f"fixed.{name}")
+        fixed[name] = _checked(name, finite_number(v, path, f"fixed.{name}"), path, f"fixed.{name}")
     names_free = {f.name for f in free}
     both = names_free & set(fixed)
     if both:
@@ -120,5 +107,5 @@ def load_fit_spec(path: str | Path) -> FitSpec:
     for name, v in (data.get("initial") or {}).items():
         if name not in INITIAL_NAMES:
             raise InputError(f"unknown initial state (allowed: {', '.join(INITIAL_NAMES)})", path, f"initial.{name}")
-        initial[name] = _checked(name, _num(v, path, f"initial.{name}"), path, f"initial.{name}")
+        initial[name] = _checked(name, finite_number(v, path, f"initial.{name}"), path, f"initial.{name}")
     return FitSpec(free, fixed, initial, str(path))

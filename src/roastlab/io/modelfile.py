@@ -30,7 +30,7 @@ from pathlib import Path
 from ..errors import InputError, ParameterError
 from ..model.parameters import REGISTRY, STATE0, THETA_NAMES, Theta
 from ..model.plant import GEOMETRY_KEYS, Plant, plant_from_mapping
-from .files import read_input_text
+from .files import finite_number, read_input_text
 
 FORMAT = "roastlab-model/1"
 INITIAL_HOW = ("fixed", "fitted", "fitted per batch", "from log")
@@ -60,18 +60,6 @@ def _depth_ok(text: str) -> bool:
         elif ch in "]}":
             depth -= 1
     return True
-
-
-def _finite(v, path, where) -> float:
-    if isinstance(v, bool) or not isinstance(v, (int, float)):
-        raise InputError(f"must be a number, got {json.dumps(v)[:40]}", path, where)
-    try:
-        x = float(v)
-    except OverflowError:
-        raise InputError("number out of range", path, where) from None
-    if not math.isfinite(x):
-        raise InputError(f"must be finite, got {v}", path, where)
-    return x
 
 
 def parse_json_document(text: str, path) -> object:
@@ -166,7 +154,7 @@ def check_document(doc: dict, path) -> dict:
             )
         if not isinstance(entry, dict):
             raise InputError("must be an object with a value", path, where)
-        entry["value"] = _finite(entry.get("value"), path, where)
+        entry["value"] = finite_number(entry.get("value"), path, where)
         if entry.get("how", "fitted") not in PARAMETER_HOW:
             raise InputError(f"how must be one of {', '.join(PARAMETER_HOW)}", path, where)
         if REGISTRY[name].kind != "theta" and not entry["value"] > 0:
@@ -185,12 +173,12 @@ def check_document(doc: dict, path) -> dict:
         if entry.get("how") not in INITIAL_HOW:
             raise InputError(f"how must be one of {', '.join(INITIAL_HOW)}", path, where)
         if entry.get("value") is not None:
-            entry["value"] = _finite(entry["value"], path, where)
+            entry["value"] = finite_number(entry["value"], path, where)
         per = entry.get("per_batch")
         if entry["how"] == "fitted per batch":
             if not isinstance(per, dict) or not per:
                 raise InputError("'fitted per batch' needs per_batch values", path, where)
-            entry["per_batch"] = {str(k): _finite(v, path, f"{where}.{k}") for k, v in per.items()}
+            entry["per_batch"] = {str(k): finite_number(v, path, f"{where}.{k}") for k, v in per.items()}
         elif entry["how"] != "from log" and entry.get("value") is None:
             raise InputError("needs a value", path, where)
     for key, allowed in (("moisture", ("schwartzberg", "printed")), ("hold", ("linear", "zoh"))):
@@ -212,14 +200,14 @@ def plant_mapping(plant: Plant) -> dict:
     return {"name": plant.name, **plant.geometry(), "process": plant.process.as_dict()}
 
 
-def _jsonable(value):
+def jsonable(value):
     """NaN and inf become null: a model file is strict JSON."""
     if isinstance(value, float):
         return value if math.isfinite(value) else None
     if isinstance(value, dict):
-        return {str(k): _jsonable(v) for k, v in value.items()}
+        return {str(k): jsonable(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
-        return [_jsonable(v) for v in value]
+        return [jsonable(v) for v in value]
     if isinstance(value, Plant):
         return plant_mapping(value)
     return value
@@ -227,4 +215,4 @@ def _jsonable(value):
 
 def model_document_text(doc: dict) -> str:
     """The model mapping as the text of a ``roastlab-model/1`` file."""
-    return json.dumps(_jsonable({"format": FORMAT, **doc}), indent=1, allow_nan=False) + "\n"
+    return json.dumps(jsonable({"format": FORMAT, **doc}), indent=1, allow_nan=False) + "\n"
