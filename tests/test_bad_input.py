@@ -7,6 +7,7 @@ import os
 import numpy as np
 import pytest
 
+from roastlab.io.files import MAX_INPUT_BYTES
 from roastlab.workflows.reproduce import default_dataset_root
 
 DATA = default_dataset_root()
@@ -146,7 +147,7 @@ CASES = {
     "truncated alog": (
         lambda d: import_with(d, "t.alog", GOOD_ALOG[: len(GOOD_ALOG) // 2]),
         "t.alog",
-        "truncated or malformed",
+        "truncated Artisan profile",
     ),
     "alog containing code": (
         lambda d: import_with(d, "evil.alog", "{'timex': __import__('os').system('touch /tmp/roastlab_pwned')}"),
@@ -199,7 +200,7 @@ CASES = {
     "negative geometry": (
         lambda d: plant_with(d, PLANT.replace("Lch_m = 1.335", "Lch_m = -1.335")),
         "plant.toml",
-        "Lch_m: chamber length [m] must be > 0",
+        "Lch_m (chamber length) = -1.335 m outside the plausible range 0.02..20 m",
     ),
     "plant missing key": (
         lambda d: plant_with(d, PLANT.replace("Mm_kg = 2000\n", "")),
@@ -265,8 +266,8 @@ CASES = {
         "out.csv",
         "output folder does not exist",
     ),
-    "file over 200 MB": (lambda d: _huge(d), "huge.csv", "over the 200 MB limit"),
-    "huge alog": (lambda d: _huge(d, "huge.alog", import_=True), "huge.alog", "over the 200 MB limit"),
+    "file over the size limit": (lambda d: _huge(d), "huge.csv", "over the 16 MB limit"),
+    "huge alog": (lambda d: _huge(d, "huge.alog", import_=True), "huge.alog", "over the 16 MB limit"),
 }
 
 
@@ -285,7 +286,7 @@ def _same_path(d):
 def _huge(d, name="huge.csv", import_=False):
     f = d / name
     with open(f, "wb") as fh:  # sparse: 201 MB on paper, nothing on disk
-        fh.truncate(201 * 1024 * 1024)
+        fh.truncate(MAX_INPUT_BYTES + 1)
     if import_:
         m = d / "map.toml"
         m.write_text(SKY_MAP)
@@ -391,7 +392,7 @@ HOSTILE = {
     "spec frees a capacity down to zero": (
         lambda d: _fit_spec(d, "[free]\ncm = [0.0, 1.0, 0.4]\n"),
         "spec.toml",
-        "cm must stay > 0",
+        "cm (metal specific heat) = 0 kJ/(kg K) outside the plausible range",
     ),
     "negative moisture": (lambda d: _good_sim(d, "--x0", "-0.1"), "--x0", "X0 (green moisture, dry basis) = -0.1"),
     "absolute-zero drum": (lambda d: _good_sim(d, "--tm0", "-273.15"), "--tm0", "outside the plausible range"),

@@ -132,7 +132,7 @@ def test_negative_geometry(cli, tmp_path, check_inputs):
     plant = tmp_path / "neg.toml"
     plant.write_text("Mb_kg = 120\nDch_m = -1.24\nLch_m = 1.335\nHflap_m = 0.3\nSflap_m = 0.1\nMm_kg = 2000\n")
     code, _, err = cli("simulate", "--plant", plant, "--inputs", check_inputs, "--out", tmp_path / "o.csv")
-    assert code == 2 and "neg.toml: Dch_m" in err and "> 0" in err
+    assert code == 2 and "neg.toml: Dch_m" in err and "outside the plausible range 0.02..10 m" in err
 
 
 def test_second_cli_process_uses_disk_cache(tmp_path, check_inputs):

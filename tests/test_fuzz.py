@@ -8,6 +8,7 @@ import json
 import tempfile
 from pathlib import Path
 
+import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -73,7 +74,13 @@ def _mutate(base, i, n, text, how):
 # Structured inputs: well-formed documents with the right keys and values of any type, so the
 # loaders' type and range checks are exercised, not only their parsers.
 SCALARS = st.one_of(
-    st.booleans(), st.integers(-(10**6), 10**6), st.floats(allow_nan=True, allow_infinity=True), st.text(max_size=8)
+    st.booleans(),
+    st.integers(-(10**6), 10**6),
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.text(max_size=8),
+    # huge numbers: beyond float range, beyond int64, at the edges of float
+    st.integers(10**18, 10**400),
+    st.sampled_from([1e308, -1e308, 5e-324, -0.0, 2**63, -(2**63) - 1]),
 )
 VALUES = st.recursive(
     SCALARS, lambda c: st.lists(c, max_size=6) | st.dictionaries(st.text(max_size=6), c, max_size=4), max_leaves=12
@@ -165,8 +172,32 @@ def structured(kind):
     return st.one_of(doc.map(repr), doc.map(lambda d: json.dumps(d, allow_nan=True)))
 
 
+def deeply_nested(kind):
+    """A valid file with a deep nest of brackets, braces or tuples inserted somewhere."""
+    base = VALID[kind]
+    return st.tuples(
+        st.integers(0, len(base)), st.integers(1, 5000), st.sampled_from(["[", '{"a": ', "(", "[{'a': "])
+    ).map(lambda a: base[: a[0]] + a[2] * a[1] + base[a[0] :])
+
+
+def huge_number_text(kind):
+    """A valid file with a number of hundreds of digits (or an exponent far out of range) inserted."""
+    base = VALID[kind]
+    return st.tuples(
+        st.integers(0, len(base)),
+        st.sampled_from(["9" * 5000, "1e999999", "-1e-999999", "0x" + "f" * 400, "1" + "0" * 400 + ".5"]),
+    ).map(lambda a: base[: a[0]] + a[1] + base[a[0] :])
+
+
 def content(kind):
-    options = [mutated(kind), mutated(kind), st.text(max_size=400), st.binary(max_size=400)]
+    options = [
+        mutated(kind),
+        mutated(kind),
+        st.text(max_size=400),
+        st.binary(max_size=400),
+        deeply_nested(kind),
+        huge_number_text(kind),
+    ]
     if kind in KEYS:
         options += [structured(kind)] * 3
     return st.one_of(*options)
@@ -238,3 +269,69 @@ def test_fuzz_dataset_folder(data):
             read_dataset(folder)
         except RoastlabError:
             pass
+
+
+SPECIAL = ["fifo", "/dev/zero", "/dev/null", "directory", "symlink to /dev/zero", "dangling symlink"]
+
+
+@pytest.mark.parametrize("special", SPECIAL)
+@pytest.mark.parametrize("kind", sorted(LOADERS))
+def test_special_files_are_refused_without_hanging(kind, special, tmp_path):
+    """Pipes, devices, folders and odd links given as any input: one RoastlabError, at once."""
+    import os
+    import signal
+
+    path = tmp_path / f"x{kind}"
+    if special == "fifo":
+        os.mkfifo(path)
+    elif special == "directory":
+        path.mkdir()
+    elif special == "symlink to /dev/zero":
+        path.symlink_to("/dev/zero")
+    elif special == "dangling symlink":
+        path.symlink_to(tmp_path / "nowhere")
+    else:
+        path = Path(special)
+
+    def hang(*_):
+        raise AssertionError(f"{kind} loader hung on {special}")
+
+    old = signal.signal(signal.SIGALRM, hang)
+    signal.alarm(10)
+    try:
+        for loader in LOADERS[kind]:
+            with pytest.raises(RoastlabError):
+                loader(path)
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, old)
+
+
+NAME_CHARS = st.characters(blacklist_characters="/\x00", blacklist_categories=("Cs",))
+
+
+@settings(max_examples=60, deadline=None, derandomize=True)
+@given(st.text(NAME_CHARS, min_size=1, max_size=24).filter(lambda n: n not in (".", "..")))
+def test_fuzz_control_characters_in_names_stay_data(name):
+    """A log named with newlines, tabs, escapes or any Unicode imports into a batch CSV whose
+    header and rows are the same as for a plain name: the name never becomes structure."""
+    from roastlab.apps.cli import main
+    from roastlab.io.batch import read_batch_csv as read
+
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        (folder / "map.toml").write_text('[Ta]\ncolumn = "BT"\n[Tgi]\ncolumn = "ET"\n[Gg]\nconstant_kg_s = 0.01\n')
+        outs = []
+        for stem in ("plain", name):
+            log = folder / f"{stem}.alog"
+            try:
+                log.write_text(VALID[".alog"])
+            except OSError:  # a name the file system refuses (too long in bytes)
+                return
+            out = folder / f"out-{len(outs)}.csv"
+            assert main(["import", str(log), "--map", str(folder / "map.toml"), "--out", str(out)]) == 0
+            outs.append(out)
+        a, b = read(outs[0]), read(outs[1])
+        assert np.array_equal(a.time_s, b.time_s) and np.array_equal(a.Ta_C, b.Ta_C)
+        lines = [ln for ln in outs[1].read_text().splitlines() if not ln.startswith("#")]
+        assert lines == [ln for ln in outs[0].read_text().splitlines() if not ln.startswith("#")]

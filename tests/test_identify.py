@@ -138,3 +138,30 @@ def test_standard_errors_cover_the_truth(seed):
         se = fit.stderr[name]
         assert se is not None and se > 0, name
         assert abs(fit.values[name] - true_value) <= 3.0 * se, (name, fit.values[name], true_value, se)
+
+
+@pytest.mark.parametrize("fail_when", ["always", "except_at_start"])
+def test_identification_that_cannot_simulate_is_an_error(monkeypatch, fail_when):
+    """A model that diverges everywhere (or everywhere but the start) gives no result, not SE 0."""
+    import importlib
+
+    from roastlab.errors import ParameterError
+
+    ident = importlib.import_module("roastlab.fit.identify")  # the module, not the function of that name
+    batches = noise_free_batches(5, "120kg", THETA_START, count=2)
+    packed = pack_batches(batches, "120kg", THETA_START, InitialState(Ta0_C=30.0))
+    free, fixed = build_free_parameters()
+    real = ident.predict_ta
+    calls = {"n": 0}
+
+    def diverging(packed_, names, values):
+        calls["n"] += 1
+        out = real(packed_, names, values)
+        if fail_when == "always" or calls["n"] > 1:
+            out[:] = np.nan
+        return out
+
+    monkeypatch.setattr(ident, "predict_ta", diverging)
+    needle = "at the starting values" if fail_when == "always" else "every batch can be simulated"
+    with pytest.raises(ParameterError, match=needle):
+        identify(packed, free, fixed, n_trial=8, n_starts=1)

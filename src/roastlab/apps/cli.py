@@ -369,8 +369,8 @@ def cmd_validate(args) -> int:
             outputs.check(target)
     if args.plot:
         check_figure_path(args.plot)
-    if args.predictions and not Path(args.predictions).is_dir():
-        raise InputError("not an existing folder (create it first)", args.predictions)
+    if args.predictions:
+        outputs.folder(args.predictions, create=False)
     if args.baseline:
         return _validate_baseline(args, outputs)
     model = _model_from_args(args, args.plant)

@@ -113,6 +113,7 @@ class Objective:
         mask = packed.mask() & np.isfinite(packed.TA)
         self.mask = mask
         self.measured = packed.TA[mask]
+        self.batch_of_residual = np.nonzero(mask)[0]
         self.nfev = 0
 
     @property
@@ -143,6 +144,13 @@ class Objective:
 
     def residuals(self, z: np.ndarray) -> np.ndarray:
         return self.residuals_many(z[None, :])[0]
+
+    def failed_batches(self, z: np.ndarray) -> list[str]:
+        """Names of the batches whose simulation at ``z`` is not finite (empty when all run)."""
+        self.nfev += 1
+        ta = predict_ta(self.packed, self.names, self.values_array(np.atleast_2d(z)))[0]
+        bad = ~np.isfinite(ta[self.mask])
+        return [self.packed.names[b] for b in np.unique(self.batch_of_residual[bad])]
 
     def ssr_many(self, Z: np.ndarray) -> np.ndarray:
         r = self.residuals_many(Z)
@@ -273,6 +281,13 @@ def identify(
     if obj.n_residuals == 0:
         raise ParameterError("no measured Ta samples to fit")
     nz = len(obj.start)
+    failed = obj.failed_batches(obj.start)
+    if failed:
+        raise ParameterError(
+            f"the model cannot be simulated at the starting values for {len(failed)} batch(es) "
+            f"({', '.join(failed[:3])}{', ...' if len(failed) > 3 else ''}): check the initial state, plant and "
+            "inputs, or give other starting values in the fit spec"
+        )
     rng = np.random.default_rng(seed)
     starts_log = []
     if method == "global":
@@ -317,6 +332,12 @@ def identify(
         if progress is not None:
             progress(k + 1, len(candidates), f"SSR {best[1]:.6g}, {obj.nfev} simulations")
     z, ssr = best
+    failed = obj.failed_batches(z)
+    if failed:
+        raise ParameterError(
+            f"no fitted values found at which every batch can be simulated ({', '.join(failed[:3])} fail): "
+            "the bounds admit only values for which the model diverges"
+        )
     span_all = obj.upper - obj.lower
     on_bound = (z - obj.lower <= 1e-4 * span_all) | (obj.upper - z <= 1e-4 * span_all)
     se, corr = _uncertainty(obj, z, ssr, ~on_bound)

@@ -12,6 +12,7 @@ import csv
 import io
 import math
 import os
+from array import array
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -120,15 +121,51 @@ def read_table(
     """
     path = Path(path)
     text = read_text(path) if text is None else text  # callers that already read it pass it
-    lines = [(i + 1, ln) for i, ln in enumerate(text.splitlines()) if ln.strip() and not ln.lstrip().startswith("#")]
-    if not lines:
-        raise InputError("empty file (no header row)", path)
-    header_line, header_text = lines[0]
+    # Streamed: the C csv reader walks the text once and each value goes into a compact
+    # array of doubles, so memory is a small multiple of the file size whatever its shape.
+    at = [0]  # number of the line the reader is on; comment lines never reach the csv reader
+
+    def data_lines():
+        for n, line in enumerate(io.StringIO(text), start=1):
+            if not line.lstrip().startswith("#"):
+                at[0] = n
+                yield line
+
+    reader = csv.reader(data_lines())
+    header = None
+    wanted: list[str] = []
+    index: dict[str, int] = {}
+    values: dict[str, array] = {}
+    rows = 0
     try:
-        header = next(csv.reader(io.StringIO(header_text)))
+        for row in reader:
+            line_no = at[0]
+            if not row or not "".join(row).strip():
+                continue
+            if header is None:
+                header, header_line = [h.strip() for h in row], line_no
+                wanted, index = _columns(header, required, optional, path, header_line)
+                values = {c: array("d") for c in wanted}
+                continue
+            rows += 1
+            for c in wanted:
+                j = index[c]
+                if j >= len(row):
+                    raise InputError(
+                        f"row has {len(row)} cells, column {c} missing (truncated file?)", path, f"line {line_no}"
+                    )
+                values[c].append(parse_number(row[j], path, line_no, c))
     except csv.Error as exc:
-        raise InputError(f"unreadable header ({exc})", path, f"line {header_line}") from None
-    header = [h.strip() for h in header]
+        raise InputError(f"unreadable row ({exc})", path, f"line {at[0]}") from None
+    if header is None:
+        raise InputError("empty file (no header row)", path)
+    if rows == 0:
+        raise InputError("header only, no data rows", path)
+    return {c: np.frombuffer(v, dtype=np.float64).copy() for c, v in values.items()}
+
+
+def _columns(header, required, optional, path, header_line) -> tuple[list[str], dict[str, int]]:
+    """The wanted columns of a header and their positions; duplicated or missing ones refused."""
     seen = set()
     for h in header:
         if h in seen and h in required + optional:
@@ -139,24 +176,8 @@ def read_table(
         raise InputError(
             f"missing column(s) {', '.join(missing)} (header has: {', '.join(header)})", path, f"line {header_line}"
         )
-    if len(lines) == 1:
-        raise InputError("header only, no data rows", path)
     wanted = list(dict.fromkeys(c for c in required + optional if c in header))
-    index = {c: header.index(c) for c in wanted}
-    values = {c: [] for c in wanted}
-    for line_no, row_text in lines[1:]:
-        try:
-            row = next(csv.reader(io.StringIO(row_text)))
-        except csv.Error as exc:
-            raise InputError(f"unreadable row ({exc})", path, f"line {line_no}") from None
-        for c in wanted:
-            j = index[c]
-            if j >= len(row):
-                raise InputError(
-                    f"row has {len(row)} cells, column {c} missing (truncated file?)", path, f"line {line_no}"
-                )
-            values[c].append(parse_number(row[j], path, line_no, c))
-    return {c: np.asarray(v, dtype=np.float64) for c, v in values.items()}
+    return wanted, {c: header.index(c) for c in wanted}
 
 
 def _refuse_raw_log(text: str, path) -> None:

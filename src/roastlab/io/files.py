@@ -23,8 +23,13 @@ from pathlib import Path
 
 from ..errors import InputError
 
-#: Largest input file roastlab reads [bytes]; a larger one is refused without reading it all.
-MAX_INPUT_BYTES = 200 * 1024 * 1024
+#: Largest data file roastlab reads (batch CSV, roast log, Parquet, model file) [bytes]; a
+#: larger one is refused without reading it all. Real logs are 20-100 kB and an hour at 10 Hz
+#: is ~2 MB, so this leaves room while keeping the parse of the largest accepted file of each
+#: format in bounded memory (tests/test_memory.py measures it under a hard cap).
+MAX_INPUT_BYTES = 16 * 1024 * 1024
+#: Largest configuration file (plant, map, fit spec, dataset index, scenario; TOML) [bytes].
+CONFIG_MAX_BYTES = 1024 * 1024
 
 _READ: dict[tuple[int, int], str] = {}  # (device, inode) -> path of every input read in this run
 _RUN = {"active": False}
@@ -102,9 +107,9 @@ def decode_text(raw: bytes, path: str | Path, what: str = "text") -> str:
         return raw.decode("latin-1")
 
 
-def read_input_text(path: str | Path, what: str = "text") -> str:
+def read_input_text(path: str | Path, what: str = "text", limit: int = MAX_INPUT_BYTES) -> str:
     """An input file as text (see :func:`read_input_bytes` and :func:`decode_text`)."""
-    return decode_text(read_input_bytes(path), path, what)
+    return decode_text(read_input_bytes(path, limit), path, what)
 
 
 def finite_number(v, path, where: str) -> float:
@@ -125,7 +130,7 @@ def read_toml(path: str | Path) -> dict:
     import tomllib
 
     try:
-        return tomllib.loads(read_input_text(path, "TOML text"))
+        return tomllib.loads(read_input_text(path, "TOML text", CONFIG_MAX_BYTES))
     except tomllib.TOMLDecodeError as exc:
         raise InputError(f"not valid TOML ({str(exc)[:120]})", path) from None
     except (RecursionError, MemoryError, OverflowError, ValueError):
@@ -162,6 +167,32 @@ class Outputs:
     def __init__(self, inputs: list[str | Path] | None = None):
         self.inputs = [Path(p) for p in (inputs or []) if p]
         self._pending: list[tuple[Path, str]] = []  # (final path, temporary path)
+        self._created: list[Path] = []  # folders made by :meth:`folder`, removed again if left empty
+
+    def folder(self, path: str | Path, create: bool = True) -> Path:
+        """Check (and with ``create`` make) a folder that outputs go into.
+
+        Refuses a path that is an input of the run or that exists as anything but a folder (a
+        file, a FIFO, a device). Folders made here are removed again, if still empty, when the
+        outputs are discarded.
+        """
+        out = Path(path)
+        for src in self.inputs + [Path(p) for p in inputs_read()]:
+            if src.exists() and _same_file(src, out):
+                raise InputError(f"is an input of this run ({src}); refusing to write into it", out)
+        if out.exists() or out.is_symlink():
+            if not out.is_dir():
+                raise InputError("exists and is not a folder; give a folder for this output", out)
+            return out
+        if not create:
+            raise InputError("not an existing folder (create it first)", out)
+        missing = [out, *(p for p in out.parents if not p.exists())]
+        try:
+            out.mkdir(parents=True)
+        except OSError as exc:
+            raise InputError(f"cannot create output folder ({exc.strerror})", out) from None
+        self._created += missing
+        return out
 
     def check(self, path: str | Path) -> Path:
         """Refuse an output that is an input, a folder or a special file, or sits in a missing folder."""
@@ -222,19 +253,32 @@ class Outputs:
             self.discard()
 
     def discard(self) -> None:
-        """Remove every temporary file not yet renamed into place."""
+        """Remove every temporary file not yet renamed into place, and folders left empty."""
         for _, tmp in self._pending:
             Path(tmp).unlink(missing_ok=True)
         self._pending = []
+
+    def _remove_created_folders(self) -> None:
+        for folder in sorted(self._created, key=lambda p: len(p.parts), reverse=True):
+            try:
+                folder.rmdir()  # only when empty
+            except OSError:
+                pass
+        self._created = []
 
     def __enter__(self) -> Outputs:
         return self
 
     def __exit__(self, exc_type, exc, tb) -> None:
         if exc_type is None:
-            self.commit()
+            try:
+                self.commit()
+            except BaseException:
+                self._remove_created_folders()
+                raise
         else:
             self.discard()
+            self._remove_created_folders()
 
 
 def atomic_write_bytes(path: str | Path, data: bytes) -> None:

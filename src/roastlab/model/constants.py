@@ -24,6 +24,7 @@ import dataclasses
 from dataclasses import dataclass
 
 from ..errors import ParameterError
+from .limits import check_value
 
 #: eq. 2 coefficients alpha_0..alpha_6 of cg(T) in J/(kg K), T in kelvin.
 CG_ALPHA_J_KG_K = (
@@ -93,11 +94,7 @@ class ProcessConstants:
 
     def __post_init__(self) -> None:
         for f in dataclasses.fields(self):
-            value = getattr(self, f.name)
-            if not isinstance(value, (int, float)) or isinstance(value, bool):
-                raise ParameterError(f"process constant {f.name} must be a number, got {value!r}")
-            if not (value > 0 and value < float("inf")):
-                raise ParameterError(f"process constant {f.name} must be > 0 and finite, got {value!r}")
+            check_value(f.name, getattr(self, f.name))  # the one plausibility table
 
     #: Names accepted in a plant file's ``[process]`` table, mapped to field names.
     ALIASES = {"Ha/R": "Ha_R", "lambda": "lam"}
@@ -112,9 +109,7 @@ class ProcessConstants:
             if name not in known:
                 allowed = ", ".join(sorted(known))
                 raise ParameterError(f"unknown process constant {key!r} (allowed: {allowed})", source, "[process]")
-            if not isinstance(value, (int, float)) or isinstance(value, bool):
-                raise ParameterError(f"process constant {key} must be a number, got {value!r}", source, "[process]")
-            kwargs[name] = float(value)
+            kwargs[name] = check_value(name, value, source)
         try:
             return cls(**kwargs)
         except ParameterError as exc:

@@ -34,6 +34,24 @@ LIMITS: dict[str, tuple[float, float, str, str]] = {
     "Mb_kg": (1e-4, 1e5, "kg", "green batch mass"),
     "batch_kg": (1e-4, 1e5, "kg", "green batch mass"),
     "Tgi_offset_C": (-500.0, 500.0, "degC", "change of the inlet gas temperature"),
+    # plant geometry (Table 5); from a 50 g sample roaster to a 5 t drum, with room
+    "Dch_m": (0.02, 10.0, "m", "chamber diameter"),
+    "Lch_m": (0.02, 20.0, "m", "chamber length"),
+    "Hflap_m": (1e-4, 2.0, "m", "flap height"),
+    "Sflap_m": (1e-3, 20.0, "m", "flap step"),
+    "Mm_kg": (1e-3, 1e6, "kg", "drum metal mass"),
+    # process constants (Table 4); each within orders of magnitude of the paper's value
+    "A": (1e-6, 1e12, "1/s", "reaction pre-exponential factor"),
+    "cm": (0.01, 10.0, "kJ/(kg K)", "metal specific heat"),
+    "cw": (0.1, 20.0, "kJ/(kg K)", "partial heat capacity of water"),
+    "Db": (1e-4, 0.05, "m", "bean diameter"),
+    "Ha_R": (1.0, 1e5, "K", "activation energy over R"),
+    "Het": (1e-3, 1e4, "kJ/kg", "total reaction heat"),
+    "k1": (1e-6, 1e12, "m2/s", "Schwartzberg pre-factor"),
+    "k2": (1.0, 1e5, "K", "Schwartzberg activation temperature"),
+    "Kt": (1e-5, 10.0, "1/s", "bean-probe inverse time constant"),
+    "mb": (1e-6, 1e-2, "kg", "mass of one bean"),
+    "lam": (10.0, 1e4, "kJ/kg", "latent heat of vaporisation"),
 }
 
 
@@ -48,7 +66,9 @@ def check_value(name: str, value, source: str | None = None) -> float:
         raise ParameterError(f"{name} ({meaning}) must be a number, got {value!r}", source)
     try:
         v = float(value)
-    except (TypeError, ValueError, OverflowError):
+    except OverflowError:
+        v = math.copysign(math.inf, value)  # an integer beyond float range: reported as out of range below
+    except (TypeError, ValueError):
         raise ParameterError(f"{name} ({meaning}) must be a number, got {str(value)[:40]!r}", source) from None
     if not math.isfinite(v) or not lo <= v <= hi:
         raise ParameterError(

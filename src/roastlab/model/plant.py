@@ -14,8 +14,9 @@ from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 
-from ..errors import InputError, ParameterError
+from ..errors import InputError
 from .constants import ProcessConstants
+from .limits import check_value
 from .rhs import bean_areas_m2, bean_heat_transfer_coefficient_kW_m2K, conductance_ratio_F, dry_mass_kg
 
 GEOMETRY_KEYS = ("Mb_kg", "Dch_m", "Lch_m", "Hflap_m", "Sflap_m", "Mm_kg")
@@ -77,11 +78,7 @@ class Plant:
 
     def __post_init__(self) -> None:
         for key in GEOMETRY_KEYS:
-            value = getattr(self, key)
-            if not (isinstance(value, (int, float)) and not isinstance(value, bool)):
-                raise ParameterError(f"{key} must be a number, got {value!r}")
-            if not (value > 0 and math.isfinite(value)):
-                raise ParameterError(f"{key} ({_GEOMETRY_DOC[key]}) must be > 0 and finite, got {value!r}")
+            check_value(key, getattr(self, key))  # the one plausibility table
 
     # --- derived geometry (eq. 7, section 3.1) ------------------------------------
     @property
@@ -153,12 +150,7 @@ def plant_from_mapping(data: dict, source: str | Path, default_name: str) -> Pla
         raise InputError(f"name must be a string, got {name!r}", source, "name")
     geometry = {}
     for key in GEOMETRY_KEYS:
-        value = data[key]
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise ParameterError(f"must be a number, got {value!r}", source, key)
-        if not (value > 0 and math.isfinite(value)):
-            raise ParameterError(f"{_GEOMETRY_DOC[key]} must be > 0, got {value!r}", source, key)
-        geometry[key] = float(value)
+        geometry[key] = check_value(key, data[key], source)
     return Plant(name=name, process=process, **geometry)
 
 

@@ -20,8 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io.batch import Batch, write_batch_csv
-from ..io.files import atomic_write_text
+from ..io.batch import Batch, write_batch_csv_text
+from ..io.files import Outputs
 from ..io.plants import load_plant
 from ..model.parameters import THETA_PAPER
 from ..sim.simulate import InitialState, simulate
@@ -93,18 +93,26 @@ def make_paper(seed: int = PAPER_SEED, folder: str | Path = "paper-synthetic") -
     folder = Path(folder)
     rng = np.random.default_rng(seed)
     written = []
+    with Outputs() as outputs:  # every file or none
+        _make_paper_into(outputs, folder, rng, seed, written)
+    return written
+
+
+def _make_paper_into(outputs: Outputs, folder: Path, rng, seed: int, written: list) -> None:
+    outputs.folder(folder)
     for ds_name, (plant_name, count) in SPECS.items():
-        out = folder / ds_name
-        out.mkdir(parents=True, exist_ok=True)
+        out = outputs.folder(folder / ds_name)
         truths, entries = [], []
         for i in range(1, count + 1):
             batch, truth = make_batch(rng, plant_name, i, cold_first=(i == 1))
             path = out / f"{batch.name}.csv"
-            write_batch_csv(
+            outputs.write_text(
                 path,
-                batch,
-                comment=f"{SYNTHETIC_NOTE}\n{ds_name}, plant {plant_name}, {batch.name}, seed {seed}",
-                decimals=4,
+                write_batch_csv_text(
+                    batch,
+                    comment=f"{SYNTHETIC_NOTE}\n{ds_name}, plant {plant_name}, {batch.name}, seed {seed}",
+                    decimals=4,
+                ),
             )
             written.append(path)
             truths.append(truth)
@@ -115,7 +123,7 @@ def make_paper(seed: int = PAPER_SEED, folder: str | Path = "paper-synthetic") -
             f'description = "Synthetic stand-in for the paper\'s {ds_name} ({count} batches, {plant_name} plant)."\n\n'
             + "\n".join(entries)
         )
-        atomic_write_text(out / "dataset.toml", toml)
+        outputs.write_text(out / "dataset.toml", toml)
         truth_doc = {
             "synthetic": True,
             "note": SYNTHETIC_NOTE,
@@ -129,7 +137,7 @@ def make_paper(seed: int = PAPER_SEED, folder: str | Path = "paper-synthetic") -
             "noise": NOISE,
             "batches": truths,
         }
-        atomic_write_text(out / "truth.json", json.dumps(truth_doc, indent=1) + "\n")
+        outputs.write_text(out / "truth.json", json.dumps(truth_doc, indent=1) + "\n")
         written += [out / "dataset.toml", out / "truth.json"]
     readme = (
         "# paper-synthetic: SYNTHETIC stand-ins for the paper's private data\n\n"
@@ -138,6 +146,5 @@ def make_paper(seed: int = PAPER_SEED, folder: str | Path = "paper-synthetic") -
         "Each folder's `truth.json` holds everything used to generate it: theta, per-batch X0, Tm0, charge\n"
         "temperature, burner program, true inputs and noise-free probe readings, and the noise levels.\n"
     )
-    atomic_write_text(folder / "README.md", readme)
+    outputs.write_text(folder / "README.md", readme)
     written.append(folder / "README.md")
-    return written

@@ -13,7 +13,6 @@ import time
 from importlib import resources
 from pathlib import Path
 
-from ..errors import InputError
 from ..evaluate.metrics import METRIC_NAMES
 from ..io.batch import read_dataset
 from ..io.files import Outputs
@@ -73,13 +72,11 @@ def run(
 ) -> dict:
     """Run the whole reproduction; return a summary dict."""
     out = Path(out_dir)
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise InputError(f"cannot create output folder ({exc.strerror})", out) from None
     root = Path(data_root) if data_root else default_dataset_root()
     ds_i = read_dataset(root / "dataset-I")
     ds_v = read_dataset(root / "dataset-V")
+    outputs = Outputs()
+    outputs.folder(out)  # checked against the inputs before the identification runs
     t0 = time.perf_counter()
     result = fit_model(ds_i.batches, ds_i.plant, seed=seed, progress=progress)
     identify_s = time.perf_counter() - t0
@@ -96,7 +93,7 @@ def run(
         "dataset-I": res_i.to_json_dict(),
         "dataset-V": res_v.to_json_dict(),
     }
-    with Outputs() as outputs:  # every file or none
+    with outputs:  # every file or none
         model.doc["provenance"]["synthetic_data"] = synthetic
         from ..io.modelfile import model_document_text
 

@@ -5,7 +5,7 @@
 * :mod:`.mapping`: a TOML column map saying which channel is time, Ta, Tgi and Gg, in which
   units, and how to get Gg (a column, a constant to identify, or a Pitot tube, eq. 16).
 
-Untrusted files are parsed as data only (``json`` / ``ast.literal_eval``), never executed.
+Untrusted files are parsed as data only (JSON parsers, a token translator for Python literals), never executed.
 """
 
 from ...model.pitot import gas_flow_pitot_kg_s

@@ -8,14 +8,21 @@ newer files), ``weight`` = [green, roasted, unit], extra devices (``extratimex``
 and special events (``specialevents`` sample indices, ``specialeventstype`` indices into
 ``etypes``, ``specialeventsvalue`` in Artisan's internal encoding).
 
-The file is parsed as data only: JSON when it is JSON, otherwise ``ast.literal_eval``; a
-file holding code (a call, a name) is refused, never run.
+The file is parsed as data only and in bounded memory: JSON when it is JSON; otherwise the
+Python literal Artisan writes (``repr`` of a dict) is translated token by token to JSON
+(:func:`python_literal_to_json`) and parsed by the JSON parser, so parsing costs a small
+multiple of the file's size (``ast.literal_eval`` builds a syntax tree of ~1 kB per number,
+about 18 GB for a 16 MB file). A file holding code (a call, a name) is refused, never run.
 """
 
 from __future__ import annotations
 
 import ast
+import io
 import json
+import math
+import re
+from array import array
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -66,6 +73,46 @@ class ArtisanLog:
     title: str = ""
 
 
+# Tokens of a Python literal that JSON spells differently. Strings come first so that words,
+# brackets and colons inside a string are consumed with it; what is left between matches
+# (numbers, [ ] { } , :, white space) is the same in both languages, and anything else
+# (a name, a call, a bytes literal) stays and makes the JSON parser refuse the text.
+_PY_TOKENS = re.compile(
+    r"""(?P<s>[uU]?'(?:[^'\\\n]|\\.)*'|[uU]?"(?:[^"\\\n]|\\.)*")"""
+    r"|(?P<w>\b(?:True|False|None)\b)"
+    r"|(?P<k>-?\d+(?:\.\d*)?(?=\s*:))"
+    r"|(?P<o>\()|(?P<c>\))",
+    re.S,
+)
+_PY_WORDS = {"True": "true", "False": "false", "None": "null"}
+
+
+def _py_token_to_json(m: re.Match) -> str:
+    kind = m.lastgroup
+    tok = m.group()
+    if kind == "s":
+        body = tok[2:-1] if tok[0] in "uU" else tok[1:-1]
+        if "\\" in body:
+            return json.dumps(ast.literal_eval(tok))  # one string literal: bounded, data only
+        return json.dumps(body)
+    if kind == "w":
+        return _PY_WORDS[tok]
+    if kind == "k":
+        return json.dumps(tok)  # a number used as a dict key: JSON keys are strings
+    return "[" if kind == "o" else "]"
+
+
+def python_literal_to_json(text: str) -> str:
+    """Translate the Python literal of an Artisan profile into JSON text.
+
+    Single- and double-quoted strings (with escapes), ``True``/``False``/``None`` and
+    tuples are rewritten; numbers and punctuation are shared by both languages. The result
+    is parsed by ``json.loads``, which refuses anything that is not data. Work and memory are
+    linear in the text's length.
+    """
+    return _PY_TOKENS.sub(_py_token_to_json, text)
+
+
 def _parse_text(path: Path, text: str) -> dict:
     stripped = text.strip()
     if not stripped:
@@ -74,19 +121,27 @@ def _parse_text(path: Path, text: str) -> dict:
         raise InputError("not an Artisan profile (expected a dict starting with '{')", path)
     try:
         data = json.loads(stripped)
-    except (json.JSONDecodeError, RecursionError):
+    except json.JSONDecodeError:
         try:
-            data = ast.literal_eval(stripped)
-        except (ValueError, TypeError) as exc:
+            data = json.loads(python_literal_to_json(stripped))
+        except json.JSONDecodeError as exc:
+            if exc.pos >= len(exc.doc) - 1:
+                raise InputError("truncated Artisan profile (ends before its closing brace)", path) from None
             raise InputError(
-                f"not a data-only Artisan profile ({str(exc).splitlines()[0][:80]}); code is never run", path
+                f"not a data-only Artisan profile (unexpected text at line {exc.lineno}, column {exc.colno}); "
+                "code is never run",
+                path,
             ) from None
-        except SyntaxError as exc:
-            raise InputError(
-                f"truncated or malformed Artisan profile (syntax error at line {exc.lineno})", path
-            ) from None
-        except (MemoryError, RecursionError):
+        except SyntaxError:  # a malformed escape inside one string
+            raise InputError("malformed string in the Artisan profile", path) from None
+        except RecursionError:
             raise InputError("Artisan profile nested too deeply to parse", path) from None
+        except ValueError as exc:  # e.g. an integer longer than Python's digit limit
+            raise InputError(f"number out of range in the Artisan profile ({str(exc)[:60]})", path) from None
+    except RecursionError:
+        raise InputError("Artisan profile nested too deeply to parse", path) from None
+    except ValueError as exc:  # e.g. an integer longer than Python's digit limit
+        raise InputError(f"number out of range in the Artisan profile ({str(exc)[:60]})", path) from None
     if not isinstance(data, dict):
         raise InputError(f"expected a dict at the top level, got {type(data).__name__}", path)
     return data
@@ -109,14 +164,28 @@ def _numeric_list(data: dict, key: str, path: Path, required: bool = True):
     for i, v in enumerate(value):
         if isinstance(v, bool) or not isinstance(v, (int, float)):
             raise InputError(f"expected numbers, found {type(v).__name__} at position {i}", path, f"key {key}")
-        out[i] = v
+        try:
+            out[i] = v
+        except OverflowError:
+            raise InputError(f"number out of range at position {i}", path, f"key {key}") from None
     return out
+
+
+def _weight(value, factor: float, path: Path) -> float | None:
+    """A logged weight in kg, or None when absent (Artisan writes 0 for 'not weighed')."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
+        return None
+    try:
+        kg = float(value) * factor
+    except OverflowError:
+        raise InputError("weight out of range", path, "key weight") from None
+    return kg if math.isfinite(kg) else None
 
 
 def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: bool = True) -> ArtisanLog:
     """Parse an Artisan ``.alog`` file into an :class:`ArtisanLog` (see module docstring)."""
     path = Path(path)
-    data = _parse_text(path, read_input_text(path))
+    data = _parse_text(path, read_input_text(path, "an Artisan profile"))
     timex = _numeric_list(data, "timex", path)
     et = _numeric_list(data, "temp1", path)
     bt = _numeric_list(data, "temp2", path)
@@ -210,10 +279,7 @@ def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: boo
     if isinstance(w, list) and len(w) >= 3 and isinstance(w[2], str):
         factor = WEIGHT_UNITS.get(w[2].lower())
         if factor is not None:
-            if isinstance(w[0], (int, float)) and w[0] > 0:
-                weight_in = float(w[0]) * factor
-            if isinstance(w[1], (int, float)) and w[1] > 0:
-                weight_out = float(w[1]) * factor
+            weight_in, weight_out = (_weight(v, factor, path) for v in w[:2])
     return ArtisanLog(
         str(path),
         time_s,
@@ -250,32 +316,32 @@ def read_artisan_csv(path: str | Path, keep_after_drop: bool = False) -> Artisan
     from ..batch import read_text
 
     text = read_text(path)
-    lines = [ln for ln in text.splitlines() if ln.strip()]
-    if len(lines) < 3:
+    # Streamed line by line into compact arrays: memory stays a small multiple of the file.
+    lines = ((n, ln) for n, ln in enumerate(io.StringIO(text), start=1) if ln.strip())
+    first = [next(lines, None), next(lines, None)]
+    if first[1] is None:
         raise InputError("too short for an Artisan CSV export (meta line, header, data)", path)
-    sep = "\t" if "\t" in lines[1] else ","
+    meta_line, header_line = first[0][1].rstrip("\r\n"), first[1][1].rstrip("\r\n")
+    sep = "\t" if "\t" in header_line else ","
     meta = {}
-    for item in lines[0].split(sep):
+    for item in meta_line.split(sep):
         k, _, v = item.partition(":")
         meta[k.strip()] = v.strip()
     mode = meta.get("Unit", "C")
     if mode not in ("C", "F"):
         raise InputError(f"Unit must be C or F, got {mode!r}", path, "line 1")
-    header = [h.strip() for h in lines[1].split(sep)]
+    header = [h.strip() for h in header_line.split(sep)]
     for col in ("Time1", "ET", "BT"):
         if col not in header:
             raise InputError(f"missing column {col} (header has: {', '.join(header)})", path, "line 2")
-    rows = []
-    for line_no, ln in enumerate(lines[2:], start=3):
-        cells = ln.split(sep)
+    idx = {c: header.index(c) for c in header}
+    t1, t2, et, bt = array("d"), array("d"), array("d"), array("d")
+    for line_no, ln in lines:
+        cells = ln.rstrip("\r\n").split(sep)
         if len(cells) < len(header) - 1:
             raise InputError(
                 f"row has {len(cells)} cells, header {len(header)} (truncated file?)", path, f"line {line_no}"
             )
-        rows.append((line_no, cells))
-    idx = {c: header.index(c) for c in header}
-    t1, t2, et, bt = [], [], [], []
-    for line_no, cells in rows:
         try:
             t1.append(_mmss(cells[idx["Time1"]]))
             t2.append(_mmss(cells[idx["Time2"]]) if "Time2" in idx and idx["Time2"] < len(cells) else float("nan"))
@@ -288,6 +354,8 @@ def read_artisan_csv(path: str | Path, keep_after_drop: bool = False) -> Artisan
             except ValueError:
                 raise InputError(f"not a number: {cell[:20]!r}", path, f"line {line_no}, column {col}") from None
             dest.append(float("nan") if v == -1 else v)
+    if not t1:
+        raise InputError("too short for an Artisan CSV export (meta line, header, data)", path)
     t1, t2 = np.array(t1), np.array(t2)
     et, bt = np.array(et), np.array(bt)
     if mode == "F":

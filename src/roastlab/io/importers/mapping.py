@@ -34,6 +34,7 @@ types (``Burner``, ``Air``, ...). Every error names the map or log file and the 
 
 from __future__ import annotations
 
+import io
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -42,7 +43,7 @@ import numpy as np
 from ...errors import InputError
 from ...model.pitot import gas_flow_pitot_kg_s
 from ..batch import Batch, read_table
-from ..files import read_toml
+from ..files import finite_number, read_input_bytes, read_toml
 from .artisan import read_alog, read_artisan_csv
 
 FORMATS = ("auto", "alog", "artisan-csv", "csv", "parquet")
@@ -132,11 +133,10 @@ def _check_num(table: dict, key: str, src, where: str, positive=False, default=N
     v = table.get(key, default)
     if v is None:
         return None
-    if isinstance(v, bool) or not isinstance(v, (int, float)) or v != v:
-        raise InputError(f"must be a number, got {v!r}", src, f"{where}.{key}")
-    if positive and not v > 0:
+    x = finite_number(v, src, f"{where}.{key}")
+    if positive and not x > 0:
         raise InputError(f"must be > 0, got {v!r}", src, f"{where}.{key}")
-    return float(v)
+    return x
 
 
 def load_map(path: str | Path) -> ColumnMap:
@@ -234,20 +234,30 @@ def _detect_format(path: Path, fmt: str) -> str:
     if suffix in (".parquet", ".pq"):
         return "parquet"
     if suffix in (".csv", ".txt", ".tsv"):
-        try:
-            with open(path, encoding="utf-8", errors="replace") as fh:
-                first = fh.readline()
-        except OSError:
-            first = ""
-        return "artisan-csv" if "Unit:" in first else "csv"
+        first = read_input_bytes(path)[:4096].split(b"\n", 1)[0]  # through the guard: never a FIFO
+        return "artisan-csv" if b"Unit:" in first else "csv"
     raise InputError(f"cannot tell the log format from suffix {suffix!r}; set format in the map", path)
 
 
-def _read_parquet(path: Path, columns: list[str]) -> dict[str, np.ndarray]:
-    try:
-        import pandas as pd
+#: Most rows a Parquet log may declare; checked from its footer before any column is decoded,
+#: so a small file that would decompress to gigabytes is refused first.
+MAX_PARQUET_ROWS = 2_000_000
 
-        frame = pd.read_parquet(path)
+
+def _read_parquet(path: Path, columns: list[str]) -> dict[str, np.ndarray]:
+    raw = read_input_bytes(path)  # the bytes come through the guard, never from the name
+    try:
+        import pyarrow.parquet as pq
+
+        pfile = pq.ParquetFile(io.BytesIO(raw))
+        n_rows = pfile.metadata.num_rows
+        if n_rows > MAX_PARQUET_ROWS:
+            raise InputError(f"declares {n_rows} rows, over the limit of {MAX_PARQUET_ROWS}", path)
+        names = set(pfile.schema_arrow.names)
+        frame = pfile.read(columns=[c for c in columns if c in names]).to_pandas()
+        frame = frame.reindex(columns=[*frame.columns, *(c for c in names if c not in frame.columns)])
+    except InputError:
+        raise
     except ImportError:
         raise InputError("reading Parquet needs pyarrow (pip install 'roastlab[parquet]')", path) from None
     except Exception as exc:  # pyarrow raises many types for a bad file

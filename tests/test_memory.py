@@ -1,0 +1,173 @@
+"""Bounded memory: the largest input each reader accepts is parsed under a hard memory cap.
+
+Each case writes a worst-case file just under its format's size limit (as many values as
+fit, so the parser builds as many objects as it can), then loads it in a child process whose
+address space is capped with ``resource.setrlimit(RLIMIT_AS)``. The child must finish (a
+result or the project's own one-line error, never MemoryError or a kill) and its peak
+resident memory must stay under :data:`RSS_BOUND_MB`.
+
+Before this test, a Python-literal ``.alog`` just under the old 200 MB limit needed ~18 GB
+(``ast.literal_eval`` builds a syntax tree of every number).
+"""
+
+import json
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+from roastlab.io.files import CONFIG_MAX_BYTES, MAX_INPUT_BYTES
+
+resource = pytest.importorskip("resource")
+
+#: Address-space cap of the child [bytes]: importing NumPy, SciPy and numba alone maps ~0.5 GB.
+ADDRESS_SPACE_CAP = 2 * 1024**3
+#: Peak resident memory allowed for parsing the largest accepted file of any format [MB].
+RSS_BOUND_MB = 640
+
+
+def _fill(head: str, item: str, sep: str, tail: str, limit: int) -> str:
+    """``head + item sep item ... + tail`` with as many items as fit under ``limit`` bytes."""
+    n = (limit - len(head) - len(tail) - 64) // (len(item) + len(sep))
+    return head + sep.join([item] * n) + tail
+
+
+def _rows(header: str, row, limit: int) -> str:
+    """A CSV text of ``header`` and rows ``row(i)`` up to ``limit`` bytes."""
+    parts, size, i = [header], len(header), 0
+    while True:
+        r = row(i)
+        if size + len(r) > limit - 64:
+            return "".join(parts)
+        parts.append(r)
+        size += len(r)
+        i += 1
+
+
+def _alog_python(limit):
+    """A valid profile: three series of n samples (time up to 7 digits, temperatures '1.5')."""
+    n = (limit - 200) // (len("1234567, ") + 2 * len("1.5, "))
+    body = ", ".join(str(i) for i in range(n))  # strictly increasing time
+    temps = ", ".join(["1.5"] * n)
+    return "{'mode': 'C', 'timex': [" + body + "], 'temp1': [" + temps + "], 'temp2': [" + temps + "]}"
+
+
+def _alog_day(limit):
+    """A day-long profile sampled every 0.1 s up to the size limit (import resamples it)."""
+    n = min((limit - 200) // (len("12345.6, ") + 2 * len("150.5, ")), 864_000)
+    timex = ", ".join(f"{86_400 * i / (n - 1):.1f}" for i in range(n))
+    temps = ", ".join(["150.5"] * n)
+    return (
+        "{'mode': 'C', 'timeindex': [0, 0, 0, 0, 0, 0, 0, 0], 'timex': ["
+        + timex
+        + "], 'temp1': ["
+        + temps
+        + "], 'temp2': ["
+        + temps
+        + "]}"
+    )
+
+
+def _alog_strings(limit):
+    return _fill(
+        "{'mode': 'C', 'timex': [0, 1], 'temp1': [1, 2], 'temp2': [1, 2], 'etypes': [", "'a\\'b'", ", ", "]}", limit
+    )
+
+
+CASES = {
+    # name: (file name, text builder, loader source run in the child)
+    "batch CSV": (
+        "big.csv",
+        lambda: _rows("time_s,Gg_kg_s,Tgi_C,Ta_C\n", lambda i: f"{i / 20:.2f},0.4,400,30\n", MAX_INPUT_BYTES),
+        "from roastlab.io.batch import read_batch_csv as load",
+    ),
+    "Artisan .alog (Python literal, numbers)": (
+        "big.alog",
+        lambda: _alog_python(MAX_INPUT_BYTES),
+        "from roastlab.io.importers.artisan import read_alog as load",
+    ),
+    "Artisan .alog (Python literal, strings)": (
+        "strings.alog",
+        lambda: _alog_strings(MAX_INPUT_BYTES),
+        "from roastlab.io.importers.artisan import read_alog as load",
+    ),
+    "Artisan .alog (JSON)": (
+        "big-json.alog",
+        lambda: _fill(
+            '{"mode": "C", "timex": [0, 1], "temp1": [1, 2], "temp2": [1, 2], "x": [', "1", ",", "]}", MAX_INPUT_BYTES
+        ),
+        "from roastlab.io.importers.artisan import read_alog as load",
+    ),
+    "Artisan CSV export": (
+        "export.csv",
+        lambda: _rows(
+            "Date:01.01.2026\tUnit:C\tCHARGE:00:00\tDROP:00:09\nTime1\tTime2\tET\tBT\tEvent\n",
+            lambda i: f"{i // 60:02d}:{i % 60:02d}\t\t1\t1\t\n",
+            MAX_INPUT_BYTES,
+        ),
+        "from roastlab.io.importers.artisan import read_artisan_csv as load",
+    ),
+    "model JSON": (
+        "model.json",
+        lambda: _fill('{"format": "roastlab-model/1", "x": [', "1", ",", "]}", MAX_INPUT_BYTES),
+        "from roastlab.io.modelfile import read_model_document as load",
+    ),
+    "map TOML": (
+        "map.toml",
+        lambda: _fill('format = "auto"\nx = [', "1", ",", "]\n", CONFIG_MAX_BYTES),
+        "from roastlab.io.importers import load_map as load",
+    ),
+    "plant TOML (many tables)": (
+        "plant.toml",
+        lambda: _rows('name = "x"\n', lambda i: f"[t{i}]\n", CONFIG_MAX_BYTES),
+        "from roastlab.io.plants import load_plant as load",
+    ),
+    "import with the finest resampling over a day": (
+        "day.alog",
+        lambda: _alog_day(MAX_INPUT_BYTES),
+        "from roastlab.io.importers.mapping import import_log, map_from_mapping\n"
+        "MAP = {'format': 'alog', 'resample_s': 0.1, 'Ta': {'column': 'BT'}, 'Tgi': {'column': 'ET'},"
+        " 'Gg': {'constant_kg_s': 0.01}}\n"
+        "load = lambda p: import_log(p, map_from_mapping(MAP, 'map'))",
+    ),
+}
+
+CHILD = textwrap.dedent(
+    """
+    import json, resource, sys
+    {loader}
+    from roastlab.errors import RoastlabError
+    resource.setrlimit(resource.RLIMIT_AS, ({cap}, {cap}))
+    try:
+        load(sys.argv[1])
+        outcome = "loaded"
+    except RoastlabError as exc:
+        outcome = "refused: " + str(exc).split(": ", 1)[-1][:200]
+    rss_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    print(json.dumps({{"outcome": outcome, "rss_mb": rss_mb}}))
+    """
+)
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_largest_accepted_input_parses_in_bounded_memory(case, tmp_path):
+    name, build, loader = CASES[case]
+    text = build()
+    path = tmp_path / name
+    path.write_text(text)
+    size = path.stat().st_size
+    limit = CONFIG_MAX_BYTES if name.endswith(".toml") else MAX_INPUT_BYTES
+    assert limit * 0.9 < size <= limit, (case, size)  # the case really is at the limit
+    proc = subprocess.run(
+        [sys.executable, "-c", CHILD.format(loader=loader, cap=ADDRESS_SPACE_CAP), str(path)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "PATH": "/usr/bin:/bin"},
+    )
+    assert proc.returncode == 0, (case, proc.stderr[-2000:])
+    result = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert "MemoryError" not in result["outcome"], result
+    assert result["rss_mb"] <= RSS_BOUND_MB, (case, result)
+    print(f"{case}: {size / 1e6:.1f} MB file, peak RSS {result['rss_mb']:.0f} MB, {result['outcome'][:80]}")
