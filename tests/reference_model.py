@@ -32,7 +32,9 @@ PLANTS = {
 }
 
 
-def make_rhs(plant: str, theta, X0: float, moisture: str = "schwartzberg"):
+def make_rhs(plant: str, theta, X0: float, moisture: str = "schwartzberg", act=None):
+    """The slow reference right-hand side. ``act`` holds the actuator extension's values
+    (Qe_gain, Qe_offset, Tgi_gain, tau, Gg_fan); None = the paper's model."""
     g = PLANTS[plant]
     c = PROCESS
     hgm, hbm, Pbm = theta
@@ -42,8 +44,15 @@ def make_rhs(plant: str, theta, X0: float, moisture: str = "schwartzberg"):
     Mbd = g["Mb"] / (1 + X0)
     k1, xexp = (c["k1"], 2) if moisture == "schwartzberg" else (4.32e-9, 0)
 
-    def f(x, Gg, Tgi):
-        Tb, Tm, X, He, Ta = x
+    a = act or {}
+
+    def f(x, Gg, Tgi, heater=0.0, fan=0.0):
+        Tb, Tm, X, He, Ta, H = x
+        # actuator extension: fan -> flow, lagged heater -> inlet gas rise and heat into the metal
+        Gg = max(Gg + a.get("Gg_fan", 0.0) * fan, 1e-6)
+        Tgi = Tgi + a.get("Tgi_gain", 0.0) * H
+        Qe = max(a.get("Qe_offset", 0.0) + a.get("Qe_gain", 0.0) * H, 0.0)
+        dH = (heater - H) / a.get("tau", 1.0)
         cg = sum(a * (Tgi + 273.15) ** i for i, a in enumerate(ALPHA)) / 1000
         he = 0.49 - 0.443 * math.exp(-0.206 * X)
         F = hgm * Agm / (he * Agb)
@@ -57,33 +66,52 @@ def make_rhs(plant: str, theta, X0: float, moisture: str = "schwartzberg"):
         Qr = c["A"] * (c["Het"] - He) / c["Het"] * math.exp(-c["HaR"] / (Tb + 273.15))
         cs = 1.099 + 0.007 * Tb
         dTb = (Qgb - Qgm + Qbm + Mbd * (Qr + c["lam"] * dX)) / (Mbd * (cs + c["cw"] * X))
-        dTm = (Qgm - Qbm) / (g["Mm"] * c["cm"])
-        return [dTb, dTm, dX, Qr, c["Kt"] * (Tb - Ta)], Tgi - drop
+        dTm = (Qgm - Qbm + Qe) / (g["Mm"] * c["cm"])
+        return [dTb, dTm, dX, Qr, c["Kt"] * (Tb - Ta), dH], Tgi - drop
 
     return f
 
 
-def reference_simulate(plant, theta, t, Gg, Tgi, x0, moisture="schwartzberg", hold="linear", rtol=1e-10, atol=1e-10):
-    """Return (states (n, 5), Tgo (n,)) at the sample times."""
-    f = make_rhs(plant, theta, x0[2], moisture)
+def reference_simulate(
+    plant,
+    theta,
+    t,
+    Gg,
+    Tgi,
+    x0,
+    moisture="schwartzberg",
+    hold="linear",
+    rtol=1e-10,
+    atol=1e-10,
+    heater=None,
+    fan=None,
+    act=None,
+):
+    """Return (states (n, 6), Tgo (n,)) at the sample times (x0 of 5 states gets H = heater[0])."""
+    f = make_rhs(plant, theta, x0[2], moisture, act)
     n = len(t)
-    out = np.empty((n, 5))
+    heater = np.zeros(n) if heater is None else np.asarray(heater, dtype=float)
+    fan = np.zeros(n) if fan is None else np.asarray(fan, dtype=float)
+    x0 = list(x0[:5]) + [heater[0]]
+    out = np.empty((n, 6))
     tgo = np.empty(n)
     x = np.array(x0, dtype=float)
     out[0] = x
-    tgo[0] = f(x, Gg[0], Tgi[0])[1]
+    tgo[0] = f(x, Gg[0], Tgi[0], heater[0], fan[0])[1]
     for k in range(n - 1):
         t0, t1 = t[k], t[k + 1]
 
         def u(s, k=k, t0=t0, t1=t1):
+            series = (Gg, Tgi, heater, fan)
             if hold == "zoh":
-                return Gg[k], Tgi[k]
+                return tuple(v[k] for v in series)
             w = (s - t0) / (t1 - t0)
-            return Gg[k] + w * (Gg[k + 1] - Gg[k]), Tgi[k] + w * (Tgi[k + 1] - Tgi[k])
+            return tuple(v[k] + w * (v[k + 1] - v[k]) for v in series)
 
         sol = solve_ivp(lambda s, y: f(y, *u(s))[0], (t0, t1), x, method="DOP853", rtol=rtol, atol=atol)
         x = sol.y[:, -1]
         out[k + 1] = x
-        uk = (Gg[k], Tgi[k]) if hold == "zoh" else (Gg[k + 1], Tgi[k + 1])
+        j = k if hold == "zoh" else k + 1
+        uk = (Gg[j], Tgi[j], heater[j], fan[j])
         tgo[k + 1] = f(x, *uk)[1]
     return out, tgo

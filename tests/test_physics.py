@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from roastlab import InitialState, Simulator, load_plant, pack_params, rhs, simulate
-from roastlab.model.rhs import gas_heat_capacity_kJ_kgK
+from roastlab.model.rhs import P, gas_heat_capacity_kJ_kgK
 from roastlab.sim.kernels import simulate_one
 
 T = np.arange(0.0, 961.0, 30.0)
@@ -74,9 +74,72 @@ def test_rhs_is_pure_and_matches_kernel_step():
     assert np.all(x == [30.0, 121.0, 0.1, 0.0, 30.0])
     # the compiled integrator over a tiny step moves the state by h * rhs (Euler), to O(h^2)
     h = 1e-3
-    out = simulate_one(np.array([0.0, h]), np.array([0.4, 0.4]), np.array([450.0, 450.0]), x, p, False, 30.0)
+    zero = np.zeros(2)
+    x6 = np.append(x, 0.0)
+    out = simulate_one(
+        np.array([0.0, h]), np.array([0.4, 0.4]), np.array([450.0, 450.0]), zero, zero, x6, p, False, 30.0
+    )
     np.testing.assert_allclose(out[1, :5], x + h * d1, rtol=0, atol=1e-4 * h * np.abs(d1).max())
     assert d1[0] > 0 and d1[2] <= 0 and d1[3] > 0
+
+
+def test_actuator_terms_enter_the_one_rhs():
+    """Heater -> Qe on the metal and Tgi rise through the lag state, fan -> Gg: each term moves
+    the derivative it should and nothing else; the compiled step agrees with rhs()."""
+    plant = load_plant("120kg")
+    p = pack_params(plant, (0.01, 0.0254, 0.5793), 0.1)
+    x = np.array([150.0, 200.0, 0.05, 10.0, 140.0, 4.0])
+    base = rhs(0.0, x, np.array([0.4, 300.0, 6.0, 2.0]), p)
+    assert base[5] == pytest.approx((6.0 - 4.0) / 1.0)  # lag state only; gains 0 = the paper's model
+    q = p.copy()
+    q[P["Qe_gain"]] = 2.0  # kW per unit: H = 4 gives 8 kW more into the metal
+    d = rhs(0.0, x, np.array([0.4, 300.0, 6.0, 2.0]), q)
+    assert d[1] - base[1] == pytest.approx(8.0 / (plant.Mm_kg * plant.process.cm))
+    np.testing.assert_array_equal(np.delete(d, 1), np.delete(base, 1))
+    q = p.copy()
+    q[P["Tgi_gain"]] = 5.0  # H = 4 raises the gas by 20 degC: same as logging Tgi 20 degC higher
+    np.testing.assert_allclose(
+        rhs(0.0, x, np.array([0.4, 300.0, 6.0, 2.0]), q)[:5], rhs(0.0, x, np.array([0.4, 320.0]), p)[:5]
+    )
+    q = p.copy()
+    q[P["Gg_fan"]] = 0.05  # fan 2 adds 0.1 kg/s
+    np.testing.assert_allclose(
+        rhs(0.0, x, np.array([0.4, 300.0, 6.0, 2.0]), q)[:5], rhs(0.0, x, np.array([0.5, 300.0]), p)[:5]
+    )
+    q[P["Qe_gain"]], q[P["tau_heater"]] = 2.0, 30.0
+    h = 1e-3
+    u = [np.full(2, v) for v in (0.4, 300.0, 6.0, 2.0)]
+    out = simulate_one(np.array([0.0, h]), *u, x, q, False, 30.0)
+    d = rhs(0.0, x, np.array([0.4, 300.0, 6.0, 2.0]), q)
+    np.testing.assert_allclose(out[1, :6], x + h * d, rtol=0, atol=1e-4 * h * np.abs(d).max())
+
+
+def test_heater_energy_balance_at_steady_state():
+    """Independent number: at steady state with the reaction spent and the beans dry, all the
+    heater's power leaves with the gas, Qe = Gg cg(Tgi) (Tgo - Tgi) (eqs. 9, 12, 15a-b)."""
+    from roastlab.model.rhs import gas_heat_capacity_kJ_kgK
+    from roastlab.sim.simulate import InitialState, simulate
+
+    t = np.arange(0.0, 40001.0, 50.0)
+    n = len(t)
+    values = {"Qe_gain_kW": 0.15, "Qe_offset_kW": 0.0, "tau_heater_s": 20.0, "Gg_fan_kg_s": 0.002}
+    res = simulate(
+        "120kg",
+        t,
+        np.full(n, 0.3),
+        np.full(n, 25.0),
+        theta=(0.05, 0.05, 0.6),
+        initial=InitialState(Tb0_C=25.0, Tm0_C=25.0, X0=0.0, He0_kJ_kg=232.0),
+        heater=np.full(n, 400.0),
+        fan=np.full(n, 50.0),
+        values=values,
+    )
+    Qe = 0.15 * 400.0
+    Gg = 0.3 + 0.002 * 50.0
+    carried = Gg * gas_heat_capacity_kJ_kgK(25.0) * (res.Tgo_C[-1] - 25.0)
+    assert abs(res.Tm_C[-1] - res.Tm_C[-20]) < 1e-3  # settled
+    assert carried == pytest.approx(Qe, rel=1e-4)
+    assert res.heat_flows()["Qe_kW"][-1] == pytest.approx(Qe)
 
 
 def test_derived_geometry_matches_model_md():

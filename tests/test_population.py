@@ -28,8 +28,8 @@ def test_population_equals_one_at_a_time():
         for b, (batch, plant) in enumerate(zip(batches, plants)):
             one = simulate(plant, batch.time_s, batch.Gg_kg_s, batch.Tgi_C, theta=theta, Ta_measured_C=batch.Ta_C)
             n = batch.n
-            assert np.max(np.abs(pop[m, b, :n, :5] - one.states)) <= 1e-9
-            assert np.max(np.abs(pop[m, b, :n, 5] - one.Tgo_C)) <= 1e-9
+            assert np.max(np.abs(pop[m, b, :n, :6] - one.states)) <= 1e-9
+            assert np.max(np.abs(pop[m, b, :n, 6] - one.Tgo_C)) <= 1e-9
             assert np.max(np.abs(ta[m, b, :n] - one.Ta_C)) <= 1e-9
             assert np.all(np.isnan(pop[m, b, n:]))
 
@@ -43,7 +43,7 @@ def test_population_varies_initial_state_and_dry_mass():
     for m, (tm0, x0) in enumerate(values[:, 0, :]):
         init = InitialState(Tm0_C=tm0, X0=x0)
         one = simulate("120kg", b.time_s, b.Gg_kg_s, b.Tgi_C, initial=init, Ta_measured_C=b.Ta_C)
-        assert np.max(np.abs(pop[m, 0, :, :5] - one.states)) <= 1e-9
+        assert np.max(np.abs(pop[m, 0, :, :6] - one.states)) <= 1e-9
 
 
 @pytest.mark.parametrize("index", [0, 2, 4])

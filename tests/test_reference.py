@@ -6,6 +6,7 @@ term in the right-hand side shows up as degrees, not hundredths.
 """
 
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -54,6 +55,30 @@ def test_compiled_matches_reference(seed, plant, hold, hgm, hbm, Pbm):
     assert np.max(np.abs(fast.X_kg_kg - ref[:, 2])) < TOL_X
     # He is not a temperature; hold it to the same relative standard (kJ/kg, scale 232)
     assert np.max(np.abs(fast.He_kJ_kg - ref[:, 3])) < 0.01
+
+
+@pytest.mark.parametrize("seed, hold", [(11, "zoh"), (12, "linear"), (13, "zoh")])
+def test_actuator_extension_matches_reference(seed, hold):
+    """Heater steps through the lag into Qe and Tgi, fan steps into Gg: compiled vs reference."""
+    t, Gg, Tgi, x0 = random_case(seed, "120kg")
+    rng = np.random.default_rng(seed)
+    n = len(t)
+    heater = rng.permutation(10)[(np.arange(n) // 3) % 10].astype(float)  # levels held for 3 samples
+    fan = rng.permutation(12)[(np.arange(n) // 4) % 12].astype(float)
+    act = {"Qe_gain": 4.0, "Qe_offset": 2.0, "Tgi_gain": 6.0, "tau": 25.0, "Gg_fan": 0.01}
+    values = {"Qe_gain_kW": 4.0, "Qe_offset_kW": 2.0, "Tgi_gain_C": 6.0, "tau_heater_s": 25.0, "Gg_fan_kg_s": 0.01}
+    theta = (0.03, 0.04, 0.6)
+    fast = simulate(
+        "120kg", t, Gg, Tgi - 150.0, theta=theta, initial=x0, hold=hold, heater=heater, fan=fan, values=values
+    )
+    ref, ref_tgo = reference_simulate(
+        "120kg", theta, t, Gg, Tgi - 150.0, x0.vector(), hold=hold, heater=heater, fan=fan, act=act
+    )
+    for j in (0, 1, 4):
+        assert np.max(np.abs(fast.states[:, j] - ref[:, j])) < TOL_C
+    assert np.max(np.abs(fast.states[:, 5] - ref[:, 5])) < 1e-3  # the lagged heater, in levels
+    assert np.max(np.abs(fast.Tgo_C - ref_tgo)) < TOL_C
+    assert np.ptp(fast.states[:, 5]) > 1.0  # the heater really moved
 
 
 def test_printed_moisture_law_matches_reference():

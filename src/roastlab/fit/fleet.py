@@ -33,7 +33,7 @@ from ..errors import InputError
 from ..evaluate.metrics import fit_percent
 from ..model.parameters import REGISTRY, THETA_NAMES, THETA_START
 from ..model.rhs import P
-from ..sim.kernels import integrate_into
+from ..sim.kernels import N_OUT, integrate_into
 from ..sim.population import PackedBatches, predict_ta
 from .identify import FD_STEP
 
@@ -88,18 +88,18 @@ def _set_theta(z, lo, span, p):
 
 
 @njit(cache=True)
-def _residual_vec(z, lo, span, t, Gg, Tgi, n, Ta, x0, p, zoh, h_max, scratch, out):
+def _residual_vec(z, lo, span, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, out):
     """Residuals T^a - Ta for scaled parameters z in [0, 1]^3, into out[:n]."""
     _set_theta(z, lo, span, p)
-    integrate_into(t, Gg, Tgi, n, x0, p, zoh, h_max, scratch, 5.0, False)
+    integrate_into(t, Gg, Tgi, Q, F, n, x0, p, zoh, h_max, scratch, 5.0, False)
     for i in range(n):
         out[i] = scratch[i, 4] - Ta[i]
 
 
 @njit(cache=True)
-def _ssr_of(z, lo, span, t, Gg, Tgi, n, Ta, x0, p, zoh, h_max, scratch, r):
+def _ssr_of(z, lo, span, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, r):
     """SSR of the probe reading (a failed simulation counts as 1e300); r is a work buffer."""
-    _residual_vec(z, lo, span, t, Gg, Tgi, n, Ta, x0, p, zoh, h_max, scratch, r)
+    _residual_vec(z, lo, span, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, r)
     s = 0.0
     for i in range(n):
         s += r[i] * r[i]
@@ -109,16 +109,16 @@ def _ssr_of(z, lo, span, t, Gg, Tgi, n, Ta, x0, p, zoh, h_max, scratch, r):
 
 
 @njit(cache=True)
-def _fit_one(t, Gg, Tgi, n, Ta, x0, p_in, lo, span, trial, zoh, h_max, max_iter, gain_tol, z_out):
+def _fit_one(t, Gg, Tgi, Q, F, n, Ta, x0, p_in, lo, span, trial, zoh, h_max, max_iter, gain_tol, z_out):
     """Score the trial points, then projected Levenberg-Marquardt from the best; returns (SSR, sims)."""
     p = p_in.copy()
-    scratch = np.empty((t.shape[0], 6))
+    scratch = np.empty((t.shape[0], N_OUT))
     rs = np.empty(n)
     best = 1e300
     z = np.empty(3)
     sims = 0
     for k in range(trial.shape[0]):
-        s = _ssr_of(trial[k], lo, span, t, Gg, Tgi, n, Ta, x0, p, zoh, h_max, scratch, rs)
+        s = _ssr_of(trial[k], lo, span, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, rs)
         sims += 1
         if s < best:
             best = s
@@ -142,7 +142,7 @@ def _fit_one(t, Gg, Tgi, n, Ta, x0, p_in, lo, span, trial, zoh, h_max, max_iter,
     need_jac = True
     for _it in range(max_iter):
         if need_jac:
-            _residual_vec(z, lo, span, t, Gg, Tgi, n, Ta, x0, p, zoh, h_max, scratch, r0)
+            _residual_vec(z, lo, span, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, r0)
             sims += 1
             for j in range(3):
                 if not free[j]:
@@ -153,9 +153,9 @@ def _fit_one(t, Gg, Tgi, n, Ta, x0, p_in, lo, span, trial, zoh, h_max, max_iter,
                 zp = min(z[j] + FD_STEP, 1.0)
                 zm = max(z[j] - FD_STEP, 0.0)
                 zt[j] = zp
-                _residual_vec(zt, lo, span, t, Gg, Tgi, n, Ta, x0, p, zoh, h_max, scratch, rp)
+                _residual_vec(zt, lo, span, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, rp)
                 zt[j] = zm
-                _residual_vec(zt, lo, span, t, Gg, Tgi, n, Ta, x0, p, zoh, h_max, scratch, rm)
+                _residual_vec(zt, lo, span, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, rm)
                 sims += 2
                 for i in range(n):
                     J[i, j] = (rp[i] - rm[i]) / (zp - zm)
@@ -205,7 +205,7 @@ def _fit_one(t, Gg, Tgi, n, Ta, x0, p_in, lo, span, trial, zoh, h_max, max_iter,
                 break
         for j in range(3):
             zt[j] = min(max(z[j] + step[j], 0.0), 1.0)
-        s = _ssr_of(zt, lo, span, t, Gg, Tgi, n, Ta, x0, p, zoh, h_max, scratch, rs)
+        s = _ssr_of(zt, lo, span, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, rs)
         sims += 1
         if s < ssr:
             gain = (ssr - s) / max(ssr, 1e-300)
@@ -229,10 +229,26 @@ def _fit_one(t, Gg, Tgi, n, Ta, x0, p_in, lo, span, trial, zoh, h_max, max_iter,
 
 
 @njit(cache=True, parallel=True)
-def _fit_population(T, GG, TGI, N, TA, X0, PB, lo, span, trial, zoh, h_max, max_iter, gain_tol, Z, SSR, SIMS):
+def _fit_population(T, GG, TGI, QQ, FF, N, TA, X0, PB, lo, span, trial, zoh, h_max, max_iter, gain_tol, Z, SSR, SIMS):
     for b in prange(N.shape[0]):
         ssr, sims = _fit_one(
-            T[b], GG[b], TGI[b], N[b], TA[b], X0[b], PB[b], lo, span, trial, zoh, h_max, max_iter, gain_tol, Z[b]
+            T[b],
+            GG[b],
+            TGI[b],
+            QQ[b],
+            FF[b],
+            N[b],
+            TA[b],
+            X0[b],
+            PB[b],
+            lo,
+            span,
+            trial,
+            zoh,
+            h_max,
+            max_iter,
+            gain_tol,
+            Z[b],
         )
         SSR[b] = ssr
         SIMS[b] = sims
@@ -289,6 +305,8 @@ def identify_each(
                 packed.T[sl],
                 packed.GG[sl],
                 packed.TGI[sl],
+                packed.QQ[sl],
+                packed.FF[sl],
                 packed.N[sl],
                 TA[sl],
                 packed.X0[sl],

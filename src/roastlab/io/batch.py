@@ -23,7 +23,11 @@ from ..model.limits import check_array, check_value
 from .files import atomic_write_text, read_input_text, read_toml
 
 REQUIRED_COLUMNS = ("time_s", "Gg_kg_s", "Tgi_C")
-OPTIONAL_COLUMNS = ("Ta_C",)
+#: Optional columns: the probe reading, the actuator settings (the actuator extension) and a
+#: second bean reading compared with the model's Tb (e.g. an infrared bean-surface channel).
+OPTIONAL_COLUMNS = ("Ta_C", "heater", "fan", "Tb2_C")
+#: Columns whose empty cells mean "not measured here" (read as NaN, written empty).
+SPARSE_COLUMNS = ("Tb2_C",)
 
 
 @dataclass
@@ -41,6 +45,11 @@ class Batch:
     initial : per-batch initial-state overrides (e.g. ``{"Tm0_C": 105.0}``)
     Mb_kg : green batch mass [kg] if it differs from the plant's (read from a
         ``# Mb_kg = ...`` comment line of a batch CSV, or from an Artisan log's weight)
+    heater, fan : (n,) arrays or None, logged settings (the actuator extension), held between
+        changes; units as the map declares (percent, levels or kW)
+    Tb2_C : (n,) array or None, a second bean reading compared with the model's Tb (e.g. an
+        infrared bean-surface channel); NaN where not measured
+    events : {event name: time after CHARGE [s]} from the log (e.g. ``FCs``, ``DROP``)
     """
 
     name: str
@@ -52,6 +61,10 @@ class Batch:
     initial: dict = field(default_factory=dict)
     Mb_kg: float | None = None
     notes: list = field(default_factory=list)  # import warnings worth telling the user
+    heater: np.ndarray | None = None
+    fan: np.ndarray | None = None
+    Tb2_C: np.ndarray | None = None
+    events: dict = field(default_factory=dict)
 
     @property
     def n(self) -> int:
@@ -61,8 +74,11 @@ class Batch:
         """Check the physical sanity of the arrays; raise InputError naming the source."""
         src = self.source or self.name
         cols = {"time_s": self.time_s, "Gg_kg_s": self.Gg_kg_s, "Tgi_C": self.Tgi_C}
-        if self.Ta_C is not None:
-            cols["Ta_C"] = self.Ta_C
+        for name in ("Ta_C", "heater", "fan"):
+            if getattr(self, name) is not None:
+                cols[name] = getattr(self, name)
+        if self.Tb2_C is not None and len(self.Tb2_C) != len(self.time_s):
+            raise InputError(f"column Tb2_C has {len(self.Tb2_C)} values, time has {len(self.time_s)}", src)
         n = len(self.time_s)
         if n < 2:
             raise InputError(f"needs at least 2 samples, got {n}", src)
@@ -84,9 +100,12 @@ class Batch:
                 src,
                 f"row {i + 1}, column time_s",
             )
-        for name in ("time_s", "Gg_kg_s", "Tgi_C", "Ta_C"):
+        for name in ("time_s", "Gg_kg_s", "Tgi_C", "Ta_C", "heater", "fan"):
             if name in cols:
                 check_array(name, cols[name], src, None)
+        if self.Tb2_C is not None:
+            seen = self.Tb2_C[np.isfinite(self.Tb2_C)]  # NaN = not measured there
+            check_array("Ta_C", seen, src, "column Tb2_C")
         check_array("dt_s", dt, src)
         if self.Mb_kg is not None:
             check_value("Mb_kg", self.Mb_kg, src)
@@ -154,7 +173,10 @@ def read_table(
                     raise InputError(
                         f"row has {len(row)} cells, column {c} missing (truncated file?)", path, f"line {line_no}"
                     )
-                values[c].append(parse_number(row[j], path, line_no, c))
+                if c in SPARSE_COLUMNS and not row[j].strip():
+                    values[c].append(math.nan)  # a reading not taken at this sample
+                else:
+                    values[c].append(parse_number(row[j], path, line_no, c))
     except csv.Error as exc:
         raise InputError(f"unreadable row ({exc})", path, f"line {at[0]}") from None
     if header is None:
@@ -219,6 +241,9 @@ def read_batch_csv(path: str | Path, name: str | None = None, require_Ta: bool =
         Ta_C=cols.get("Ta_C"),
         source=str(path),
         Mb_kg=meta.get("Mb_kg"),
+        heater=cols.get("heater"),
+        fan=cols.get("fan"),
+        Tb2_C=cols.get("Tb2_C"),
     )
     return batch.validate()
 
@@ -260,11 +285,11 @@ def write_batch_csv_text(batch: Batch, comment: str | None = None, decimals: int
         out.write("## " + "".join(c if c.isprintable() else "?" for c in line) + "\n")
     if batch.Mb_kg:
         out.write(f"# Mb_kg = {batch.Mb_kg:.6g}\n")
-    cols = ["time_s", "Gg_kg_s", "Tgi_C"] + (["Ta_C"] if batch.Ta_C is not None else [])
+    cols = ["time_s", "Gg_kg_s", "Tgi_C"] + [c for c in OPTIONAL_COLUMNS if getattr(batch, c) is not None]
     out.write(",".join(cols) + "\n")
-    arrays = [batch.time_s, batch.Gg_kg_s, batch.Tgi_C] + ([batch.Ta_C] if batch.Ta_C is not None else [])
+    arrays = [getattr(batch, c) for c in cols]
     for row in zip(*arrays):
-        out.write(",".join(f"{v:.{decimals}f}" for v in row) + "\n")
+        out.write(",".join(f"{v:.{decimals}f}" if v == v else "" for v in row) + "\n")
     return out.getvalue()
 
 

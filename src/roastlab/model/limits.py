@@ -34,6 +34,14 @@ LIMITS: dict[str, tuple[float, float, str, str]] = {
     "Mb_kg": (1e-4, 1e5, "kg", "green batch mass"),
     "batch_kg": (1e-4, 1e5, "kg", "green batch mass"),
     "Tgi_offset_C": (-500.0, 500.0, "degC", "change of the inlet gas temperature"),
+    # actuator extension: logged settings (percent, levels or physical units) and their maps
+    "heater": (-1e3, 1e4, "setting", "heater setting"),
+    "fan": (-1e3, 1e4, "setting", "fan setting"),
+    "Qe_gain_kW": (0.0, 1e4, "kW/unit", "heat into the drum per unit of heater setting"),
+    "Qe_offset_kW": (-1e4, 1e4, "kW", "heat into the drum at heater setting 0"),
+    "Tgi_gain_C": (-100.0, 1e3, "degC/unit", "inlet gas rise per unit of heater setting"),
+    "tau_heater_s": (0.1, 1e4, "s", "heater lag"),
+    "Gg_fan_kg_s": (-100.0, 100.0, "kg/s/unit", "gas flow per unit of fan setting"),
     # plant geometry (Table 5); from a 50 g sample roaster to a 5 t drum, with room
     "Dch_m": (0.02, 10.0, "m", "chamber diameter"),
     "Lch_m": (0.02, 20.0, "m", "chamber length"),

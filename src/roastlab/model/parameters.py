@@ -136,6 +136,46 @@ def _build_registry() -> dict[str, Quantity]:
             "Gg_scale",
             "constant gas flow of a log that does not record it (factor on a 1 kg/s placeholder)",
         ),
+        # actuator extension (a map with [heater] / [fan]; not in the paper)
+        Quantity(
+            "Qe_gain_kW",
+            "kW/unit",
+            "actuator",
+            (0.0, 10.0),
+            False,
+            "Qe_gain",
+            "heat into the drum metal per unit of heater setting (eq. 12's Qe)",
+        ),
+        Quantity(
+            "Qe_offset_kW",
+            "kW",
+            "actuator",
+            (-5.0, 5.0),
+            False,
+            "Qe_offset",
+            "heat into the drum metal at heater setting 0 (eq. 12's Qe)",
+        ),
+        Quantity(
+            "Tgi_gain_C",
+            "degC/unit",
+            "actuator",
+            (0.0, 100.0),
+            False,
+            "Tgi_gain",
+            "rise of the inlet gas temperature per unit of heater setting",
+        ),
+        Quantity(
+            "tau_heater_s", "s", "actuator", (1.0, 600.0), False, "tau_heater", "first-order lag of the heater's effect"
+        ),
+        Quantity(
+            "Gg_fan_kg_s",
+            "kg/s/unit",
+            "actuator",
+            (0.0, 1.0),
+            False,
+            "Gg_fan",
+            "gas flow per unit of fan setting (affine with Gg_kg_s)",
+        ),
         Quantity("Tb0_C", "degC", "initial", (0.0, 60.0), True, "Tb0_C", "bean temperature at CHARGE"),
         Quantity("Tm0_C", "degC", "initial", (20.0, 300.0), False, "Tm0_C", "drum metal temperature at CHARGE"),
         Quantity("X0", "kg/kg", "initial", (0.02, 0.2), True, "X0", "green moisture, dry basis"),
@@ -147,6 +187,23 @@ def _build_registry() -> dict[str, Quantity]:
 
 #: Every identifiable quantity by name (see :class:`Quantity`).
 REGISTRY: dict[str, Quantity] = _build_registry()
+
+
+def set_values(p, values: dict) -> None:
+    """Write ``{registry name: value}`` into a parameter vector ``p`` in place (parameter
+    entries only; initial states are set through :class:`roastlab.sim.InitialState`)."""
+    from .limits import LIMITS, check_value
+    from .rhs import P
+
+    for name, v in values.items():
+        q = REGISTRY.get(name)
+        if q is None or q.slot not in P:
+            raise ParameterError(
+                f"{name!r} is not a model parameter (allowed: {', '.join(n for n in REGISTRY if REGISTRY[n].slot in P)})"
+            )
+        p[P[q.slot]] = check_value(name, v) if name in LIMITS else float(v)
+
+
 #: Names usable as free or fixed parameters of a fit, in registry order.
 FREE_NAMES = tuple(REGISTRY)
 

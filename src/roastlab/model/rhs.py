@@ -1,7 +1,7 @@
 """The roasting-chamber model: one pure right-hand side (paper eqs. 2-17, MODEL.md).
 
-States ``x = [Tb, Tm, X, He, Ta]`` (see :data:`STATE_NAMES`), inputs ``u = [Gg, Tgi]``
-(:data:`INPUT_NAMES`), parameters a flat float64 vector ``p`` built by :func:`pack_params`
+States ``x = [Tb, Tm, X, He, Ta, H]`` (see :data:`STATE_NAMES`), inputs
+``u = [Gg, Tgi, heater, fan]`` (:data:`INPUT_NAMES`), parameters a flat float64 vector ``p`` built by :func:`pack_params`
 (:data:`PARAM_NAMES`). The functions here are plain Python when called from Python (the
 slow reference path and the benchmark baseline) and are compiled inline into the
 integrators of :mod:`roastlab.sim.kernels` through ``numba.extending.register_jitable``: one
@@ -13,6 +13,14 @@ Departures from the printed paper, each a reading fixed by MODEL.md:
 * eq. 13/15c: Schwartzberg's law dX/dt = -k1 X^2 / Db^2 exp(-k2/T) by default; the printed
   law (no X factor, k1 = 4.32e-9) is the ``"printed"`` variant (exponent 0);
 * heat-transfer coefficients are in kW/(m^2 K), not W/(m^2 K).
+
+The actuator extension (not in the paper; off unless a map declares a heater or fan setting)
+adds a sixth state and two inputs to the same function: the logged heater setting passes a
+first-order actuator lag (state H, in the setting's own units) and becomes heat into the drum
+metal, Qe = Qe_offset + Qe_gain H [kW] (eq. 12/15b's Qe, zero in the paper), and/or a rise of
+the inlet gas temperature Tgi + Tgi_gain H [degC]; the fan setting moves the gas flow
+affinely, Gg Gg_scale + Gg_fan fan [kg/s]. With the gains at their default 0 and no heater
+input the model is the paper's (MODEL.md's check value holds; tests/test_physics.py).
 """
 
 from __future__ import annotations
@@ -26,7 +34,11 @@ from ..errors import ParameterError
 from .constants import CG_ALPHA_J_KG_K, K1_PRINTED, MOISTURE_LAWS
 
 STATE_NAMES = ("Tb_C", "Tm_C", "X_kg_kg", "He_kJ_kg", "Ta_C")
-INPUT_NAMES = ("Gg_kg_s", "Tgi_C")
+#: The actuator extension's state: the heater setting after its first-order lag [setting units].
+HEATER_STATE = "heater_lagged"
+#: Number of states the integrator carries: the paper's five and the lagged heater setting.
+N_STATES = 6
+INPUT_NAMES = ("Gg_kg_s", "Tgi_C", "heater", "fan")
 #: Layout of the parameter vector ``p``.
 PARAM_NAMES = (
     "hgm",
@@ -48,6 +60,12 @@ PARAM_NAMES = (
     "lam",  # process constants
     "x_exp",  # exponent of X in the moisture law: 2 (Schwartzberg) or 0 (printed)
     "Gg_scale",  # factor on the gas-flow input [-], 1 = as given (identifies an unlogged constant Gg)
+    # actuator extension (0 = the paper's model)
+    "Qe_gain",  # heat into the drum metal per unit of heater setting [kW/unit]
+    "Qe_offset",  # heat into the drum metal at heater setting 0 [kW]
+    "Tgi_gain",  # rise of the inlet gas temperature per unit of heater setting [degC/unit]
+    "tau_heater",  # first-order lag of the heater's effect [s]
+    "Gg_fan",  # gas flow per unit of fan setting [kg/s per unit]
 )
 P = {name: i for i, name in enumerate(PARAM_NAMES)}
 N_PARAMS = len(PARAM_NAMES)
@@ -55,6 +73,9 @@ N_PARAMS = len(PARAM_NAMES)
 I_HGM, I_HBM, I_PBM, I_AGM, I_AB, I_MBD, I_MM = (P[k] for k in ("hgm", "hbm", "Pbm", "Agm", "Ab", "Mbd", "Mm"))
 I_A, I_CM, I_CW, I_DB, I_HAR, I_HET = (P[k] for k in ("A", "cm", "cw", "Db", "Ha_R", "Het"))
 I_K1, I_K2, I_KT, I_LAM, I_XEXP, I_GGS = (P[k] for k in ("k1", "k2", "Kt", "lam", "x_exp", "Gg_scale"))
+I_QEG, I_QEO, I_TGIG, I_TAUH, I_GGF = (P[k] for k in ("Qe_gain", "Qe_offset", "Tgi_gain", "tau_heater", "Gg_fan"))
+#: Smallest gas flow the fan map may give [kg/s] (a fan map fitted below zero is clipped here).
+GG_MIN_KG_S = 1e-6
 
 _A0, _A1, _A2, _A3, _A4, _A5, _A6 = CG_ALPHA_J_KG_K
 KELVIN = 273.15
@@ -98,13 +119,31 @@ def dry_mass_kg(Mb_kg, X0):
 
 
 @register_jitable
-def heat_flows(Tb, Tm, X, Gg, Tgi, p):
-    """Outlet gas temperature and heat flows at one instant.
+def gas_inputs(Gg, Tgi, H, fan, p):
+    """The gas flow [kg/s] and inlet temperature [degC] the chamber sees (actuator extension).
 
+    Gg_eff = Gg Gg_scale + Gg_fan fan (at least :data:`GG_MIN_KG_S`): the logged or placeholder
+    flow, scaled, plus the fan map; Tgi_eff = Tgi + Tgi_gain H: the logged or ambient inlet
+    temperature plus the lagged heater's rise. Both reduce to (Gg, Tgi) in the paper's model.
+    """
+    g = Gg * p[I_GGS] + p[I_GGF] * fan
+    return max(g, GG_MIN_KG_S), Tgi + p[I_TGIG] * H
+
+
+@register_jitable
+def heater_power_kW(H, p):
+    """Heat into the drum metal Qe = Qe_offset + Qe_gain H [kW], never negative (eq. 12's Qe)."""
+    return max(p[I_QEO] + p[I_QEG] * H, 0.0)
+
+
+@register_jitable
+def heat_flows(Tb, Tm, X, Gg, Tgi, p):
+    """Outlet gas temperature and heat flows at one instant, for the gas the chamber sees.
+
+    ``Gg`` [kg/s] and ``Tgi`` [degC] are the effective gas inputs (:func:`gas_inputs`).
     Returns ``(Tgo [degC], Qgb, Qgm, Qbm [kW])``:
     Tgi - Tgo from eq. 15e, Qgb eq. 9, Qgm eq. 10, Qbm eq. 11.
     """
-    Gg = Gg * p[I_GGS]  # gas-flow factor (1 unless a constant flow is being identified)
     Agb, Abm = bean_areas_m2(p[I_AB], p[I_PBM])  # section 3.1
     he = bean_heat_transfer_coefficient_kW_m2K(X)  # eq. 3
     cg = gas_heat_capacity_kJ_kgK(Tgi)  # eq. 2
@@ -135,17 +174,31 @@ def reaction_heat_rate_kW_kg(Tb, He, p):
 
 
 @register_jitable
-def derivatives(Tb, Tm, X, He, Ta, Gg, Tgi, p):
-    """Time derivatives of the five states (eqs. 15a-15d, 17) as a tuple."""
-    Tgo, Qgb, Qgm, Qbm = heat_flows(Tb, Tm, X, Gg, Tgi, p)
+def derivatives(Tb, Tm, X, He, Ta, H, Gg, Tgi, heater, fan, p):
+    """Time derivatives of the six states (eqs. 15a-15d, 17, actuator lag) as a tuple.
+
+    ``Gg`` [kg/s], ``Tgi`` [degC] are the logged (or placeholder) gas inputs, ``heater`` and
+    ``fan`` the logged settings (0 when not used); :func:`gas_inputs` and
+    :func:`heater_power_kW` turn them into what the chamber sees.
+    """
+    g, T = gas_inputs(Gg, Tgi, H, fan, p)
+    Tgo, Qgb, Qgm, Qbm = heat_flows(Tb, Tm, X, g, T, p)
     dX = moisture_rate_1_s(Tb, X, p)  # eq. 15c
     Qr = reaction_heat_rate_kW_kg(Tb, He, p)  # eq. 15d
     Mbd = p[I_MBD]
     cs = 1.099 + 0.007 * Tb  # partial heat capacity of bean solids, section 3.2
     dTb = (Qgb - Qgm + Qbm + Mbd * (Qr + p[I_LAM] * dX)) / (Mbd * (cs + p[I_CW] * X))  # eq. 15a
-    dTm = (Qgm - Qbm) / (p[I_MM] * p[I_CM])  # eq. 15b, Qe = 0
+    dTm = (Qgm - Qbm + heater_power_kW(H, p)) / (p[I_MM] * p[I_CM])  # eq. 15b with eq. 12's Qe
     dTa = p[I_KT] * (Tb - Ta)  # eq. 17
-    return dTb, dTm, dX, Qr, dTa
+    dH = (heater - H) / p[I_TAUH]  # actuator lag (extension)
+    return dTb, dTm, dX, Qr, dTa, dH
+
+
+@register_jitable
+def outlet_gas_C(x, Gg, Tgi, fan, p):
+    """Outlet gas temperature Tgo [degC] at state ``x`` (eq. 15e, effective gas inputs)."""
+    g, T = gas_inputs(Gg, Tgi, x[5], fan, p)
+    return heat_flows(x[0], x[1], x[2], g, T, p)[0]
 
 
 @register_jitable
@@ -156,16 +209,22 @@ def rhs(t, x, u, p):
     ----------
     t : float
         Time [s]; the model is autonomous, so ``t`` is unused but kept for the ODE form.
-    x : array of 5 floats
-        ``[Tb degC, Tm degC, X kg/kg dry, He kJ/kg dry, Ta degC]``.
-    u : array of 2 floats
-        ``[Gg kg/s, Tgi degC]``.
+    x : array of 5 or 6 floats
+        ``[Tb degC, Tm degC, X kg/kg dry, He kJ/kg dry, Ta degC[, H setting units]]``
+        (H = 0 when omitted).
+    u : array of 2 or 4 floats
+        ``[Gg kg/s, Tgi degC[, heater, fan]]`` (settings 0 when omitted).
     p : array
         Parameter vector from :func:`pack_params`.
+
+    Returns an array of the same length as ``x``.
     """
-    d = derivatives(x[0], x[1], x[2], x[3], x[4], u[0], u[1], p)
-    out = np.empty(5)
-    for i in range(5):
+    H = x[5] if x.shape[0] > 5 else 0.0
+    heater = u[2] if u.shape[0] > 2 else 0.0
+    fan = u[3] if u.shape[0] > 3 else 0.0
+    d = derivatives(x[0], x[1], x[2], x[3], x[4], H, u[0], u[1], heater, fan, p)
+    out = np.empty(x.shape[0])
+    for i in range(x.shape[0]):
         out[i] = d[i]
     return out
 
@@ -208,5 +267,10 @@ def pack_params(plant, theta, X0: float = 0.1, moisture: str = "schwartzberg") -
         "lam": pc.lam,
         "x_exp": MOISTURE_LAWS[moisture],
         "Gg_scale": 1.0,
+        "Qe_gain": 0.0,
+        "Qe_offset": 0.0,
+        "Tgi_gain": 0.0,
+        "tau_heater": 1.0,
+        "Gg_fan": 0.0,
     }
     return np.array([values[name] for name in PARAM_NAMES], dtype=np.float64)

@@ -21,16 +21,19 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from ..model.rhs import derivatives, heat_flows
+from ..model.rhs import N_STATES, derivatives, outlet_gas_C
 
 #: Largest integration step [s].
 H_MAX_S = 30.0
-#: Local error tolerances per state [Tb degC, Tm degC, X kg/kg, He kJ/kg, Ta degC] and relative.
-#: The temperatures bind: the worst global error against the reference is ~6e-4 degC, 17x
-#: inside the 0.01 degC contract; 10x tighter costs ~25 % more evaluations for no user gain.
-ATOL = np.array([1e-4, 1e-4, 1e-7, 1e-3, 1e-4])
+#: Local error tolerances per state [Tb degC, Tm degC, X kg/kg, He kJ/kg, Ta degC, H setting]
+#: and relative. The temperatures bind: the worst global error against the reference is
+#: ~6e-4 degC, 17x inside the 0.01 degC contract; 10x tighter costs ~25 % more evaluations.
+ATOL = np.array([1e-4, 1e-4, 1e-7, 1e-3, 1e-4, 1e-4])
 RTOL = 1e-6
-N_OUT = 6  # five states and Tgo
+NS = N_STATES
+#: Output columns: the six states, then the outlet gas temperature Tgo.
+N_OUT = NS + 1
+I_TGO = NS
 
 
 # Dormand-Prince 5(4) tableau (Hairer, Norsett & Wanner, Solving ODEs I, table 5.2).
@@ -45,86 +48,102 @@ _E1, _E3, _E4, _E5, _E6, _E7 = 71 / 57600, -71 / 16695, 71 / 1920, -17253 / 3392
 
 
 @njit(cache=True, inline="always")
-def _f(x, g, T, p, out):
-    d = derivatives(x[0], x[1], x[2], x[3], x[4], g, T, p)
+def _f(x, g, T, q, f, p, out):
+    d = derivatives(x[0], x[1], x[2], x[3], x[4], x[5], g, T, q, f, p)
     out[0] = d[0]
     out[1] = d[1]
     out[2] = d[2]
     out[3] = d[3]
     out[4] = d[4]
+    out[5] = d[5]
 
 
 @njit(cache=True)
-def integrate_into(t, Gg, Tgi, n, x0, p, zoh, h_max, out, h0=5.0, with_tgo=True):
-    """Integrate one batch over samples t[0..n-1]; write states and Tgo to out[:n, :6].
+def integrate_into(t, Gg, Tgi, Q, F, n, x0, p, zoh, h_max, out, h0=5.0, with_tgo=True):
+    """Integrate one batch over samples t[0..n-1]; write states and Tgo to out[:n, :N_OUT].
 
+    Inputs per sample: gas flow ``Gg`` [kg/s], inlet temperature ``Tgi`` [degC], heater
+    setting ``Q`` and fan setting ``F`` (zeros when the actuator extension is off).
     Adaptive Dormand-Prince 5(4) inside each sample interval (input kinks are always step
     boundaries). Local error per step is kept below ATOL + RTOL |x| per state. ``h0`` is the
     first trial step; the step size the next call should start from is returned. Fitting
-    needs only Ta, so ``with_tgo=False`` skips the outlet-gas output (column 5 is left as is).
+    needs only Ta, so ``with_tgo=False`` skips the outlet-gas output (column I_TGO left as is).
     """
-    x = np.empty(5)
-    for i in range(5):
+    x = np.empty(NS)
+    for i in range(NS):
         x[i] = x0[i]
         out[0, i] = x0[i]
     if with_tgo:
-        out[0, 5] = heat_flows(x[0], x[1], x[2], Gg[0], Tgi[0], p)[0]
-    k1 = np.empty(5)
-    k2 = np.empty(5)
-    k3 = np.empty(5)
-    k4 = np.empty(5)
-    k5 = np.empty(5)
-    k6 = np.empty(5)
-    k7 = np.empty(5)
-    y = np.empty(5)
-    xn = np.empty(5)
+        out[0, I_TGO] = outlet_gas_C(x, Gg[0], Tgi[0], F[0], p)
+    k1 = np.empty(NS)
+    k2 = np.empty(NS)
+    k3 = np.empty(NS)
+    k4 = np.empty(NS)
+    k5 = np.empty(NS)
+    k6 = np.empty(NS)
+    k7 = np.empty(NS)
+    y = np.empty(NS)
+    xn = np.empty(NS)
     h = min(h_max, h0)
     for k in range(n - 1):
         t0 = t[k]
         dt = t[k + 1] - t0
         g0 = Gg[k]
         T0 = Tgi[k]
+        q0 = Q[k]
+        f0 = F[k]
         if zoh:
             dg = 0.0
             dT = 0.0
+            dq = 0.0
+            df = 0.0
         else:
             dg = (Gg[k + 1] - g0) / dt
             dT = (Tgi[k + 1] - T0) / dt
+            dq = (Q[k + 1] - q0) / dt
+            df = (F[k + 1] - f0) / dt
         s = 0.0
         if zoh or k == 0:
             # a zero-order hold jumps at the sample, so the derivative there is new; a linear
             # hold is continuous, so the last stage of the previous interval is still valid
-            _f(x, g0, T0, p, k1)
+            _f(x, g0, T0, q0, f0, p, k1)
         while s < dt:
             last = False
             h_try = h
             if s + h >= dt * (1.0 - 1e-12):
                 h = dt - s  # land exactly on the next sample
                 last = True
-            for i in range(5):
+            a = s + _C2 * h
+            for i in range(NS):
                 y[i] = x[i] + h * _A21 * k1[i]
-            _f(y, g0 + dg * (s + _C2 * h), T0 + dT * (s + _C2 * h), p, k2)
-            for i in range(5):
+            _f(y, g0 + dg * a, T0 + dT * a, q0 + dq * a, f0 + df * a, p, k2)
+            a = s + _C3 * h
+            for i in range(NS):
                 y[i] = x[i] + h * (_A31 * k1[i] + _A32 * k2[i])
-            _f(y, g0 + dg * (s + _C3 * h), T0 + dT * (s + _C3 * h), p, k3)
-            for i in range(5):
+            _f(y, g0 + dg * a, T0 + dT * a, q0 + dq * a, f0 + df * a, p, k3)
+            a = s + _C4 * h
+            for i in range(NS):
                 y[i] = x[i] + h * (_A41 * k1[i] + _A42 * k2[i] + _A43 * k3[i])
-            _f(y, g0 + dg * (s + _C4 * h), T0 + dT * (s + _C4 * h), p, k4)
-            for i in range(5):
+            _f(y, g0 + dg * a, T0 + dT * a, q0 + dq * a, f0 + df * a, p, k4)
+            a = s + _C5 * h
+            for i in range(NS):
                 y[i] = x[i] + h * (_A51 * k1[i] + _A52 * k2[i] + _A53 * k3[i] + _A54 * k4[i])
-            _f(y, g0 + dg * (s + _C5 * h), T0 + dT * (s + _C5 * h), p, k5)
-            for i in range(5):
+            _f(y, g0 + dg * a, T0 + dT * a, q0 + dq * a, f0 + df * a, p, k5)
+            a = s + h
+            for i in range(NS):
                 y[i] = x[i] + h * (_A61 * k1[i] + _A62 * k2[i] + _A63 * k3[i] + _A64 * k4[i] + _A65 * k5[i])
-            _f(y, g0 + dg * (s + h), T0 + dT * (s + h), p, k6)
-            for i in range(5):
+            _f(y, g0 + dg * a, T0 + dT * a, q0 + dq * a, f0 + df * a, p, k6)
+            for i in range(NS):
                 xn[i] = x[i] + h * (_B1 * k1[i] + _B3 * k3[i] + _B4 * k4[i] + _B5 * k5[i] + _B6 * k6[i])
-            _f(xn, g0 + dg * (s + h), T0 + dT * (s + h), p, k7)
+            _f(xn, g0 + dg * a, T0 + dT * a, q0 + dq * a, f0 + df * a, p, k7)
             err = 0.0
-            for i in range(5):
+            for i in range(NS):
                 e = h * (_E1 * k1[i] + _E3 * k3[i] + _E4 * k4[i] + _E5 * k5[i] + _E6 * k6[i] + _E7 * k7[i])
                 sc = ATOL[i] + RTOL * max(abs(x[i]), abs(xn[i]))
                 r = e / sc
                 err += r * r
+            # RMS over the paper's five states (H adds its error only when a heater moves it), so
+            # runs without the actuator extension take exactly the steps they always took
             err = math.sqrt(err / 5.0)
             if not (err == err) or h < 1e-9 * dt:
                 # non-finite state or step collapse: report NaN rather than loop or lie
@@ -134,7 +153,7 @@ def integrate_into(t, Gg, Tgi, n, x0, p, zoh, h_max, out, h0=5.0, with_tgo=True)
                 return h
             if err <= 1.0:
                 s = dt if last else s + h
-                for i in range(5):
+                for i in range(NS):
                     x[i] = xn[i]
                     k1[i] = k7[i]  # first same as last
                 if x[2] < 0.0:
@@ -144,53 +163,59 @@ def integrate_into(t, Gg, Tgi, n, x0, p, zoh, h_max, out, h0=5.0, with_tgo=True)
                 h = h_try if last else min(h_max, h * fac)
             else:
                 h = h * max(0.2, 0.9 * err**-0.2)
-        for i in range(5):
+        for i in range(NS):
             out[k + 1, i] = x[i]
         if with_tgo:
-            gk = Gg[k] if zoh else Gg[k + 1]
-            Tk = Tgi[k] if zoh else Tgi[k + 1]
-            out[k + 1, 5] = heat_flows(x[0], x[1], x[2], gk, Tk, p)[0]
+            j = k if zoh else k + 1
+            out[k + 1, I_TGO] = outlet_gas_C(x, Gg[j], Tgi[j], F[j], p)
     return h
 
 
 @njit(cache=True)
-def simulate_one(t, Gg, Tgi, x0, p, zoh, h_max):
+def simulate_one(t, Gg, Tgi, Q, F, x0, p, zoh, h_max):
     n = t.shape[0]
     out = np.empty((n, N_OUT))
-    integrate_into(t, Gg, Tgi, n, x0, p, zoh, h_max, out)
+    integrate_into(t, Gg, Tgi, Q, F, n, x0, p, zoh, h_max, out)
     return out
 
 
 @njit(cache=True, parallel=True)
-def simulate_population_kernel(T, GG, TGI, N, batch_of, X0, PP, zoh, h_max, out):
+def simulate_population_kernel(T, GG, TGI, QQ, FF, N, batch_of, X0, PP, zoh, h_max, out):
     """Simulate ``len(batch_of)`` runs in parallel.
 
-    Run i uses the inputs of batch ``batch_of[i]`` (rows of the padded arrays T, GG, TGI with
-    valid length N[b]), initial state X0[i] and parameter vector PP[i]; writes out[i, :N[b]].
+    Run i uses the inputs of batch ``batch_of[i]`` (rows of the padded arrays T, GG, TGI, QQ
+    (heater), FF (fan) with valid length N[b]), initial state X0[i] and parameter vector
+    PP[i]; writes out[i, :N[b]].
     """
     for i in prange(batch_of.shape[0]):
         b = batch_of[i]
-        integrate_into(T[b], GG[b], TGI[b], N[b], X0[i], PP[i], zoh, h_max, out[i])
+        integrate_into(T[b], GG[b], TGI[b], QQ[b], FF[b], N[b], X0[i], PP[i], zoh, h_max, out[i])
 
 
 @njit(cache=True, parallel=True)
-def ta_population_kernel(T, GG, TGI, N, batch_of, X0, PP, zoh, h_max, out_ta):
-    """Like :func:`simulate_population_kernel` but keeps only the probe reading Ta (for fitting)."""
+def ta_population_kernel(T, GG, TGI, QQ, FF, N, batch_of, X0, PP, zoh, h_max, out_ta, out_tb):
+    """Like :func:`simulate_population_kernel` but keeps only the probe reading Ta and the bean
+    temperature Tb (the outputs a fit compares with measurements)."""
     nmax = T.shape[1]
     for i in prange(batch_of.shape[0]):
         b = batch_of[i]
         scratch = np.empty((nmax, N_OUT))
         n = N[b]
-        integrate_into(T[b], GG[b], TGI[b], n, X0[i], PP[i], zoh, h_max, scratch, 5.0, False)
+        integrate_into(T[b], GG[b], TGI[b], QQ[b], FF[b], n, X0[i], PP[i], zoh, h_max, scratch, 5.0, False)
         for j in range(n):
             out_ta[i, j] = scratch[j, 4]
+            out_tb[i, j] = scratch[j, 0]
 
 
 @njit(cache=True)
-def step_kernel(x, Gg0, Tgi0, Gg1, Tgi1, dt, p, zoh, h_max, h0):
+def step_kernel(x, u0, u1, dt, p, zoh, h_max, h0):
+    """One step of ``dt`` seconds from state ``x`` (length NS) with inputs ``u0`` at the start
+    and ``u1`` at the end (each [Gg, Tgi, heater, fan]); returns (state, Tgo, next step)."""
     t = np.array([0.0, dt])
-    g = np.array([Gg0, Gg1])
-    T = np.array([Tgi0, Tgi1])
+    g = np.array([u0[0], u1[0]])
+    T = np.array([u0[1], u1[1]])
+    q = np.array([u0[2], u1[2]])
+    f = np.array([u0[3], u1[3]])
     out = np.empty((2, N_OUT))
-    h = integrate_into(t, g, T, 2, x, p, zoh, h_max, out, h0)
-    return out[1, :5].copy(), out[1, 5], h
+    h = integrate_into(t, g, T, q, f, 2, x, p, zoh, h_max, out, h0)
+    return out[1, :NS].copy(), out[1, I_TGO], h

@@ -19,7 +19,7 @@ import numpy as np
 
 from ..model.parameters import REGISTRY, STATE0
 from ..model.rhs import P, dry_mass_kg, pack_params
-from .kernels import H_MAX_S, N_OUT, simulate_population_kernel, ta_population_kernel
+from .kernels import H_MAX_S, N_OUT, NS, simulate_population_kernel, ta_population_kernel
 from .simulate import InitialState, check_hold
 
 #: Registry names that set a parameter-vector entry, and its index. ``Gg_kg_s`` sets the
@@ -32,9 +32,11 @@ PARAM_SLOTS = {name: P[q.slot] for name, q in REGISTRY.items() if q.slot in P}
 class PackedBatches:
     """Batches packed for the population kernels.
 
-    T, GG, TGI : (nb, nmax) padded inputs [s], [kg/s], [degC]; N : (nb,) valid lengths;
+    T, GG, TGI : (nb, nmax) padded inputs [s], [kg/s], [degC]; QQ, FF : (nb, nmax) heater and
+    fan settings (zeros without the actuator extension); N : (nb,) valid lengths;
     TA : (nb, nmax) measured Ta, NaN-padded (NaN everywhere if not measured);
-    X0 : (nb, 5) initial states; PB : (nb, n_params) parameter vectors at the start theta;
+    TB2 : (nb, nmax) a second bean reading compared with Tb, NaN where not measured;
+    X0 : (nb, 6) initial states; PB : (nb, n_params) parameter vectors at the start theta;
     Mb : (nb,) green batch mass of each batch's plant [kg] (for Mbd when X0 varies).
     """
 
@@ -49,6 +51,16 @@ class PackedBatches:
     names: list[str]
     zoh: bool
     h_max_s: float = H_MAX_S
+    QQ: np.ndarray | None = None
+    FF: np.ndarray | None = None
+    TB2: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        for name in ("QQ", "FF"):
+            if getattr(self, name) is None:
+                setattr(self, name, np.zeros_like(self.T))
+        if self.TB2 is None:
+            self.TB2 = np.full_like(self.T, np.nan)
 
     @property
     def n_batches(self) -> int:
@@ -84,7 +96,10 @@ def pack_batches(
     GG = np.ones((nb, nmax))
     TGI = np.zeros((nb, nmax))
     TA = np.full((nb, nmax), np.nan)
-    X0 = np.zeros((nb, 5))
+    QQ = np.zeros((nb, nmax))
+    FF = np.zeros((nb, nmax))
+    TB2 = np.full((nb, nmax), np.nan)
+    X0 = np.zeros((nb, NS))
     N = np.zeros(nb, dtype=np.int64)
     PB = None
     Mb = np.zeros(nb)
@@ -97,9 +112,14 @@ def pack_batches(
         GG[i, n:], TGI[i, n:] = b.Gg_kg_s[-1], b.Tgi_C[-1]
         if b.Ta_C is not None:
             TA[i, :n] = b.Ta_C
+        for arr, series in ((QQ, b.heater), (FF, b.fan)):
+            if series is not None:
+                arr[i, :n], arr[i, n:] = series, series[-1]
+        if b.Tb2_C is not None:
+            TB2[i, :n] = b.Tb2_C
         fields = {**base.__dict__, **b.initial}
         state = InitialState(**fields)
-        X0[i] = state.vector(None if b.Ta_C is None else float(b.Ta_C[0]))
+        X0[i] = state.vector(None if b.Ta_C is None else float(b.Ta_C[0]), float(QQ[i, 0]))
         if getattr(b, "Mb_kg", None):  # the batch's own green weight (e.g. from an Artisan log)
             plant = dataclasses.replace(plant, Mb_kg=float(b.Mb_kg))
         p = pack_params(plant, theta, state.X0, moisture)
@@ -107,7 +127,9 @@ def pack_batches(
             PB = np.zeros((nb, len(p)))
         PB[i] = p
         Mb[i] = plant.Mb_kg
-    return PackedBatches(T, GG, TGI, N, TA, X0, PB, Mb, [b.name for b in batches], check_hold(hold), float(h_max_s))
+    return PackedBatches(
+        T, GG, TGI, N, TA, X0, PB, Mb, [b.name for b in batches], check_hold(hold), float(h_max_s), QQ, FF, TB2
+    )
 
 
 def run_arrays(packed: PackedBatches, names: list[str], values: np.ndarray):
@@ -130,20 +152,40 @@ def run_arrays(packed: PackedBatches, names: list[str], values: np.ndarray):
         else:
             raise KeyError(name)
     batch_of = np.tile(np.arange(nb, dtype=np.int64), m)
-    return batch_of, X0.reshape(m * nb, 5), PP.reshape(m * nb, -1)
+    return batch_of, X0.reshape(m * nb, NS), PP.reshape(m * nb, -1)
 
 
-def predict_ta(packed: PackedBatches, names: list[str], values: np.ndarray) -> np.ndarray:
-    """Simulated probe reading for every (value set, batch): shape (m, nb, nmax), NaN-padded."""
+def predict_ta(packed: PackedBatches, names: list[str], values: np.ndarray, with_tb: bool = False):
+    """Simulated probe reading for every (value set, batch): shape (m, nb, nmax), NaN-padded.
+
+    With ``with_tb`` also the bean temperature Tb (same shape): returns ``(Ta, Tb)``.
+    """
     m, nb = values.shape[0], packed.n_batches
     batch_of, X0, PP = run_arrays(packed, names, values)
     out = np.full((m * nb, packed.T.shape[1]), np.nan)
-    ta_population_kernel(packed.T, packed.GG, packed.TGI, packed.N, batch_of, X0, PP, packed.zoh, packed.h_max_s, out)
+    out_tb = np.full_like(out, np.nan)
+    ta_population_kernel(
+        packed.T,
+        packed.GG,
+        packed.TGI,
+        packed.QQ,
+        packed.FF,
+        packed.N,
+        batch_of,
+        X0,
+        PP,
+        packed.zoh,
+        packed.h_max_s,
+        out,
+        out_tb,
+    )
+    if with_tb:
+        return out.reshape(m, nb, -1), out_tb.reshape(m, nb, -1)
     return out.reshape(m, nb, -1)
 
 
 def simulate_population(packed: PackedBatches, names: list[str] = (), values: np.ndarray | None = None) -> np.ndarray:
-    """All states and Tgo for every (value set, batch): shape (m, nb, nmax, 6), NaN-padded.
+    """All six states and Tgo for every (value set, batch): shape (m, nb, nmax, 7), NaN-padded.
 
     With no ``names``, simulates each batch once at its packed parameters.
 
@@ -164,7 +206,18 @@ def simulate_population(packed: PackedBatches, names: list[str] = (), values: np
     batch_of, X0, PP = run_arrays(packed, names, values)
     out = np.full((m * nb, packed.T.shape[1], N_OUT), np.nan)
     simulate_population_kernel(
-        packed.T, packed.GG, packed.TGI, packed.N, batch_of, X0, PP, packed.zoh, packed.h_max_s, out
+        packed.T,
+        packed.GG,
+        packed.TGI,
+        packed.QQ,
+        packed.FF,
+        packed.N,
+        batch_of,
+        X0,
+        PP,
+        packed.zoh,
+        packed.h_max_s,
+        out,
     )
     mask = packed.mask()
     out = out.reshape(m, nb, packed.T.shape[1], N_OUT)

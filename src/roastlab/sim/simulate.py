@@ -12,8 +12,16 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..model.limits import check_array, check_value
-from ..model.rhs import STATE_NAMES, heat_flows, pack_params, reaction_heat_rate_kW_kg
-from .kernels import H_MAX_S, simulate_one, step_kernel
+from ..model.rhs import (
+    HEATER_STATE,
+    STATE_NAMES,
+    gas_inputs,
+    heat_flows,
+    heater_power_kW,
+    pack_params,
+    reaction_heat_rate_kW_kg,
+)
+from .kernels import H_MAX_S, I_TGO, NS, simulate_one, step_kernel
 
 
 @dataclass(frozen=True)
@@ -31,10 +39,11 @@ class InitialState:
     He0_kJ_kg: float = 0.0
     Ta0_C: float | None = None
 
-    def vector(self, Ta_measured0: float | None = None) -> np.ndarray:
-        """The state vector [Tb, Tm, X, He, Ta]; Ta from ``Ta_measured0`` (the log's first reading) if set."""
+    def vector(self, Ta_measured0: float | None = None, heater0: float = 0.0) -> np.ndarray:
+        """The state vector [Tb, Tm, X, He, Ta, H]; Ta from ``Ta_measured0`` (the log's first
+        reading) if set; the lagged heater H starts at the setting at charge ``heater0`` (settled)."""
         Ta0 = self.Ta0_C if self.Ta0_C is not None else (Ta_measured0 if Ta_measured0 is not None else self.Tb0_C)
-        return np.array([self.Tb0_C, self.Tm0_C, self.X0, self.He0_kJ_kg, Ta0], dtype=np.float64)
+        return np.array([self.Tb0_C, self.Tm0_C, self.X0, self.He0_kJ_kg, Ta0, heater0], dtype=np.float64)
 
 
 def check_hold(hold: str) -> bool:
@@ -52,11 +61,12 @@ class SimulationResult:
     Attributes
     ----------
     time_s : (n,) array
-    states : (n, 5) array, columns :data:`roastlab.model.STATE_NAMES`
+    states : (n, 6) array, columns :data:`roastlab.model.STATE_NAMES` and the lagged heater
     Tgo_C : (n,) array, outlet gas temperature (eq. 15e)
-    Gg_kg_s, Tgi_C : (n,) arrays, the inputs
+    Gg_kg_s, Tgi_C : (n,) arrays, the logged (or placeholder) gas inputs
     params : the parameter vector used
     Ta_measured_C : (n,) array or None, the measured probe reading if the batch had one
+    heater, fan : (n,) arrays or None, the logged settings (actuator extension)
     """
 
     time_s: np.ndarray
@@ -68,6 +78,28 @@ class SimulationResult:
     name: str = "batch"
     Ta_measured_C: np.ndarray | None = None
     meta: dict = field(default_factory=dict)
+    heater: np.ndarray | None = None
+    fan: np.ndarray | None = None
+
+    @property
+    def uses_actuators(self) -> bool:
+        """True when the run had heater or fan settings as inputs (the actuator extension)."""
+        return self.heater is not None or self.fan is not None
+
+    def _settings(self):
+        n = len(self.time_s)
+        q = self.heater if self.heater is not None else np.zeros(n)
+        f = self.fan if self.fan is not None else np.zeros(n)
+        return q, f
+
+    def gas_seen(self) -> tuple[np.ndarray, np.ndarray]:
+        """Gas flow [kg/s] and inlet temperature [degC] the chamber saw (after the actuator maps)."""
+        _, f = self._settings()
+        pairs = [
+            gas_inputs(g, T, H, fi, self.params) for g, T, H, fi in zip(self.Gg_kg_s, self.Tgi_C, self.states[:, 5], f)
+        ]
+        a = np.array(pairs, dtype=float).reshape(-1, 2)
+        return a[:, 0], a[:, 1]
 
     @property
     def Tb_C(self) -> np.ndarray:
@@ -90,15 +122,21 @@ class SimulationResult:
         return self.states[:, 4]
 
     def heat_flows(self) -> dict[str, np.ndarray]:
-        """Qgb, Qgm, Qbm [kW] (eqs. 9-11) and Qr [kW, whole batch] (eq. 14) at each sample."""
+        """Qgb, Qgm, Qbm [kW] (eqs. 9-11), Qr [kW, whole batch] (eq. 14) and, with actuator
+        inputs, the heater's Qe [kW] (eq. 12) at each sample."""
         n = len(self.time_s)
-        q = np.empty((n, 4))
+        q = np.empty((n, 5))
         Mbd = self.params[5]
+        g, T = self.gas_seen()
         for i in range(n):
-            Tb, Tm, X, He, _ = self.states[i]
-            _, Qgb, Qgm, Qbm = heat_flows(Tb, Tm, X, self.Gg_kg_s[i], self.Tgi_C[i], self.params)
-            q[i] = (Qgb, Qgm, Qbm, Mbd * reaction_heat_rate_kW_kg(Tb, He, self.params))
-        return {"Qgb_kW": q[:, 0], "Qgm_kW": q[:, 1], "Qbm_kW": q[:, 2], "Qr_kW": q[:, 3]}
+            Tb, Tm, X, He, _, H = self.states[i]
+            _, Qgb, Qgm, Qbm = heat_flows(Tb, Tm, X, g[i], T[i], self.params)
+            Qr = Mbd * reaction_heat_rate_kW_kg(Tb, He, self.params)
+            q[i] = (Qgb, Qgm, Qbm, Qr, heater_power_kW(H, self.params))
+        out = {"Qgb_kW": q[:, 0], "Qgm_kW": q[:, 1], "Qbm_kW": q[:, 2], "Qr_kW": q[:, 3]}
+        if self.uses_actuators:
+            out["Qe_kW"] = q[:, 4]
+        return out
 
     def to_frame(self, heat_flows: bool = False):
         """A pandas DataFrame with time, states, Tgo (and the heat flows if ``heat_flows``)."""
@@ -108,6 +146,10 @@ class SimulationResult:
         for j, name in enumerate(STATE_NAMES):
             data[name] = self.states[:, j]
         data["Tgo_C"] = self.Tgo_C
+        if self.uses_actuators:
+            q, f = self._settings()
+            g, T = self.gas_seen()
+            data.update({"heater": q, "fan": f, HEATER_STATE: self.states[:, 5], "Gg_seen_kg_s": g, "Tgi_seen_C": T})
         if heat_flows:
             data.update(self.heat_flows())
         return pd.DataFrame(data)
@@ -155,6 +197,9 @@ def simulate(
     hold: str = "linear",
     h_max_s: float = H_MAX_S,
     name: str = "batch",
+    heater=None,
+    fan=None,
+    values: dict | None = None,
 ) -> SimulationResult:
     """Simulate one batch.
 
@@ -168,6 +213,9 @@ def simulate(
     moisture : ``"schwartzberg"`` (default) or ``"printed"`` (eq. 13 variants)
     hold : ``"linear"`` (default) or ``"zoh"`` input hold between samples
     h_max_s : largest integration step [s]
+    heater, fan : arrays of logged settings (the actuator extension; None = not used)
+    values : {registry name: value} for the other parameter-vector entries (e.g. the
+        actuator gains ``Qe_gain_kW``, a process constant ``Kt``)
 
     Examples
     --------
@@ -186,7 +234,10 @@ def simulate(
     zoh = check_hold(hold)
     t, g, T = (_input_array(n, v) for n, v in (("time_s", time_s), ("Gg_kg_s", Gg_kg_s), ("Tgi_C", Tgi_C)))
     Ta_meas = None if Ta_measured_C is None else _input_array("Ta_C", Ta_measured_C)
-    for label, arr in (("Gg_kg_s", g), ("Tgi_C", T)) + ((("Ta_C", Ta_meas),) if Ta_meas is not None else ()):
+    q = None if heater is None else _input_array("heater", heater)
+    f = None if fan is None else _input_array("fan", fan)
+    optional = (("Ta_C", Ta_meas), ("heater", q), ("fan", f))
+    for label, arr in (("Gg_kg_s", g), ("Tgi_C", T)) + tuple((k, a) for k, a in optional if a is not None):
         if arr.shape != t.shape:
             raise ParameterError(
                 f"{label} has {arr.size} values, time_s has {t.size}: inputs must have one value per time"
@@ -195,12 +246,17 @@ def simulate(
         raise ParameterError(f"need at least 2 time samples, got {t.size}")
     check_array("dt_s", np.diff(t), "simulate()", "time_s")
     check_value_h = check_value("dt_s", h_max_s, "h_max_s")
-    x0 = initial.vector(None if Ta_meas is None else float(Ta_meas[0]))
+    x0 = initial.vector(None if Ta_meas is None else float(Ta_meas[0]), 0.0 if q is None else float(q[0]))
     _check_initial(x0)
     p = pack_params(plant, theta, initial.X0, moisture)
-    out = simulate_one(t, g, T, x0, p, zoh, check_value_h)
+    if values:
+        from ..model.parameters import set_values
+
+        set_values(p, values)
+    zeros = np.zeros_like(t)
+    out = simulate_one(t, g, T, zeros if q is None else q, zeros if f is None else f, x0, p, zoh, check_value_h)
     _check_finite(out, t)
-    return SimulationResult(t, out[:, :5].copy(), out[:, 5].copy(), g, T, p, name, Ta_meas)
+    return SimulationResult(t, out[:, :NS].copy(), out[:, I_TGO].copy(), g, T, p, name, Ta_meas, heater=q, fan=f)
 
 
 def _input_array(name: str, values) -> np.ndarray:
@@ -221,12 +277,20 @@ def _check_initial(x0: np.ndarray) -> None:
 
 
 def _check_finite(out: np.ndarray, t: np.ndarray) -> None:
-    bad = ~np.isfinite(out[:, :5])
+    bad = ~np.isfinite(out[:, :NS])
     if bad.any():
         i = int(np.argwhere(bad)[0][0])
         raise ParameterError(
             f"the simulation went non-finite after t = {t[max(i - 1, 0)]:g} s: inputs, initial state or values out of the model's range"
         )
+
+
+def _u4(Gg_kg_s, Tgi_C, heater=0.0, fan=0.0) -> np.ndarray:
+    """Inputs of one instant as the kernel's [Gg, Tgi, heater, fan] vector."""
+    u = np.array([Gg_kg_s, Tgi_C, heater, fan], dtype=np.float64)
+    if not np.all(np.isfinite(u)):
+        raise ParameterError(f"inputs must be finite, got {u.tolist()}")
+    return u
 
 
 class Simulator:
@@ -261,30 +325,35 @@ class Simulator:
         self.params = pack_params(self.plant, THETA_PAPER if theta is None else theta, self.initial.X0, moisture)
         self.zoh = check_hold(hold)
         self.h_max_s = float(h_max_s)
-        self.x = self.initial.vector()
+        self.x = self.initial.vector()  # heater lag starts settled at 0
         _check_initial(self.x)
         self.t_s = 0.0
         self.Tgo_C = float("nan")
         self._h = 5.0  # the integrator's step size carries over, so stepping equals a batch run
         # with a linear hold, each step ramps from the previous inputs (u0 before the first)
-        self._u_prev: tuple[float, float] | None = None if u0 is None else (float(u0[0]), float(u0[1]))
+        self._u_prev: np.ndarray | None = None if u0 is None else _u4(*u0)
 
     @property
     def state(self) -> dict[str, float]:
         return {name: float(v) for name, v in zip(STATE_NAMES, self.x)}
 
-    def step(self, dt_s: float, Gg_kg_s: float, Tgi_C: float) -> np.ndarray:
-        """Advance by ``dt_s`` seconds; return the new state vector."""
+    def step(self, dt_s: float, Gg_kg_s: float, Tgi_C: float, heater: float = 0.0, fan: float = 0.0) -> np.ndarray:
+        """Advance by ``dt_s`` seconds; return the new state vector (six states).
+
+        ``Gg_kg_s`` [kg/s] and ``Tgi_C`` [degC] are the gas inputs; ``heater`` and ``fan`` the
+        actuator settings (the actuator extension; 0 when not used).
+        """
         dt_s = check_value("dt_s", dt_s, "Simulator.step")
         Gg_kg_s = check_value("Gg_kg_s", Gg_kg_s, "Simulator.step")
         Tgi_C = check_value("Tgi_C", Tgi_C, "Simulator.step")
-        g0, T0 = self._u_prev if (self._u_prev and not self.zoh) else (Gg_kg_s, Tgi_C)
-        x, Tgo, h = step_kernel(self.x, g0, T0, Gg_kg_s, Tgi_C, dt_s, self.params, self.zoh, self.h_max_s, self._h)
+        u1 = _u4(Gg_kg_s, Tgi_C, heater, fan)
+        u0 = self._u_prev if (self._u_prev is not None and not self.zoh) else u1
+        x, Tgo, h = step_kernel(self.x, u0, u1, dt_s, self.params, self.zoh, self.h_max_s, self._h)
         if not np.all(np.isfinite(x)):
             raise ParameterError(
                 f"the simulation went non-finite at t = {self.t_s + dt_s:g} s (state kept at {self.t_s:g} s)"
             )
         self.x, self.Tgo_C, self._h = x, Tgo, h
-        self._u_prev = (Gg_kg_s, Tgi_C)
+        self._u_prev = u1
         self.t_s += dt_s
         return self.x.copy()

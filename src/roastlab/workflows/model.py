@@ -35,6 +35,7 @@ from ..io.plants import load_plant
 from ..model.parameters import REGISTRY, STATE0, THETA_NAMES, THETA_PAPER, THETA_UNITS, Theta
 from ..model.plant import Plant
 from ..model.rhs import P
+from ..sim.kernels import I_TGO, NS
 from ..sim.population import pack_batches, run_arrays, simulate_population
 from ..sim.simulate import InitialState, SimulationResult
 
@@ -270,7 +271,16 @@ class FittedModel:
             Gg = b.Gg_kg_s * p[P["Gg_scale"]]  # the flow as applied; the result's params then carry 1
             p[P["Gg_scale"]] = 1.0
             meta = {"notes": list(applied.notes), "plant": applied.plant.name}
-            res = SimulationResult(b.time_s.copy(), out[i, :n, :5].copy(), out[i, :n, 5].copy(), Gg, b.Tgi_C.copy(), p)
+            res = SimulationResult(
+                b.time_s.copy(),
+                out[i, :n, :NS].copy(),
+                out[i, :n, I_TGO].copy(),
+                Gg,
+                b.Tgi_C.copy(),
+                p,
+                heater=None if b.heater is None else b.heater.copy(),
+                fan=None if b.fan is None else b.fan.copy(),
+            )
             res.name, res.meta = b.name, meta
             res.Ta_measured_C = None if b.Ta_C is None else b.Ta_C.copy()
             bad = ~np.isfinite(res.states)
