@@ -216,7 +216,7 @@ CASES = {
     "Pbm outside (0, 1) in THETA.json": (
         lambda d: theta_with(d, '{"hgm": 0.01, "hbm": 0.02, "Pbm": 1.3}'),
         "theta.json",
-        "Pbm must be in (0, 1)",
+        "Pbm (bean area touching the metal) = 1.3 - outside the plausible range",
     ),
     "missing theta keys": (lambda d: theta_with(d, '{"hgm": 0.01}'), "theta.json", "missing key(s) hbm, Pbm"),
     "theta wrong JSON type": (

@@ -244,12 +244,15 @@ def read_batch_csv(path: str | Path, name: str | None = None, require_Ta: bool =
         heater=cols.get("heater"),
         fan=cols.get("fan"),
         Tb2_C=cols.get("Tb2_C"),
+        initial={k: v for k, v in meta.items() if k in INITIAL_METADATA},
     )
     return batch.validate()
 
 
 #: Metadata a batch CSV may carry in ``# key = value`` comment lines, with allowed ranges.
-COMMENT_METADATA = {"Mb_kg": (1e-4, 1e4)}
+COMMENT_METADATA = {"Mb_kg": (1e-4, 1e4), "Tm0_C": (-50.0, 700.0), "Tb0_C": (-50.0, 400.0), "X0": (0.0, 1.0)}
+#: Of those, the initial states a log set through its map's ``[initial]`` (kept in ``Batch.initial``).
+INITIAL_METADATA = ("Tm0_C", "Tb0_C", "X0")
 
 
 def read_comment_metadata(path: str | Path, text: str | None = None) -> dict[str, float]:
@@ -285,6 +288,9 @@ def write_batch_csv_text(batch: Batch, comment: str | None = None, decimals: int
         out.write("## " + "".join(c if c.isprintable() else "?" for c in line) + "\n")
     if batch.Mb_kg:
         out.write(f"# Mb_kg = {batch.Mb_kg:.6g}\n")
+    for key in INITIAL_METADATA:
+        if key in batch.initial:
+            out.write(f"# {key} = {float(batch.initial[key]):.10g}\n")
     cols = ["time_s", "Gg_kg_s", "Tgi_C"] + [c for c in OPTIONAL_COLUMNS if getattr(batch, c) is not None]
     out.write(",".join(cols) + "\n")
     arrays = [getattr(batch, c) for c in cols]

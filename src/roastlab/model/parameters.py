@@ -230,7 +230,7 @@ class FreeParameter:
         if self.name in LIMITS:
             check_value(self.name, self.lower)
             check_value(self.name, self.upper)
-        elif REGISTRY[self.name].kind != "theta" and not self.lower > 0:
+        elif REGISTRY[self.name].kind not in ("theta", "actuator") and not self.lower > 0:
             raise ParameterError(f"{self.name} must stay > 0 {REGISTRY[self.name].unit}: lower bound {self.lower:g}")
         if not self.lower <= self.start <= self.upper:
             self.start = min(max(self.start, self.lower), self.upper)

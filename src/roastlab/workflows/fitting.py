@@ -180,8 +180,11 @@ def _document(ident, free, fixed, init, plant, moisture, hold, column_map) -> di
             }
         else:
             params[name] = {"value": float(fixed.get(name, values.get(name))), "unit": unit, "how": "fixed"}
+    from_log = dict(column_map.initial) if column_map is not None else {}
     for name in STATE0:
-        if name in by_name and by_name[name].per_batch:
+        if name in from_log and name not in by_name:
+            initial[name] = {"how": "from log", "field": from_log[name]}  # the map reads it from each log
+        elif name in by_name and by_name[name].per_batch:
             labels = [f"{name}[{b}]" for b in ident.batches]
             initial[name] = {
                 "how": "fitted per batch",

@@ -71,6 +71,7 @@ class ArtisanLog:
     weight_in_kg: float | None = None
     weight_out_kg: float | None = None
     title: str = ""
+    fields: dict = field(default_factory=dict)  # scalar fields of the log (e.g. RoasTime's drum charge temperature)
 
 
 # Tokens of a Python literal that JSON spells differently. Strings come first so that words,

@@ -19,6 +19,9 @@ A map is a TOML file::
     unit = "C"
     offset_C = 0.0
 
+    [Tgi]                      # or a constant, e.g. room air drawn into an induction drum
+    constant_C = 22.0
+
     [Gg]                       # exactly one of: column, constant_kg_s, identify, [Gg.pitot]
     column = "flow"
     unit = "kg/h"              # kg/s | kg/h | g/s | m3/h (with density_kg_m3)
@@ -28,8 +31,27 @@ A map is a TOML file::
     # [Gg.pitot]               # eq. 16
     # dp_column = "dp_Pa"; T_column = "T_pitot_C"; section_m2 = 0.03; rho0_kg_m3 = 1.275
 
+    # --- the actuator extension (optional; the paper's model uses none of these) ---
+    batch_kg = 0.5             # green weight when the log has none [kg]
+    [heater]                   # a logged heater/burner setting, held between changes
+    column = "Burner"          # Artisan event type, RoasTime "heater" (P1-P9), or a CSV column
+    unit = "percent"           # percent | level | kW
+    [fan]                      # a logged fan/air setting
+    column = "Air"             # Artisan event type, RoasTime "fan" (F0-F12), or a CSV column
+    unit = "percent"
+    [Tb2]                      # a second bean reading compared with the model's Tb
+    column = "drumTemperature" # e.g. the Bullet's infrared channel
+    [initial]                  # initial states from the log: a scalar field or a channel at CHARGE
+    Tm0_C = "drumChargeTemperature"
+
+The fit spec decides what the settings drive: free ``Qe_gain_kW`` (heater -> heat into the
+drum metal), ``Tgi_gain_C`` (heater -> inlet gas), ``tau_heater_s`` (its lag) and
+``Gg_fan_kg_s`` (fan -> flow, affine with ``Gg_kg_s``).
+
 Artisan channel names are ``BT``, ``ET``, the extra devices' names and the special-event
-types (``Burner``, ``Air``, ...). Every error names the map or log file and the key.
+types (``Burner``, ``Air``, ...); RoasTime's are ``beanTemperature`` (also ``BT``),
+``drumTemperature``, ``exitTemperature``, ``heater``, ``fan``, ``drum``. Every error names the
+map or log file and the key.
 """
 
 from __future__ import annotations
@@ -41,12 +63,18 @@ from pathlib import Path
 import numpy as np
 
 from ...errors import InputError
+from ...model.limits import check_value
 from ...model.pitot import gas_flow_pitot_kg_s
 from ..batch import Batch, read_table
 from ..files import finite_number, read_input_bytes, read_toml
 from .artisan import read_alog, read_artisan_csv
+from .roastime import read_roastime
 
-FORMATS = ("auto", "alog", "artisan-csv", "csv", "parquet")
+FORMATS = ("auto", "alog", "artisan-csv", "roastime", "csv", "parquet")
+#: Units a logged setting may be given in, and the plausible range of each.
+SETTING_UNITS = {"percent": (0.0, 100.0), "level": (0.0, 20.0), "kW": (0.0, 1e4)}
+#: Initial states a map may take from the log.
+INITIAL_FROM_LOG = ("Tm0_C", "Tb0_C", "X0")
 TIME_UNITS = {"s": 1.0, "min": 60.0, "ms": 1e-3}
 TEMP_UNITS = ("C", "F", "K")
 FLOW_UNITS = {"kg/s": 1.0, "kg/h": 1.0 / 3600.0, "g/s": 1e-3, "m3/h": None}
@@ -70,6 +98,11 @@ class ColumnMap:
     Ta: dict = field(default_factory=lambda: {"column": "Ta_C", "unit": "C"})
     Tgi: dict = field(default_factory=lambda: {"column": "Tgi_C", "unit": "C"})
     Gg: dict = field(default_factory=lambda: {"column": "Gg_kg_s", "unit": "kg/s"})
+    heater: dict | None = None
+    fan: dict | None = None
+    Tb2: dict | None = None
+    initial: dict = field(default_factory=dict)
+    batch_kg: float | None = None
 
     def to_mapping(self) -> dict:
         """The map as the TOML-shaped mapping :func:`map_from_mapping` reads (for model files)."""
@@ -86,8 +119,18 @@ class ColumnMap:
                 "Ta": self.Ta,
                 "Tgi": self.Tgi,
                 "Gg": self.Gg,
+                "heater": self.heater,
+                "fan": self.fan,
+                "Tb2": self.Tb2,
+                "initial": self.initial or None,
+                "batch_kg": self.batch_kg,
             }
         )
+
+    @property
+    def uses_actuators(self) -> bool:
+        """True if the map reads heater or fan settings (the actuator extension)."""
+        return self.heater is not None or self.fan is not None
 
     @property
     def identifies_flow(self) -> bool:
@@ -99,7 +142,11 @@ class ColumnMap:
 TABLE_KEYS = {
     "time": {"column", "unit"},
     "Ta": {"column", "unit", "offset_C"},
-    "Tgi": {"column", "unit", "offset_C"},
+    "Tgi": {"column", "unit", "offset_C", "constant_C"},
+    "heater": {"column", "unit"},
+    "fan": {"column", "unit"},
+    "Tb2": {"column", "unit", "offset_C", "start_s"},
+    "initial": set(INITIAL_FROM_LOG),
     "Gg": {"column", "unit", "density_kg_m3", "constant_kg_s", "identify", "pitot"},
     "pitot": {"dp_column", "T_column", "section_m2", "rho0_kg_m3", "T_unit"},
 }
@@ -149,6 +196,7 @@ def map_from_mapping(data: dict, path: str | Path) -> ColumnMap:
     if not isinstance(data, dict):
         raise InputError("a column map must be a table", path)
     known = {"format", "keep_after_drop", "resample_s", "time", "Ta", "Tgi", "Gg", "name", "description", "notes"}
+    known |= {"heater", "fan", "Tb2", "initial", "batch_kg"}
     unknown = sorted(set(data) - known)
     if unknown:
         raise InputError(f"unknown key(s) {', '.join(unknown)} (allowed: {', '.join(sorted(known))})", path)
@@ -167,15 +215,41 @@ def map_from_mapping(data: dict, path: str | Path) -> ColumnMap:
             "column": _check_str(t, "column", path, "time", required=False) or "time_s",
             "unit": _check_str(t, "unit", path, "time", required=False, choices=tuple(TIME_UNITS)) or "s",
         }
-    for key in ("Ta", "Tgi"):
+    for key in ("Ta", "Tgi", "Tb2"):
         if key in data:
             t = _table(data, key, path)
+            if key == "Tgi" and "constant_C" in t:
+                if "column" in t:
+                    raise InputError("give column or constant_C, not both", path, "Tgi")
+                m.Tgi = {"constant_C": check_value("Tgi_C", _check_num(t, "constant_C", path, key), str(path))}
+                continue
             m_t = {
                 "column": _check_str(t, "column", path, key),
                 "unit": _check_str(t, "unit", path, key, required=False, choices=TEMP_UNITS) or "C",
                 "offset_C": _check_num(t, "offset_C", path, key, default=0.0),
             }
             setattr(m, key, m_t)
+    if m.Tb2 is not None:
+        start = _check_num(data["Tb2"], "start_s", path, "Tb2", default=0.0)
+        if not 0 <= start <= 3600:
+            raise InputError(f"must be 0..3600 s, got {start:g}", path, "Tb2.start_s")
+        m.Tb2["start_s"] = start
+    for key in ("heater", "fan"):
+        if key in data:
+            t = _table(data, key, path)
+            setattr(
+                m,
+                key,
+                {
+                    "column": _check_str(t, "column", path, key),
+                    "unit": _check_str(t, "unit", path, key, required=False, choices=tuple(SETTING_UNITS)) or "percent",
+                },
+            )
+    if "initial" in data:
+        t = _table(data, "initial", path)
+        m.initial = {k: _check_str(t, k, path, "initial") for k in t}
+    if "batch_kg" in data:
+        m.batch_kg = check_value("batch_kg", _check_num(data, "batch_kg", path, "map"), str(path))
     if "Gg" in data:
         g = _table(data, "Gg", path)
         ways = [k for k in ("column", "constant_kg_s", "identify", "pitot") if k in g]
@@ -231,6 +305,10 @@ def _detect_format(path: Path, fmt: str) -> str:
     suffix = path.suffix.lower()
     if suffix == ".alog":
         return "alog"
+    if suffix == ".json":
+        head = read_input_bytes(path)[:65536]
+        if b"beanTemperature" in head or b"actionTimeList" in head:
+            return "roastime"
     if suffix in (".parquet", ".pq"):
         return "parquet"
     if suffix in (".csv", ".txt", ".tsv"):
@@ -291,12 +369,16 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
     fmt = _detect_format(path, cmap.format)
     gg = cmap.Gg
     Mb = None
-    if fmt in ("alog", "artisan-csv"):
-        log = (
-            read_alog(path, keep_after_drop=cmap.keep_after_drop)
-            if fmt == "alog"
-            else read_artisan_csv(path, cmap.keep_after_drop)
-        )
+    initial: dict = {}
+    events: dict = {}
+    settings = {k: spec for k, spec in (("heater", cmap.heater), ("fan", cmap.fan), ("Tb2", cmap.Tb2)) if spec}
+    if fmt in ("alog", "artisan-csv", "roastime"):
+        if fmt == "alog":
+            log = read_alog(path, keep_after_drop=cmap.keep_after_drop)
+        elif fmt == "roastime":
+            log = read_roastime(path, keep_after_drop=cmap.keep_after_drop)
+        else:
+            log = read_artisan_csv(path, cmap.keep_after_drop)
         time_s = log.time_s
         available = log.channels
 
@@ -304,36 +386,75 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
             col = spec["column"]
             if col not in available:
                 raise InputError(f"{what}: no channel {col!r} in the log (has: {', '.join(sorted(available))})", path)
-            return np.array(available[col], dtype=float)  # Artisan temperatures already in degC
+            return np.array(available[col], dtype=float)  # log temperatures already in degC
 
         Ta = channel(cmap.Ta, "Ta") + (cmap.Ta.get("offset_C") or 0.0)
-        Tgi = channel(cmap.Tgi, "Tgi") + (cmap.Tgi.get("offset_C") or 0.0)
+        Tgi = _constant_or(cmap.Tgi, len(time_s), lambda: channel(cmap.Tgi, "Tgi") + (cmap.Tgi.get("offset_C") or 0.0))
         extra = {}
         if "column" in gg:
             extra["Gg"] = channel(gg, "Gg")
         elif "pitot" in gg:
             extra["dp"] = channel({"column": gg["pitot"]["dp_column"]}, "Gg.pitot.dp_column")
             extra["Tp"] = channel({"column": gg["pitot"]["T_column"]}, "Gg.pitot.T_column")
+        series = {k: channel(spec, k) + (spec.get("offset_C") or 0.0) for k, spec in settings.items()}
         Mb = log.weight_in_kg
         drop_known = log.drop_index is not None
+        events = dict(log.events)
+        for state, source in cmap.initial.items():
+            if source in log.fields:
+                initial[state] = float(log.fields[source])
+            elif source in available and np.isfinite(available[source][0]):
+                initial[state] = float(available[source][0])  # the channel's reading at CHARGE
+            else:
+                have = ", ".join(sorted(set(log.fields) | set(available)))
+                raise InputError(f"initial.{state}: no field or channel {source!r} in the log (has: {have})", path)
     else:
-        needed = [cmap.time["column"], cmap.Ta["column"], cmap.Tgi["column"]]
+        needed = [cmap.time["column"], cmap.Ta["column"]]
+        needed += [cmap.Tgi["column"]] if "column" in cmap.Tgi else []
         if "column" in gg:
             needed.append(gg["column"])
         elif "pitot" in gg:
             needed += [gg["pitot"]["dp_column"], gg["pitot"]["T_column"]]
+        needed += [spec["column"] for spec in settings.values()]
         needed = list(dict.fromkeys(needed))
         cols = _read_parquet(path, needed) if fmt == "parquet" else read_table(path, tuple(needed))
         time_s = cols[cmap.time["column"]] * TIME_UNITS[cmap.time["unit"]]
         Ta = to_celsius(cols[cmap.Ta["column"]], cmap.Ta["unit"]) + (cmap.Ta.get("offset_C") or 0.0)
-        Tgi = to_celsius(cols[cmap.Tgi["column"]], cmap.Tgi["unit"]) + (cmap.Tgi.get("offset_C") or 0.0)
+        Tgi = _constant_or(
+            cmap.Tgi,
+            len(time_s),
+            lambda: to_celsius(cols[cmap.Tgi["column"]], cmap.Tgi["unit"]) + (cmap.Tgi.get("offset_C") or 0.0),
+        )
         extra = {}
         if "column" in gg:
             extra["Gg"] = cols[gg["column"]]
         elif "pitot" in gg:
             extra["dp"] = cols[gg["pitot"]["dp_column"]]
             extra["Tp"] = to_celsius(cols[gg["pitot"]["T_column"]], gg["pitot"]["T_unit"])
+        series = {}
+        for k, spec in settings.items():
+            v = cols[spec["column"]]
+            series[k] = to_celsius(v, spec.get("unit", "C")) + (spec.get("offset_C") or 0.0) if k == "Tb2" else v
         drop_known = True
+        if cmap.initial:
+            raise InputError("[initial] from the log needs a roast log (alog, artisan-csv, roastime)", cmap.source)
+    if Mb is None and cmap.batch_kg is not None:
+        Mb = cmap.batch_kg
+    if Mb is None and fmt == "roastime":
+        raise InputError(
+            "the log has no green weight (weightGreen 0): set batch_kg = ... in the map, or pass --batch-kg", path
+        )
+    for k, spec in settings.items():
+        if k in ("heater", "fan"):
+            lo, hi = SETTING_UNITS[spec["unit"]]
+            v = series[k][np.isfinite(series[k])]
+            if v.size and (v.min() < lo or v.max() > hi):
+                raise InputError(
+                    f"{k} setting {v.min():g}..{v.max():g} outside {lo:g}..{hi:g} for unit {spec['unit']!r} "
+                    "(wrong unit in the map?)",
+                    path,
+                    f"channel {spec['column']}",
+                )
 
     # Gg in kg/s
     if "column" in gg:
@@ -348,11 +469,18 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
     else:  # identify: a 1 kg/s placeholder scaled by the identified Gg_kg_s
         Gg = np.ones(len(time_s))
 
-    # missing samples (Artisan -1, empty cells) are dropped rather than invented
+    # missing samples (Artisan -1, empty cells) are dropped rather than invented; a missing
+    # second bean reading (Tb2) only leaves a gap in that reading
     ok = np.isfinite(time_s) & np.isfinite(Ta) & np.isfinite(Tgi) & np.isfinite(Gg)
+    for k in ("heater", "fan"):
+        if k in series:
+            ok &= np.isfinite(series[k])
+    if "Tb2" in series:  # the second reading only counts from start_s (e.g. once the beans are in view)
+        series["Tb2"] = np.where(time_s >= settings["Tb2"].get("start_s", 0.0), series["Tb2"], np.nan)
     if ok.sum() < 2:
         raise InputError("fewer than 2 complete samples after dropping missing values", path)
     time_s, Ta, Tgi, Gg = time_s[ok], Ta[ok], Tgi[ok], Gg[ok]
+    series = {k: v[ok] for k, v in series.items()}
     notes = []
     if ok.sum() < ok.size:
         notes.append(f"dropped {ok.size - ok.sum()} incomplete sample(s) (missing values)")
@@ -369,6 +497,7 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
             f"bean temperature jumps {Ta[j]:.0f} -> {Ta[j + 1]:.0f} degC at t = {time_s[j + 1]:.0f} s (probe fault): log cut there"
         )
         time_s, Ta, Tgi, Gg = time_s[: j + 1], Ta[: j + 1], Tgi[: j + 1], Gg[: j + 1]
+        series = {k: v[: j + 1] for k, v in series.items()}
     if drop_known and Ta[-1] > DROP_BT_LIMIT_C:
         raise InputError(
             f"bean temperature {Ta[-1]:.0f} degC at DROP is above {DROP_BT_LIMIT_C:.0f}: °F data declared as °C?", path
@@ -376,8 +505,12 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
     if cmap.resample_s > 0:
         if np.any(np.diff(time_s) <= 0):
             raise InputError("time not strictly increasing", path)
-        time_s, cols = _resample(time_s, {"Ta": Ta, "Tgi": Tgi, "Gg": Gg}, cmap.resample_s, path)
-        Ta, Tgi, Gg = cols["Ta"], cols["Tgi"], cols["Gg"]
+        grid, cols = _resample(time_s, {"Ta": Ta, "Tgi": Tgi, "Gg": Gg, **series}, cmap.resample_s, path)
+        for k in ("heater", "fan"):  # settings are steps: hold the last change, never interpolate
+            if k in series:
+                cols[k] = series[k][np.searchsorted(time_s, grid, side="right") - 1]
+        time_s, Ta, Tgi, Gg = grid, cols["Ta"], cols["Tgi"], cols["Gg"]
+        series = {k: cols[k] for k in series}
     batch = Batch(
         name or path.stem,
         np.asarray(time_s, float),
@@ -386,6 +519,18 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
         np.asarray(Ta, float),
         source=str(path),
         Mb_kg=Mb,
+        heater=series.get("heater"),
+        fan=series.get("fan"),
+        Tb2_C=series.get("Tb2"),
+        events=events,
     )
+    batch.initial.update(initial)
     batch.notes = notes
     return batch.validate()
+
+
+def _constant_or(spec: dict, n: int, read) -> np.ndarray:
+    """A map entry that is a constant (``constant_C``) as a series of n, else ``read()``."""
+    if "constant_C" in spec:
+        return np.full(n, float(spec["constant_C"]))
+    return read()

@@ -1,0 +1,185 @@
+"""Aillio RoasTime roast logs (the Bullet's own JSON format), parsed as data only.
+
+Fields used (see ``../shared/data/real/README.md`` for what each holds on a Bullet R1):
+
+* ``sampleRate`` [samples/s]; ``roastStartIndex`` / ``roastEndIndex`` bound the roast
+  (charge to drop, end exclusive);
+* equal-length series ``beanTemperature`` (the lagging bean probe), ``drumTemperature``
+  (after charge an infrared bean-surface-like reading; before charge the drum), and
+  ``exitTemperature``, ``beanDerivative``, ``ibtsDerivative`` when present;
+* ``actions.actionTimeList``: the operator's changes ``{ctrlType, index, value}``, ctrlType
+  0 = heater power P (levels 1-9), 1 = fan F (0-12), 2 = drum speed D (0-9); each holds until
+  the next change of its type (before the first change: the first value);
+* ``weightGreen`` / ``weightRoasted`` [g] as strings or numbers ("0" = not weighed);
+* events ``indexYellowingStart``, ``indexFirstCrackStart``, ``indexFirstCrackEnd``,
+  ``indexSecondCrackStart``, ``indexSecondCrackEnd`` (0 = not marked);
+* scalar fields ``preheatTemperature``, ``drumChargeTemperature``, ``beanChargeTemperature``,
+  ``beanDropTemperature``, ``drumDropTemperature`` [degC], kept in ``fields`` so a map can set
+  an initial state from them (e.g. the drum temperature at charge).
+
+The result is the same :class:`~roastlab.io.importers.artisan.ArtisanLog` the Artisan readers
+give, with time 0 at charge, so the column map treats every log format alike.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ...errors import InputError
+from ..files import read_input_text
+from ..modelfile import parse_json_document
+from .artisan import ArtisanLog
+
+#: RoasTime's control types in ``actions.actionTimeList`` and the channel each becomes.
+CONTROL_TYPES = {0: "heater", 1: "fan", 2: "drum"}
+#: Temperature series read when present, under the file's own names.
+SERIES = ("beanTemperature", "drumTemperature", "exitTemperature")
+EVENTS = {
+    "indexYellowingStart": "DRY",
+    "indexFirstCrackStart": "FCs",
+    "indexFirstCrackEnd": "FCe",
+    "indexSecondCrackStart": "SCs",
+    "indexSecondCrackEnd": "SCe",
+}
+FIELDS = (
+    "preheatTemperature",
+    "drumChargeTemperature",
+    "beanChargeTemperature",
+    "beanDropTemperature",
+    "drumDropTemperature",
+)
+#: Largest sample rate accepted [1/s] (RoasTime records 2).
+MAX_SAMPLE_RATE = 100.0
+
+
+def _number(data: dict, key: str, path, lo: float, hi: float, required: bool = True):
+    v = data.get(key)
+    if v is None or v == "":
+        if required:
+            raise InputError("missing key", path, f"key {key}")
+        return None
+    if isinstance(v, str):  # RoasTime writes some numbers as strings
+        try:
+            v = float(v)
+        except ValueError:
+            raise InputError(f"not a number: {v[:20]!r}", path, f"key {key}") from None
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        raise InputError(f"expected a number, got {type(v).__name__}", path, f"key {key}")
+    try:
+        x = float(v)
+    except OverflowError:
+        raise InputError("number out of range", path, f"key {key}") from None
+    if not (math.isfinite(x) and lo <= x <= hi):
+        raise InputError(f"{x:g} outside {lo:g}..{hi:g}", path, f"key {key}")
+    return x
+
+
+def _series(data: dict, key: str, path) -> np.ndarray | None:
+    if key not in data:
+        return None
+    value = data[key]
+    if not isinstance(value, list):
+        raise InputError(f"expected a list of numbers, got {type(value).__name__}", path, f"key {key}")
+    out = np.empty(len(value))
+    for i, v in enumerate(value):
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            raise InputError(f"expected numbers, found {type(v).__name__} at position {i}", path, f"key {key}")
+        try:
+            out[i] = v
+        except OverflowError:
+            raise InputError(f"number out of range at position {i}", path, f"key {key}") from None
+    return out
+
+
+def _actions(data: dict, n: int, path) -> dict[str, np.ndarray]:
+    """Step series of each control type over the n samples (held until the next change)."""
+    actions = data.get("actions", {})
+    if not isinstance(actions, dict):
+        raise InputError("expected an object", path, "key actions")
+    items = actions.get("actionTimeList", [])
+    if not isinstance(items, list):
+        raise InputError("expected a list", path, "key actions.actionTimeList")
+    changes: dict[str, list[tuple[int, float]]] = {name: [] for name in CONTROL_TYPES.values()}
+    for k, item in enumerate(items):
+        where = f"actions.actionTimeList[{k}]"
+        if not isinstance(item, dict):
+            raise InputError("expected an object", path, where)
+        ctrl, index, value = item.get("ctrlType"), item.get("index"), item.get("value")
+        for label, v in (("ctrlType", ctrl), ("index", index), ("value", value)):
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+                raise InputError(f"{label} must be a finite number, got {str(v)[:20]!r}", path, where)
+        if ctrl not in CONTROL_TYPES:
+            continue  # a control this reader does not model
+        if not 0 <= index < 10 * max(n, 1) or not -1e3 <= value <= 1e3:
+            raise InputError(f"index {index} or value {value} out of range", path, where)
+        changes[CONTROL_TYPES[int(ctrl)]].append((int(index), float(value)))
+    out = {}
+    for name, steps in changes.items():
+        if not steps:
+            continue
+        steps.sort(key=lambda s: s[0])  # stable: the later of two changes at one index wins
+        series = np.full(n, steps[0][1])
+        for index, value in steps:
+            series[min(index, n) :] = value
+        out[name] = series
+    return out
+
+
+def read_roastime(path: str | Path, keep_after_drop: bool = False) -> ArtisanLog:
+    """Parse an Aillio RoasTime JSON log into an :class:`ArtisanLog` (see module docstring)."""
+    path = Path(path)
+    data = parse_json_document(read_input_text(path, "a RoasTime log"), path)
+    if not isinstance(data, dict):
+        raise InputError("expected a JSON object (an Aillio RoasTime log)", path)
+    bt = _series(data, "beanTemperature", path)
+    if bt is None:
+        raise InputError("missing key (not an Aillio RoasTime log?)", path, "key beanTemperature")
+    n = len(bt)
+    if n < 2:
+        raise InputError(f"needs at least 2 samples, beanTemperature has {n}", path, "key beanTemperature")
+    rate = _number(data, "sampleRate", path, 1e-3, MAX_SAMPLE_RATE)
+    start = int(_number(data, "roastStartIndex", path, 0, n - 1, required=False) or 0)
+    end_raw = _number(data, "roastEndIndex", path, 0, 10 * n, required=False)
+    end = n if not end_raw else int(min(end_raw, n))
+    if end - start < 2:
+        raise InputError(f"roastStartIndex {start} and roastEndIndex {end} leave fewer than 2 samples", path)
+    channels = {"beanTemperature": bt}
+    for key in SERIES[1:]:
+        s = _series(data, key, path)
+        if s is not None:
+            if len(s) != n:
+                raise InputError(
+                    f"has {len(s)} values but beanTemperature has {n} (truncated file?)", path, f"key {key}"
+                )
+            channels[key] = s
+    channels.update(_actions(data, n, path))
+    stop = n if keep_after_drop else end
+    time_s = (np.arange(n, dtype=float) - start) / rate
+    sl = slice(start, stop)
+    channels = {k: v[sl].copy() for k, v in channels.items()}
+    channels["BT"] = channels["beanTemperature"]  # the curve a roaster reads, under Artisan's name
+    events = {"CHARGE": 0.0, "DROP": (end - 1 - start) / rate}
+    for key, name in EVENTS.items():
+        idx = _number(data, key, path, 0, 10 * n, required=False)
+        if idx and start < idx < n:
+            events[name] = (idx - start) / rate
+    weight = _number(data, "weightGreen", path, 0, 1e7, required=False)
+    roasted = _number(data, "weightRoasted", path, 0, 1e7, required=False)
+    log = ArtisanLog(
+        str(path),
+        time_s[sl],
+        channels,
+        set(SERIES) | {"BT"},
+        "C",
+        start,
+        end - 1,
+        events,
+        weight_in_kg=weight / 1000.0 if weight else None,
+        weight_out_kg=roasted / 1000.0 if roasted else None,
+        title=str(data.get("roastName", ""))[:200],
+    )
+    log.fields = {k: v for k in FIELDS if (v := _number(data, k, path, -100, 1000, required=False)) is not None}
+    return log
