@@ -147,7 +147,9 @@ def test_unknown_change_is_refused():
     t = np.arange(0, 301, 30.0)
     b = Batch("b", t, np.full_like(t, 0.4), np.full_like(t, 450.0))
     with pytest.raises(roastlab.ParameterError, match="unknown change"):
-        m.predict(b, heater=3)
+        m.predict(b, burner=3)
+    with pytest.raises(roastlab.ParameterError, match="no heater setting"):
+        m.predict(b, heater=3)  # a real change, but this batch logs no heater
 
 
 def test_placeholder_flow_without_a_spec_is_refused():

@@ -435,7 +435,36 @@ HOSTILE = {
         "--baseline first-order",
     ),
 }
+RT_MAP = (
+    'format = "roastime"\n[Ta]\ncolumn = "beanTemperature"\n[Tgi]\nconstant_C = 22\n[Gg]\nidentify = true\n'
+    '[heater]\ncolumn = "heater"\nunit = "level"\n'
+)
+RT = '{"sampleRate": 2, "weightGreen": "490", "beanTemperature": [150, 140, 130, 135], "actions": {"actionTimeList": [{"index": 0, "value": 6, "ctrlType": 0}]}}'
+ROASTIME = {
+    "RoasTime with a zero sample rate": (
+        lambda d: import_with(d, "r.json", RT.replace('"sampleRate": 2', '"sampleRate": 0'), RT_MAP),
+        "r.json",
+        "key sampleRate",
+    ),
+    "RoasTime truncated": (lambda d: import_with(d, "r.json", RT[:60], RT_MAP), "r.json", "r.json"),
+    "RoasTime heater level of 600": (
+        lambda d: import_with(d, "r.json", RT.replace('"value": 6', '"value": 600'), RT_MAP),
+        "r.json",
+        "outside 0..20 for unit 'level'",
+    ),
+    "map with an unknown setting unit": (
+        lambda d: import_with(d, "r.json", RT, RT_MAP.replace('unit = "level"', 'unit = "watts"')),
+        "map.toml",
+        "must be one of percent, level, kW",
+    ),
+    "map Tgi with both a column and a constant": (
+        lambda d: import_with(d, "r.json", RT, RT_MAP.replace("constant_C = 22", 'constant_C = 22\ncolumn = "x"')),
+        "map.toml",
+        "column or constant_C",
+    ),
+}
 CASES.update(HOSTILE)
+CASES.update(ROASTIME)
 
 
 @pytest.mark.parametrize("case", sorted(CASES))

@@ -18,6 +18,8 @@ from roastlab.io.batch import read_batch_csv, read_dataset
 from roastlab.io.fitspec import load_fit_spec
 from roastlab.io.importers import import_log, load_map
 from roastlab.io.importers.artisan import read_alog, read_artisan_csv
+from roastlab.io.importers.mapping import map_from_mapping
+from roastlab.io.importers.roastime import read_roastime
 from roastlab.io.modelfile import read_model_document
 from roastlab.io.plants import load_plant
 
@@ -47,8 +49,38 @@ VALID = {
     ".map.toml": 'format = "auto"\nresample_s = 2\n[time]\ncolumn = "time_s"\nunit = "s"\n[Ta]\ncolumn = "Ta_C"\nunit = "F"\n[Tgi]\ncolumn = "Tgi_C"\noffset_C = 5\n[Gg]\ncolumn = "Gg_kg_s"\nunit = "kg/h"\n',
     ".plant.toml": 'name = "x"\nMb_kg = 1\nDch_m = 0.3\nLch_m = 0.4\nHflap_m = 0.02\nSflap_m = 0.1\nMm_kg = 20\n[process]\nKt = 0.02\n"Ha/R" = 5000\n',
     ".json": json.dumps({"hgm": 0.02, "hbm": 0.03, "Pbm": 0.6, "SSR": 1.0, "Tm0_C": [100, 120], "batches": ["a", "b"]}),
+    ".roastime.json": json.dumps(
+        {
+            "sampleRate": 2,
+            "roastStartIndex": 0,
+            "roastEndIndex": 6,
+            "beanTemperature": [150, 140, 120, 110, 115, 120],
+            "drumTemperature": [240, 25, 60, 80, 95, 105],
+            "weightGreen": "490",
+            "drumChargeTemperature": 240,
+            "indexFirstCrackStart": 4,
+            "actions": {
+                "actionTimeList": [{"index": 1, "value": 6, "ctrlType": 0}, {"index": 2, "value": 2, "ctrlType": 1}]
+            },
+        }
+    ),
     ".fit.toml": "[free]\nhgm = [0.001, 1.0, 0.02]\nTm0_C = { lower = 60, upper = 300, start = 170, per_batch = true }\n[fixed]\nKt = 0.02\n[initial]\nTb0_C = 22\n",
 }
+
+
+ROASTIME_MAP = map_from_mapping(
+    {
+        "format": "roastime",
+        "Ta": {"column": "beanTemperature"},
+        "Tgi": {"constant_C": 22.0},
+        "Gg": {"identify": True},
+        "heater": {"column": "heater", "unit": "level"},
+        "fan": {"column": "fan", "unit": "level"},
+        "Tb2": {"column": "drumTemperature", "start_s": 1.0},
+        "initial": {"Tm0_C": "drumChargeTemperature"},
+    },
+    "fuzz map",
+)
 
 
 def mutated(kind):
@@ -125,6 +157,34 @@ KEYS = {
         "Pbm": st.one_of(VALUES, st.floats(-1, 2)),
         "SSR": VALUES,
         "batches": VALUES,
+    },
+    ".roastime.json": {
+        "sampleRate": st.one_of(VALUES, st.floats(-1, 1e4)),
+        "roastStartIndex": st.one_of(VALUES, st.integers(-3, 10)),
+        "roastEndIndex": st.one_of(VALUES, st.integers(-3, 10)),
+        "beanTemperature": st.one_of(VALUES, NUMBER_LISTS),
+        "drumTemperature": st.one_of(VALUES, NUMBER_LISTS),
+        "weightGreen": st.one_of(VALUES, st.sampled_from(["0", "490", "-5", "1e999", ""])),
+        "drumChargeTemperature": VALUES,
+        "indexFirstCrackStart": VALUES,
+        "actions": st.one_of(
+            VALUES,
+            st.fixed_dictionaries(
+                {
+                    "actionTimeList": st.lists(
+                        st.fixed_dictionaries(
+                            {},
+                            optional={
+                                "index": VALUES,
+                                "value": VALUES,
+                                "ctrlType": st.one_of(VALUES, st.integers(0, 3)),
+                            },
+                        ),
+                        max_size=4,
+                    )
+                }
+            ),
+        ),
     },
     ".alog": {
         "mode": st.one_of(VALUES, st.sampled_from(["C", "F"])),
@@ -205,9 +265,13 @@ def content(kind):
 
 def run_loader(kind, data, loader):
     with tempfile.TemporaryDirectory() as tmp:
-        suffix = {".export.csv": ".csv", ".map.toml": ".toml", ".plant.toml": ".toml", ".fit.toml": ".toml"}.get(
-            kind, kind
-        )
+        suffix = {
+            ".export.csv": ".csv",
+            ".map.toml": ".toml",
+            ".plant.toml": ".toml",
+            ".fit.toml": ".toml",
+            ".roastime.json": ".json",
+        }.get(kind, kind)
         path = Path(tmp) / f"fuzz{suffix}"
         if isinstance(data, bytes):
             path.write_bytes(data)
@@ -240,6 +304,7 @@ LOADERS = {
     ".plant.toml": [load_plant],
     ".json": [read_model_document],
     ".fit.toml": [load_fit_spec],
+    ".roastime.json": [read_roastime, lambda p: import_log(p, ROASTIME_MAP)],
 }
 
 

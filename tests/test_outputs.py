@@ -44,6 +44,11 @@ VALUES = {
     "--pbm",
     "--hold",
     "--moisture",
+    "--heater",
+    "--fan",
+    "--set",
+    "--tgi",
+    "--batch-kg",
     "--help",
     "-h",
 }
@@ -132,6 +137,10 @@ RUNS = {
         ["data/dataset-I/dataset.toml", "data/dataset-V/b1.csv"],
     ),
     ("bench",): ("bench --save {d}/bench.json", []),
+    ("whatif",): (
+        "whatif {d}/log.alog --model {d}/model.json --map {d}/map.toml --tgi 10 --json {d}/w.json --plot {d}/w.png",
+        ["log.alog", "model.json", "map.toml"],
+    ),
     ("import",): ("import {d}/log.alog --map {d}/map.toml --out {d}/b.csv", ["log.alog", "map.toml"]),
     ("datasets", "make-paper"): ("datasets make-paper --out {d}/synthetic", []),
 }

@@ -67,3 +67,83 @@ def test_skywalker_fit_and_validate(cli, real_data, tmp_path):
     assert code == 0, err
     code, out, err = cli("validate", *common, "--baseline", "first-order", "--model", base, *val_logs)
     assert code == 0 and "first-order baseline" in out, err
+
+
+BULLET = Path(__file__).resolve().parents[1] / "examples" / "bullet"
+
+
+@pytest.fixture
+def bullet_data(real_data):
+    folder = real_data.parent / "bullet"
+    if not folder.is_dir():
+        pytest.skip("../shared/data/real/bullet is absent")
+    return folder
+
+
+def test_roastime_import_reads_settings_events_and_weight(bullet_data):
+    from roastlab.io.importers import import_log, load_map
+
+    log = bullet_data / "bullet_2020-07-31_0152_490g.json"
+    b = import_log(log, load_map(BULLET / "map.toml"))
+    assert b.Mb_kg == pytest.approx(0.49)
+    assert b.heater is not None and set(np.unique(b.heater)) <= set(range(0, 10))
+    assert b.fan is not None and b.fan.min() >= 0 and b.fan.max() <= 12
+    assert "FCs" in b.events and 0 < b.events["FCs"] < b.time_s[-1]
+    assert b.initial["Tm0_C"] == pytest.approx(245.1)  # drumChargeTemperature of that log
+    assert np.isnan(b.Tb2_C[0]) and np.isfinite(b.Tb2_C[5:]).all()  # IR counts once the beans are in view
+
+
+def test_roastime_without_weight_is_refused_with_the_way_out(cli, bullet_data, tmp_path):
+    code, _, err = cli(
+        "import",
+        bullet_data / "bullet_2020-08-16_2334_noweight.json",
+        "--map",
+        BULLET / "map.toml",
+        "--out",
+        tmp_path / "o.csv",
+    )
+    assert code == 2 and "no green weight" in err and "batch_kg" in err and err.count("\n") == 1
+
+
+def test_bullet_fit_and_whatif(cli, bullet_data, tmp_path):
+    """The example fits in seconds, beats nothing by luck (held-out FIT > 70 %), and whatif answers."""
+    logs = sorted(p for p in bullet_data.glob("*_49*g.json"))[:6]
+    model = tmp_path / "bullet.json"
+    common = ["--plant", BULLET / "plant.toml", "--map", BULLET / "map.toml"]
+    code, _, err = cli("identify", *common, "--spec", BULLET / "fit.toml", *logs[0::2], "--out", model, "--starts", "2")
+    assert code == 0, err
+    code, _, err = cli("validate", "--model", model, *logs[1::2], "--json", tmp_path / "v.json")
+    assert code == 0, err
+    assert json.loads((tmp_path / "v.json").read_text())["average"]["FIT"] > 70
+    code, out, err = cli(
+        "whatif",
+        logs[1],
+        "--model",
+        model,
+        "--heater",
+        "+1",
+        "--plot",
+        tmp_path / "w.png",
+        "--json",
+        tmp_path / "w.json",
+    )
+    assert code == 0, err
+    rows = json.loads((tmp_path / "w.json").read_text())["rows"]
+    assert rows[0]["changed"] > rows[0]["as_run"]  # more heat, hotter at DROP
+    assert all(r["changed"] < r["as_run"] for r in rows[1:] if r["changed"] is not None and r["as_run"] is not None)
+    assert (tmp_path / "w.png").stat().st_size > 10_000
+
+
+def test_skywalker_whatif_set_and_tm0(cli, real_data, tmp_path):
+    logs = sorted(real_data.glob("*.alog"))[:3]
+    model = tmp_path / "sky.json"
+    common = ["--plant", EXAMPLE / "plant.toml", "--map", EXAMPLE / "map.toml"]
+    assert cli("identify", *common, "--spec", EXAMPLE / "fit.toml", *logs[:2], "--out", model, "--starts", "2")[0] == 0
+    code, out, err = cli(
+        "whatif", logs[2], "--model", model, "--set", "heater=0@60", "--tm0", "150", "--json", tmp_path / "w.json"
+    )
+    assert code == 0, err
+    rows = json.loads((tmp_path / "w.json").read_text())["rows"]
+    assert rows[0]["changed"] < rows[0]["as_run"]  # heater off after a minute: colder at DROP
+    code, _, err = cli("whatif", logs[2], "--model", model, "--set", "burner=5")
+    assert code == 2 and "SETTING=VALUE@SECONDS" in err

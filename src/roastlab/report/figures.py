@@ -198,3 +198,49 @@ def plot_fig3(ident, valid, path, note="synthetic data", outputs=None):
     ax.set_title(f"Absolute error distribution ({note})")
     ax.grid(alpha=0.3, axis="y")
     return _finish(fig, path, None, outputs)
+
+
+def plot_whatif(w, path=None, outputs=None):
+    """Measured BT, the model's BT for the log as run and with the changes, the settings below.
+
+    ``w`` is a :class:`roastlab.workflows.whatif.WhatIf`.
+    """
+    b = w.batch
+    t_min = b.time_s / 60.0
+    fig = new_figure(figsize=(9, 7), layout="constrained")
+    ax, ax2 = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1.3]})
+    if b.Ta_C is not None:
+        ax.plot(t_min, b.Ta_C, ".", ms=3, color="0.3", label="BT measured")
+    ax.plot(t_min, w.as_run.Ta_C, color="tab:blue", lw=1.8, label="BT predicted, as run")
+    ax.plot(
+        t_min,
+        w.changed.Ta_C,
+        color="tab:orange",
+        lw=1.8,
+        label="BT predicted, " + ("; ".join(w.changes) or "no change"),
+    )
+    for r in w.rows[1:]:
+        for value, color in ((r["as_run"], "tab:blue"), (r["changed"], "tab:orange")):
+            if value is not None:
+                ax.axvline(value / 60.0, color=color, lw=0.6, ls=":")
+    _events(ax, b.events)
+    ax.set_ylabel("bean temperature BT [°C]")
+    ax.legend(loc="lower right", fontsize=8)
+    ax.grid(alpha=0.3)
+    shown = False
+    for name, color in (("heater", "tab:red"), ("fan", "tab:green")):
+        before = getattr(b, name)
+        after = getattr(w.changed, name)
+        if before is not None:
+            ax2.step(t_min, before, where="post", color=color, lw=1.2, label=f"{name} as run")
+            if after is not None and not np.array_equal(after, before):
+                ax2.step(t_min, after, where="post", color=color, lw=1.2, ls="--", label=f"{name} changed")
+            shown = True
+    if not shown:
+        ax2.plot(t_min, w.as_run.Tgi_C, color="tab:red", label="inlet gas Tgi as run")
+        ax2.plot(t_min, w.changed.Tgi_C, color="tab:red", ls="--", label="inlet gas Tgi changed")
+    ax2.set_ylabel("setting" if shown else "Tgi [°C]")
+    ax2.set_xlabel("time after CHARGE [min]")
+    ax2.legend(loc="upper right", fontsize=7, ncol=2)
+    ax2.grid(alpha=0.3)
+    return _finish(fig, path, f"what if: {b.name}", outputs)

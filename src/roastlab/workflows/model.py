@@ -174,7 +174,8 @@ class FittedModel:
         flow, metal mass, drum start temperature) are dropped and named in ``notes``.
         ``changes`` override by name: any registry quantity (``hgm``, ``Kt``, ``Tm0_C`` ...),
         ``Tgi_offset_C`` (added to the inlet temperature [degC]), ``Tgi_C`` / ``Gg_kg_s``
-        (replace an input by a value or an array) and ``batch_kg`` (green batch mass [kg]).
+        (replace an input by a value or an array), ``batch_kg`` (green batch mass [kg]) and
+        ``heater`` / ``fan`` (a number is added to the logged setting, an array replaces it).
         """
         batches = [as_batch(b) for b in (batches if isinstance(batches, (list, tuple)) else [batches])]
         if not batches:
@@ -183,7 +184,7 @@ class FittedModel:
         transfer = bool(notes)
         params = {k: e["value"] for k, e in self.parameters.items() if not (transfer and not REGISTRY[k].carries_over)}
         initial = {k: e for k, e in self.initial.items() if not (transfer and _plant_specific_initial(k, e))}
-        allowed = set(REGISTRY) | {"Tgi_offset_C", "Tgi_C", "Gg_kg_s", "batch_kg"}
+        allowed = set(REGISTRY) | {"Tgi_offset_C", "Tgi_C", "Gg_kg_s", "batch_kg", "heater", "fan"}
         unknown = sorted(set(changes) - allowed)
         if unknown:
             raise ParameterError(f"unknown change(s) {', '.join(unknown)} (allowed: {', '.join(sorted(allowed))})")
@@ -258,7 +259,15 @@ class FittedModel:
         if "Tgi_offset_C" in changes:
             Tgi = Tgi + float(changes["Tgi_offset_C"])
         Mb = float(changes["batch_kg"]) if "batch_kg" in changes else b.Mb_kg
-        return dataclasses.replace(b, Gg_kg_s=Gg, Tgi_C=Tgi, Mb_kg=Mb).validate()
+        settings = {}
+        for name in ("heater", "fan"):  # a number shifts the logged setting; an array replaces it
+            if name in changes:
+                current = getattr(b, name)
+                if current is None:
+                    raise ParameterError(f"the batch has no {name} setting to change (its map reads none)")
+                v = np.asarray(changes[name], dtype=np.float64)
+                settings[name] = current + float(v) if v.ndim == 0 else column(name, current)
+        return dataclasses.replace(b, Gg_kg_s=Gg, Tgi_C=Tgi, Mb_kg=Mb, **settings).validate()
 
     def simulate(self, applied: Applied) -> list[SimulationResult]:
         """Run applied batches in one compiled population call; one result per batch."""
