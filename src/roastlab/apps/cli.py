@@ -96,15 +96,7 @@ def _add_model_options(p: argparse.ArgumentParser, with_model: bool = True) -> N
         p.add_argument(
             "--pbm", type=_float_arg("--pbm"), help="bean-metal contact fraction in (0, 1); overrides the model"
         )
-    p.add_argument(
-        "--tb0", type=_float_arg("--tb0"), help="initial bean temperature [degC] (default: the model's, else 30)"
-    )
-    p.add_argument(
-        "--tm0", type=_float_arg("--tm0"), help="initial drum metal temperature [degC] (default: the model's, else 121)"
-    )
-    p.add_argument(
-        "--x0", type=_float_arg("--x0"), help="initial moisture [kg/kg dry] (default: the model's, else 0.1)"
-    )
+    _add_initial_options(p)
     p.add_argument(
         "--moisture",
         choices=("schwartzberg", "printed"),
@@ -112,6 +104,21 @@ def _add_model_options(p: argparse.ArgumentParser, with_model: bool = True) -> N
     )
     p.add_argument(
         "--hold", choices=("linear", "zoh"), help="input hold between samples (default: the model's, else linear)"
+    )
+
+
+def _add_initial_options(p: argparse.ArgumentParser) -> None:
+    """--tb0, --tm0, --x0: the charge state (read back by :func:`_initial_changes`)."""
+    p.add_argument(
+        "--tb0", type=_float_arg("--tb0"), help="initial bean temperature [degC] (default: the model's, else 30)"
+    )
+    p.add_argument(
+        "--tm0",
+        type=_float_arg("--tm0"),
+        help="initial drum metal temperature, the preheat [degC] (default: the model's or the log's, else 121)",
+    )
+    p.add_argument(
+        "--x0", type=_float_arg("--x0"), help="initial moisture [kg/kg dry] (default: the model's, else 0.1)"
     )
 
 
@@ -697,9 +704,7 @@ def _add_fit_commands(sub) -> None:
     )
     p.add_argument("--tgi", type=_float_arg("--tgi"), help="add this to the inlet gas temperature [degC]")
     p.add_argument("--batch-kg", type=_float_arg("--batch-kg"), help="green batch mass [kg] (default: the log's)")
-    p.add_argument("--tm0", type=_float_arg("--tm0"), help="drum temperature at CHARGE [degC] (preheat)")
-    p.add_argument("--tb0", type=_float_arg("--tb0"), help="bean temperature at CHARGE [degC]")
-    p.add_argument("--x0", type=_float_arg("--x0"), help="green moisture [kg/kg dry]")
+    _add_initial_options(p)
     p.add_argument("--json", metavar="WHATIF.json", help="write the table as JSON")
     p.add_argument("--plot", metavar="FIG.png", help="overlay measured BT and both predictions (.png/.svg/.pdf)")
     p.set_defaults(func=cmd_whatif)

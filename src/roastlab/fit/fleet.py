@@ -302,12 +302,7 @@ def identify_each(
         # batches differ several-fold in work: hand them out one at a time, not in equal blocks
         with parallel_chunksize(1):
             _fit_population(
-                packed.T[sl],
-                packed.GG[sl],
-                packed.TGI[sl],
-                packed.QQ[sl],
-                packed.FF[sl],
-                packed.N[sl],
+                *(a[sl] for a in packed.inputs),
                 TA[sl],
                 packed.X0[sl],
                 packed.PB[sl],

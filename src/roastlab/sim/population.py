@@ -63,6 +63,11 @@ class PackedBatches:
             self.TB2 = np.full_like(self.T, np.nan)
 
     @property
+    def inputs(self) -> tuple:
+        """The kernels' leading arguments: (T, GG, TGI, QQ, FF, N)."""
+        return self.T, self.GG, self.TGI, self.QQ, self.FF, self.N
+
+    @property
     def n_batches(self) -> int:
         return len(self.N)
 
@@ -155,32 +160,12 @@ def run_arrays(packed: PackedBatches, names: list[str], values: np.ndarray):
     return batch_of, X0.reshape(m * nb, NS), PP.reshape(m * nb, -1)
 
 
-def predict_ta(packed: PackedBatches, names: list[str], values: np.ndarray, with_tb: bool = False):
-    """Simulated probe reading for every (value set, batch): shape (m, nb, nmax), NaN-padded.
-
-    With ``with_tb`` also the bean temperature Tb (same shape): returns ``(Ta, Tb)``.
-    """
+def predict_ta(packed: PackedBatches, names: list[str], values: np.ndarray) -> np.ndarray:
+    """Simulated probe reading for every (value set, batch): shape (m, nb, nmax), NaN-padded."""
     m, nb = values.shape[0], packed.n_batches
     batch_of, X0, PP = run_arrays(packed, names, values)
     out = np.full((m * nb, packed.T.shape[1]), np.nan)
-    out_tb = np.full_like(out, np.nan)
-    ta_population_kernel(
-        packed.T,
-        packed.GG,
-        packed.TGI,
-        packed.QQ,
-        packed.FF,
-        packed.N,
-        batch_of,
-        X0,
-        PP,
-        packed.zoh,
-        packed.h_max_s,
-        out,
-        out_tb,
-    )
-    if with_tb:
-        return out.reshape(m, nb, -1), out_tb.reshape(m, nb, -1)
+    ta_population_kernel(*packed.inputs, batch_of, X0, PP, packed.zoh, packed.h_max_s, out)
     return out.reshape(m, nb, -1)
 
 
@@ -205,20 +190,7 @@ def simulate_population(packed: PackedBatches, names: list[str] = (), values: np
     m, nb = values.shape[0], packed.n_batches
     batch_of, X0, PP = run_arrays(packed, names, values)
     out = np.full((m * nb, packed.T.shape[1], N_OUT), np.nan)
-    simulate_population_kernel(
-        packed.T,
-        packed.GG,
-        packed.TGI,
-        packed.QQ,
-        packed.FF,
-        packed.N,
-        batch_of,
-        X0,
-        PP,
-        packed.zoh,
-        packed.h_max_s,
-        out,
-    )
+    simulate_population_kernel(*packed.inputs, batch_of, X0, PP, packed.zoh, packed.h_max_s, out)
     mask = packed.mask()
     out = out.reshape(m, nb, packed.T.shape[1], N_OUT)
     out[:, ~mask, :] = np.nan

@@ -153,12 +153,12 @@ def _as_list(value) -> list:
     return value if isinstance(value, list) else []
 
 
-def _numeric_list(data: dict, key: str, path: Path, required: bool = True):
-    if key not in data:
-        if required:
-            raise InputError("missing key", path, f"key {key}")
-        return None
-    value = data[key]
+def number_list(value, path: Path, key: str) -> np.ndarray:
+    """A parsed list of numbers as a float array; else one InputError naming file and key.
+
+    Shared by the log readers (Artisan, RoasTime): booleans and strings are refused, integers
+    beyond float range are "out of range", never an OverflowError.
+    """
     if not isinstance(value, (list, tuple)):
         raise InputError(f"expected a list of numbers, got {type(value).__name__}", path, f"key {key}")
     out = np.empty(len(value))
@@ -170,6 +170,14 @@ def _numeric_list(data: dict, key: str, path: Path, required: bool = True):
         except OverflowError:
             raise InputError(f"number out of range at position {i}", path, f"key {key}") from None
     return out
+
+
+def _numeric_list(data: dict, key: str, path: Path, required: bool = True):
+    if key not in data:
+        if required:
+            raise InputError("missing key", path, f"key {key}")
+        return None
+    return number_list(data[key], path, key)
 
 
 def _weight(value, factor: float, path: Path) -> float | None:

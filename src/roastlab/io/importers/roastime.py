@@ -31,7 +31,7 @@ import numpy as np
 from ...errors import InputError
 from ..files import read_input_text
 from ..modelfile import parse_json_document
-from .artisan import ArtisanLog
+from .artisan import ArtisanLog, number_list
 
 #: RoasTime's control types in ``actions.actionTimeList`` and the channel each becomes.
 CONTROL_TYPES = {0: "heater", 1: "fan", 2: "drum"}
@@ -78,20 +78,7 @@ def _number(data: dict, key: str, path, lo: float, hi: float, required: bool = T
 
 
 def _series(data: dict, key: str, path) -> np.ndarray | None:
-    if key not in data:
-        return None
-    value = data[key]
-    if not isinstance(value, list):
-        raise InputError(f"expected a list of numbers, got {type(value).__name__}", path, f"key {key}")
-    out = np.empty(len(value))
-    for i, v in enumerate(value):
-        if isinstance(v, bool) or not isinstance(v, (int, float)):
-            raise InputError(f"expected numbers, found {type(v).__name__} at position {i}", path, f"key {key}")
-        try:
-            out[i] = v
-        except OverflowError:
-            raise InputError(f"number out of range at position {i}", path, f"key {key}") from None
-    return out
+    return number_list(data[key], path, key) if key in data else None
 
 
 def _actions(data: dict, n: int, path) -> dict[str, np.ndarray]:
