@@ -91,7 +91,7 @@ def _peak_memory_child(count: int) -> dict:
         "from roastlab.sim.population import pack_batches\n"
         "from roastlab.model.parameters import THETA_START\n"
         f"b = _fleet_batches({count})\n"
-        "t0 = time.perf_counter(); r = identify_each(pack_batches(b, '120kg', THETA_START), progress=False); dt = time.perf_counter() - t0\n"
+        "t0 = time.perf_counter(); r = identify_each(pack_batches(b, '120kg', THETA_START), progress=None); dt = time.perf_counter() - t0\n"
         "print(json.dumps({'wall_s': dt, 'peak_MB': resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, 'mean_FIT': float(r.FIT.mean())}))\n"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
@@ -169,15 +169,15 @@ def run(quiet: bool = False, baseline_repeats: int = 5) -> dict:
     _log("identify on dataset-I ...", quiet)
     free, fixed = build_free_parameters()
     pk_i = pack_batches(ds.batches, ds.plant, THETA_START)
-    identify(pk_i, free, fixed, seed=0, progress=False)
+    identify(pk_i, free, fixed, seed=0, progress=None)
     res["identify_paper_s"] = _median_time(
-        lambda: identify(pack_batches(ds.batches, ds.plant, THETA_START), free, fixed, seed=0, progress=False), 5
+        lambda: identify(pack_batches(ds.batches, ds.plant, THETA_START), free, fixed, seed=0, progress=None), 5
     )
 
     # --- fleet identification scaling ------------------------------------------------------
     _log("fleet identification: 10, 100, 1,000 batches ...", quiet)
     fleet = _fleet_batches(1000)
-    identify_each(pack_batches(fleet[:10], "120kg", THETA_START), progress=False)
+    identify_each(pack_batches(fleet[:10], "120kg", THETA_START), progress=None)
     scaling = {}
     for size in (10, 100, 1000):
         passes = []  # three passes over the whole fleet: VM noise is not scaling
@@ -187,7 +187,7 @@ def run(quiet: bool = False, baseline_repeats: int = 5) -> dict:
             for k in range(len(fleet) // size):  # the whole fleet, in calls of `size` batches
                 part = fleet[k * size : (k + 1) * size]
                 t0 = time.perf_counter()
-                identify_each(pack_batches(part, "120kg", THETA_START), progress=False)
+                identify_each(pack_batches(part, "120kg", THETA_START), progress=None)
                 pass_walls.append(time.perf_counter() - t0)
             passes.append(float(np.sum(pass_walls)) / len(fleet))
             walls += pass_walls
