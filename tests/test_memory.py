@@ -144,7 +144,11 @@ CHILD = textwrap.dedent(
         outcome = "loaded"
     except RoastlabError as exc:
         outcome = "refused: " + str(exc).split(": ", 1)[-1][:200]
-    rss_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    # VmHWM is the peak of this process image only; ru_maxrss would carry over the peak of the
+    # pytest process that forked us (Linux keeps it across exec), which depends on test order.
+    with open("/proc/self/status") as status:
+        hwm_kb = next(int(line.split()[1]) for line in status if line.startswith("VmHWM:"))
+    rss_mb = hwm_kb / 1024
     print(json.dumps({{"outcome": outcome, "rss_mb": rss_mb}}))
     """
 )
