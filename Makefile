@@ -5,7 +5,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: test reproduce bench lint clean wheel-check
+.PHONY: test reproduce bench lint clean wheel-check real-roaster
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -35,3 +35,7 @@ wheel-check:
 	rm -rf /tmp/roastlab-wheel && $(PYTHON) -m venv /tmp/roastlab-wheel/venv
 	/tmp/roastlab-wheel/venv/bin/python -m pip install --quiet .
 	cd /tmp/roastlab-wheel && venv/bin/roastlab reproduce --out X && test -s X/model.json && test -s X/fig2_profiles.png
+
+# The measured figures of docs/real-roaster.md, from the real logs in ../shared/data/real.
+real-roaster: $(STAMP)
+	$(PY) docs/real_roaster.py

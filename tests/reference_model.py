@@ -34,7 +34,7 @@ PLANTS = {
 
 def make_rhs(plant: str, theta, X0: float, moisture: str = "schwartzberg", act=None):
     """The slow reference right-hand side. ``act`` holds the actuator extension's values
-    (Qe_gain, Qe_offset, Tgi_gain, tau, Gg_fan); None = the paper's model."""
+    (Qe_gain, Qe_offset, Tgi_gain, tau, Gg_fan, U_shell, T_room); None = the paper's model."""
     g = PLANTS[plant]
     c = PROCESS
     hgm, hbm, Pbm = theta
@@ -66,7 +66,9 @@ def make_rhs(plant: str, theta, X0: float, moisture: str = "schwartzberg", act=N
         Qr = c["A"] * (c["Het"] - He) / c["Het"] * math.exp(-c["HaR"] / (Tb + 273.15))
         cs = 1.099 + 0.007 * Tb
         dTb = (Qgb - Qgm + Qbm + Mbd * (Qr + c["lam"] * dX)) / (Mbd * (cs + c["cw"] * X))
-        dTm = (Qgm - Qbm + Qe) / (g["Mm"] * c["cm"])
+        # shell loss to the room from the outer drum surface (mantle and two end discs)
+        Qloss = a.get("U_shell", 0.0) * math.pi * g["Dch"] * (g["Lch"] + g["Dch"] / 2) * (Tm - a.get("T_room", 22.0))
+        dTm = (Qgm - Qbm + Qe - Qloss) / (g["Mm"] * c["cm"])
         return [dTb, dTm, dX, Qr, c["Kt"] * (Tb - Ta), dH], Tgi - drop
 
     return f

@@ -142,6 +142,36 @@ def test_heater_energy_balance_at_steady_state():
     assert res.heat_flows()["Qe_kW"][-1] == pytest.approx(Qe)
 
 
+def test_shell_loss_energy_balance_at_steady_state():
+    """Independent number: with a shell loss, the heater's power at steady state splits into what
+    the gas carries out and U_shell Ashell (Tm - T_room), Ashell = pi D (L + D/2) from the plant."""
+    from roastlab.model.rhs import gas_heat_capacity_kJ_kgK
+    from roastlab.sim.simulate import InitialState, simulate
+
+    plant = load_plant("120kg")
+    t = np.arange(0.0, 40001.0, 50.0)
+    n = len(t)
+    values = {"Qe_gain_kW": 0.15, "tau_heater_s": 20.0, "U_shell_kW_m2K": 0.01, "T_room_C": 20.0}
+    res = simulate(
+        plant,
+        t,
+        np.full(n, 0.3),
+        np.full(n, 25.0),
+        theta=(0.05, 0.05, 0.6),
+        initial=InitialState(Tb0_C=25.0, Tm0_C=25.0, X0=0.0, He0_kJ_kg=232.0),
+        heater=np.full(n, 400.0),
+        values=values,
+    )
+    Ashell = math.pi * 1.24 * (1.335 + 1.24 / 2)  # MODEL.md 120 kg drum: D = 1.24 m, L = 1.335 m
+    assert plant.Ashell_m2 == pytest.approx(Ashell, rel=1e-3)
+    loss = 0.01 * Ashell * (res.Tm_C[-1] - 20.0)
+    carried = 0.3 * gas_heat_capacity_kJ_kgK(25.0) * (res.Tgo_C[-1] - 25.0)
+    assert abs(res.Tm_C[-1] - res.Tm_C[-20]) < 1e-3  # settled
+    assert loss > 0.2 * 60.0  # the loss takes a real share, so the balance tests it
+    assert carried + loss == pytest.approx(0.15 * 400.0, rel=1e-4)
+    assert res.heat_flows()["Qloss_kW"][-1] == pytest.approx(loss)
+
+
 def test_derived_geometry_matches_model_md():
     assert math.isclose(load_plant("120kg").Agm_m2, 23.2, abs_tol=0.05)
     assert math.isclose(load_plant("360kg").Agm_m2, 54.4, abs_tol=0.05)

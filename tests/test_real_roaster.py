@@ -32,6 +32,26 @@ def test_first_order_fit_recovers_parameters():
     assert fit["tau_s"] == pytest.approx(140.0, rel=1e-5) and fit["offset_C"] == pytest.approx(12.0, abs=1e-4)
 
 
+def test_first_order_fit_with_settings_recovers_the_gains():
+    """The baseline fed the actuator map's inputs (room-air Tgi, heater and fan settings)."""
+    from roastlab.fit.baseline import validate_first_order
+
+    t = np.arange(0, 601, 5.0)
+    batches = []
+    for k in range(3):
+        heater = np.where(t < 200 + 50 * k, 8.0, 5.0)
+        fan = np.where(t < 300, 2.0, 4.0 + k)
+        drive = 22.0 + 30.0 * heater - 6.0 * fan
+        bt = first_order_response(t, drive, 100.0 + k, 250.0, -15.0)
+        batches.append(Batch(f"b{k}", t, np.ones_like(t), np.full_like(t, 22.0), bt, heater=heater, fan=fan))
+    fit = fit_first_order(batches)
+    assert fit["tau_s"] == pytest.approx(250.0, rel=1e-4)
+    assert fit["heater_gain_C"] == pytest.approx(30.0, rel=1e-4)
+    assert fit["fan_gain_C"] == pytest.approx(-6.0, rel=1e-4)
+    _, rows = validate_first_order(batches, fit)
+    assert min(r["FIT"] for r in rows) > 99.9
+
+
 def test_skywalker_fit_and_validate(cli, real_data, tmp_path):
     logs = sorted(real_data.glob("*.alog"))
     fit_logs, val_logs = logs[0:4:2], logs[1:4:2]

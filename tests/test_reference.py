@@ -59,14 +59,16 @@ def test_compiled_matches_reference(seed, plant, hold, hgm, hbm, Pbm):
 
 @pytest.mark.parametrize("seed, hold", [(11, "zoh"), (12, "linear"), (13, "zoh")])
 def test_actuator_extension_matches_reference(seed, hold):
-    """Heater steps through the lag into Qe and Tgi, fan steps into Gg: compiled vs reference."""
+    """Heater steps through the lag into Qe and Tgi, fan steps into Gg, the shell loses heat to
+    the room: compiled vs reference."""
     t, Gg, Tgi, x0 = random_case(seed, "120kg")
     rng = np.random.default_rng(seed)
     n = len(t)
     heater = rng.permutation(10)[(np.arange(n) // 3) % 10].astype(float)  # levels held for 3 samples
     fan = rng.permutation(12)[(np.arange(n) // 4) % 12].astype(float)
-    act = {"Qe_gain": 4.0, "Qe_offset": 2.0, "Tgi_gain": 6.0, "tau": 25.0, "Gg_fan": 0.01}
+    act = {"Qe_gain": 4.0, "Qe_offset": 2.0, "Tgi_gain": 6.0, "tau": 25.0, "Gg_fan": 0.01, "U_shell": 0.02}
     values = {"Qe_gain_kW": 4.0, "Qe_offset_kW": 2.0, "Tgi_gain_C": 6.0, "tau_heater_s": 25.0, "Gg_fan_kg_s": 0.01}
+    values["U_shell_kW_m2K"] = 0.02  # shell loss to a 22 degC room
     theta = (0.03, 0.04, 0.6)
     fast = simulate(
         "120kg", t, Gg, Tgi - 150.0, theta=theta, initial=x0, hold=hold, heater=heater, fan=fan, values=values

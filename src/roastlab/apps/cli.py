@@ -288,14 +288,12 @@ def cmd_identify(args) -> int:
     if plant_spec is None:
         raise InputError("--plant is required unless a dataset folder names its plant", "command line")
     if args.baseline:
-        from ..fit.baseline import fit_first_order
+        from ..fit.baseline import describe, fit_first_order
 
         doc = {**fit_first_order(batches), "plant": str(plant_spec)}
         with outputs as out:
             out.write_text(args.out, json.dumps(doc, indent=1, allow_nan=False) + "\n")
-        print(
-            f"first-order baseline on {len(batches)} batch(es): tau {doc['tau_s']:.1f} s, offset {doc['offset_C']:+.2f} degC, SSR {doc['SSR']:.1f} -> {args.out}"
-        )
+        print(f"first-order baseline on {len(batches)} batch(es): {describe(doc)}, SSR {doc['SSR']:.1f} -> {args.out}")
         return 0
     fix = _parse_assignments(args.fix, "--fix", ranged=False)
     bounds = _parse_assignments(args.bounds, "--bounds", ranged=True)
@@ -424,7 +422,7 @@ def _safe_stem(name: str, taken: set) -> str:
 def _validate_baseline(args, outputs) -> int:
     from ..evaluate.metrics import average_metrics
     from ..evaluate.validate import ValidationResult
-    from ..fit.baseline import validate_first_order
+    from ..fit.baseline import SETTING_GAINS, describe, validate_first_order
     from ..io.modelfile import jsonable
     from ..report.figures import plot_fit
 
@@ -444,13 +442,14 @@ def _validate_baseline(args, outputs) -> int:
         rows,
         str(plant_spec),
     )
-    print(result.table(f"first-order baseline (tau {params['tau_s']:.1f} s, offset {params['offset_C']:+.2f} degC)"))
+    print(result.table(f"first-order baseline ({describe(params)})"))
     with outputs as out:
         if args.json:
             doc = {
                 "baseline": "first-order",
                 "tau_s": params["tau_s"],
                 "offset_C": params["offset_C"],
+                **{k: params[k] for k in SETTING_GAINS.values() if k in params},
                 "batches": [{"name": n, **r} for n, r in zip(result.names, rows)],
                 "average": average_metrics(rows),
             }
@@ -469,7 +468,10 @@ def _read_baseline_json(path) -> dict:
         raise InputError("expected a JSON object", path)
     if data.get("baseline") != "first-order":
         raise InputError("not a first-order baseline file (from 'identify --baseline first-order')", path)
-    for key in ("tau_s", "offset_C"):
+    from ..fit.baseline import SETTING_GAINS
+
+    optional = [k for k in SETTING_GAINS.values() if k in data]
+    for key in ("tau_s", "offset_C", *optional):
         v = data.get(key)
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
             raise InputError("missing or not a finite number", path, f"key {key}")
@@ -600,7 +602,11 @@ def _add_fit_commands(sub) -> None:
         "standard errors and bounds, the initial states, the column map, fit-set metrics and provenance.",
         epilog="example: roastlab identify --plant 120kg dataset-I/ --out model.json",
     )
-    _add_batch_options(p, "fit the first-order baseline dBT/dt = (ET + offset - BT)/tau instead")
+    _add_batch_options(
+        p,
+        "fit the first-order baseline dBT/dt = (Tgi + offset [+ k_h heater + k_f fan] - BT)/tau instead "
+        "(Tgi = ET on an ET map; the settings when the map reads heater/fan)",
+    )
     p.add_argument("--out", required=True, metavar="MODEL.json", help="where to write the model file")
     p.add_argument(
         "--method", choices=("global", "de"), default="global", help="global search (default) or differential evolution"

@@ -1,9 +1,12 @@
-"""A first-order baseline for real roasters: dBT/dt = (ET + offset - BT) / tau.
+"""A first-order baseline for real roasters: dBT/dt = (Tgi + k_h heater + k_f fan + offset - BT) / tau.
 
-What a user gets without the physics: the bean probe chases the environment temperature with
-one time constant ``tau`` [s] and a constant ``offset`` [degC]. Fitted by least squares on
-the same batches as the model (Tgi column = ET), so the comparison shows what the physical
-model buys. ET is held linearly between samples and each interval is solved exactly.
+What a user gets without the physics: the bean probe chases one driving temperature with one
+time constant ``tau`` [s] and a constant ``offset`` [degC]. The driving temperature is the
+batch's Tgi column (ET on a map that reads ET as Tgi) plus, when the batches carry heater or
+fan settings (the actuator maps), a fitted gain per setting [degC per unit]: the same inputs
+the physical model is fed. Fitted by least squares on the same batches as the model, so the
+comparison shows what the physics buys. The input is held linearly between samples and each
+interval is solved exactly.
 """
 
 from __future__ import annotations
@@ -36,35 +39,65 @@ def first_order_response(t, u, y0, tau, offset):
     return y
 
 
+#: The settings a baseline may take a gain on, and the name of that gain in its file.
+SETTING_GAINS = {"heater": "heater_gain_C", "fan": "fan_gain_C"}
+
+
+def _drive(b, gains: dict) -> np.ndarray:
+    """The baseline's driving temperature [degC] for batch ``b``: Tgi plus the settings' gains."""
+    u = np.asarray(b.Tgi_C, dtype=float).copy()
+    for setting, key in SETTING_GAINS.items():
+        series = getattr(b, setting, None)
+        if key in gains and series is not None:
+            u += gains[key] * series
+    return u
+
+
 def fit_first_order(batches) -> dict:
-    """Fit (tau, offset) jointly on batches with Tgi (= ET) and Ta (= BT)."""
+    """Fit tau, offset (and a gain per logged setting) jointly on batches with Tgi and Ta."""
+    settings = [k for s, k in SETTING_GAINS.items() if any(getattr(b, s, None) is not None for b in batches)]
+
+    def predictions(z):
+        gains = dict(zip(settings, z[2:]))
+        return [first_order_response(b.time_s, _drive(b, gains), float(b.Ta_C[0]), z[0], z[1]) for b in batches]
 
     def residuals(z):
-        tau, off = z
-        return np.concatenate(
-            [first_order_response(b.time_s, b.Tgi_C, float(b.Ta_C[0]), tau, off) - b.Ta_C for b in batches]
-        )
+        return np.concatenate([y - b.Ta_C for y, b in zip(predictions(z), batches)])
 
-    res = least_squares(
-        residuals,
-        [120.0, 0.0],
-        bounds=([BOUNDS["tau_s"][0], BOUNDS["offset_C"][0]], [BOUNDS["tau_s"][1], BOUNDS["offset_C"][1]]),
-        x_scale=[100.0, 10.0],
-    )
+    lo = [BOUNDS["tau_s"][0], BOUNDS["offset_C"][0]] + [-1e3] * len(settings)
+    hi = [BOUNDS["tau_s"][1], BOUNDS["offset_C"][1]] + [1e3] * len(settings)
+    # start: the heater alone (else the offset) carries the probe ~200 degC above its inputs;
+    # a few time constants, the best local solution kept
+    heater_mean = np.mean([np.mean(b.heater) for b in batches if b.heater is not None]) if settings else 0.0
+    g0 = [200.0 / heater_mean if k == "heater_gain_C" and heater_mean > 0 else 0.0 for k in settings]
+    res = None
+    for tau0 in (120.0, 400.0, 1200.0):
+        r = least_squares(residuals, [tau0, 0.0] + g0, bounds=(lo, hi), x_scale=[100.0, 10.0] + [1.0] * len(settings))
+        if res is None or r.cost < res.cost:
+            res = r
     return {
         "baseline": "first-order",
         "tau_s": float(res.x[0]),
         "offset_C": float(res.x[1]),
+        **{k: float(v) for k, v in zip(settings, res.x[2:])},
         "SSR": float(res.fun @ res.fun),
         "batches": [b.name for b in batches],
     }
+
+
+def describe(params: dict) -> str:
+    """One line: the baseline's fitted values."""
+    gains = "".join(
+        f", {k.removesuffix('_gain_C')} gain {params[k]:+.3g} degC/unit" for k in SETTING_GAINS.values() if k in params
+    )
+    return f"tau {params['tau_s']:.1f} s, offset {params['offset_C']:+.2f} degC{gains}"
 
 
 def validate_first_order(batches, params: dict):
     """Simulate the baseline on each batch: (predictions, metric rows)."""
     preds, rows = [], []
     for b in batches:
-        y = first_order_response(b.time_s, b.Tgi_C, float(b.Ta_C[0]), params["tau_s"], params["offset_C"])
+        y = first_order_response(b.time_s, _drive(b, params), float(b.Ta_C[0]), params["tau_s"], params["offset_C"])
         preds.append(y)
         rows.append(batch_metrics(b.Ta_C, y))
     return preds, rows

@@ -42,6 +42,8 @@ LIMITS: dict[str, tuple[float, float, str, str]] = {
     "Tgi_gain_C": (-100.0, 1e3, "degC/unit", "inlet gas rise per unit of heater setting"),
     "tau_heater_s": (0.1, 1e4, "s", "heater lag"),
     "Gg_fan_kg_s": (-100.0, 100.0, "kg/s/unit", "gas flow per unit of fan setting"),
+    "U_shell_kW_m2K": (0.0, 10.0, "kW/(m2 K)", "drum-shell heat-loss coefficient"),
+    "T_room_C": (-50.0, 60.0, "degC", "room temperature"),
     # plant geometry (Table 5); from a 50 g sample roaster to a 5 t drum, with room
     "Dch_m": (0.02, 10.0, "m", "chamber diameter"),
     "Lch_m": (0.02, 20.0, "m", "chamber length"),

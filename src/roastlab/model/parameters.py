@@ -85,7 +85,8 @@ class Quantity:
     unit : str
     kind : str
         ``"theta"`` (Table 1), ``"process"`` (Table 5 left), ``"plant"`` (a plant value),
-        ``"input"`` (a factor on a logged input) or ``"initial"`` (an initial state).
+        ``"input"`` (a factor on a logged input), ``"actuator"`` (the actuator and shell-loss
+        extensions, not in the paper) or ``"initial"`` (an initial state).
     bounds : (float, float)
         Default fit bounds.
     carries_over : bool
@@ -176,6 +177,17 @@ def _build_registry() -> dict[str, Quantity]:
             "Gg_fan",
             "gas flow per unit of fan setting (affine with Gg_kg_s)",
         ),
+        # drum-shell heat loss (not in the paper, whose shell is adiabatic)
+        Quantity(
+            "U_shell_kW_m2K",
+            "kW/(m2 K)",
+            "actuator",
+            (0.0, 0.1),
+            False,
+            "U_shell",
+            "heat loss of the drum's outer surface to the room per m2 and K (eq. 12 extension)",
+        ),
+        Quantity("T_room_C", "degC", "actuator", (0.0, 40.0), False, "T_room", "room temperature for the shell loss"),
         Quantity("Tb0_C", "degC", "initial", (0.0, 60.0), True, "Tb0_C", "bean temperature at CHARGE"),
         Quantity("Tm0_C", "degC", "initial", (20.0, 300.0), False, "Tm0_C", "drum metal temperature at CHARGE"),
         Quantity("X0", "kg/kg", "initial", (0.02, 0.2), True, "X0", "green moisture, dry basis"),

@@ -87,6 +87,15 @@ class Plant:
         return math.pi * self.Dch_m * (self.Lch_m + self.Hflap_m * self.Lch_m / self.Sflap_m + self.Dch_m / 2)
 
     @property
+    def Ashell_m2(self) -> float:
+        """Outer drum surface exposed to the room: mantle and two end discs, pi D (L + D/2) [m^2].
+
+        Not in the paper (its shell is adiabatic); the area of the shell heat-loss extension
+        (:func:`roastlab.model.rhs.shell_loss_kW`).
+        """
+        return math.pi * self.Dch_m * (self.Lch_m + self.Dch_m / 2)
+
+    @property
     def Ab_m2(self) -> float:
         """Total bean surface, (Mb/mb) * pi * Db^2 [m^2] (section 3.1)."""
         return self.Mb_kg / self.process.mb * math.pi * self.process.Db**2
@@ -122,6 +131,7 @@ class Plant:
             rows.append((symbol, float(getattr(self, key)), unit, _GEOMETRY_DOC[key].split(" [")[0]))
         rows += [
             ("Agm", self.Agm_m2, "m2", "gas-metal area, eq. 7"),
+            ("Ashell", self.Ashell_m2, "m2", "outer drum surface (shell-loss extension)"),
             ("Ab", self.Ab_m2, "m2", "total bean area"),
             ("Agb", self.Agb_m2(Pbm), "m2", f"gas-bean area at Pbm={Pbm:g}"),
             ("Abm", self.Abm_m2(Pbm), "m2", f"metal-bean area at Pbm={Pbm:g}"),

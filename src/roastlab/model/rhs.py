@@ -19,8 +19,9 @@ adds a sixth state and two inputs to the same function: the logged heater settin
 first-order actuator lag (state H, in the setting's own units) and becomes heat into the drum
 metal, Qe = Qe_offset + Qe_gain H [kW] (eq. 12/15b's Qe, zero in the paper), and/or a rise of
 the inlet gas temperature Tgi + Tgi_gain H [degC]; the fan setting moves the gas flow
-affinely, Gg Gg_scale + Gg_fan fan [kg/s]. With the gains at their default 0 and no heater
-input the model is the paper's (MODEL.md's check value holds; tests/test_physics.py).
+affinely, Gg Gg_scale + Gg_fan fan [kg/s]. A heat loss of the drum shell to the room,
+U_shell Ashell (Tm - T_room) [kW], leaves the metal (eq. 12; the paper's shell is adiabatic).
+With the gains and U_shell at their default 0 and no heater input the model is the paper's (MODEL.md's check value holds; tests/test_physics.py).
 """
 
 from __future__ import annotations
@@ -66,6 +67,10 @@ PARAM_NAMES = (
     "Tgi_gain",  # rise of the inlet gas temperature per unit of heater setting [degC/unit]
     "tau_heater",  # first-order lag of the heater's effect [s]
     "Gg_fan",  # gas flow per unit of fan setting [kg/s per unit]
+    # drum-shell heat loss to the room (extension; 0 = the paper's adiabatic shell)
+    "U_shell",  # heat-loss coefficient of the drum's outer surface [kW/(m2 K)]
+    "Ashell",  # outer drum surface exposed to the room [m2] (plant-derived)
+    "T_room",  # room temperature the shell loses heat to [degC]
 )
 P = {name: i for i, name in enumerate(PARAM_NAMES)}
 N_PARAMS = len(PARAM_NAMES)
@@ -74,6 +79,7 @@ I_HGM, I_HBM, I_PBM, I_AGM, I_AB, I_MBD, I_MM = (P[k] for k in ("hgm", "hbm", "P
 I_A, I_CM, I_CW, I_DB, I_HAR, I_HET = (P[k] for k in ("A", "cm", "cw", "Db", "Ha_R", "Het"))
 I_K1, I_K2, I_KT, I_LAM, I_XEXP, I_GGS = (P[k] for k in ("k1", "k2", "Kt", "lam", "x_exp", "Gg_scale"))
 I_QEG, I_QEO, I_TGIG, I_TAUH, I_GGF = (P[k] for k in ("Qe_gain", "Qe_offset", "Tgi_gain", "tau_heater", "Gg_fan"))
+I_USH, I_ASH, I_TROOM = (P[k] for k in ("U_shell", "Ashell", "T_room"))
 #: Smallest gas flow the fan map may give [kg/s] (a fan map fitted below zero is clipped here).
 GG_MIN_KG_S = 1e-6
 
@@ -137,6 +143,18 @@ def heater_power_kW(H, p):
 
 
 @register_jitable
+def shell_loss_kW(Tm, p):
+    """Heat the drum metal loses to the room, Qloss = U_shell Ashell (Tm - T_room) [kW].
+
+    An extension of eq. 12 (the paper's shell is adiabatic: U_shell = 0). ``Tm`` [degC];
+    U_shell [kW/(m2 K)] is a combined convection and radiation coefficient of the outer drum
+    surface Ashell [m2] (:attr:`roastlab.model.plant.Plant.Ashell_m2`, computed from the
+    geometry, so the loss scales with the drum and not with the batch).
+    """
+    return p[I_USH] * p[I_ASH] * (Tm - p[I_TROOM])
+
+
+@register_jitable
 def heat_flows(Tb, Tm, X, Gg, Tgi, p):
     """Outlet gas temperature and heat flows at one instant, for the gas the chamber sees.
 
@@ -188,7 +206,7 @@ def derivatives(Tb, Tm, X, He, Ta, H, Gg, Tgi, heater, fan, p):
     Mbd = p[I_MBD]
     cs = 1.099 + 0.007 * Tb  # partial heat capacity of bean solids, section 3.2
     dTb = (Qgb - Qgm + Qbm + Mbd * (Qr + p[I_LAM] * dX)) / (Mbd * (cs + p[I_CW] * X))  # eq. 15a
-    dTm = (Qgm - Qbm + heater_power_kW(H, p)) / (p[I_MM] * p[I_CM])  # eq. 15b with eq. 12's Qe
+    dTm = (Qgm - Qbm + heater_power_kW(H, p) - shell_loss_kW(Tm, p)) / (p[I_MM] * p[I_CM])  # eq. 15b, eq. 12's Qe
     dTa = p[I_KT] * (Tb - Ta)  # eq. 17
     dH = (heater - H) / p[I_TAUH]  # actuator lag (extension)
     return dTb, dTm, dX, Qr, dTa, dH
@@ -272,5 +290,8 @@ def pack_params(plant, theta, X0: float = 0.1, moisture: str = "schwartzberg") -
         "Tgi_gain": 0.0,
         "tau_heater": 1.0,
         "Gg_fan": 0.0,
+        "U_shell": 0.0,
+        "Ashell": plant.Ashell_m2,
+        "T_room": 22.0,
     }
     return np.array([values[name] for name in PARAM_NAMES], dtype=np.float64)

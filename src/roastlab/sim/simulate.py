@@ -15,11 +15,13 @@ from ..model.limits import check_array, check_value
 from ..model.rhs import (
     HEATER_STATE,
     STATE_NAMES,
+    P,
     gas_inputs,
     heat_flows,
     heater_power_kW,
     pack_params,
     reaction_heat_rate_kW_kg,
+    shell_loss_kW,
 )
 from .kernels import H_MAX_S, I_TGO, NS, simulate_one, step_kernel
 
@@ -123,19 +125,21 @@ class SimulationResult:
 
     def heat_flows(self) -> dict[str, np.ndarray]:
         """Qgb, Qgm, Qbm [kW] (eqs. 9-11), Qr [kW, whole batch] (eq. 14) and, with actuator
-        inputs, the heater's Qe [kW] (eq. 12) at each sample."""
+        inputs, the heater's Qe [kW] (eq. 12) and, with a shell loss, Qloss [kW] at each sample."""
         n = len(self.time_s)
-        q = np.empty((n, 5))
+        q = np.empty((n, 6))
         Mbd = self.params[5]
         g, T = self.gas_seen()
         for i in range(n):
             Tb, Tm, X, He, _, H = self.states[i]
             _, Qgb, Qgm, Qbm = heat_flows(Tb, Tm, X, g[i], T[i], self.params)
             Qr = Mbd * reaction_heat_rate_kW_kg(Tb, He, self.params)
-            q[i] = (Qgb, Qgm, Qbm, Qr, heater_power_kW(H, self.params))
+            q[i] = (Qgb, Qgm, Qbm, Qr, heater_power_kW(H, self.params), shell_loss_kW(Tm, self.params))
         out = {"Qgb_kW": q[:, 0], "Qgm_kW": q[:, 1], "Qbm_kW": q[:, 2], "Qr_kW": q[:, 3]}
         if self.uses_actuators:
             out["Qe_kW"] = q[:, 4]
+        if self.params[P["U_shell"]] > 0.0:
+            out["Qloss_kW"] = q[:, 5]
         return out
 
     def to_frame(self, heat_flows: bool = False):

@@ -1,0 +1,178 @@
+"""Regenerate the measured figures of docs/real-roaster.md (`make real-roaster`).
+
+Fits both real machines with their example files, split alternately by sorted name (first of
+each pair fits, second is held out), fits the first-order baseline on the same logs and the
+same inputs, and tests batch-size scaling on the Bullet (fit on 490-500 g only, every other
+batch mass predicted with nothing refitted). Writes docs/real-roaster-results.md and
+docs/real-roaster-scaling.png. Needs ../shared/data/real beside the repository.
+"""
+
+from __future__ import annotations
+
+import re
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+import roastlab
+from roastlab.fit.baseline import describe, fit_first_order, validate_first_order
+from roastlab.io.fitspec import load_fit_spec
+from roastlab.io.importers.mapping import load_map
+from roastlab.model.parameters import REGISTRY
+
+ROOT = Path(__file__).resolve().parents[1]
+DATA = ROOT.parent / "shared" / "data" / "real"
+DOCS = ROOT / "docs"
+
+
+def grams(path: Path) -> int | None:
+    m = re.search(r"_(\d+)g\.json$", path.name)
+    return int(m.group(1)) if m else None
+
+
+def load(paths, column_map):
+    return [roastlab.load_log(p, column_map) for p in paths]
+
+
+def mean(rows, key):
+    return float(np.mean([r[key] for r in rows]))
+
+
+def machine(title, example, paths, lines):
+    """Fit, hold out and compare with the baseline; append markdown to ``lines``; return the model."""
+    column_map = load_map(example / "map.toml")
+    fit_paths, val_paths = paths[0::2], paths[1::2]
+    fit_b, val_b = load(fit_paths, column_map), load(val_paths, column_map)
+    t0 = time.perf_counter()
+    result = roastlab.fit(fit_b, example / "plant.toml", example / "fit.toml", column_map=column_map)
+    fit_s = time.perf_counter() - t0
+    model = result.model
+    v_fit, v_val = model.validate(fit_b), model.validate(val_b)
+    base = fit_first_order(fit_b)
+    _, b_fit = validate_first_order(fit_b, base)
+    _, b_val = validate_first_order(val_b, base)
+    lines += [
+        f"### {title}",
+        "",
+        f"Fit on {len(fit_b)} logs in {fit_s:.1f} s; held out {len(val_b)} logs.",
+        "",
+        "| set | logs | model FIT % | model MAE °C | baseline FIT % | baseline MAE °C |",
+        "|---|---|---|---|---|---|",
+        f"| fit | {len(fit_b)} | {v_fit.average['FIT']:.1f} | {v_fit.average['MAE']:.2f} "
+        f"| {mean(b_fit, 'FIT'):.1f} | {mean(b_fit, 'MAE'):.2f} |",
+        f"| held out | {len(val_b)} | {v_val.average['FIT']:.1f} | {v_val.average['MAE']:.2f} "
+        f"| {mean(b_val, 'FIT'):.1f} | {mean(b_val, 'MAE'):.2f} |",
+        "",
+        f"First-order baseline on the same inputs: {describe(base)}.",
+        "",
+        "| parameter | value | std. error | bounds | unit |",
+        "|---|---|---|---|---|",
+    ]
+    bounds = {f.name: (f.lower, f.upper) for f in load_fit_spec(example / "fit.toml").free}
+    for name, entry in model.parameters.items():
+        se = entry.get("stderr")
+        lo, hi = bounds.get(name, (None, None))
+        tol = 1e-4 * (hi - lo) if lo is not None else 0.0
+        on = lo is not None and min(abs(entry["value"] - lo), abs(entry["value"] - hi)) <= tol
+        se_text = "on bound" if on else ("-" if se is None else f"{se:.3g}")
+        b_text = "" if lo is None else f"[{lo:g}, {hi:g}]"
+        lines.append(f"| {name} | {entry['value']:.4g} | {se_text} | {b_text} | {REGISTRY[name].unit} |")
+    lines.append("")
+    print(
+        f"{title}: fit FIT {v_fit.average['FIT']:.1f} %, held-out FIT {v_val.average['FIT']:.1f} % "
+        f"MAE {v_val.average['MAE']:.2f} °C; baseline held-out {mean(b_val, 'FIT'):.1f} %",
+        file=sys.stderr,
+    )
+    return model, column_map, (v_val.average["FIT"], v_val.average["MAE"])
+
+
+def scaling(model, column_map, paths, nominal_val, lines):
+    """The Bullet's batch-size test: FIT per batch mass with the 490-500 g model; a figure."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    others = [p for p in paths if grams(p) not in (490, 500)]
+    batches = load(others, column_map)
+    v = model.validate(batches)
+    by_mass: dict[int, list] = {}
+    for p, row in zip(others, v.rows):
+        by_mass.setdefault(grams(p), []).append(row)
+    lines += [
+        "### Batch-size scaling on the Bullet",
+        "",
+        "Model fitted on the 490-500 g logs only (above); each other log predicted with its own green "
+        "weight and nothing refitted.",
+        "",
+        "| batch g | logs | FIT % | MAE °C | MPE % |",
+        "|---|---|---|---|---|",
+    ]
+    for g in sorted(by_mass):
+        rows = by_mass[g]
+        lines.append(
+            f"| {g} | {len(rows)} | {mean(rows, 'FIT'):.1f} | {mean(rows, 'MAE'):.2f} | {mean(rows, 'MPE'):+.2f} |"
+        )
+    groups = {
+        "200-470 g": [r for g, rs in by_mass.items() if g <= 470 for r in rs],
+        "550 g": by_mass.get(550, []),
+        "800-900 g": [r for g, rs in by_mass.items() if g >= 800 for r in rs],
+    }
+    lines.append("")
+    for name, rows in groups.items():
+        if rows:
+            lines.append(
+                f"- {name}: mean FIT {mean(rows, 'FIT'):.1f} % ({len(rows)} logs), "
+                f"{mean(rows, 'FIT') - nominal_val[0]:+.1f} points against the held-out 490-500 g logs."
+            )
+    lines.append("")
+
+    fig, (ax, ax2) = plt.subplots(1, 2, figsize=(11, 4.2), gridspec_kw={"width_ratios": [1, 1.3]})
+    ms = np.array([grams(p) for p in others], dtype=float)
+    fits = np.array([r["FIT"] for r in v.rows])
+    ax.scatter(ms, fits, color="C3", label="predicted (batch mass changed)")
+    ax.axhline(nominal_val[0], color="C0", ls="--", label=f"held-out 490-500 g ({nominal_val[0]:.1f} %)")
+    ax.axhspan(nominal_val[0] - 10, nominal_val[0], color="C0", alpha=0.1, label="target: within 10 points")
+    ax.set_xlabel("green batch mass [g]")
+    ax.set_ylabel("FIT [%]")
+    ax.set_title("Aillio Bullet: model fitted on 490-500 g")
+    ax.set_ylim(0, 100)
+    ax.legend(fontsize=8, loc="lower center")
+    ax.grid(alpha=0.3)
+    pick = [int(np.argmin(ms)), int(np.argmax(ms))]
+    for i, color in zip(pick, ("C2", "C4")):
+        b, pred = batches[i], v.predicted[i]
+        ax2.plot(b.time_s / 60, b.Ta_C, color=color, lw=1.5, label=f"{int(ms[i])} g measured")
+        ax2.plot(v.time_s[i] / 60, pred, color=color, lw=1.2, ls="--", label=f"{int(ms[i])} g predicted")
+    ax2.set_xlabel("time since CHARGE [min]")
+    ax2.set_ylabel("bean probe [°C]")
+    ax2.set_title("smallest and largest batch")
+    ax2.legend(fontsize=8)
+    ax2.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(DOCS / "real-roaster-scaling.png", dpi=110)
+    plt.close(fig)
+
+
+def main() -> int:
+    if not DATA.is_dir():
+        print(f"{DATA}: real logs not found (../shared/data/real beside the repository)", file=sys.stderr)
+        return 2
+    lines = ["<!-- generated by docs/real_roaster.py (make real-roaster); do not edit by hand -->", ""]
+    sky = sorted((DATA / "skywalker").glob("*.alog"))
+    machine("Skywalker (heater and fan settings, shell loss)", ROOT / "examples" / "skywalker", sky, lines)
+    bullet = sorted(p for p in (DATA / "bullet").glob("*.json") if grams(p) is not None)
+    nominal = [p for p in bullet if grams(p) in (490, 500)]
+    model, column_map, val = machine(
+        "Aillio Bullet R1, 490-500 g batches", ROOT / "examples" / "bullet", nominal, lines
+    )
+    scaling(model, column_map, bullet, val, lines)
+    (DOCS / "real-roaster-results.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
+    print("wrote docs/real-roaster-results.md, docs/real-roaster-scaling.png", file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
