@@ -20,9 +20,10 @@ from roastlab.apps.cli import build_parser
 from test_bad_input import GOOD_ALOG, GOOD_ROWS, HEADER, PLANT
 
 #: Options that name a file or folder the command writes.
-OUTPUTS = {"--out", "--json", "--plot", "--predictions", "--save"}
+OUTPUTS = {"--out", "--json", "--plot", "--predictions", "--save", "--alog"}
 #: Options that name a file or folder the command reads.
 INPUTS = {"--model", "--theta", "--plant", "--inputs", "--map", "--spec", "--data", "batches", "log", "plant"}
+INPUTS |= {"--from", "--to", "--reference"}
 #: Options that take no path: numbers, names, choices and flags.
 VALUES = {
     "--tgi-offset",
@@ -49,6 +50,20 @@ VALUES = {
     "--set",
     "--tgi",
     "--batch-kg",
+    "--tm0-range",
+    "--decide",
+    "--tgi-min",
+    "--tgi-max",
+    "--tgi-rate",
+    "--heater-min",
+    "--heater-max",
+    "--heater-rate",
+    "--gg",
+    "--gg-min",
+    "--gg-max",
+    "--interval-s",
+    "--tolerance",
+    "--only",
     "--help",
     "-h",
 }
@@ -140,6 +155,12 @@ RUNS = {
     ("whatif",): (
         "whatif {d}/log.alog --model {d}/model.json --map {d}/map.toml --tgi 10 --json {d}/w.json --plot {d}/w.png",
         ["log.alog", "model.json", "map.toml"],
+    ),
+    ("transfer",): (
+        "transfer --model {d}/model.json --from {d}/plant.toml --to {d}/plant.toml --batch-kg 100 "
+        "--reference {d}/ds/b1.csv --interval-s 10 --out {d}/p.csv --json {d}/m.json --plot {d}/t.png "
+        "--alog {d}/bg.alog",
+        ["model.json", "plant.toml", "ds/b1.csv"],
     ),
     ("import",): ("import {d}/log.alog --map {d}/map.toml --out {d}/b.csv", ["log.alog", "map.toml"]),
     ("datasets", "make-paper"): ("datasets make-paper --out {d}/synthetic", []),

@@ -250,9 +250,15 @@ def read_batch_csv(path: str | Path, name: str | None = None, require_Ta: bool =
 
 
 #: Metadata a batch CSV may carry in ``# key = value`` comment lines, with allowed ranges.
-COMMENT_METADATA = {"Mb_kg": (1e-4, 1e4), "Tm0_C": (-50.0, 700.0), "Tb0_C": (-50.0, 400.0), "X0": (0.0, 1.0)}
+COMMENT_METADATA = {
+    "Mb_kg": (1e-4, 1e4),
+    "Tm0_C": (-50.0, 700.0),
+    "Tb0_C": (-50.0, 400.0),
+    "X0": (0.0, 1.0),
+    "Ta0_C": (-50.0, 700.0),
+}
 #: Of those, the initial states a log set through its map's ``[initial]`` (kept in ``Batch.initial``).
-INITIAL_METADATA = ("Tm0_C", "Tb0_C", "X0")
+INITIAL_METADATA = ("Tm0_C", "Tb0_C", "X0", "Ta0_C")
 
 
 def read_comment_metadata(path: str | Path, text: str | None = None) -> dict[str, float]:

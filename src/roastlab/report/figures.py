@@ -244,3 +244,62 @@ def plot_whatif(w, path=None, outputs=None):
     ax2.legend(loc="upper right", fontsize=7, ncol=2)
     ax2.grid(alpha=0.3)
     return _finish(fig, path, f"what if: {b.name}", outputs)
+
+
+def plot_transfer(r, path=None, outputs=None):
+    """Target vs predicted BT on plant B with the baselines; below, the program with its limits
+    shaded and the baselines' inputs; bottom, the tracking error.
+
+    ``r`` is a :class:`roastlab.workflows.transfer.TransferResult`.
+    """
+    t_min = r.time_s / 60.0
+    lim = r.limits
+    fig = new_figure(figsize=(9, 8.5), layout="constrained")
+    ax, ax2, ax3 = fig.subplots(3, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1.6, 1]})
+    ax.plot(t_min, r.target_C, color="0.2", lw=2.4, label=f"target BT ({r.reference} on {r.plant_from})")
+    m = r.metrics
+    ax.plot(
+        t_min,
+        r.program.Ta_pred_C,
+        color="tab:blue",
+        lw=1.6,
+        label=f"predicted on {r.plant_to}, optimised program (RMSE {m['rmse_C']:.2f} °C)",
+    )
+    styles = {"A's inputs unchanged": ("tab:orange", "--"), "A's inputs retimed": ("tab:green", ":")}
+    keys = {"A's inputs unchanged": "baseline_same_inputs", "A's inputs retimed": "baseline_retimed"}
+    for name, ta in r.baselines.items():
+        color, ls = styles[name]
+        rm = m[keys[name]]["rmse_C"]
+        if rm is not None:
+            ax.plot(t_min, ta, color=color, ls=ls, lw=1.3, label=f"{name} (RMSE {rm:.1f} °C)")
+    ax.set_ylabel("bean temperature BT [°C]")
+    ax.set_title(
+        f"{r.plant_from} -> {r.plant_to}, {r.batch_kg:g} kg: "
+        + ("feasible" if m["feasible"] else f"NOT feasible (max |e| {m['max_abs_C']:.1f} °C)"),
+        fontsize=10,
+    )
+    ax.legend(loc="lower right", fontsize=8)
+    ax.grid(alpha=0.3)
+
+    u = r.program.Tgi_C if lim.decide == "Tgi" else r.program.heater
+    span = lim.high - lim.low
+    ax2.axhspan(lim.high, lim.high + 0.08 * span, color="tab:red", alpha=0.15, lw=0)
+    ax2.axhspan(lim.low - 0.08 * span, lim.low, color="tab:red", alpha=0.15, lw=0, label="outside the limits")
+    for s in m["on_limits"]:
+        ax2.axvspan(s["from_s"] / 60.0, s["to_s"] / 60.0, color="tab:red", alpha=0.08, lw=0)
+    for name, inp in r.baseline_inputs.items():
+        color, ls = styles[name]
+        ax2.plot(t_min, inp, color=color, ls=ls, lw=1.0, label=name)
+    ax2.plot(t_min, u, color="tab:blue", lw=1.6, label="optimised program")
+    ax2.set_ylim(lim.low - 0.08 * span, lim.high + 0.08 * span)
+    ax2.set_ylabel("Tgi [°C]" if lim.decide == "Tgi" else "heater setting")
+    ax2.legend(loc="upper right", fontsize=7, ncol=2)
+    ax2.grid(alpha=0.3)
+
+    ax3.axhspan(-m["tolerance_C"], m["tolerance_C"], color="tab:blue", alpha=0.1, lw=0, label="tolerance")
+    ax3.plot(t_min, r.program.Ta_pred_C - r.target_C, color="tab:blue", lw=1.2, label="predicted - target")
+    ax3.set_ylabel("error [°C]")
+    ax3.set_xlabel("time after CHARGE [min]")
+    ax3.legend(loc="upper right", fontsize=7)
+    ax3.grid(alpha=0.3)
+    return _finish(fig, path, f"transfer: {r.reference}", outputs)

@@ -314,6 +314,21 @@ class FittedModel:
             batch_or_inputs = load_log(batch_or_inputs, self.column_map)
         return self.simulate(self.apply([batch_or_inputs], plant, **changes))[0]
 
+    def transfer(self, reference, plant_from=None, plant_to=None, **options):
+        """The input program that reproduces ``reference``'s probe curve on ``plant_to``.
+
+        ``reference`` is a Batch or a log path (read with the model's map); ``plant_from`` the
+        plant it was roasted on (default: the model's); ``options`` are those of
+        :func:`roastlab.workflows.transfer.transfer` (``limits``, ``batch_kg``, ``gg_kg_s``,
+        ``interval_s``, ``tm0_free``, ``tolerance_C``, ``initial``). Returns a
+        :class:`~roastlab.workflows.transfer.TransferResult`.
+        """
+        from .transfer import transfer
+
+        if isinstance(reference, (str, Path)):
+            reference = load_log(reference, self.column_map)
+        return transfer(self, reference, plant_from, plant_to, **options)
+
     def predict_many(self, batches, plant=None, **changes) -> list[SimulationResult]:
         """Predict several ``batches`` in one compiled call (``plant``, ``changes`` as in :meth:`apply`)."""
         return self.simulate(self.apply(list(batches), plant, **changes))

@@ -257,6 +257,8 @@ def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: boo
     for i, ty, v in zip(idx, types, vals):
         if not all(isinstance(q, (int, float)) and not isinstance(q, bool) for q in (i, ty, v)):
             raise InputError("special events must be numbers", path, "key specialevents")
+        if not all(abs(q) <= 1e9 for q in (i, ty, v)):  # also False for NaN; exact for huge ints
+            raise InputError("special event index, type or value out of range", path, "key specialevents")
         ty, i = int(ty), int(i)
         if not 0 <= ty < len(etypes) or not 0 <= i < n:
             continue

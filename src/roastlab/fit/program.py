@@ -1,0 +1,311 @@
+"""Input-program optimisation: the inlet-gas program that makes the model's probe follow a target.
+
+The one optimiser behind profile transfer (:mod:`roastlab.workflows.transfer`) and model
+predictive control. The problem, on a time grid t_0..t_{n-1} (the program's knots):
+
+    minimise   sum_i (Ta_i(z) - target_i)^2  +  lam^2 sum_k d_k^2
+    over       z = (u_0, d_1..d_{n-1} [, Gg] [, Tm0]),   u_k = u_0 + d_1 + ... + d_k
+    subject to |d_k| <= rate (t_k - t_{k-1})      (rate limit: box bounds on the increments)
+               u_min <= u_k <= u_max              (level limits: a stiff penalty while solving,
+                                                   then the program is clipped, which keeps the
+                                                   rate limit since clipping is 1-Lipschitz)
+
+where u is the inlet gas temperature Tgi [degC] (the paper's input) or, with the actuator
+extension, the heater setting.
+
+Ta(z) is the compiled model (:func:`roastlab.sim.kernels.integrate_into`, the one right-hand
+side) run with Tgi held linearly (or zero-order) between knots. The Jacobian of Ta in the
+knots comes from :func:`roastlab.sim.sensitivity.ta_input_jacobian` (finite differences that
+restart from the stored state, in parallel); the optional constant gas flow and drum start
+temperature get one forward-difference column each. The solver is SciPy's bounded
+trust-region least squares (``least_squares(method="trf")``), started from a given program
+(for transfer: the reference's own inputs). Deterministic: no random starts.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from ..errors import InputError
+from ..sim.kernels import H_MAX_S, simulate_one
+from ..sim.sensitivity import ta_input_jacobian
+
+#: Most knots a program may have (the Jacobian is dense, n x n).
+MAX_KNOTS = 2500
+#: Weight of a degree outside the level limits against a degree of tracking error, while solving.
+LEVEL_PENALTY = 30.0
+#: Default smoothness weight lam [-]: a 1 degC step of the program costs like 0.03 degC of error.
+SMOOTHNESS = 0.03
+
+
+#: The inputs a program can decide, with their unit.
+DECISIONS = {"Tgi": "degC", "heater": "setting"}
+
+
+@dataclass
+class ProgramLimits:
+    """Limits of the program: the decided input's level and rate (per minute), and an optional
+    range for a constant gas flow [kg/s] that the optimiser may then choose.
+
+    ``decide`` is ``"Tgi"`` (inlet gas temperature [degC], the paper's input) or ``"heater"``
+    (the heater setting of the actuator extension, in the map's units).
+    """
+
+    low: float = 150.0
+    high: float = 550.0
+    rate_per_min: float = 120.0
+    Gg_min_kg_s: float | None = None
+    Gg_max_kg_s: float | None = None
+    decide: str = "Tgi"
+
+    def __post_init__(self) -> None:
+        if self.decide not in DECISIONS:
+            raise InputError(f"cannot decide {self.decide!r} (allowed: {', '.join(DECISIONS)})", "limits")
+        if not self.low < self.high:
+            raise InputError(f"{self.decide} limits inverted or empty: min {self.low:g} >= max {self.high:g}", "limits")
+        if not self.rate_per_min > 0:
+            raise InputError(f"{self.decide} rate limit must be > 0 per min, got {self.rate_per_min:g}", "limits")
+        if (self.Gg_min_kg_s is None) != (self.Gg_max_kg_s is None):
+            raise InputError("give both Gg limits (min and max) or neither", "limits")
+        if self.Gg_min_kg_s is not None and not 0 < self.Gg_min_kg_s < self.Gg_max_kg_s:
+            raise InputError(
+                f"Gg limits must satisfy 0 < min < max, got {self.Gg_min_kg_s:g}..{self.Gg_max_kg_s:g} kg/s", "limits"
+            )
+
+    @property
+    def gg_free(self) -> bool:
+        return self.Gg_min_kg_s is not None
+
+    @property
+    def unit(self) -> str:
+        return DECISIONS[self.decide]
+
+
+@dataclass
+class ProgramResult:
+    """The optimised program and what it gives."""
+
+    time_s: np.ndarray
+    Tgi_C: np.ndarray
+    heater: np.ndarray  # zeros without the actuator extension
+    Gg_kg_s: np.ndarray
+    Tm0_C: float
+    Ta_pred_C: np.ndarray
+    states: np.ndarray  # (n, N_OUT) the model's run with the program
+    solve_s: float
+    iterations: int
+    simulations: int
+    notes: list[str] = field(default_factory=list)
+
+
+def _run(t, Gg, Tgi, Q, F, x0, p, zoh):
+    return simulate_one(t, Gg, Tgi, Q, F, x0, p, zoh, H_MAX_S)
+
+
+def optimise_program(
+    t,
+    target_C,
+    x0,
+    p,
+    Gg_kg_s,
+    Tgi_C,
+    limits: ProgramLimits,
+    *,
+    heater=None,
+    fan=None,
+    zoh: bool = False,
+    tm0_bounds: tuple[float, float] | None = None,
+    smoothness: float = SMOOTHNESS,
+    weights=None,
+    max_iterations: int = 60,
+) -> ProgramResult:
+    """The program of one input (Tgi or the heater, ``limits.decide``; optionally also a constant
+    Gg and the drum start temperature) whose simulated probe follows ``target_C`` on ``t`` [s].
+
+    Parameters
+    ----------
+    t : (n,) knot times [s], strictly increasing; the program and the target live on them
+    target_C : (n,) the probe curve to follow [degC]
+    x0 : (NS,) initial state [Tb, Tm, X, He, Ta, H]; Ta should be the target's first reading
+    p : parameter vector of the plant the program is for (:func:`roastlab.model.rhs.pack_params`)
+    Gg_kg_s : (n,) gas flow [kg/s] (kept when ``limits`` has no Gg range; else the start value)
+    Tgi_C, heater : (n,) inlet temperature [degC] and heater setting; the decided one is the
+        starting program (projected into the limits first), the other is held as given
+    limits : :class:`ProgramLimits`
+    fan : (n,) fan setting held as given (zeros when omitted)
+    zoh : zero-order hold between knots instead of linear
+    tm0_bounds : (lo, hi) [degC] to make the drum temperature at CHARGE a decision
+    smoothness : weight lam on the program's increments (see the module docstring)
+    weights : (n,) weight of each knot's tracking error (default 1)
+    """
+    t0_clock = time.perf_counter()
+    t = np.ascontiguousarray(t, dtype=np.float64)
+    n = t.shape[0]
+    if n < 3:
+        raise InputError(f"a program needs at least 3 knots (two intervals), got {n}", "reference")
+    if n > MAX_KNOTS:
+        raise InputError(f"{n} knots is more than {MAX_KNOTS}: use a longer --interval-s", "reference")
+    target = np.asarray(target_C, dtype=np.float64)
+    w = np.ones(n) if weights is None else np.asarray(weights, dtype=np.float64)
+    Q = np.zeros(n) if heater is None else np.array(heater, dtype=np.float64)
+    F = np.zeros(n) if fan is None else np.ascontiguousarray(fan, dtype=np.float64)
+    T_in = np.array(Tgi_C, dtype=np.float64)
+    which = 0 if limits.decide == "Tgi" else 1
+    x0 = np.array(x0, dtype=np.float64)
+    dt = np.diff(t)
+    step_max = limits.rate_per_min / 60.0 * dt
+    lo_T, hi_T = limits.low, limits.high
+
+    # start: the given program made feasible (levels clipped, then the rate limit walked forward)
+    start = np.clip(T_in if which == 0 else Q, lo_T, hi_T)
+    for k in range(1, n):
+        start[k] = start[k - 1] + np.clip(start[k] - start[k - 1], -step_max[k - 1], step_max[k - 1])
+    Gg0 = np.ascontiguousarray(Gg_kg_s, dtype=np.float64)
+    extra_names: list[str] = []
+    z0 = [start[0], *np.diff(start)]
+    lb = [lo_T, *(-step_max)]
+    ub = [hi_T, *step_max]
+    if limits.gg_free:
+        extra_names.append("Gg")
+        g_start = float(np.clip(np.mean(Gg0), limits.Gg_min_kg_s, limits.Gg_max_kg_s))
+        z0.append(g_start)
+        lb.append(limits.Gg_min_kg_s)
+        ub.append(limits.Gg_max_kg_s)
+    if tm0_bounds is not None:
+        extra_names.append("Tm0")
+        z0.append(float(np.clip(x0[1], *tm0_bounds)))
+        lb.append(tm0_bounds[0])
+        ub.append(tm0_bounds[1])
+    z0 = np.array(z0)
+    lb, ub = np.array(lb), np.array(ub)
+    counter = {"sims": 0}
+
+    def unpack(z):
+        u = np.cumsum(z[:n])
+        tgi, q = (u, Q) if which == 0 else (T_in, u)
+        gg = Gg0
+        x = x0
+        j = n
+        if limits.gg_free:
+            gg = np.full(n, z[j])
+            j += 1
+        if tm0_bounds is not None:
+            x = x0.copy()
+            x[1] = z[j]
+        return u, tgi, q, gg, x
+
+    cache: dict = {}
+
+    def simulate(z):
+        key = z.tobytes()
+        if key not in cache:
+            u, tgi, q, gg, x = unpack(z)
+            cache.clear()
+            cache[key] = (u, tgi, q, gg, x, _run(t, gg, tgi, q, F, x, p, zoh))
+            counter["sims"] += 1
+        return cache[key]
+
+    def residuals(z):
+        u, _, _, _, _, out = simulate(z)
+        r_track = w * (out[:, 4] - target)
+        over = np.maximum(u - hi_T, 0.0) - np.maximum(lo_T - u, 0.0)
+        r = np.concatenate([r_track, LEVEL_PENALTY * over, smoothness * z[1:n]])
+        return np.where(np.isfinite(r), r, 1e6)
+
+    def jacobian(z):
+        u, tgi, q, gg, x, out = simulate(z)
+        jt = np.empty((n, n))
+        ta = np.ascontiguousarray(out[:, 4])
+        states = np.ascontiguousarray(out[:, :6])
+        delta = 1.0 if which == 0 else 1e-2 * (hi_T - lo_T)
+        ta_input_jacobian(t, gg, tgi, q, F, which, states, ta, p, zoh, H_MAX_S, delta, jt)
+        counter["sims"] += n // 2
+        m = z.shape[0]
+        J = np.zeros((3 * n - 1, m))
+        # Tgi_k = sum_{j <= k} z_j: a column j of the tracking block is the sum of columns k >= j
+        J[:n, :n] = w[:, None] * np.cumsum(jt[:, ::-1], axis=1)[:, ::-1]
+        active = ((u > hi_T) | (u < lo_T)).astype(float)
+        J[n : 2 * n, :n] = LEVEL_PENALTY * np.tril(np.ones((n, n))) * active[:, None]
+        J[2 * n :, 1:n] = smoothness * np.eye(n - 1)
+        j = n
+        for name in extra_names:
+            h = 1e-3 * max(abs(z[j]), 1e-3) if name == "Gg" else 0.5
+            zp = z.copy()
+            zp[j] += h
+            _, tp, qp, gp, xp = unpack(zp)
+            outp = _run(t, gp, tp, qp, F, xp, p, zoh)
+            counter["sims"] += 1
+            J[:n, j] = w * (outp[:, 4] - out[:, 4]) / h
+            j += 1
+        return np.where(np.isfinite(J), J, 0.0)
+
+    sol = least_squares(
+        residuals,
+        z0,
+        jac=jacobian,
+        bounds=(lb, ub),
+        method="trf",
+        x_scale="jac",
+        max_nfev=max_iterations,
+        xtol=1e-8,
+        ftol=1e-8,
+    )
+    u, tgi, q, gg, x = unpack(sol.x)
+    u = np.clip(u, lo_T, hi_T)  # keeps the rate limit (clipping is 1-Lipschitz)
+    tgi, q = (u, q) if which == 0 else (tgi, u)
+    out = _run(t, gg, tgi, q, F, x, p, zoh)
+    counter["sims"] += 1
+    notes = [] if sol.success else [f"optimiser stopped: {sol.message}"]
+    return ProgramResult(
+        time_s=t,
+        Tgi_C=np.array(tgi),
+        heater=np.array(q),
+        Gg_kg_s=np.array(gg, dtype=np.float64),
+        Tm0_C=float(x[1]),
+        Ta_pred_C=out[:, 4].copy(),
+        states=out,
+        solve_s=time.perf_counter() - t0_clock,
+        iterations=int(sol.nfev),
+        simulations=counter["sims"],
+        notes=notes,
+    )
+
+
+def limit_spans(t, u, limits: ProgramLimits) -> list[dict]:
+    """Time ranges where the program ``u`` sits on a limit: ``[{"limit", "from_s", "to_s"}, ...]``.
+
+    Levels: within 0.01 % of the range of the floor or ceiling at a knot. Rate: an interval
+    whose change is within 1 % of the largest the rate limit allows.
+    """
+    t = np.asarray(t, dtype=float)
+    u = np.asarray(u, dtype=float)
+    tol = 1e-4 * (limits.high - limits.low)
+    name, unit = limits.decide, limits.unit
+    flags = {
+        f"{name} at its {limits.high:g} {unit} ceiling": u >= limits.high - tol,
+        f"{name} at its {limits.low:g} {unit} floor": u <= limits.low + tol,
+    }
+    step = np.diff(u)
+    cap = limits.rate_per_min / 60.0 * np.diff(t)
+    up = np.concatenate([[False], step >= 0.99 * cap])
+    down = np.concatenate([[False], step <= -0.99 * cap])
+    flags[f"{name} rising at its {limits.rate_per_min:g} {unit}/min rate limit"] = up
+    flags[f"{name} falling at its {limits.rate_per_min:g} {unit}/min rate limit"] = down
+    spans = []
+    for name, mask in flags.items():
+        k = 0
+        while k < len(mask):
+            if mask[k]:
+                j = k
+                while j + 1 < len(mask) and mask[j + 1]:
+                    j += 1
+                start = t[k - 1] if "rate" in name and k > 0 else t[k]
+                spans.append({"limit": name, "from_s": float(start), "to_s": float(t[j])})
+                k = j + 1
+            else:
+                k += 1
+    return sorted(spans, key=lambda s: s["from_s"])

@@ -1,0 +1,464 @@
+"""Profile transfer: the input program that reproduces a roast's bean-probe curve on another
+plant or at another batch size (``roastlab transfer``, ``model.transfer``).
+
+The target is the reference's probe curve from CHARGE to DROP, resampled to the program's
+knots (every ``interval_s``). The fitted model is applied to plant B (values that carry over
+stay, plant-specific ones are dropped, as everywhere: :meth:`FittedModel.apply`) with the
+reference's inputs, which gives plant B's parameter vector, its charge state and the first
+baseline (B run with A's inputs unchanged). :func:`roastlab.fit.program.optimise_program`
+then finds the program within the limits. A second baseline retimes A's inputs by the phase
+times the first baseline gives on B, as a person does with Artisan's Transposer.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import datetime as _dt
+import io
+import math
+
+import numpy as np
+
+from ..errors import InputError
+from ..fit.program import ProgramLimits, ProgramResult, limit_spans, optimise_program
+from ..io.batch import Batch
+from ..model.limits import check_value
+from ..model.plant import Plant
+
+#: Probe temperatures [degC] whose crossing times define the phases of the retimed baseline:
+#: end of drying (~150 degC, Artisan's DRY) and start of first crack (~196 degC, FCs).
+PHASE_LEVELS_C = (150.0, 196.0)
+
+
+def _fmt_time(s: float) -> str:
+    s = int(round(s))
+    return f"{s // 60}:{s % 60:02d}"
+
+
+def _crossing(t, y, level, after):
+    """First time after ``after`` [s] at which ``y`` rises through ``level`` (interpolated)."""
+    idx = np.flatnonzero((y[:-1] < level) & (y[1:] >= level) & (t[:-1] >= after))
+    if idx.size == 0:
+        return None
+    i = int(idx[0])
+    return float(t[i] + (level - y[i]) * (t[i + 1] - t[i]) / (y[i + 1] - y[i]))
+
+
+def _crossing_or_projected(t, y, level, after, window_s: float = 120.0):
+    """:func:`_crossing`, or when ``y`` never gets there, the time it would at the rate of rise
+    of its last ``window_s`` seconds (what a person reads off a curve that stops short)."""
+    hit = _crossing(t, y, level, after)
+    if hit is not None:
+        return hit
+    k = int(np.searchsorted(t, t[-1] - window_s))
+    ror = (y[-1] - y[k]) / max(t[-1] - t[k], 1e-9)
+    if ror <= 1e-6 or y[-1] >= level:
+        return None
+    return float(t[-1] + (level - y[-1]) / ror)
+
+
+def _errors(pred, target) -> dict:
+    e = np.asarray(pred) - np.asarray(target)
+    if not np.all(np.isfinite(e)):
+        return {"rmse_C": None, "max_abs_C": None}
+    return {"rmse_C": float(np.sqrt(np.mean(e**2))), "max_abs_C": float(np.max(np.abs(e)))}
+
+
+@dataclasses.dataclass
+class TransferResult:
+    """The program, its predicted curve, the baselines and the metrics of a transfer."""
+
+    reference: str
+    plant_from: str
+    plant_to: str
+    batch_kg: float
+    time_s: np.ndarray
+    target_C: np.ndarray
+    program: ProgramResult
+    limits: ProgramLimits
+    baselines: dict  # name -> predicted Ta on B [degC]
+    baseline_inputs: dict  # name -> the decided input's program [u units]
+    metrics: dict
+    initial: dict  # the charge state on B: Tb0_C, Tm0_C, X0, Ta0_C
+    model_fits_flow: bool = False
+    actuators: bool = False
+
+    # ------------------------------------------------------------------ text outputs
+    def summary(self) -> str:
+        m = self.metrics
+        head = (
+            f"transfer of {self.reference}: {self.plant_from} -> {self.plant_to} ({self.batch_kg:g} kg), "
+            f"{len(self.time_s)} knots every {self.time_s[1] - self.time_s[0]:g} s"
+        )
+        rows = [head, "", f"{'program':<24} {'RMSE °C':>9} {'max |e| °C':>11}"]
+        rows.append(f"{'optimised':<24} {m['rmse_C']:>9.3f} {m['max_abs_C']:>11.3f}")
+        for key, label in (
+            ("baseline_same_inputs", "A's inputs unchanged"),
+            ("baseline_retimed", "A's inputs retimed"),
+        ):
+            b = m[key]
+            if b["rmse_C"] is None:
+                rows.append(f"{label:<24} {'(could not be simulated)':>21}")
+            else:
+                rows.append(f"{label:<24} {b['rmse_C']:>9.3f} {b['max_abs_C']:>11.3f}")
+        rows.append("")
+        verdict = "feasible" if m["feasible"] else "NOT feasible"
+        rows.append(
+            f"{verdict} (max |e| {'<=' if m['feasible'] else '>'} {m['tolerance_C']:g} °C); "
+            f"solved in {m['solve_s']:.2f} s ({m['simulations']} simulations)"
+        )
+        rows += [f"  {s}" for s in m["explanation"]]
+        return "\n".join(rows)
+
+    def to_json_dict(self) -> dict:
+        return self.metrics
+
+    def program_csv_text(self) -> str:
+        """PROGRAM.csv: the knots, the inputs and the predicted probe; metadata lines carry the
+        charge state and batch mass, so ``roastlab simulate --inputs`` reproduces ``Ta_pred_C``."""
+        pr = self.program
+        out = io.StringIO()
+        out.write(f"## roastlab transfer program: {self.plant_from} -> {self.plant_to}\n")
+        if self.model_fits_flow:
+            out.write("## Gg_kg_s is the model's placeholder: the flow is the model's fitted Gg_kg_s\n")
+        out.write(f"# Mb_kg = {self.batch_kg:.6g}\n")
+        for key in ("Tm0_C", "Tb0_C", "X0", "Ta0_C"):
+            v = pr.Tm0_C if key == "Tm0_C" else self.initial[key]
+            out.write(f"# {key} = {v:.10g}\n")
+        cols = ["time_s", "Gg_kg_s", "Tgi_C"] + (["heater", "fan"] if self.actuators else []) + ["Ta_pred_C"]
+        out.write(",".join(cols) + "\n")
+        fan = self.initial.get("_fan")
+        for i, t in enumerate(pr.time_s):
+            gg = 1.0 if self.model_fits_flow else pr.Gg_kg_s[i]
+            vals = [f"{t:.6g}", f"{gg:.10g}", f"{pr.Tgi_C[i]:.10g}"]
+            if self.actuators:
+                vals += [f"{pr.heater[i]:.10g}", f"{(fan[i] if fan is not None else 0.0):.10g}"]
+            vals.append(f"{pr.Ta_pred_C[i]:.6f}")
+            out.write(",".join(vals) + "\n")
+        return out.getvalue()
+
+    def alog_text(self) -> str:
+        """An Artisan profile (Python-literal .alog, as Artisan writes) to load as a background:
+        BT = the predicted probe, ET = the program's inlet temperature, CHARGE and DROP marks,
+        the program as Burner events (0-100 % of the decided input's range) and Air events (gas
+        flow as 0-100 % of its range, or 50 % when fixed), in Artisan's value encoding."""
+        pr = self.program
+        lim = self.limits
+        u = pr.Tgi_C if lim.decide == "Tgi" else pr.heater
+        burner = np.clip(np.round(100.0 * (u - lim.low) / (lim.high - lim.low)), 0, 100)
+        if lim.gg_free:
+            air = np.clip(
+                np.round(100.0 * (pr.Gg_kg_s - lim.Gg_min_kg_s) / (lim.Gg_max_kg_s - lim.Gg_min_kg_s)), 0, 100
+            )
+        else:
+            air = np.full(len(u), 50.0)
+        idx, types, vals, strings = [], [], [], []
+        last = {0: None, 3: None}
+        for i in range(len(u)):
+            for etype, series in ((3, burner), (0, air)):
+                v = float(series[i])
+                if last[etype] is None or abs(v - last[etype]) >= 1.0:
+                    idx.append(i)
+                    types.append(etype)
+                    vals.append(v / 10.0 + 1.0)  # Artisan's internal event encoding
+                    strings.append(f"{'Burner' if etype == 3 else 'Air'} {int(v)}%")
+                    last[etype] = v
+        n = len(pr.time_s)
+        now = _dt.datetime.now(_dt.UTC)
+        profile = {
+            "recording_version": "roastlab",
+            "version": "2.8.4",
+            "revision": "",
+            "build": "",
+            "artisan_os": "roastlab",
+            "mode": "C",
+            "title": f"roastlab transfer: {self.reference} on {self.plant_to} (predicted)",
+            "roastertype": self.plant_to,
+            "operator": "",
+            "beans": "",
+            "roastingnotes": (
+                f"Computed by roastlab transfer from {self.reference} ({self.plant_from} -> {self.plant_to}, "
+                f"{self.batch_kg:g} kg). BT is the model's prediction, ET the program's inlet temperature; "
+                f"Burner = {lim.decide} as 0-100 % of {lim.low:g}..{lim.high:g} {lim.unit}."
+            ),
+            "roastdate": now.strftime("%a %b %d %Y"),
+            "roastisodate": now.strftime("%Y-%m-%d"),
+            "roasttime": now.strftime("%H:%M:%S"),
+            "roastepoch": int(now.timestamp()),
+            "samplinginterval": float(pr.time_s[1] - pr.time_s[0]),
+            "timex": [round(float(t), 3) for t in pr.time_s],
+            "temp1": [round(float(v), 2) for v in pr.Tgi_C],
+            "temp2": [round(float(v), 2) for v in pr.Ta_pred_C],
+            "timeindex": [0, 0, 0, 0, 0, 0, n - 1, 0],
+            "specialevents": idx,
+            "specialeventstype": types,
+            "specialeventsvalue": vals,
+            "specialeventsStrings": strings,
+            "etypes": ["Air", "Drum", "Damper", "Burner", "--"],
+            "weight": [round(self.batch_kg, 6), 0.0, "Kg"],
+            "extradevices": [],
+            "extratimex": [],
+            "extratemp1": [],
+            "extratemp2": [],
+            "extraname1": [],
+            "extraname2": [],
+        }
+        return repr(profile) + "\n"
+
+    def plot(self, path, outputs=None) -> None:
+        from ..report.figures import plot_transfer
+
+        plot_transfer(self, path, outputs=outputs)
+
+
+def grid_batch(ref: Batch, interval_s: float) -> Batch:
+    """The reference on the program's knots: inputs and probe interpolated, settings held."""
+    t_end = float(ref.time_s[-1])
+    t = np.arange(0.0, t_end + 1e-9, interval_s) + float(ref.time_s[0])
+
+    def held(series):
+        if series is None:
+            return None
+        j = np.clip(np.searchsorted(ref.time_s, t, side="right") - 1, 0, ref.n - 1)
+        return series[j].astype(np.float64)
+
+    return dataclasses.replace(
+        ref,
+        time_s=t - t[0],
+        Gg_kg_s=np.interp(t, ref.time_s, ref.Gg_kg_s),
+        Tgi_C=np.interp(t, ref.time_s, ref.Tgi_C),
+        Ta_C=np.interp(t, ref.time_s, ref.Ta_C),
+        heater=held(ref.heater),
+        fan=held(ref.fan),
+        Tb2_C=None,
+        initial=dict(ref.initial),
+    )
+
+
+def _retime(t, u, t_ref_marks, t_same_marks):
+    """``u`` retimed so that at the reference's phase time t_ref_i the program has reached
+    what it had at t_same_i (piecewise linear, the last ratio held after the last mark)."""
+    xs, ys = [0.0], [0.0]
+    for a, b in zip(t_ref_marks, t_same_marks):
+        if a > xs[-1] and b > ys[-1]:
+            xs.append(a)
+            ys.append(b)
+    ratio = ys[-1] / xs[-1] if xs[-1] > 0 else 1.0
+    phi = np.where(t <= xs[-1], np.interp(t, xs, ys), ys[-1] + (t - xs[-1]) * ratio)
+    return np.interp(phi, t, u), list(zip(xs[1:], ys[1:]))
+
+
+def transfer(
+    model,
+    reference: Batch,
+    plant_from=None,
+    plant_to=None,
+    *,
+    limits: ProgramLimits | None = None,
+    batch_kg: float | None = None,
+    gg_kg_s: float | None = None,
+    interval_s: float = 5.0,
+    tm0_free: tuple[float, float] | None = None,
+    tolerance_C: float = 2.0,
+    initial: dict | None = None,
+) -> TransferResult:
+    """Compute the program that reproduces ``reference``'s probe curve on ``plant_to``.
+
+    Parameters
+    ----------
+    model : FittedModel (its carried-over values are applied on ``plant_to``)
+    reference : Batch with ``Ta_C`` from CHARGE (t = 0) to DROP, and the inputs it was run with
+    plant_from, plant_to : Plant, preset name or PLANT.toml (default: the model's plant)
+    limits : :class:`ProgramLimits` (default: Tgi 150-550 degC, 120 degC/min)
+    batch_kg : green batch mass on B [kg] (default: B's nominal batch when B differs from A,
+        else the reference's)
+    gg_kg_s : fixed gas flow on B [kg/s] (default: A's flow scaled by the batch-mass ratio);
+        ignored when ``limits`` gives a Gg range (then a constant Gg is a decision)
+    interval_s : spacing of the program's knots [s]
+    tm0_free : (lo, hi) [degC] to make the drum temperature at CHARGE a decision
+    tolerance_C : the program is ``feasible`` when max |Ta_pred - target| is at most this
+    initial : charge state changes on B (``Tb0_C``, ``Tm0_C``, ``X0``)
+    """
+    from ..io.plants import load_plant
+
+    limits = limits or ProgramLimits()
+    src = reference.source or reference.name
+    if reference.Ta_C is None:
+        raise InputError("the reference has no bean-probe curve (Ta_C): nothing to transfer", src)
+    interval_s = check_value("dt_s", interval_s, "--interval-s")
+    span = float(reference.time_s[-1] - reference.time_s[0])
+    if span < 2 * interval_s:
+        raise InputError(
+            f"the reference spans {span:g} s from CHARGE to DROP, shorter than two {interval_s:g} s intervals", src
+        )
+    if not tolerance_C > 0 or not math.isfinite(tolerance_C):
+        raise InputError(f"tolerance must be a positive number of degC, got {tolerance_C!r}", "--tolerance")
+    pa: Plant = load_plant(plant_from) if plant_from is not None else model.plant
+    pb: Plant = load_plant(plant_to) if plant_to is not None else pa
+    if pa is None:
+        raise InputError("the model names no plant: give the reference's plant (--from)", model.source)
+    if limits.decide == "heater" and reference.heater is None:
+        raise InputError("the program is to decide the heater, but the reference has no heater setting", src)
+    same_plant = pa == pb
+    mass_a = reference.Mb_kg or pa.Mb_kg
+    mass_b = (
+        check_value("batch_kg", batch_kg, "--batch-kg")
+        if batch_kg is not None
+        else (mass_a if same_plant else pb.Mb_kg)
+    )
+    grid = grid_batch(reference, interval_s)
+    ta0 = float(grid.Ta_C[0])
+    changes = dict(initial or {})
+    changes["Ta0_C"] = ta0
+    res_a = model.predict(grid, plant=pa, **changes)
+    own = _errors(res_a.Ta_C, grid.Ta_C)
+
+    # B with A's inputs, unchanged (baseline 1); it also gives B's parameters and charge state.
+    # On another plant a flow the model fitted for A is dropped, so B gets A's flow as applied.
+    grid_b = dataclasses.replace(grid, Mb_kg=mass_b)
+    if not same_plant:
+        grid_b.Gg_kg_s = res_a.Gg_kg_s.copy()
+    res_same = model.predict(grid_b, plant=pb, **changes)
+    p_b = res_same.params
+    x0 = res_same.states[0].copy()
+    # on its own plant a model that fitted a constant flow applies it; elsewhere that value is dropped
+    fits_flow = same_plant and "Gg_kg_s" in model.parameters
+    if limits.gg_free or fits_flow:
+        gg_b = res_same.Gg_kg_s.copy()
+    elif gg_kg_s is not None:
+        gg_b = np.full(grid.n, check_value("Gg_kg_s", gg_kg_s, "--gg"))
+    else:
+        gg_b = res_a.Gg_kg_s * (mass_b / mass_a)
+    target = grid.Ta_C
+
+    program = optimise_program(
+        grid.time_s,
+        target,
+        x0,
+        p_b,
+        gg_b,
+        res_a.Tgi_C,
+        limits,
+        heater=grid.heater,
+        fan=grid.fan,
+        zoh=model.hold == "zoh",
+        tm0_bounds=tm0_free,
+    )
+    # what the Python simulator says for the program (the check that PROGRAM.csv reproduces it)
+    err = _errors(program.Ta_pred_C, target)
+
+    # baseline 2: A's inputs retimed by the phase times baseline 1 gives on B
+    t = grid.time_s
+    tp = float(t[int(np.argmin(target))])
+    levels = [lv for lv in PHASE_LEVELS_C if _crossing(t, target, lv, tp) is not None]
+    if not levels:  # a light or short roast: the level 80 % of the way from the turning point to DROP
+        levels = [float(np.min(target) + 0.8 * (target[-1] - np.min(target)))]
+    marks_ref = [_crossing(t, target, lv, tp) for lv in levels]
+    tp_same = float(t[int(np.argmin(res_same.Ta_C))])
+    marks_same = [_crossing_or_projected(t, res_same.Ta_C, lv, tp_same) for lv in levels]
+    pairs = [(a, b) for a, b in zip(marks_ref, marks_same) if b is not None]
+    decided = res_a.Tgi_C if limits.decide == "Tgi" else grid.heater
+    retimed, used = _retime(t, decided, [a for a, _ in pairs], [b for _, b in pairs])
+    kw = {"Tgi_C": retimed} if limits.decide == "Tgi" else {"heater": retimed}
+    try:
+        res_ret = model.predict(grid_b, plant=pb, **changes, **kw)
+        ta_ret = res_ret.Ta_C
+    except InputError:
+        ta_ret = np.full(grid.n, np.nan)
+    base_same = {**_errors(res_same.Ta_C, target), "what": "plant B run with plant A's inputs unchanged"}
+    base_ret = {
+        **_errors(ta_ret, target),
+        "what": "plant A's inputs retimed by the phase times the same-input run gives on B (Transposer-style)",
+        "phase_marks_s": [{"reference_s": a, "same_inputs_s": b} for a, b in used],
+    }
+    spans = limit_spans(t, program.Tgi_C if limits.decide == "Tgi" else program.heater, limits)
+    feasible = err["max_abs_C"] is not None and err["max_abs_C"] <= tolerance_C
+    explanation = _explain(t, program.Ta_pred_C - target, spans, tolerance_C, pb.name, mass_b, feasible)
+    baselines_best = min((b["rmse_C"] for b in (base_same, base_ret) if b["rmse_C"] is not None), default=None)
+    metrics = {
+        "reference": src,
+        "plant_from": pa.name,
+        "plant_to": pb.name,
+        "batch_kg": mass_b,
+        "decide": limits.decide,
+        **err,
+        "feasible": bool(feasible),
+        "tolerance_C": tolerance_C,
+        "solve_s": program.solve_s,
+        "iterations": program.iterations,
+        "simulations": program.simulations,
+        "knots": int(grid.n),
+        "interval_s": interval_s,
+        "limits": {
+            "low": limits.low,
+            "high": limits.high,
+            "rate_per_min": limits.rate_per_min,
+            "unit": limits.unit,
+            "Gg_min_kg_s": limits.Gg_min_kg_s,
+            "Gg_max_kg_s": limits.Gg_max_kg_s,
+        },
+        "on_limits": spans,
+        "Gg_kg_s": float(np.mean(program.Gg_kg_s)),
+        "Tm0_C": program.Tm0_C,
+        "reference_own_inputs_on_A": own,
+        "baseline_same_inputs": base_same,
+        "baseline_retimed": base_ret,
+        "improvement_over_best_baseline": (
+            None if baselines_best is None or not err["rmse_C"] else baselines_best / err["rmse_C"]
+        ),
+        "explanation": explanation,
+        "notes": list(res_same.meta.get("notes", [])) + program.notes,
+    }
+    init = {"Tb0_C": float(x0[0]), "X0": float(x0[2]), "Ta0_C": float(x0[4]), "_fan": grid.fan}
+    return TransferResult(
+        reference=reference.name,
+        plant_from=pa.name,
+        plant_to=pb.name,
+        batch_kg=mass_b,
+        time_s=t,
+        target_C=target,
+        program=program,
+        limits=limits,
+        baselines={"A's inputs unchanged": res_same.Ta_C, "A's inputs retimed": ta_ret},
+        baseline_inputs={"A's inputs unchanged": decided, "A's inputs retimed": retimed},
+        metrics=metrics,
+        initial=init,
+        model_fits_flow=fits_flow,
+        actuators=grid.heater is not None or grid.fan is not None,
+    )
+
+
+def _explain(t, e, spans, tol, plant, mass, feasible) -> list[str]:
+    """Where the program misses the target by more than ``tol`` and the limits active then."""
+    out = []
+    bad = np.abs(e) > tol
+    if feasible:
+        if spans:
+            out.append(
+                "on a limit: "
+                + "; ".join(f"{s['limit']} {_fmt_time(s['from_s'])}-{_fmt_time(s['to_s'])}" for s in spans)
+            )
+        return out
+    i = 0
+    while i < len(t):
+        if bad[i]:
+            j = i
+            while j + 1 < len(t) and bad[j + 1]:
+                j += 1
+            worst = int(i + np.argmax(np.abs(e[i : j + 1])))
+            side = "below" if e[worst] < 0 else "above"
+            active = [s for s in spans if s["from_s"] <= t[j] and s["to_s"] >= t[i] - 60.0]
+            why = (
+                "; ".join(f"{s['limit']} from {_fmt_time(s['from_s'])} to {_fmt_time(s['to_s'])}" for s in active)
+                if active
+                else "no limit active: the target's shape is not reachable with this model"
+            )
+            verb = "cannot heat that fast" if side == "below" else "cannot cool that fast"
+            out.append(
+                f"{_fmt_time(t[i])}-{_fmt_time(t[j])}: predicted BT up to {abs(e[worst]):.1f} °C {side} the target; "
+                f"{why}" + (f": the {mass:g} kg batch on {plant} {verb}" if active else "")
+            )
+            i = j + 1
+        else:
+            i += 1
+    return out

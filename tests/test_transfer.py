@@ -1,0 +1,165 @@
+"""Profile transfer (roastlab transfer): the program, its file, its baselines and its bad input."""
+
+import ast
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from roastlab.apps.bench import random_reference
+from roastlab.fit.program import ProgramLimits, limit_spans
+from roastlab.io.batch import read_batch_csv, write_batch_csv
+from roastlab.io.importers.artisan import read_alog
+from roastlab.model.plant import as_plant
+from roastlab.model.rhs import P, pack_params
+from roastlab.sim.kernels import H_MAX_S, simulate_one
+from roastlab.sim.sensitivity import ta_input_jacobian
+from roastlab.workflows.transfer import transfer
+
+
+@pytest.mark.parametrize("zoh, which", [(False, 0), (True, 0), (False, 1)])
+def test_restarting_jacobian_matches_full_reruns(zoh, which):
+    """Each column restarts from the stored state; a full re-run from CHARGE must agree."""
+    p = pack_params(as_plant("120kg"), (0.01, 0.0254, 0.5793), 0.1)
+    p[P["Qe_gain"]] = 0.5  # the heater heats the metal, so its column is not zero
+    t = np.arange(0.0, 301.0, 10.0)
+    n = len(t)
+    Gg, Tgi = np.full(n, 0.4), np.linspace(450.0, 380.0, n)
+    Q, F = np.full(n, 20.0), np.zeros(n)
+    x0 = np.array([25.0, 121.0, 0.1, 0.0, 25.0, 20.0])
+    out = simulate_one(t, Gg, Tgi, Q, F, x0, p, zoh, H_MAX_S)
+    jac = np.empty((n, n))
+    ta_input_jacobian(
+        t, Gg, Tgi, Q, F, which, np.ascontiguousarray(out[:, :6]), out[:, 4].copy(), p, zoh, H_MAX_S, 1.0, jac
+    )
+    for k in (0, 5, 17, n - 1):
+        T2, Q2 = Tgi.copy(), Q.copy()
+        (T2 if which == 0 else Q2)[k] += 1.0
+        full = simulate_one(t, Gg, T2, Q2, F, x0, p, zoh, H_MAX_S)[:, 4]
+        np.testing.assert_allclose(jac[:, k], full - out[:, 4], atol=2e-3)
+    assert np.abs(jac).max() > 0.003  # the inputs really move the probe (30x the tolerance)
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_same_plant_same_batch_matches_as_well_as_the_references_own_inputs(seed):
+    model, ref = random_reference(np.random.default_rng(seed), "120kg")
+    r = transfer(model, ref, "120kg", "120kg")
+    own = r.metrics["reference_own_inputs_on_A"]["rmse_C"]
+    assert own < 1e-6  # the noise-free reference is the model's own run
+    assert r.metrics["rmse_C"] < 0.05 and r.metrics["max_abs_C"] < 0.2
+    assert r.metrics["feasible"]
+    lim = r.limits
+    assert np.all((r.program.Tgi_C >= lim.low - 1e-9) & (r.program.Tgi_C <= lim.high + 1e-9))
+    assert np.all(np.abs(np.diff(r.program.Tgi_C)) <= lim.rate_per_min / 60 * 5.0 + 1e-9)
+
+
+def test_scale_up_beats_both_baselines_and_is_deterministic():
+    model, ref = random_reference(np.random.default_rng(11), "120kg")
+    a = transfer(model, ref, "120kg", "360kg")
+    b = transfer(model, ref, "120kg", "360kg")
+    assert a.program_csv_text() == b.program_csv_text()
+    m = a.metrics
+    assert m["rmse_C"] <= 0.5 and m["max_abs_C"] <= 2.0
+    better = min(m["baseline_same_inputs"]["rmse_C"], m["baseline_retimed"]["rmse_C"])
+    assert better >= 5 * m["rmse_C"]
+
+
+def test_unreachable_target_returns_the_best_program_and_says_why():
+    model, ref = random_reference(np.random.default_rng(4), "120kg")
+    r = transfer(model, ref, "120kg", "360kg", limits=ProgramLimits(150.0, 330.0, 120.0))
+    m = r.metrics
+    assert not m["feasible"] and m["max_abs_C"] > 2.0
+    assert any("330 degC ceiling" in s["limit"] for s in m["on_limits"])
+    assert any("ceiling" in line and "cannot heat that fast" in line for line in m["explanation"])
+    assert r.program.Tgi_C.max() <= 330.0 + 1e-9
+
+
+def test_limit_spans_name_levels_and_rates():
+    t = np.arange(0.0, 60.0, 5.0)
+    u = np.array([150, 150, 160, 170, 180, 180, 180, 550, 550, 550, 540, 540], dtype=float)
+    spans = limit_spans(t, u, ProgramLimits(150.0, 550.0, 120.0))
+    names = {s["limit"] for s in spans}
+    assert "Tgi at its 150 degC floor" in names and "Tgi at its 550 degC ceiling" in names
+    assert "Tgi rising at its 120 degC/min rate limit" in names  # 10 degC per 5 s = 120 degC/min
+
+
+def test_cli_program_file_reproduces_with_simulate_and_alog_loads(cli, tmp_path):
+    model, ref = random_reference(np.random.default_rng(5), "120kg")
+    model.save(tmp_path / "model.json")
+    write_batch_csv(tmp_path / "ref.csv", ref, comment="SYNTHETIC reference for a test")
+    before = (tmp_path / "ref.csv").read_bytes()
+    code, out, err = cli(
+        "transfer", "--model", f"{tmp_path}/model.json", "--from", "120kg", "--to", "120kg",
+        "--batch-kg", "84", "--reference", f"{tmp_path}/ref.csv", "--out", f"{tmp_path}/prog.csv",
+        "--json", f"{tmp_path}/m.json", "--alog", f"{tmp_path}/bg.alog", "--plot", f"{tmp_path}/t.png", "--tm0", "free",
+    )  # fmt: skip
+    assert code == 0, err
+    assert "feasible" in out and (tmp_path / "ref.csv").read_bytes() == before
+    m = json.loads((tmp_path / "m.json").read_text())
+    for key in ("rmse_C", "max_abs_C", "feasible", "solve_s", "baseline_same_inputs", "baseline_retimed", "on_limits"):
+        assert key in m
+    assert m["rmse_C"] <= 0.5 and m["batch_kg"] == 84.0
+    prog = read_batch_csv(tmp_path / "prog.csv")
+    assert prog.Mb_kg == 84.0 and "Tm0_C" in prog.initial and "Ta0_C" in prog.initial
+    code, _, err = cli(
+        "simulate", "--model", f"{tmp_path}/model.json", "--plant", "120kg",
+        "--inputs", f"{tmp_path}/prog.csv", "--out", f"{tmp_path}/sim.csv",
+    )  # fmt: skip
+    assert code == 0, err
+    sim = pd.read_csv(tmp_path / "sim.csv", comment="#")
+    pred = pd.read_csv(tmp_path / "prog.csv", comment="#")
+    assert np.max(np.abs(sim["Ta_C"] - pred["Ta_pred_C"])) < 1e-3
+    # the background profile: a Python literal as Artisan writes it, read back by the importer
+    text = (tmp_path / "bg.alog").read_text()
+    profile = ast.literal_eval(text)
+    for key in ("timex", "temp1", "temp2", "timeindex", "specialevents", "specialeventstype", "specialeventsvalue",
+                "specialeventsStrings", "etypes", "mode", "samplinginterval", "weight", "title"):  # fmt: skip
+        assert key in profile
+    log = read_alog(tmp_path / "bg.alog")
+    np.testing.assert_allclose(log.channels["BT"], pred["Ta_pred_C"], atol=0.01)
+    assert "DROP" in log.events and np.isfinite(log.channels["Burner"]).any()
+    burner = log.channels["Burner"]
+    assert np.nanmin(burner) >= 0 and np.nanmax(burner) <= 100
+
+
+@pytest.mark.parametrize(
+    "extra, needle",
+    [
+        (["--tgi-min", "500", "--tgi-max", "400"], "inverted"),
+        (["--tgi-rate", "0"], "rate limit must be > 0"),
+        (["--interval-s", "200"], "shorter than two"),
+        (["--gg", "0.4", "--gg-min", "0.1", "--gg-max", "1"], "one or the other"),
+        (["--gg-min", "0.1"], "both Gg limits"),
+        (["--tm0", "hot"], "'free'"),
+        (["--tm0", "free", "--tm0-range", "300:100"], "LO < HI"),
+        (["--decide", "heater"], "heater setting"),
+    ],
+)
+def test_bad_transfer_input_is_one_line_and_exit_2(cli, tmp_path, extra, needle):
+    model, ref = random_reference(np.random.default_rng(6), "120kg", minutes=5.0)
+    model.save(tmp_path / "model.json")
+    write_batch_csv(tmp_path / "ref.csv", ref)
+    code, _, err = cli(
+        "transfer", "--model", f"{tmp_path}/model.json", "--reference", f"{tmp_path}/ref.csv",
+        "--out", f"{tmp_path}/p.csv", *extra,
+    )  # fmt: skip
+    assert code == 2 and err.count("\n") == 1 and "Traceback" not in err, err
+    assert needle in err, err
+    assert not (tmp_path / "p.csv").exists()
+
+
+def test_reference_without_probe_curve_is_refused(cli, tmp_path):
+    model, _ = random_reference(np.random.default_rng(6), "120kg", minutes=2.0)
+    model.save(tmp_path / "model.json")
+    (tmp_path / "ref.csv").write_text("time_s,Gg_kg_s,Tgi_C\n0,0.4,450\n60,0.4,450\n120,0.4,450\n")
+    code, _, err = cli(
+        "transfer",
+        "--model",
+        f"{tmp_path}/model.json",
+        "--reference",
+        f"{tmp_path}/ref.csv",
+        "--out",
+        f"{tmp_path}/p.csv",
+    )
+    assert code == 2 and "ref.csv" in err and "Ta_C" in err, err
