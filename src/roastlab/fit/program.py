@@ -196,6 +196,9 @@ def optimise_program(
         if tm0_bounds is not None:
             x = x0.copy()
             x[1] = z[j]
+        if which == 1:
+            x = x.copy()
+            x[5] = u[0]  # the heater's lag starts settled at the first setting, as the simulator does
         return u, tgi, q, gg, x
 
     cache: dict = {}

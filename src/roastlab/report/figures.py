@@ -285,8 +285,9 @@ def plot_transfer(r, path=None, outputs=None):
     span = lim.high - lim.low
     ax2.axhspan(lim.high, lim.high + 0.08 * span, color="tab:red", alpha=0.15, lw=0)
     ax2.axhspan(lim.low - 0.08 * span, lim.low, color="tab:red", alpha=0.15, lw=0, label="outside the limits")
-    for s in m["on_limits"]:
-        ax2.axvspan(s["from_s"] / 60.0, s["to_s"] / 60.0, color="tab:red", alpha=0.08, lw=0)
+    for j, s in enumerate(m["on_limits"]):
+        label = "program on a limit" if j == 0 else None
+        ax2.axvspan(s["from_s"] / 60.0, s["to_s"] / 60.0, color="tab:purple", alpha=0.10, lw=0, label=label)
     for name, inp in r.baseline_inputs.items():
         color, ls = styles[name]
         ax2.plot(t_min, inp, color=color, ls=ls, lw=1.0, label=name)
