@@ -278,6 +278,13 @@ def optimise_program(
     )
 
 
+def true_runs(mask) -> list[tuple[int, int]]:
+    """(first, last) index of each run of True in a boolean sequence."""
+    m = np.asarray(mask, dtype=bool)
+    edges = np.flatnonzero(np.diff(np.concatenate([[False], m, [False]]).astype(np.int8)))
+    return [(int(a), int(b) - 1) for a, b in zip(edges[0::2], edges[1::2])]
+
+
 def limit_spans(t, u, limits: ProgramLimits) -> list[dict]:
     """Time ranges where the program ``u`` sits on a limit: ``[{"limit", "from_s", "to_s"}, ...]``.
 
@@ -300,15 +307,7 @@ def limit_spans(t, u, limits: ProgramLimits) -> list[dict]:
     flags[f"{name} falling at its {limits.rate_per_min:g} {unit}/min rate limit"] = down
     spans = []
     for name, mask in flags.items():
-        k = 0
-        while k < len(mask):
-            if mask[k]:
-                j = k
-                while j + 1 < len(mask) and mask[j + 1]:
-                    j += 1
-                start = t[k - 1] if "rate" in name and k > 0 else t[k]
-                spans.append({"limit": name, "from_s": float(start), "to_s": float(t[j])})
-                k = j + 1
-            else:
-                k += 1
+        for k, j in true_runs(mask):
+            start = t[k - 1] if "rate" in name and k > 0 else t[k]
+            spans.append({"limit": name, "from_s": float(start), "to_s": float(t[j])})
     return sorted(spans, key=lambda s: s["from_s"])

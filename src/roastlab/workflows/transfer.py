@@ -20,7 +20,7 @@ import math
 import numpy as np
 
 from ..errors import InputError
-from ..fit.program import ProgramLimits, ProgramResult, limit_spans, optimise_program
+from ..fit.program import ProgramLimits, ProgramResult, limit_spans, optimise_program, true_runs
 from ..io.batch import Batch
 from ..model.limits import check_value
 from ..model.plant import Plant
@@ -439,26 +439,18 @@ def _explain(t, e, spans, tol, plant, mass, feasible) -> list[str]:
                 + "; ".join(f"{s['limit']} {_fmt_time(s['from_s'])}-{_fmt_time(s['to_s'])}" for s in spans)
             )
         return out
-    i = 0
-    while i < len(t):
-        if bad[i]:
-            j = i
-            while j + 1 < len(t) and bad[j + 1]:
-                j += 1
-            worst = int(i + np.argmax(np.abs(e[i : j + 1])))
-            side = "below" if e[worst] < 0 else "above"
-            active = [s for s in spans if s["from_s"] <= t[j] and s["to_s"] >= t[i] - 60.0]
-            why = (
-                "; ".join(f"{s['limit']} from {_fmt_time(s['from_s'])} to {_fmt_time(s['to_s'])}" for s in active)
-                if active
-                else "no limit active: the target's shape is not reachable with this model"
-            )
-            verb = "cannot heat that fast" if side == "below" else "cannot cool that fast"
-            out.append(
-                f"{_fmt_time(t[i])}-{_fmt_time(t[j])}: predicted BT up to {abs(e[worst]):.1f} °C {side} the target; "
-                f"{why}" + (f": the {mass:g} kg batch on {plant} {verb}" if active else "")
-            )
-            i = j + 1
-        else:
-            i += 1
+    for i, j in true_runs(bad):
+        worst = int(i + np.argmax(np.abs(e[i : j + 1])))
+        side = "below" if e[worst] < 0 else "above"
+        active = [s for s in spans if s["from_s"] <= t[j] and s["to_s"] >= t[i] - 60.0]
+        why = (
+            "; ".join(f"{s['limit']} from {_fmt_time(s['from_s'])} to {_fmt_time(s['to_s'])}" for s in active)
+            if active
+            else "no limit active: the target's shape is not reachable with this model"
+        )
+        verb = "cannot heat that fast" if side == "below" else "cannot cool that fast"
+        out.append(
+            f"{_fmt_time(t[i])}-{_fmt_time(t[j])}: predicted BT up to {abs(e[worst]):.1f} °C {side} the target; "
+            f"{why}" + (f": the {mass:g} kg batch on {plant} {verb}" if active else "")
+        )
     return out
