@@ -28,8 +28,8 @@ Figures (medians of repeated runs):
   to the program's, the slowest solve; and the speed-up over a generic solver on the same
   problem (120 -> 360 kg): SciPy ``minimize(method="L-BFGS-B")`` over the same knots with
   finite-difference gradients on a plain ``solve_ivp`` shooting run (the baseline above),
-  stopped after 3 iterations (about 550 simulations). It has not converged then (its RMSE is
-  reported), so the ratio of its time to the project's is a lower bound.
+  stopped after 400 simulations (about two gradients). It has not converged then (the best
+  RMSE it saw is reported), so the ratio of its time to the project's is a lower bound.
 """
 
 from __future__ import annotations
@@ -102,7 +102,7 @@ TRANSFER_CASES = (
 )
 
 
-def transfer_bench(quiet: bool = False, seed: int = 2026, scipy_iterations: int = 3) -> dict:
+def transfer_bench(quiet: bool = False, seed: int = 2026, scipy_simulations: int = 400) -> dict:
     """The transfer figures (see the module docstring)."""
     from scipy.optimize import minimize
 
@@ -147,24 +147,28 @@ def transfer_bench(quiet: bool = False, seed: int = 2026, scipy_iterations: int 
     p, x0 = res_b.params, res_b.states[0, :5].copy()
     t, target = grid.time_s, grid.Ta_C
     gg = r.program.Gg_kg_s
-    count = {"n": 0}
+    count = {"n": 0, "best": np.inf}
+
+    class _Budget(Exception):
+        pass
 
     def objective(tgi):
+        if count["n"] >= scipy_simulations:
+            raise _Budget
         count["n"] += 1
         ta = baseline_simulate(t, gg, tgi, x0, p)[:, 4]
-        return float(np.sum((ta - target) ** 2))
+        value = float(np.sum((ta - target) ** 2))
+        count["best"] = min(count["best"], value)
+        return value
 
-    _log(f"  generic solver: L-BFGS-B on solve_ivp shooting, {scipy_iterations} iterations ...", quiet)
+    _log(f"  generic solver: L-BFGS-B on solve_ivp shooting, {scipy_simulations} simulations ...", quiet)
     t0 = time.perf_counter()
-    sol = minimize(
-        objective,
-        np.clip(grid.Tgi_C, 150.0, 550.0),
-        method="L-BFGS-B",
-        bounds=[(150.0, 550.0)] * grid.n,
-        options={"maxiter": scipy_iterations},
-    )
+    try:
+        minimize(objective, np.clip(grid.Tgi_C, 150.0, 550.0), method="L-BFGS-B", bounds=[(150.0, 550.0)] * grid.n)
+    except _Budget:
+        pass
     scipy_s = time.perf_counter() - t0
-    scipy_rmse = float(np.sqrt(sol.fun / grid.n))
+    scipy_rmse = float(np.sqrt(count["best"] / grid.n))
     project_s = cases[0]["solve_s"]
     return {
         "cases": cases,
