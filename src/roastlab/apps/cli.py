@@ -167,12 +167,13 @@ def _read_inputs(path, map_path, model):
 
     if map_path:
         return load_log(path, map_path)
-    if (
-        model is not None
-        and model.column_map is not None
-        and Path(path).suffix.lower() in (".alog", ".json", ".parquet", ".pq")
-    ):
-        return load_log(path, model.column_map)
+    cmap = None if model is None else model.column_map
+    suffix = Path(path).suffix.lower()
+    raw_csv = suffix == ".csv" and cmap is not None and cmap.format in ("artisan-csv", "csv")
+    if raw_csv or suffix in (".alog", ".json", ".parquet", ".pq"):
+        if cmap is None:
+            raise InputError("a raw log needs a column map: the model has none, pass --map MAP.toml", path)
+        return load_log(path, cmap)
     return load_log(path)
 
 
@@ -231,27 +232,33 @@ def _parse_assignments(items, option: str, ranged: bool):
             raise InputError(
                 f"{option} expects NAME={'LO:HI' if ranged else 'VALUE'}, got {item[:60]!r}", "command line"
             )
+        if ranged:
+            out[name.strip()] = _range_arg(text, f"{option} {name[:30]}")
+            continue
         try:
-            if ranged:
-                lo, sep2, hi = text.partition(":")
-                if not sep2:
-                    raise ValueError
-                value = (float(lo), float(hi))
-            else:
-                value = (float(text),)
+            value = float(text)
         except (ValueError, OverflowError):
-            raise InputError(
-                f"{option} {name[:30]}: cannot read {text[:40]!r} as {'LO:HI' if ranged else 'a number'}",
-                "command line",
-            ) from None
-        if not all(math.isfinite(v) for v in value):
+            raise InputError(f"{option} {name[:30]}: cannot read {text[:40]!r} as a number", "command line") from None
+        if not math.isfinite(value):
             raise InputError(f"{option} {name[:30]}: values must be finite", "command line")
-        if ranged and not value[0] < value[1]:
-            raise InputError(
-                f"{option} {name}: inverted or empty bounds {value[0]:g}:{value[1]:g} (need LO < HI)", "command line"
-            )
-        out[name.strip()] = value if ranged else value[0]
+        out[name.strip()] = value
     return out
+
+
+def _range_arg(text: str, label: str) -> tuple[float, float]:
+    """``LO:HI`` as two finite floats with LO < HI; ``label`` names the option in errors."""
+    lo, sep, hi = text.partition(":")
+    try:
+        if not sep:
+            raise ValueError
+        value = (float(lo), float(hi))
+    except (ValueError, OverflowError):
+        raise InputError(f"{label}: cannot read {text[:40]!r} as LO:HI", "command line") from None
+    if not all(math.isfinite(v) for v in value):
+        raise InputError(f"{label}: values must be finite", "command line")
+    if not value[0] < value[1]:
+        raise InputError(f"{label}: inverted or empty bounds {value[0]:g}:{value[1]:g} (need LO < HI)", "command line")
+    return value
 
 
 def _load_batches(args, model=None):
@@ -518,10 +525,9 @@ def cmd_datasets(args) -> int:
 
 def cmd_whatif(args) -> int:
     from ..io.files import Outputs
-    from ..io.importers import load_map
     from ..io.modelfile import jsonable
     from ..report.figures import check_figure_path
-    from ..workflows.model import load_log, load_model
+    from ..workflows.model import load_model
     from ..workflows.whatif import parse_set, parse_setting_change, whatif
 
     outputs = Outputs([args.log, args.model, args.map])
@@ -542,10 +548,7 @@ def cmd_whatif(args) -> int:
 
         changes["batch_kg"] = check_value("batch_kg", args.batch_kg, "--batch-kg")
     model = load_model(args.model)
-    cmap = load_map(args.map) if args.map else model.column_map
-    if cmap is None and Path(args.log).suffix.lower() != ".csv":
-        raise InputError("a raw log needs a column map: the model has none, pass --map MAP.toml", args.log)
-    batch = load_log(args.log, cmap)
+    batch = _read_inputs(args.log, args.map, model)
     _say(batch.notes)
     result = whatif(model, batch, setting_changes, **changes)
     print(result.table())
@@ -557,25 +560,13 @@ def cmd_whatif(args) -> int:
     return 0
 
 
-def _range_arg(text: str, option: str) -> tuple[float, float]:
-    lo, sep, hi = text.partition(":")
-    try:
-        a, b = float(lo), float(hi)
-    except ValueError:
-        raise InputError(f"expected LO:HI, got {text!r}", option) from None
-    if not sep or not (math.isfinite(a) and math.isfinite(b)) or not a < b:
-        raise InputError(f"expected LO:HI with LO < HI, got {text!r}", option)
-    return a, b
-
-
 def cmd_transfer(args) -> int:
     from ..fit.program import ProgramLimits
     from ..io.files import Outputs
-    from ..io.importers import load_map
     from ..io.modelfile import jsonable
     from ..model.limits import check_value
     from ..report.figures import check_figure_path
-    from ..workflows.model import load_log, load_model
+    from ..workflows.model import load_model
     from ..workflows.transfer import transfer
 
     outputs = Outputs([args.reference, args.model, args.map, args.plant_from, args.plant_to])
@@ -589,10 +580,7 @@ def cmd_transfer(args) -> int:
             "--gg fixes the flow; --gg-min/--gg-max let the optimiser choose it: give one or the other", "command line"
         )
     model = load_model(args.model)
-    cmap = load_map(args.map) if args.map else model.column_map
-    if cmap is None and Path(args.reference).suffix.lower() != ".csv":
-        raise InputError("a raw log needs a column map: the model has none, pass --map MAP.toml", args.reference)
-    reference = load_log(args.reference, cmap)
+    reference = _read_inputs(args.reference, args.map, model)
     _say(reference.notes)
     initial = {}
     for opt, name in (("tb0", "Tb0_C"), ("x0", "X0")):
