@@ -92,14 +92,20 @@ class ProgramResult:
     time_s: np.ndarray
     Tgi_C: np.ndarray
     heater: np.ndarray  # zeros without the actuator extension
+    fan: np.ndarray  # as given (zeros without the actuator extension)
     Gg_kg_s: np.ndarray
-    Tm0_C: float
     Ta_pred_C: np.ndarray
-    states: np.ndarray  # (n, N_OUT) the model's run with the program
+    states: np.ndarray  # (n, N_OUT) the model's run with the program; row 0 is the charge state
+    params: np.ndarray  # the parameter vector the program is for
     solve_s: float
     iterations: int
     simulations: int
     notes: list[str] = field(default_factory=list)
+
+    @property
+    def Tm0_C(self) -> float:
+        """Drum temperature at CHARGE [degC] (chosen by the optimiser when it was a decision)."""
+        return float(self.states[0, 1])
 
 
 def _run(t, Gg, Tgi, Q, F, x0, p, zoh):
@@ -202,6 +208,7 @@ def optimise_program(
         return u, tgi, q, gg, x
 
     cache: dict = {}
+    lower = np.tril(np.ones((n, n)))  # d u_k / d z_j = 1 for j <= k
 
     def simulate(z):
         key = z.tobytes()
@@ -232,7 +239,7 @@ def optimise_program(
         # Tgi_k = sum_{j <= k} z_j: a column j of the tracking block is the sum of columns k >= j
         J[:n, :n] = w[:, None] * np.cumsum(jt[:, ::-1], axis=1)[:, ::-1]
         active = ((u > hi_T) | (u < lo_T)).astype(float)
-        J[n : 2 * n, :n] = LEVEL_PENALTY * np.tril(np.ones((n, n))) * active[:, None]
+        J[n : 2 * n, :n] = LEVEL_PENALTY * lower * active[:, None]
         J[2 * n :, 1:n] = smoothness * np.eye(n - 1)
         j = n
         for name in extra_names:
@@ -267,10 +274,11 @@ def optimise_program(
         time_s=t,
         Tgi_C=np.array(tgi),
         heater=np.array(q),
+        fan=F,
         Gg_kg_s=np.array(gg, dtype=np.float64),
-        Tm0_C=float(x[1]),
         Ta_pred_C=out[:, 4].copy(),
         states=out,
+        params=p,
         solve_s=time.perf_counter() - t0_clock,
         iterations=int(sol.nfev),
         simulations=counter["sims"],

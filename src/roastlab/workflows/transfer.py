@@ -24,6 +24,7 @@ from ..fit.program import ProgramLimits, ProgramResult, limit_spans, optimise_pr
 from ..io.batch import Batch
 from ..model.limits import check_value
 from ..model.plant import Plant
+from .whatif import crossing_time_s
 
 #: Probe temperatures [degC] whose crossing times define the phases of the retimed baseline:
 #: end of drying (~150 degC, Artisan's DRY) and start of first crack (~196 degC, FCs).
@@ -35,19 +36,11 @@ def _fmt_time(s: float) -> str:
     return f"{s // 60}:{s % 60:02d}"
 
 
-def _crossing(t, y, level, after):
-    """First time after ``after`` [s] at which ``y`` rises through ``level`` (interpolated)."""
-    idx = np.flatnonzero((y[:-1] < level) & (y[1:] >= level) & (t[:-1] >= after))
-    if idx.size == 0:
-        return None
-    i = int(idx[0])
-    return float(t[i] + (level - y[i]) * (t[i + 1] - t[i]) / (y[i + 1] - y[i]))
-
-
-def _crossing_or_projected(t, y, level, after, window_s: float = 120.0):
-    """:func:`_crossing`, or when ``y`` never gets there, the time it would at the rate of rise
-    of its last ``window_s`` seconds (what a person reads off a curve that stops short)."""
-    hit = _crossing(t, y, level, after)
+def _crossing_or_projected(t, y, level, window_s: float = 120.0):
+    """:func:`~roastlab.workflows.whatif.crossing_time_s`, or when ``y`` never gets there, the time
+    it would at the rate of rise of its last ``window_s`` seconds (what a person reads off a
+    curve that stops short)."""
+    hit = crossing_time_s(t, y, level)
     if hit is not None:
         return hit
     k = int(np.searchsorted(t, t[-1] - window_s))
@@ -79,7 +72,6 @@ class TransferResult:
     baselines: dict  # name -> predicted Ta on B [degC]
     baseline_inputs: dict  # name -> the decided input's program [u units]
     metrics: dict
-    initial: dict  # the charge state on B: Tb0_C, Tm0_C, X0, Ta0_C
     model_fits_flow: bool = False
     actuators: bool = False
 
@@ -122,17 +114,16 @@ class TransferResult:
         if self.model_fits_flow:
             out.write("## Gg_kg_s is the model's placeholder: the flow is the model's fitted Gg_kg_s\n")
         out.write(f"# Mb_kg = {self.batch_kg:.6g}\n")
-        for key in ("Tm0_C", "Tb0_C", "X0", "Ta0_C"):
-            v = pr.Tm0_C if key == "Tm0_C" else self.initial[key]
-            out.write(f"# {key} = {v:.10g}\n")
+        x0 = pr.states[0]  # the charge state the program was optimised for (Tm0 possibly chosen)
+        for key, j in (("Tm0_C", 1), ("Tb0_C", 0), ("X0", 2), ("Ta0_C", 4)):
+            out.write(f"# {key} = {x0[j]:.10g}\n")
         cols = ["time_s", "Gg_kg_s", "Tgi_C"] + (["heater", "fan"] if self.actuators else []) + ["Ta_pred_C"]
         out.write(",".join(cols) + "\n")
-        fan = self.initial.get("_fan")
         for i, t in enumerate(pr.time_s):
             gg = 1.0 if self.model_fits_flow else pr.Gg_kg_s[i]
             vals = [f"{t:.6g}", f"{gg:.10g}", f"{pr.Tgi_C[i]:.10g}"]
             if self.actuators:
-                vals += [f"{pr.heater[i]:.10g}", f"{(fan[i] if fan is not None else 0.0):.10g}"]
+                vals += [f"{pr.heater[i]:.10g}", f"{pr.fan[i]:.10g}"]
             vals.append(f"{pr.Ta_pred_C[i]:.6f}")
             out.write(",".join(vals) + "\n")
         return out.getvalue()
@@ -211,7 +202,7 @@ class TransferResult:
         plot_transfer(self, path, outputs=outputs)
 
 
-def grid_batch(ref: Batch, interval_s: float) -> Batch:
+def _grid_batch(ref: Batch, interval_s: float) -> Batch:
     """The reference on the program's knots: inputs and probe interpolated, settings held."""
     t_end = float(ref.time_s[-1])
     t = np.arange(0.0, t_end + 1e-9, interval_s) + float(ref.time_s[0])
@@ -306,7 +297,7 @@ def transfer(
         if batch_kg is not None
         else (mass_a if same_plant else pb.Mb_kg)
     )
-    grid = grid_batch(reference, interval_s)
+    grid = _grid_batch(reference, interval_s)
     ta0 = float(grid.Ta_C[0])
     changes = dict(initial or {})
     changes["Ta0_C"] = ta0
@@ -349,13 +340,11 @@ def transfer(
 
     # baseline 2: A's inputs retimed by the phase times baseline 1 gives on B
     t = grid.time_s
-    tp = float(t[int(np.argmin(target))])
-    levels = [lv for lv in PHASE_LEVELS_C if _crossing(t, target, lv, tp) is not None]
+    levels = [lv for lv in PHASE_LEVELS_C if crossing_time_s(t, target, lv) is not None]
     if not levels:  # a light or short roast: the level 80 % of the way from the turning point to DROP
         levels = [float(np.min(target) + 0.8 * (target[-1] - np.min(target)))]
-    marks_ref = [_crossing(t, target, lv, tp) for lv in levels]
-    tp_same = float(t[int(np.argmin(res_same.Ta_C))])
-    marks_same = [_crossing_or_projected(t, res_same.Ta_C, lv, tp_same) for lv in levels]
+    marks_ref = [crossing_time_s(t, target, lv) for lv in levels]
+    marks_same = [_crossing_or_projected(t, res_same.Ta_C, lv) for lv in levels]
     pairs = [(a, b) for a, b in zip(marks_ref, marks_same) if b is not None]
     decided = res_a.Tgi_C if limits.decide == "Tgi" else grid.heater
     retimed, used = _retime(t, decided, [a for a, _ in pairs], [b for _, b in pairs])
@@ -409,7 +398,6 @@ def transfer(
         "explanation": explanation,
         "notes": list(res_same.meta.get("notes", [])) + program.notes,
     }
-    init = {"Tb0_C": float(x0[0]), "X0": float(x0[2]), "Ta0_C": float(x0[4]), "_fan": grid.fan}
     return TransferResult(
         reference=reference.name,
         plant_from=pa.name,
@@ -422,7 +410,6 @@ def transfer(
         baselines={"A's inputs unchanged": res_same.Ta_C, "A's inputs retimed": ta_ret},
         baseline_inputs={"A's inputs unchanged": decided, "A's inputs retimed": retimed},
         metrics=metrics,
-        initial=init,
         model_fits_flow=fits_flow,
         actuators=grid.heater is not None or grid.fan is not None,
     )
