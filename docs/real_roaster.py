@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 import roastlab
+from roastlab.evaluate.metrics import average_metrics
 from roastlab.fit.baseline import describe, fit_first_order, validate_first_order
 from roastlab.io.fitspec import load_fit_spec
 from roastlab.io.importers.mapping import load_map
@@ -37,7 +38,8 @@ def load(paths, column_map):
 
 
 def mean(rows, key):
-    return float(np.mean([r[key] for r in rows]))
+    """The batches' mean of one metric (evaluate.metrics.average_metrics, the paper's Average row)."""
+    return average_metrics(rows)[key]
 
 
 def machine(title, example, paths, lines):
