@@ -18,6 +18,17 @@ from roastlab.sim.sensitivity import ta_input_jacobian
 from roastlab.workflows.transfer import transfer
 
 
+def assert_simulates_back(cli, model_path, program_path, ta_pred):
+    """``roastlab simulate`` of PROGRAM.csv on the 120 kg plant gives the program's predicted BT."""
+    out = program_path.with_name("sim.csv")
+    code, _, err = cli(
+        "simulate", "--model", str(model_path), "--plant", "120kg", "--inputs", str(program_path), "--out", str(out)
+    )
+    assert code == 0, err
+    sim = pd.read_csv(out, comment="#")
+    assert np.max(np.abs(sim["Ta_C"] - np.asarray(ta_pred))) < 1e-3
+
+
 @pytest.mark.parametrize("zoh, which", [(False, 0), (True, 0), (False, 1)])
 def test_restarting_jacobian_matches_full_reruns(zoh, which):
     """Each column restarts from the stored state; a full re-run from CHARGE must agree."""
@@ -102,14 +113,8 @@ def test_cli_program_file_reproduces_with_simulate_and_alog_loads(cli, tmp_path)
     assert m["rmse_C"] <= 0.5 and m["batch_kg"] == 84.0
     prog = read_batch_csv(tmp_path / "prog.csv")
     assert prog.Mb_kg == 84.0 and "Tm0_C" in prog.initial and "Ta0_C" in prog.initial
-    code, _, err = cli(
-        "simulate", "--model", f"{tmp_path}/model.json", "--plant", "120kg",
-        "--inputs", f"{tmp_path}/prog.csv", "--out", f"{tmp_path}/sim.csv",
-    )  # fmt: skip
-    assert code == 0, err
-    sim = pd.read_csv(tmp_path / "sim.csv", comment="#")
     pred = pd.read_csv(tmp_path / "prog.csv", comment="#")
-    assert np.max(np.abs(sim["Ta_C"] - pred["Ta_pred_C"])) < 1e-3
+    assert_simulates_back(cli, tmp_path / "model.json", tmp_path / "prog.csv", pred["Ta_pred_C"])
     # the background profile: a Python literal as Artisan writes it, read back by the importer
     text = (tmp_path / "bg.alog").read_text()
     profile = ast.literal_eval(text)
@@ -184,10 +189,4 @@ def test_heater_program_on_a_heated_drum_reproduces_and_simulates_back(cli, tmp_
     assert np.all(np.abs(np.diff(r.program.heater)) <= 5.0 + 1e-9)  # 60 per min = 5 per 5 s
     model.save(tmp_path / "m.json")
     (tmp_path / "prog.csv").write_text(r.program_csv_text())
-    code, _, err = cli(
-        "simulate", "--model", f"{tmp_path}/m.json", "--plant", "120kg",
-        "--inputs", f"{tmp_path}/prog.csv", "--out", f"{tmp_path}/sim.csv",
-    )  # fmt: skip
-    assert code == 0, err
-    sim = pd.read_csv(tmp_path / "sim.csv", comment="#")
-    assert np.max(np.abs(sim["Ta_C"] - r.program.Ta_pred_C)) < 1e-3
+    assert_simulates_back(cli, tmp_path / "m.json", tmp_path / "prog.csv", r.program.Ta_pred_C)
