@@ -15,6 +15,7 @@ import subprocess
 import sys
 import textwrap
 
+import numpy as np
 import pytest
 
 from roastlab.io.files import CONFIG_MAX_BYTES, MAX_INPUT_BYTES
@@ -75,8 +76,59 @@ def _alog_strings(limit):
     )
 
 
+def _roastime_series(limit):
+    """A RoasTime log whose two temperature series fill the size limit."""
+    n = (limit - 300) // (2 * len("150.5,"))
+    temps = ",".join(["150.5"] * n)
+    head = f'{{"sampleRate": 2, "weightGreen": "500", "roastStartIndex": 0, "roastEndIndex": {n}, '
+    return head + f'"beanTemperature": [{temps}], "drumTemperature": [{temps}]}}'
+
+
+def _roastime_actions(limit):
+    """A RoasTime log of a few samples and as many operator actions as fit (one object each)."""
+    return _fill(
+        '{"sampleRate": 2, "weightGreen": 500, "beanTemperature": [20, 21, 22], "actions": {"actionTimeList": [',
+        '{"ctrlType":0,"index":1,"value":5}',
+        ",",
+        "]}}",
+        limit,
+    )
+
+
+def _parquet(path):
+    """A Parquet log declaring the largest accepted row count (compressible columns: the file is small
+    but decodes to the most memory any accepted Parquet file can)."""
+    pa = pytest.importorskip("pyarrow")
+    pq = pytest.importorskip("pyarrow.parquet")
+    from roastlab.io.importers.mapping import MAX_PARQUET_ROWS
+
+    n = MAX_PARQUET_ROWS
+    time = np.arange(n, dtype=float) * 0.04  # 2 million samples within a day
+    table = pa.table({"t": time, "bt": np.full(n, 150.0), "et": np.full(n, 300.0), "flow": np.full(n, 0.01)})
+    pq.write_table(table, path)
+    return n
+
+
 CASES = {
     # name: (file name, text builder, loader source run in the child)
+    "Aillio RoasTime JSON (series)": (
+        "series.json",
+        lambda: _roastime_series(MAX_INPUT_BYTES),
+        "from roastlab.io.importers.roastime import read_roastime as load",
+    ),
+    "Aillio RoasTime JSON (actions)": (
+        "actions.json",
+        lambda: _roastime_actions(MAX_INPUT_BYTES),
+        "from roastlab.io.importers.roastime import read_roastime as load",
+    ),
+    "Parquet log at the row limit (import)": (
+        "big.parquet",
+        _parquet,
+        "from roastlab.io.importers.mapping import import_log, map_from_mapping\n"
+        "MAP = {'format': 'parquet', 'time': {'column': 't'}, 'Ta': {'column': 'bt'}, 'Tgi': {'column': 'et'},"
+        " 'Gg': {'column': 'flow'}}\n"
+        "load = lambda p: import_log(p, map_from_mapping(MAP, 'map'))",
+    ),
     "batch CSV": (
         "big.csv",
         lambda: _rows("time_s,Gg_kg_s,Tgi_C,Ta_C\n", lambda i: f"{i / 20:.2f},0.4,400,30\n", MAX_INPUT_BYTES),
@@ -157,12 +209,16 @@ CHILD = textwrap.dedent(
 @pytest.mark.parametrize("case", sorted(CASES))
 def test_largest_accepted_input_parses_in_bounded_memory(case, tmp_path):
     name, build, loader = CASES[case]
-    text = build()
     path = tmp_path / name
-    path.write_text(text)
-    size = path.stat().st_size
-    limit = CONFIG_MAX_BYTES if name.endswith(".toml") else MAX_INPUT_BYTES
-    assert limit * 0.9 < size <= limit, (case, size)  # the case really is at the limit
+    if name.endswith(".parquet"):  # limited by its declared rows, not its (compressed) bytes
+        build(path)
+        size = path.stat().st_size
+        assert size <= MAX_INPUT_BYTES
+    else:
+        path.write_text(build())
+        size = path.stat().st_size
+        limit = CONFIG_MAX_BYTES if name.endswith(".toml") else MAX_INPUT_BYTES
+        assert limit * 0.9 < size <= limit, (case, size)  # the case really is at the limit
     proc = subprocess.run(
         [sys.executable, "-c", CHILD.format(loader=loader, cap=ADDRESS_SPACE_CAP), str(path)],
         capture_output=True,
