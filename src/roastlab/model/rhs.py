@@ -27,6 +27,7 @@ With the gains and U_shell at their default 0 and no heater input the model is t
 from __future__ import annotations
 
 import math
+import types
 
 import numpy as np
 from numba.extending import register_jitable
@@ -86,6 +87,17 @@ GG_MIN_KG_S = 1e-6
 _A0, _A1, _A2, _A3, _A4, _A5, _A6 = CG_ALPHA_J_KG_K
 KELVIN = 273.15
 
+# The elementary operations of the right-hand side, by name, so that :func:`rebind` can evaluate
+# the same equations with other number types (CasADi symbols for the control baseline).
+exp = math.exp
+fmax = max
+
+
+@register_jitable
+def where(condition, a, b):
+    """``a`` where ``condition`` holds, else ``b`` (a branch that symbolic types can also take)."""
+    return a if condition else b
+
 
 @register_jitable
 def gas_heat_capacity_kJ_kgK(Tgi_C):
@@ -103,7 +115,7 @@ def gas_heat_capacity_kJ_kgK(Tgi_C):
 @register_jitable
 def bean_heat_transfer_coefficient_kW_m2K(X):
     """Gas-to-bean coefficient he [kW/(m^2 K)] at moisture X [kg/kg dry] (eq. 3)."""
-    return 0.49 - 0.443 * math.exp(-0.206 * X)
+    return 0.49 - 0.443 * exp(-0.206 * X)
 
 
 @register_jitable
@@ -133,13 +145,13 @@ def gas_inputs(Gg, Tgi, H, fan, p):
     temperature plus the lagged heater's rise. Both reduce to (Gg, Tgi) in the paper's model.
     """
     g = Gg * p[I_GGS] + p[I_GGF] * fan
-    return max(g, GG_MIN_KG_S), Tgi + p[I_TGIG] * H
+    return fmax(g, GG_MIN_KG_S), Tgi + p[I_TGIG] * H
 
 
 @register_jitable
 def heater_power_kW(H, p):
     """Heat into the drum metal Qe = Qe_offset + Qe_gain H [kW], never negative (eq. 12's Qe)."""
-    return max(p[I_QEO] + p[I_QEG] * H, 0.0)
+    return fmax(p[I_QEO] + p[I_QEG] * H, 0.0)
 
 
 @register_jitable
@@ -168,7 +180,7 @@ def heat_flows(Tb, Tm, X, Gg, Tgi, p):
     F = conductance_ratio_F(p[I_HGM], p[I_AGM], he, Agb)  # eq. 6
     T_star = (Tb + F * Tm) / (1.0 + F)  # eq. 5/15e: mean sink temperature
     NTU = he * Agb * (1.0 + F) / (Gg * cg)  # eq. 15e
-    drop = (Tgi - T_star) * (1.0 - math.exp(-NTU))  # eq. 15e: Tgi - Tgo
+    drop = (Tgi - T_star) * (1.0 - exp(-NTU))  # eq. 15e: Tgi - Tgo
     Qgb = Gg * cg * drop  # eq. 9
     Qgm = F * (he * Agb * (Tb - Tm) + Qgb) / (1.0 + F)  # eq. 10
     Qbm = p[I_HBM] * Abm * (Tm - Tb)  # eq. 11
@@ -178,17 +190,16 @@ def heat_flows(Tb, Tm, X, Gg, Tgi, p):
 @register_jitable
 def moisture_rate_1_s(Tb, X, p):
     """dX/dt [1/s] (eqs. 13, 15c); zero once X reaches 0 so X never goes negative."""
-    if X <= 0.0:
-        return 0.0
     Xn = X * X if p[I_XEXP] == 2.0 else X ** p[I_XEXP]
-    return -p[I_K1] * Xn / (p[I_DB] * p[I_DB]) * math.exp(-p[I_K2] / (Tb + KELVIN))
+    rate = -p[I_K1] * Xn / (p[I_DB] * p[I_DB]) * exp(-p[I_K2] / (Tb + KELVIN))
+    return where(X > 0.0, rate, 0.0)
 
 
 @register_jitable
 def reaction_heat_rate_kW_kg(Tb, He, p):
     """Exothermic heat production Qr = dHe/dt [kW/kg dry] (eqs. 14, 15d)."""
     Het = p[I_HET]
-    return p[I_A] * (Het - He) / Het * math.exp(-p[I_HAR] / (Tb + KELVIN))
+    return p[I_A] * (Het - He) / Het * exp(-p[I_HAR] / (Tb + KELVIN))
 
 
 @register_jitable
@@ -245,6 +256,31 @@ def rhs(t, x, u, p):
     for i in range(x.shape[0]):
         out[i] = d[i]
     return out
+
+
+def rebind(**operations) -> types.SimpleNamespace:
+    """This module's equations evaluated with other elementary operations: the one right-hand side
+    for other number types, never a copy of it.
+
+    ``operations`` replace ``exp``, ``fmax`` and ``where`` (e.g. ``casadi.exp``, ``casadi.fmax``,
+    ``casadi.if_else``). Returns a namespace of every function of this module rebuilt over those
+    operations (``derivatives``, ``heat_flows`` ...); the parameter vector stays numeric.
+
+    >>> ns = rebind(exp=lambda v: 1.0)  # a toy "number type": exp is 1 everywhere
+    >>> ns.bean_heat_transfer_coefficient_kW_m2K(0.1) == 0.49 - 0.443
+    True
+    """
+    unknown = sorted(set(operations) - {"exp", "fmax", "where"})
+    if unknown:
+        raise ParameterError(f"unknown operation(s) {', '.join(unknown)} (allowed: exp, fmax, where)")
+    namespace = dict(globals())
+    namespace.update(operations)
+    functions = {}
+    for name, value in list(namespace.items()):
+        if isinstance(value, types.FunctionType) and value.__module__ == __name__ and name not in operations:
+            functions[name] = types.FunctionType(value.__code__, namespace, name, value.__defaults__)
+    namespace.update(functions)
+    return types.SimpleNamespace(**functions)
 
 
 def pack_params(plant, theta, X0: float = 0.1, moisture: str = "schwartzberg") -> np.ndarray:
