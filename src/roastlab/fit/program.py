@@ -128,6 +128,8 @@ def optimise_program(
     smoothness: float = SMOOTHNESS,
     weights=None,
     max_iterations: int = 60,
+    u_prev: float | None = None,
+    Tgi_bias_C: float = 0.0,
 ) -> ProgramResult:
     """The program of one input (Tgi or the heater, ``limits.decide``; optionally also a constant
     Gg and the drum start temperature) whose simulated probe follows ``target_C`` on ``t`` [s].
@@ -147,6 +149,12 @@ def optimise_program(
     tm0_bounds : (lo, hi) [degC] to make the drum temperature at CHARGE a decision
     smoothness : weight lam on the program's increments (see the module docstring)
     weights : (n,) weight of each knot's tracking error (default 1)
+    max_iterations : most residual evaluations of the solver (a warm-started receding-horizon
+        step needs a few; a transfer from scratch tens)
+    u_prev : the decided input applied just before ``t[0]`` (receding-horizon control): the
+        rate limit then also holds between it and the first knot, over ``t[1] - t[0]``
+    Tgi_bias_C : an inlet-temperature offset the model sees on top of ``Tgi_C`` [degC] (an
+        estimated disturbance; the decided program and its limits exclude it)
     """
     t0_clock = time.perf_counter()
     t = np.ascontiguousarray(t, dtype=np.float64)
@@ -166,15 +174,23 @@ def optimise_program(
     step_max = limits.rate_per_min / 60.0 * dt
     lo_T, hi_T = limits.low, limits.high
 
+    # the first knot's range: the level limits, and the rate limit from the input applied before
+    first_lo, first_hi = lo_T, hi_T
+    if u_prev is not None:
+        first_lo = min(max(lo_T, u_prev - step_max[0]), hi_T)
+        first_hi = max(min(hi_T, u_prev + step_max[0]), lo_T)
+        if first_hi - first_lo < 1e-9 * (hi_T - lo_T):  # the solver needs an interval, not a point
+            first_lo, first_hi = first_lo - 1e-9 * (hi_T - lo_T), first_hi + 1e-9 * (hi_T - lo_T)
     # start: the given program made feasible (levels clipped, then the rate limit walked forward)
     start = np.clip(T_in if which == 0 else Q, lo_T, hi_T)
+    start[0] = min(max(start[0], first_lo), first_hi)
     for k in range(1, n):
         start[k] = start[k - 1] + np.clip(start[k] - start[k - 1], -step_max[k - 1], step_max[k - 1])
     Gg0 = np.ascontiguousarray(Gg_kg_s, dtype=np.float64)
     extra_names: list[str] = []
     z0 = [start[0], *np.diff(start)]
-    lb = [lo_T, *(-step_max)]
-    ub = [hi_T, *step_max]
+    lb = [first_lo, *(-step_max)]
+    ub = [first_hi, *step_max]
     if limits.gg_free:
         extra_names.append("Gg")
         g_start = float(np.clip(np.mean(Gg0), limits.Gg_min_kg_s, limits.Gg_max_kg_s))
@@ -193,6 +209,8 @@ def optimise_program(
     def unpack(z):
         u = np.cumsum(z[:n])
         tgi, q = (u, Q) if which == 0 else (T_in, u)
+        if Tgi_bias_C:
+            tgi = tgi + Tgi_bias_C
         gg = Gg0
         x = x0
         j = n
@@ -266,8 +284,8 @@ def optimise_program(
     )
     u, tgi, q, gg, x = unpack(sol.x)
     u = np.clip(u, lo_T, hi_T)  # keeps the rate limit (clipping is 1-Lipschitz)
-    tgi, q = (u, q) if which == 0 else (tgi, u)
-    out = _run(t, gg, tgi, q, F, x, p, zoh)
+    tgi, q = (u, q) if which == 0 else (T_in, u)
+    out = _run(t, gg, tgi + Tgi_bias_C if Tgi_bias_C else tgi, q, F, x, p, zoh)
     counter["sims"] += 1
     notes = [] if sol.success else [f"optimiser stopped: {sol.message}"]
     return ProgramResult(

@@ -62,6 +62,16 @@ LIMITS: dict[str, tuple[float, float, str, str]] = {
     "Kt": (1e-5, 10.0, "1/s", "bean-probe inverse time constant"),
     "mb": (1e-6, 1e-2, "kg", "mass of one bean"),
     "lam": (10.0, 1e4, "kJ/kg", "latent heat of vaporisation"),
+    # closed-loop scenarios (roastlab.io.scenario)
+    "mass_factor": (0.1, 5.0, "-", "batch mass over the reference's"),
+    "Gg_factor": (0.1, 5.0, "-", "gas flow the plant gets over the flow set"),
+    "theta_factor": (0.1, 10.0, "-", "plant coefficient over the controller model's"),
+    "Tb0_offset_C": (-300.0, 300.0, "degC", "bean charge temperature change"),
+    "Tm0_offset_C": (-500.0, 500.0, "degC", "drum temperature change at CHARGE"),
+    "noise_C": (0.0, 20.0, "degC", "probe noise (standard deviation)"),
+    "delay_s": (0.0, 120.0, "s", "probe reading delay"),
+    "sample_s": (0.1, 60.0, "s", "control interval"),
+    "rate_per_min": (1e-3, 1e5, "unit/min", "actuator rate limit"),
 }
 
 

@@ -24,7 +24,7 @@ from ..fit.program import ProgramLimits, ProgramResult, limit_spans, optimise_pr
 from ..io.batch import Batch
 from ..model.limits import check_value
 from ..model.plant import Plant
-from .whatif import crossing_time_s
+from .whatif import crossing_or_projected_s, crossing_time_s
 
 #: Probe temperatures [degC] whose crossing times define the phases of the retimed baseline:
 #: end of drying (~150 degC, Artisan's DRY) and start of first crack (~196 degC, FCs).
@@ -34,20 +34,6 @@ PHASE_LEVELS_C = (150.0, 196.0)
 def _fmt_time(s: float) -> str:
     s = int(round(s))
     return f"{s // 60}:{s % 60:02d}"
-
-
-def _crossing_or_projected(t, y, level, window_s: float = 120.0):
-    """:func:`~roastlab.workflows.whatif.crossing_time_s`, or when ``y`` never gets there, the time
-    it would at the rate of rise of its last ``window_s`` seconds (what a person reads off a
-    curve that stops short)."""
-    hit = crossing_time_s(t, y, level)
-    if hit is not None:
-        return hit
-    k = int(np.searchsorted(t, t[-1] - window_s))
-    ror = (y[-1] - y[k]) / max(t[-1] - t[k], 1e-9)
-    if ror <= 1e-6 or y[-1] >= level:
-        return None
-    return float(t[-1] + (level - y[-1]) / ror)
 
 
 def _errors(pred, target) -> dict:
@@ -344,7 +330,7 @@ def transfer(
     if not levels:  # a light or short roast: the level 80 % of the way from the turning point to DROP
         levels = [float(np.min(target) + 0.8 * (target[-1] - np.min(target)))]
     marks_ref = [crossing_time_s(t, target, lv) for lv in levels]
-    marks_same = [_crossing_or_projected(t, res_same.Ta_C, lv) for lv in levels]
+    marks_same = [crossing_or_projected_s(t, res_same.Ta_C, lv) for lv in levels]
     pairs = [(a, b) for a, b in zip(marks_ref, marks_same) if b is not None]
     decided = res_a.Tgi_C if limits.decide == "Tgi" else grid.heater
     retimed, used = _retime(t, decided, [a for a, _ in pairs], [b for _, b in pairs])
