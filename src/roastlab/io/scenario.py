@@ -145,9 +145,7 @@ def _table(data: dict, key: str, path) -> dict:
         raise InputError("must be a table", path, key)
     unknown = sorted(set(t) - KEYS[key])
     if unknown:
-        raise InputError(
-            f"unknown key(s) {', '.join(unknown)} (allowed: {', '.join(sorted(KEYS[key]))})", path, key
-        )
+        raise InputError(f"unknown key(s) {', '.join(unknown)} (allowed: {', '.join(sorted(KEYS[key]))})", path, key)
     return t
 
 
@@ -264,9 +262,7 @@ def scenario_from_mapping(data: dict, path: str | Path = "scenario") -> Scenario
         raise InputError("expected a TOML table", path)
     unknown = sorted(set(data) - KEYS[""])
     if unknown:
-        raise InputError(
-            f"unknown key(s) {', '.join(unknown)} (allowed: {', '.join(sorted(KEYS['']))})", path
-        )
+        raise InputError(f"unknown key(s) {', '.join(unknown)} (allowed: {', '.join(sorted(KEYS['']))})", path)
     name = _text(data.get("name", Path(str(path)).stem), path, "name", 80)
     return Scenario(
         name=name.strip() or "unnamed",

@@ -304,3 +304,112 @@ def plot_transfer(r, path=None, outputs=None):
     ax3.legend(loc="upper right", fontsize=7)
     ax3.grid(alpha=0.3)
     return _finish(fig, path, f"transfer: {r.reference}", outputs)
+
+
+def plot_closed_loop(r, path=None, title=None, outputs=None):
+    """One closed-loop roast: reference, the roaster's BT and what the controller read; the rate of
+    rise; the decided input (requested and applied, limits shaded); the drum temperature with the
+    estimator's view when there is one.
+
+    ``r`` is a :class:`roastlab.control.loop.ClosedLoopResult`.
+    """
+    t_min = r.time_s / 60.0
+    lim = r.setup.limits
+    m = r.metrics
+    fig = new_figure(figsize=(9, 9), layout="constrained")
+    ax, ax_r, ax_u, ax_m = fig.subplots(4, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1.3, 1.5, 1.3]})
+    ax.plot(t_min, r.reference_C, color="0.2", lw=2.4, label="reference BT")
+    ax.plot(t_min, r.measured_C, color="tab:gray", lw=0.8, alpha=0.7, label="probe as read by the controller")
+    ax.plot(t_min, r.bt_C, color="tab:blue", lw=1.6, label=f"roaster BT (RMSE {m['rmse_C']:.2f} °C)")
+    if "Tb_C_est" in r.estimates:
+        ax.plot(t_min, r.states[:, 0], color="tab:brown", lw=1.0, label="bean Tb (true)")
+        ax.plot(t_min, r.estimates["Tb_C_est"], color="tab:brown", lw=1.0, ls="--", label="bean Tb (estimated)")
+    ax.set_ylabel("temperature [°C]")
+    ax.legend(loc="lower right", fontsize=8)
+    ax.grid(alpha=0.3)
+    ax_r.plot(t_min, rate_of_rise_C_per_min(r.time_s, r.reference_C), color="0.2", lw=1.8, label="reference")
+    ax_r.plot(t_min, rate_of_rise_C_per_min(r.time_s, r.bt_C), color="tab:blue", lw=1.2, label="roaster")
+    ax_r.set_ylabel("RoR [°C/min]")
+    ax_r.legend(loc="upper right", fontsize=7)
+    ax_r.grid(alpha=0.3)
+    span = lim.high - lim.low
+    ax_u.axhspan(lim.high, lim.high + 0.08 * span, color="tab:red", alpha=0.15, lw=0)
+    ax_u.axhspan(lim.low - 0.08 * span, lim.low, color="tab:red", alpha=0.15, lw=0, label="outside the limits")
+    if r.setup.reference_u is not None:
+        ax_u.plot(r.setup.time_s / 60.0, r.setup.reference_u, color="0.5", lw=1.0, ls=":", label="reference's own")
+    ax_u.step(
+        t_min,
+        np.clip(r.u_requested, lim.low - 0.08 * span, lim.high + 0.08 * span),
+        where="post",
+        color="tab:orange",
+        lw=0.8,
+        alpha=0.8,
+        label=f"requested ({m['constraint_violations']} clipped)",
+    )
+    ax_u.step(t_min, r.u_applied, where="post", color="tab:blue", lw=1.4, label="applied")
+    ax_u.set_ylim(lim.low - 0.08 * span, lim.high + 0.08 * span)
+    ax_u.set_ylabel("Tgi [°C]" if lim.decide == "Tgi" else "heater setting")
+    ax_u.legend(loc="upper right", fontsize=7, ncol=2)
+    ax_u.grid(alpha=0.3)
+    ax_m.plot(t_min, r.states[:, 1], color="tab:red", lw=1.4, label="drum metal Tm (true)")
+    if "Tm_C_est" in r.estimates:
+        ax_m.plot(t_min, r.estimates["Tm_C_est"], color="tab:red", lw=1.0, ls="--", label="Tm estimated")
+    ax_m.set_ylabel("Tm [°C]")
+    ax_m.set_xlabel("time after CHARGE [min]")
+    ax_m.legend(loc="lower right", fontsize=7)
+    ax_m.grid(alpha=0.3)
+    title = title or f"{r.controller} on '{r.scenario}'"
+    return _finish(fig, path, title, outputs)
+
+
+def plot_control_comparison(rows, results, path=None, outputs=None):
+    """Every controller on every scenario: RMSE bars (the oracle's as a line when computed) and, below, each scenario's BT error over time per controller.
+
+    ``rows`` are the comparison's metric dicts, ``results`` {(scenario, controller): result}.
+    """
+    scenarios = list(dict.fromkeys(r["scenario"] for r in rows))
+    controllers = list(dict.fromkeys(r["controller"] for r in rows))
+    colors = {c: col for c, col in zip(controllers, ("tab:orange", "tab:blue", "tab:green", "tab:purple", "tab:red"))}
+    fig = new_figure(figsize=(11, 9), layout="constrained")
+    top, bottom = fig.subfigures(2, 1, height_ratios=[1.1, 2])
+    ax = top.subplots()
+    x = np.arange(len(scenarios))
+    w = 0.8 / max(1, len(controllers))
+    for j, c in enumerate(controllers):
+        vals = [
+            next((r["rmse_C"] for r in rows if r["scenario"] == s and r["controller"] == c), np.nan) for s in scenarios
+        ]
+        ax.bar(x + (j - (len(controllers) - 1) / 2) * w, vals, w, color=colors[c], label=c)
+    best = [next((r.get("oracle_rmse_C") for r in rows if r["scenario"] == s), None) for s in scenarios]
+    if any(b is not None for b in best):
+        ax.scatter(
+            x,
+            [np.nan if b is None else b for b in best],
+            marker="_",
+            s=600,
+            color="k",
+            zorder=3,
+            label="oracle (open-loop optimum, roaster known)",
+        )
+    ax.set_xticks(x, scenarios, rotation=20, ha="right", fontsize=8)
+    ax.set_ylabel("BT RMSE [°C]")
+    ax.set_yscale("symlog", linthresh=1.0)
+    ax.legend(fontsize=8, ncol=4)
+    ax.grid(alpha=0.3, axis="y")
+    ncol = 3
+    nrow = int(np.ceil(len(scenarios) / ncol))
+    axes = np.atleast_1d(bottom.subplots(nrow, ncol, sharex=True, sharey=True)).ravel()
+    for a, s in zip(axes, scenarios):
+        for c in controllers:
+            r = results.get((s, c))
+            if r is not None:
+                a.plot(r.time_s / 60.0, r.bt_C - r.reference_C, color=colors[c], lw=1.0, label=c)
+        a.axhline(0.0, color="0.3", lw=0.6)
+        a.set_title(s, fontsize=8)
+        a.grid(alpha=0.3)
+    for a in axes[len(scenarios) :]:
+        a.set_visible(False)
+    axes[0].legend(fontsize=7)
+    bottom.supylabel("BT - reference [°C]", fontsize=9)
+    bottom.supxlabel("time after CHARGE [min]", fontsize=9)
+    return _finish(fig, path, "closed-loop comparison (synthetic scenarios)", outputs)
