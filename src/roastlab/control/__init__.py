@@ -41,3 +41,7 @@ __all__ = [
     "compare",
     "standard_reference",
 ]
+
+from .environment import register as _register_environment
+
+_register_environment()

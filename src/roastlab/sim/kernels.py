@@ -217,3 +217,24 @@ def step_kernel(x, u0, u1, dt, p, zoh, h_max, h0):
     out = np.empty((2, N_OUT))
     h = integrate_into(t, g, T, q, f, 2, x, p, zoh, h_max, out, h0)
     return out[1, :NS].copy(), out[1, I_TGO], h
+
+
+@njit(cache=True, parallel=True)
+def step_population_kernel(X, U, PP, zoh, h_max, H, T2, UU, scratch):
+    """Advance many roasts by one interval of ``T2[1]`` seconds in one parallel call.
+
+    Roast i starts from state X[i] (length NS, overwritten with the state at the end) with the
+    inputs U[i] = [Gg, Tgi, heater, fan] held over the interval (``zoh``; a linear hold ramps
+    from the previous call's inputs, kept in UU[i, :, 1], to U[i]), parameter vector PP[i] and first trial step H[i] (overwritten
+    with the next). T2 (2,) = [0, interval]; UU (n, 4, 2) and scratch (n, 2, N_OUT) are caller-owned
+    work arrays, so a step allocates nothing per roast beyond the integrator's own.
+    """
+    for i in prange(X.shape[0]):
+        for j in range(4):
+            UU[i, j, 0] = U[i, j] if zoh else UU[i, j, 1]  # a linear hold ramps from the last inputs
+            UU[i, j, 1] = U[i, j]
+        H[i] = integrate_into(
+            T2, UU[i, 0], UU[i, 1], UU[i, 2], UU[i, 3], 2, X[i], PP[i], zoh, h_max, scratch[i], H[i], False
+        )
+        for k in range(NS):
+            X[i, k] = scratch[i, 1, k]
