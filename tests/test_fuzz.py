@@ -22,6 +22,7 @@ from roastlab.io.importers.mapping import map_from_mapping
 from roastlab.io.importers.roastime import read_roastime
 from roastlab.io.modelfile import read_model_document
 from roastlab.io.plants import load_plant
+from roastlab.io.scenario import load_scenario
 
 VALID = {
     ".csv": "# Mb_kg = 0.2\ntime_s,Gg_kg_s,Tgi_C,Ta_C\n0,0.4,450,30\n30,0.41,449,40\n60,0.4,447,55\n",
@@ -65,6 +66,8 @@ VALID = {
         }
     ),
     ".fit.toml": "[free]\nhgm = [0.001, 1.0, 0.02]\nTm0_C = { lower = 60, upper = 300, start = 170, per_batch = true }\n[fixed]\nKt = 0.02\n[initial]\nTb0_C = 22\n",
+    ".scenario.toml": 'name = "s"\n[plant]\nmass_factor = 1.2\nTm0_offset_C = -30\ntheta_factor = { hgm = 0.8 }\n'
+    "[sensor]\nnoise_C = 0.5\ndelay_s = 2\nseed = 7\n[actuator]\nTgi_min_C = 150\nTgi_max_C = 550\nsample_s = 5\n",
 }
 
 
@@ -146,6 +149,18 @@ KEYS = {
         for k in ("name", "Mb_kg", "Dch_m", "Lch_m", "Hflap_m", "Sflap_m", "Mm_kg")
     }
     | {"process": st.dictionaries(st.sampled_from(["A", "cm", "Kt", "Ha/R", "lambda", "warp"]), VALUES, max_size=3)},
+    ".scenario.toml": {
+        "name": VALUES,
+        "plant": st.dictionaries(
+            st.sampled_from(["mass_factor", "X0", "Tm0_C", "Tm0_offset_C", "Gg_factor", "theta", "warp"]),
+            VALUES,
+            max_size=3,
+        ),
+        "sensor": st.dictionaries(st.sampled_from(["noise_C", "delay_s", "seed", "warp"]), VALUES, max_size=3),
+        "actuator": st.dictionaries(
+            st.sampled_from(["decide", "Tgi_min_C", "Tgi_max_C", "sample_s", "heater_min", "warp"]), VALUES, max_size=3
+        ),
+    },
     ".fit.toml": {
         "free": st.dictionaries(st.sampled_from(["hgm", "Pbm", "Tm0_C", "Gg_kg_s", "warp"]), VALUES, max_size=3),
         "fixed": st.dictionaries(st.sampled_from(["Kt", "hbm", "warp"]), VALUES, max_size=2),
@@ -270,6 +285,7 @@ def run_loader(kind, data, loader):
             ".map.toml": ".toml",
             ".plant.toml": ".toml",
             ".fit.toml": ".toml",
+            ".scenario.toml": ".toml",
             ".roastime.json": ".json",
         }.get(kind, kind)
         path = Path(tmp) / f"fuzz{suffix}"
@@ -304,6 +320,7 @@ LOADERS = {
     ".plant.toml": [load_plant],
     ".json": [read_model_document],
     ".fit.toml": [load_fit_spec],
+    ".scenario.toml": [load_scenario],
     ".roastime.json": [read_roastime, lambda p: import_log(p, ROASTIME_MAP)],
 }
 

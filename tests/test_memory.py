@@ -170,6 +170,11 @@ CASES = {
         lambda: _fill('format = "auto"\nx = [', "1", ",", "]\n", CONFIG_MAX_BYTES),
         "from roastlab.io.importers import load_map as load",
     ),
+    "scenario TOML": (
+        "scenario.toml",
+        lambda: _fill("[plant]\ntheta = { ", "hgm = 1", ", ", " }\n", CONFIG_MAX_BYTES),
+        "from roastlab.io.scenario import load_scenario as load",
+    ),
     "plant TOML (many tables)": (
         "plant.toml",
         lambda: _rows('name = "x"\n', lambda i: f"[t{i}]\n", CONFIG_MAX_BYTES),

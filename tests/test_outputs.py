@@ -23,7 +23,7 @@ from test_bad_input import GOOD_ALOG, GOOD_ROWS, HEADER, PLANT
 OUTPUTS = {"--out", "--json", "--plot", "--predictions", "--save", "--alog"}
 #: Options that name a file or folder the command reads.
 INPUTS = {"--model", "--theta", "--plant", "--inputs", "--map", "--spec", "--data", "batches", "log", "plant"}
-INPUTS |= {"--from", "--to", "--reference"}
+INPUTS |= {"--from", "--to", "--reference", "--scenario", "--scenarios"}
 #: Options that take no path: numbers, names, choices and flags.
 VALUES = {
     "--tgi-offset",
@@ -64,24 +64,30 @@ VALUES = {
     "--interval-s",
     "--tolerance",
     "--only",
+    "--controller",
+    "--controllers",
+    "--oracle",
     "--help",
     "-h",
 }
 
 
 def subcommands(parser, prefix=()):
-    """(path of subcommand names, its parser) for every leaf subcommand."""
+    """(path of subcommand names, its parser) for every leaf subcommand, and for every command
+    whose subcommand is optional (``control`` runs alone or as ``control compare``)."""
     for action in parser._actions:
         if isinstance(action, argparse._SubParsersAction):
             for name, sub in action.choices.items():
                 yield from subcommands(sub, prefix + (name,))
-            return
+            if action.required:
+                return
     yield prefix, parser
 
 
 def option_names(parser):
     for action in parser._actions:
-        yield from (action.option_strings or [action.dest])
+        if not isinstance(action, argparse._SubParsersAction):  # subcommands are walked, not options
+            yield from (action.option_strings or [action.dest])
 
 
 def output_options(parser):
@@ -91,6 +97,10 @@ def output_options(parser):
             yield from (o for o in action.option_strings if o in OUTPUTS)
 
 
+#: A short reference roast for the control commands (time, inputs, BT).
+REF_CSV = "time_s,Gg_kg_s,Tgi_C,Ta_C\n" + "".join(
+    f"{t},0.4,{400 + t / 10:.1f},{30 + 0.15 * t:.2f}\n" for t in range(0, 301, 20)
+)
 SMALL_PLANT = "Mb_kg = 0.2\nDch_m = 0.16\nLch_m = 0.2\nHflap_m = 0.02\nSflap_m = 0.1\nMm_kg = 1.5\n"
 
 
@@ -120,6 +130,9 @@ def _inputs(d: Path) -> None:
     (d / "log.alog").write_text(GOOD_ALOG)
     (d / "map.toml").write_text('[Ta]\ncolumn = "BT"\n[Tgi]\ncolumn = "ET"\n[Gg]\nconstant_kg_s = 0.4\n')
     (d / "small.toml").write_text(SMALL_PLANT)
+    (d / "sc").mkdir()
+    (d / "sc" / "s.toml").write_text('name = "quick"\n[actuator]\nsample_s = 20.0\n')
+    (d / "ref.csv").write_text(REF_CSV)
     data = d / "data"
     for name in ("dataset-I", "dataset-V"):
         shutil.copytree(d / "ds", data / name)
@@ -164,6 +177,16 @@ RUNS = {
     ),
     ("import",): ("import {d}/log.alog --map {d}/map.toml --out {d}/b.csv", ["log.alog", "map.toml"]),
     ("datasets", "make-paper"): ("datasets make-paper --out {d}/synthetic", []),
+    ("control",): (
+        "control --model {d}/model.json --plant {d}/plant.toml --reference {d}/ref.csv --scenario {d}/sc/s.toml "
+        "--controller pid --out {d}/trace.csv --json {d}/m.json --plot {d}/c.png",
+        ["model.json", "plant.toml", "ref.csv", "sc/s.toml"],
+    ),
+    ("control", "compare"): (
+        "control compare --model {d}/model.json --plant {d}/plant.toml --reference {d}/ref.csv --scenarios {d}/sc "
+        "--controllers replay --json {d}/t.json --plot {d}/c.png",
+        ["model.json", "plant.toml", "ref.csv", "sc/s.toml"],
+    ),
 }
 
 PARSER = build_parser()
