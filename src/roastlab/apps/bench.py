@@ -60,6 +60,13 @@ TARGETS = {
     "scaling_spread": ("<=", 0.20),
     "peak_memory_MB": ("<=", 500.0),
     "cli_cold_s": ("<=", 3.0),
+    "mpc_step_median_ms": ("<=", 10.0),
+    "mpc_step_p99_ms": ("<=", 50.0),
+    "mpc_vs_casadi": (">=", 5.0),
+    "mpc_mean_rmse_C": ("<=", 1.0),
+    "mpc_over_pid_disturbed": ("<=", 0.5),
+    "gym_steps_per_s": (">=", 20_000.0),
+    "gym_vector_steps_per_s": (">=", 1_000_000.0),
 }
 
 
@@ -183,6 +190,87 @@ def transfer_bench(quiet: bool = False, seed: int = 2026, scipy_simulations: int
     }
 
 
+def _full_horizon_steps(result, horizon_s: float) -> np.ndarray:
+    """Step times [ms] of the steps with the whole horizon ahead, the first (compile, build) left out."""
+    keep = result.time_s <= result.setup.end_s - horizon_s
+    keep[0] = False
+    return result.step_ms[keep]
+
+
+def _steps_per_second(step, reset, seconds: float = 2.0) -> float:
+    reset()
+    n, t0 = 0, time.perf_counter()
+    while time.perf_counter() - t0 < seconds:
+        if step():
+            reset()
+        n += 1
+    return n / (time.perf_counter() - t0)
+
+
+def control_bench(quiet: bool = False, horizon_s: float = 300.0, sample_s: float = 10.0) -> dict:
+    """MPC against CasADi + IPOPT on the same problem (same run), the standard scenarios' RMSE for
+    MPC and PID, and the Gymnasium environments' step rates."""
+    from ..control import MPC, compare, run_closed_loop, standard_reference, standard_scenarios
+    from ..control.casadi_mpc import CasadiMPC
+    from ..io.scenario import scenario_from_mapping
+    from ..workflows.model import FittedModel
+
+    model = FittedModel.paper("120kg")
+    ref = standard_reference()
+    out: dict = {"horizon_s": horizon_s, "sample_s": sample_s}
+    nominal = scenario_from_mapping({"name": "nominal, 10 s", "actuator": {"sample_s": sample_s}}, "bench")
+    _log(f"MPC: nominal roast, {sample_s:g} s sample, {horizon_s:g} s horizon ...", quiet)
+    run_closed_loop(model, ref, MPC(horizon_s=horizon_s), nominal)  # compile
+    ours = run_closed_loop(model, ref, MPC(horizon_s=horizon_s), nominal)
+    _log("baseline: the same problem with CasADi + IPOPT (multiple shooting) ...", quiet)
+    base_ctrl = CasadiMPC(horizon_s=horizon_s)
+    base = run_closed_loop(model, ref, base_ctrl, nominal)
+    a, b = _full_horizon_steps(ours, horizon_s), _full_horizon_steps(base, horizon_s)
+    out["mpc"] = {
+        "step_ms_median": float(np.median(a)),
+        "step_ms_p99": float(np.percentile(a, 99)),
+        "rmse_C": ours.metrics["rmse_C"],
+        "steps_timed": int(a.size),
+    }
+    out["casadi"] = {
+        "step_ms_median": float(np.median(b)),
+        "step_ms_p99": float(np.percentile(b, 99)),
+        "rmse_C": base.metrics["rmse_C"],
+        "ipopt_failures": int(base_ctrl.failures),
+        "what": "CasADi nlpsol('ipopt'), multiple shooting, RK4 x2 per interval, the one RHS evaluated on SX symbols, "
+        "warm-started; same horizon, limits, weights and Kalman filter",
+    }
+    out["speedup_vs_casadi"] = out["casadi"]["step_ms_median"] / out["mpc"]["step_ms_median"]
+    _log("standard scenarios: PID and MPC ...", quiet)
+    cmp = compare(model, ref, standard_scenarios(), ("pid", "mpc"))
+    summary = cmp.summary()
+    out["scenarios"] = [
+        {k: r[k] for k in ("scenario", "controller", "rmse_C", "max_abs_C", "step_ms_median", "step_ms_p99")}
+        for r in cmp.rows
+    ]
+    out["mpc_mean_rmse_C"] = summary["mean_rmse_C"]["mpc"]
+    out["pid_mean_rmse_C"] = summary["mean_rmse_C"]["pid"]
+    out["mpc_over_pid_disturbed"] = summary["worst_ratio_to_pid_disturbed"]["mpc"]
+    _log("Gymnasium environments ...", quiet)
+    import gymnasium
+
+    from ..control.environment import RoastVectorEnv
+
+    env = gymnasium.make("roastlab/Roast-v0")
+    action = np.array([400.0], dtype=np.float32)
+    out["gym_steps_per_s"] = _steps_per_second(lambda: env.step(action)[3], lambda: env.reset(seed=0))
+    n_env = 4096
+    vec = RoastVectorEnv(n_env)
+    actions = np.full((n_env, 1), 400.0, dtype=np.float32)
+    vec.reset(seed=0)
+    vec.step(actions)  # compile
+    out["gym_vector_envs"] = n_env
+    out["gym_vector_steps_per_s"] = n_env * _steps_per_second(
+        lambda: bool(vec.step(actions)[3][0]), lambda: vec.reset(seed=0)
+    )
+    return out
+
+
 def _median_time(fn, repeats: int) -> float:
     times = []
     for _ in range(repeats):
@@ -245,6 +333,10 @@ def run(quiet: bool = False, baseline_repeats: int = 5, only: str | None = None)
     if only == "transfer":
         _log("profile transfer ...", quiet)
         res["transfer"] = transfer_bench(quiet)
+        res["checks"] = check_targets(res)
+        return res
+    if only == "control":
+        res["control"] = control_bench(quiet)
         res["checks"] = check_targets(res)
         return res
 
@@ -358,6 +450,7 @@ def run(quiet: bool = False, baseline_repeats: int = 5, only: str | None = None)
         res["cli_cold_s"] = _median_time(lambda: subprocess.run(exe, check=True, capture_output=True), 5)
     _log("profile transfer ...", quiet)
     res["transfer"] = transfer_bench(quiet)
+    res["control"] = control_bench(quiet)
     res["checks"] = check_targets(res)
     return res
 
@@ -385,6 +478,19 @@ def check_targets(res: dict) -> dict:
                 "transfer_max_abs_C": tr["max_abs_C"],
                 "transfer_vs_baselines": tr["vs_baselines"],
                 "transfer_solve_s": tr["solve_s"],
+            }
+        )
+    if "control" in res:
+        c = res["control"]
+        values.update(
+            {
+                "mpc_step_median_ms": c["mpc"]["step_ms_median"],
+                "mpc_step_p99_ms": c["mpc"]["step_ms_p99"],
+                "mpc_vs_casadi": c["speedup_vs_casadi"],
+                "mpc_mean_rmse_C": c["mpc_mean_rmse_C"],
+                "mpc_over_pid_disturbed": c["mpc_over_pid_disturbed"],
+                "gym_steps_per_s": c["gym_steps_per_s"],
+                "gym_vector_steps_per_s": c["gym_vector_steps_per_s"],
             }
         )
     out = {}
@@ -424,6 +530,17 @@ def table(res: dict) -> str:
                 f"vs project {g['project_wall_s']:.2f} s, RMSE {g['project_rmse_C']:.3f} °C",
             )
         )
+    if "control" in res:
+        c = res["control"]
+        rows.append(
+            (
+                "MPC vs CasADi + IPOPT",
+                f"{c['mpc']['step_ms_median']:.2f} vs {c['casadi']['step_ms_median']:.1f} ms median",
+                f"p99 {c['mpc']['step_ms_p99']:.1f} vs {c['casadi']['step_ms_p99']:.1f} ms; RMSE {c['mpc']['rmse_C']:.3f} vs "
+                f"{c['casadi']['rmse_C']:.3f} °C; IPOPT failures {c['casadi']['ipopt_failures']}",
+            )
+        )
+        rows.append(("PID mean RMSE, standard scenarios", f"{c['pid_mean_rmse_C']:.2f} °C", ""))
     for size in ("10", "100", "1000") if "identify_scaling" in res else ():
         sc = res["identify_scaling"]
         rows.append(
