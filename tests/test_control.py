@@ -377,3 +377,15 @@ def test_the_symbolic_right_hand_side_is_the_compiled_one():
         x = np.array([rng.uniform(20, 240), rng.uniform(60, 300), rng.uniform(0.0, 0.15), rng.uniform(0, 400), 100, 0])
         u = np.array([rng.uniform(0.1, 1.0), rng.uniform(150, 550), 0.0, 0.0])
         assert np.allclose(np.array(f(x, u)).ravel(), derivatives(*x, *u, p), rtol=1e-12, atol=1e-15)
+
+
+def test_the_docs_own_controller_example_runs():
+    """docs/control.md's plug-in example (a bang-bang controller through run_closed_loop and compare)."""
+    import re
+    from pathlib import Path
+
+    doc = (Path(__file__).parent.parent / "docs" / "control.md").read_text()
+    block = re.findall(r"```python\n(.*?)```", doc, re.S)[-1]
+    namespace: dict = {}
+    exec(compile(block, "docs/control.md", "exec"), namespace)  # noqa: S102 - the project's own doc
+    assert namespace["table"].summary()["mean_rmse_C"]["mpc"] < namespace["table"].summary()["mean_rmse_C"]["bang-bang"]

@@ -743,9 +743,9 @@ def _add_control_options(p, compare: bool) -> None:
         )
         p.add_argument(
             "--controllers",
-            default="replay,pid,mpc",
+            default="replay,pid,pid-bumpless,mpc",
             metavar="LIST",
-            help="comma-separated controllers to run (default replay,pid,mpc)",
+            help="comma-separated controllers to run (default replay,pid,pid-bumpless,mpc)",
         )
         p.add_argument(
             "--oracle",
@@ -757,9 +757,10 @@ def _add_control_options(p, compare: bool) -> None:
     else:
         p.add_argument(
             "--controller",
-            choices=("pid", "mpc", "replay"),
+            choices=("pid", "pid-bumpless", "mpc", "replay"),
             default="mpc",
-            help="pid: Artisan's software PID; mpc: model predictive control with a Kalman filter; "
+            help="pid: Artisan's software PID (its defaults, integral from 0 at CHARGE); pid-bumpless: the same "
+            "started at the actuator's position; mpc: model predictive control with a Kalman filter; "
             "replay: the reference's own inputs (default mpc)",
         )
         p.add_argument("--scenario", metavar="S.toml", help="scenario file (default: nominal; see docs/control.md)")

@@ -44,8 +44,9 @@ from .mpc import MPC
 from .pid import PID
 from .replay import Replay
 
-#: The controllers ``roastlab control --controller`` knows, by name.
-CONTROLLERS = {"pid": PID, "mpc": MPC, "replay": Replay}
+#: The controllers ``roastlab control --controller`` knows, by name: Artisan's PID as Artisan starts
+#: it (integral from 0) and started bumpless (integral at the actuator's position), MPC, replay.
+CONTROLLERS = {"pid": PID, "pid-bumpless": lambda: PID(bumpless=True), "mpc": MPC, "replay": Replay}
 #: Span of the rate-of-rise difference [s] and the time from which it is scored [s].
 ROR_SPAN_S = 30.0
 ROR_FROM_S = 60.0
@@ -364,7 +365,7 @@ class Comparison:
 
     def summary(self) -> dict:
         """Mean RMSE per controller, and on the disturbed scenarios (all but 'nominal') each
-        controller's RMSE over the PID's, worst case."""
+        controller's RMSE over the PID's (Artisan's start), worst case."""
         out: dict = {"mean_rmse_C": {}, "worst_ratio_to_pid_disturbed": {}}
         ctrls = list(dict.fromkeys(r["controller"] for r in self.rows))
         for c in ctrls:
@@ -422,7 +423,7 @@ def compare(
     model,
     reference: Batch,
     scenarios=None,
-    controllers=("replay", "pid", "mpc"),
+    controllers=("replay", "pid", "pid-bumpless", "mpc"),
     plant=None,
     oracle: bool = False,
     progress=None,

@@ -27,6 +27,10 @@ cycle                      1 s                                         the scena
 set value                  manual, ramp/soak segments, or follow       ``setpoint="background"``
                            the background profile ``svLookahead`` s    (lookahead 0 s) or a
                            ahead (default 0)                           :class:`RampSoak`
+start                      the integral is reset to 0 when the PID    ``bumpless=False`` (as
+                           is switched on, so the first duty is the   Artisan); ``True`` starts
+                           P term alone                               the integral at the
+                                                                       actuator's position
 gain scheduling            linear between (Schedule0: Kp, Ki, Kd)      ``schedule=[(T0, kp, ki,
                            and (Schedule1: Kp1, ...), quadratic with   kd), (T1, ...)]`` on the
                            a third point, on SV (default) or PV,       set value (``on="sv"``)
@@ -101,6 +105,7 @@ class PID:
     lookahead_s : follow the background this many seconds ahead
     schedule : None, or 2 or 3 tuples (schedule value [degC], kp, ki, kd)
     on : the scheduling variable: ``"sv"`` (set value) or ``"pv"`` (the bean reading)
+    bumpless : start the integral at the actuator's position at CHARGE (default: at 0, as Artisan)
     """
 
     name = "pid"
@@ -122,6 +127,7 @@ class PID:
         lookahead_s: float = 0.0,
         schedule=None,
         on: str = "sv",
+        bumpless: bool = False,
     ):
         for label, v in (("kp", kp), ("ki", ki), ("kd", kd), ("lookahead_s", lookahead_s)):
             if not (np.isfinite(v) and v >= 0):
@@ -141,6 +147,8 @@ class PID:
         self.setpoint, self.lookahead_s = setpoint, lookahead_s
         self.schedule = None if schedule is None else [tuple(map(float, s)) for s in schedule]
         self.on = on
+        self.bumpless = bool(bumpless)
+        self.name = "pid-bumpless" if self.bumpless else "pid"
         self.estimate = None
 
     def gains(self, sv: float, pv: float) -> tuple[float, float, float]:
@@ -159,6 +167,8 @@ class PID:
         self.start_pv: float | None = None
         lim = setup.limits
         self.duty = 100.0 * (setup.u_initial - lim.low) / (lim.high - lim.low)
+        if self.bumpless:
+            self.i_term = min(max(self.duty, self.duty_min), self.duty_max)
         self.cycles_since_send = 0
 
     def set_value(self, t: float, pv: float) -> float:

@@ -394,7 +394,8 @@ def plot_control_comparison(rows, results, path=None, outputs=None):
     ax.set_xticks(x, scenarios, rotation=20, ha="right", fontsize=8)
     ax.set_ylabel("BT RMSE [°C]")
     ax.set_yscale("symlog", linthresh=1.0)
-    ax.legend(fontsize=8, ncol=4)
+    ax.set_ylim(0, 10 ** np.ceil(np.log10(max(1.0, max(r["rmse_C"] for r in rows))) + 0.6))
+    ax.legend(fontsize=8, ncol=4, loc="upper left")
     ax.grid(alpha=0.3, axis="y")
     ncol = 3
     nrow = int(np.ceil(len(scenarios) / ncol))
