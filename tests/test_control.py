@@ -389,3 +389,13 @@ def test_the_docs_own_controller_example_runs():
     namespace: dict = {}
     exec(compile(block, "docs/control.md", "exec"), namespace)  # noqa: S102 - the project's own doc
     assert namespace["table"].summary()["mean_rmse_C"]["mpc"] < namespace["table"].summary()["mean_rmse_C"]["bang-bang"]
+
+
+def test_mpc_can_also_track_the_rate_of_rise(model, reference):
+    s = load_scenario(standard_scenarios()[6])  # probe noise and delay: the RoR is what suffers
+    plain = run_closed_loop(model, reference, MPC(), s).metrics
+    ror = run_closed_loop(model, reference, MPC(ror_weight=2.0), s).metrics
+    assert ror["ror_rmse_C_per_min"] < 0.8 * plain["ror_rmse_C_per_min"]
+    assert ror["rmse_C"] < 1.0
+    with pytest.raises(InputError):
+        MPC(ror_weight=-1.0)

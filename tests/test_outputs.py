@@ -67,6 +67,7 @@ VALUES = {
     "--controller",
     "--controllers",
     "--oracle",
+    "--ror-weight",
     "--help",
     "-h",
 }

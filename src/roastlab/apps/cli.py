@@ -662,6 +662,12 @@ def cmd_control(args) -> int:
     if args.plot:
         check_figure_path(args.plot)
     controller = make_controller(args.controller)
+    if args.ror_weight:
+        if args.controller != "mpc":
+            raise InputError("--ror-weight is an MPC option", "command line")
+        from ..control import MPC
+
+        controller = MPC(ror_weight=args.ror_weight)
     scenario = load_scenario(args.scenario) if args.scenario else None
     model, reference = _control_inputs(args)
     result = run_closed_loop(model, reference, controller, scenario, args.plant)
@@ -764,6 +770,13 @@ def _add_control_options(p, compare: bool) -> None:
             "replay: the reference's own inputs (default mpc)",
         )
         p.add_argument("--scenario", metavar="S.toml", help="scenario file (default: nominal; see docs/control.md)")
+        p.add_argument(
+            "--ror-weight",
+            type=_float_arg("--ror-weight"),
+            default=0.0,
+            help="mpc: also track the reference's rate of rise, this weight per degC/min against 1 per degC "
+            "(default 0: the level only)",
+        )
         p.add_argument("--json", metavar="METRICS.json", help="write the metrics as JSON")
         p.add_argument("--plot", metavar="FIG.png", help="BT, rate of rise, the input and the drum temperature")
         p.add_argument(

@@ -39,6 +39,7 @@ class MPC:
     smoothness : weight of the program's increments (as in profile transfer)
     max_iterations : residual evaluations per solve (warm-started: a few suffice)
     estimator : the state estimator (default: an EKF assuming 0.5 degC probe noise)
+    ror_weight : also track the reference's rate of rise (weight per degC/min against per degC)
     """
 
     name = "mpc"
@@ -49,6 +50,7 @@ class MPC:
         smoothness: float = SMOOTHNESS,
         max_iterations: int = 6,
         estimator: ExtendedKalmanFilter | None = None,
+        ror_weight: float = 0.0,
     ):
         if not (math.isfinite(horizon_s) and horizon_s > 0):
             raise InputError(f"horizon must be > 0 s, got {horizon_s!r}", "MPC")
@@ -58,6 +60,9 @@ class MPC:
         self.smoothness = float(smoothness)
         self.max_iterations = int(max_iterations)
         self.estimator = estimator or ExtendedKalmanFilter()
+        if not (math.isfinite(ror_weight) and ror_weight >= 0):
+            raise InputError(f"ror_weight must be >= 0, got {ror_weight!r}", "MPC")
+        self.ror_weight = float(ror_weight)
         self.estimate = None
 
     def reset(self, setup: LoopSetup) -> None:
@@ -109,6 +114,7 @@ class MPC:
             max_iterations=self.max_iterations,
             u_prev=self.u_last if self.u_last is not None else s.u_initial,
             Tgi_bias_C=est.disturbance_C,
+            ror_weight=self.ror_weight,
         )
         plan = res.Tgi_C if s.limits.decide == "Tgi" else res.heater
         self.plan, self.plan_t = plan, knots

@@ -144,6 +144,7 @@ def optimise_program(
     max_iterations: int = 60,
     u_prev: float | None = None,
     Tgi_bias_C: float = 0.0,
+    ror_weight: float = 0.0,
 ) -> ProgramResult:
     """The program of one input (Tgi or the heater, ``limits.decide``; optionally also a constant
     Gg and the drum start temperature) whose simulated probe follows ``target_C`` on ``t`` [s].
@@ -169,6 +170,8 @@ def optimise_program(
         rate limit then also holds between it and the first knot, over ``t[1] - t[0]``
     Tgi_bias_C : an inlet-temperature offset the model sees on top of ``Tgi_C`` [degC] (an
         estimated disturbance; the decided program and its limits exclude it)
+    ror_weight : weight of the rate-of-rise error [per degC/min] between consecutive knots
+        against the level error [per degC] (0: track the level only)
     """
     t0_clock = time.perf_counter()
     t = np.ascontiguousarray(t, dtype=np.float64)
@@ -255,7 +258,10 @@ def optimise_program(
         u, _, _, _, _, out = simulate(z)
         r_track = w * (out[:, 4] - target)
         over = np.maximum(u - hi_T, 0.0) - np.maximum(lo_T - u, 0.0)
-        r = np.concatenate([r_track, LEVEL_PENALTY * over, smoothness * z[1:n]])
+        parts = [r_track, LEVEL_PENALTY * over, smoothness * z[1:n]]
+        if ror_weight:
+            parts.append(ror_weight * 60.0 * (np.diff(out[:, 4]) - np.diff(target)) / dt)
+        r = np.concatenate(parts)
         return np.where(np.isfinite(r), r, 1e6)
 
     def jacobian(z):
@@ -267,12 +273,12 @@ def optimise_program(
         ta_input_jacobian(t, gg, tgi, q, F, which, states, ta, p, zoh, H_MAX_S, delta, jt)
         counter["sims"] += n // 2
         m = z.shape[0]
-        J = np.zeros((3 * n - 1, m))
+        J = np.zeros((3 * n - 1 + (n - 1 if ror_weight else 0), m))
         # Tgi_k = sum_{j <= k} z_j: a column j of the tracking block is the sum of columns k >= j
         J[:n, :n] = w[:, None] * np.cumsum(jt[:, ::-1], axis=1)[:, ::-1]
         active = ((u > hi_T) | (u < lo_T)).astype(float)
         J[n : 2 * n, :n] = LEVEL_PENALTY * lower * active[:, None]
-        J[2 * n :, 1:n] = smoothness * np.eye(n - 1)
+        J[2 * n : 3 * n - 1, 1:n] = smoothness * np.eye(n - 1)
         j = n
         for name in extra_names:
             h = 1e-3 * max(abs(z[j]), 1e-3) if name == "Gg" else 0.5
@@ -283,6 +289,9 @@ def optimise_program(
             counter["sims"] += 1
             J[:n, j] = w * (outp[:, 4] - out[:, 4]) / h
             j += 1
+        if ror_weight:  # d(RoR)/dz: differences of the unweighted tracking rows
+            track = J[:n] / np.where(w == 0, 1.0, w)[:, None]
+            J[3 * n - 1 :] = ror_weight * 60.0 * np.diff(track, axis=0) / dt[:, None]
         return np.where(np.isfinite(J), J, 0.0)
 
     with _one_blas_thread():
