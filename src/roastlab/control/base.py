@@ -72,6 +72,11 @@ class LoopSetup:
         """DROP: the reference's last time [s]."""
         return float(self.time_s[-1])
 
+    @property
+    def ticks(self) -> np.ndarray:
+        """The control instants 0, sample_s, ... up to DROP [s]."""
+        return self.sample_s * np.arange(int(self.end_s / self.sample_s + 1e-9) + 1)
+
     def reference_at(self, t) -> np.ndarray:
         """The reference BT at times ``t`` [s], held at its first and last value outside it."""
         return np.interp(t, self.time_s, self.reference_C)

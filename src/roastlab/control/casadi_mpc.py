@@ -25,6 +25,7 @@ from ..fit.program import SMOOTHNESS
 from ..model.rhs import I_HET, N_STATES, rebind
 from .base import LoopSetup
 from .estimator import ExtendedKalmanFilter
+from .mpc import MPC
 
 
 def _casadi():
@@ -49,9 +50,10 @@ def symbolic_rhs(p: np.ndarray):
 STATE_SCALE = np.array([100.0, 100.0, 0.1, 100.0, 100.0, 1.0])
 
 
-class CasadiMPC:
-    """Receding-horizon tracking with CasADi + IPOPT (see the module docstring); parameters as
-    :class:`~roastlab.control.MPC`, plus ``substeps`` RK4 steps per interval and IPOPT's ``tol``."""
+class CasadiMPC(MPC):
+    """Receding-horizon tracking with CasADi + IPOPT (see the module docstring). The filter, the
+    horizon and the loop are :class:`~roastlab.control.MPC`'s; only the solve differs. Parameters
+    as MPC's, plus ``substeps`` RK4 steps per interval and IPOPT's ``tol``."""
 
     name = "casadi-mpc"
 
@@ -63,12 +65,9 @@ class CasadiMPC:
         tol: float = 1e-6,
         estimator: ExtendedKalmanFilter | None = None,
     ):
-        self.horizon_s = float(horizon_s)
-        self.smoothness = float(smoothness)
+        super().__init__(horizon_s=horizon_s, smoothness=smoothness, estimator=estimator)
         self.substeps = int(substeps)
         self.tol = float(tol)
-        self.estimator = estimator or ExtendedKalmanFilter()
-        self.estimate = None
         self._built_for = None
 
     def _build(self, setup: LoopSetup, n: int):
@@ -137,25 +136,16 @@ class CasadiMPC:
         self._built_for = (id(setup), n)
 
     def reset(self, setup: LoopSetup) -> None:
-        self.setup = setup
-        self.estimator.reset(setup)
-        self.u_last = None
-        self.t_last = None
+        super().reset(setup)
         self._warm = None
         self.failures = 0
 
-    def step(self, time_s: float, measurement_C: float) -> float:
+    def _solve(self, time_s: float, knots: np.ndarray) -> float:
         s, est = self.setup, self.estimator
-        if self.u_last is not None:
-            est.predict(s.input_vector(self.t_last, self.u_last), time_s - self.t_last)
-        est.update(measurement_C)
-        dt = s.sample_s
-        n = int(self.horizon_s / dt + 1e-9)
-        n = max(2, min(n, int((s.end_s - time_s) / dt + 1e-9)))
+        n = knots.size - 1
         if self._built_for != (id(s), n):
             self._build(s, n)
             self._warm = None
-        knots = time_s + dt * np.arange(n + 1)
         gg, tgi, q, fan = s.model_inputs(knots[:-1], np.zeros(n))
         u_prev = self.u_last if self.u_last is not None else s.u_initial
         params = np.concatenate(
@@ -185,7 +175,4 @@ class CasadiMPC:
         self.failures += not ok
         # warm-start the next solve from a solution, never from a failed solve's iterates
         self._warm = (z, np.array(sol["lam_x"]).ravel(), np.array(sol["lam_g"]).ravel()) if ok else None
-        u = float(np.clip(z[self._nx], s.limits.low, s.limits.high))
-        self.u_last, self.t_last = u, time_s
-        self.estimate = est.as_dict()
-        return u
+        return float(np.clip(z[self._nx], s.limits.low, s.limits.high))

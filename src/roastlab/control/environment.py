@@ -55,7 +55,7 @@ class _Episode:
         self.sensor = (scenario.sensor if scenario is not None else None) or _nominal_sensor()
         lim = setup.limits
         self.dt = setup.sample_s
-        self.n = int(setup.end_s / self.dt + 1e-9)  # intervals per episode
+        self.n = setup.ticks.size - 1  # intervals per episode
         t = self.dt * np.arange(self.n + 2)
         self.t = t
         self.ref = setup.reference_at(t)

@@ -229,8 +229,8 @@ def run_closed_loop(model, reference: Batch, controller, scenario: Scenario | st
         controller = make_controller(controller)
     setup, roaster = prepare(model, reference, scenario, plant)
     lim, dt = setup.limits, setup.sample_s
-    n = int(setup.end_s / dt + 1e-9) + 1
-    t = dt * np.arange(n)
+    t = setup.ticks
+    n = t.size
     sensor = scenario.sensor
     rng = np.random.default_rng(sensor.seed)
     noise = rng.normal(0.0, sensor.noise_C, n) if sensor.noise_C > 0 else np.zeros(n)
@@ -324,7 +324,7 @@ def oracle_rmse_C(setup: LoopSetup, roaster: Plant) -> float:
     """The BT RMSE of the open-loop program the one program optimiser finds for the roaster itself
     (its true parameters and state, the actuator's limits, :data:`ORACLE_ITERATIONS`): a reference
     for what is reachable in the scenario, not a proven bound (a longer solve can go lower)."""
-    t = setup.sample_s * np.arange(int(setup.end_s / setup.sample_s + 1e-9) + 1)
+    t = setup.ticks
     gg, tgi, q, fan = setup.model_inputs(t, np.interp(t, setup.time_s, setup.reference_u))
     res = optimise_program(
         t,

@@ -89,20 +89,24 @@ class MPC:
         return np.full(knots.shape, s.u_initial)
 
     def step(self, time_s: float, measurement_C: float) -> float:
-        s = self.setup
-        est = self.estimator
+        """Correct the estimate with the reading, solve over the horizon, apply the first move."""
+        s, est = self.setup, self.estimator
         if self.u_last is not None:
-            dt = time_s - self.t_last
-            est.predict(s.input_vector(self.t_last, self.u_last), dt)
+            est.predict(s.input_vector(self.t_last, self.u_last), time_s - self.t_last)
         est.update(measurement_C)
-        knots = self._knots(time_s)
-        target = s.reference_at(knots)
-        x0 = est.state
+        u = self._solve(time_s, self._knots(time_s))
+        self.u_last, self.t_last = u, time_s
+        self.estimate = est.as_dict()
+        return u
+
+    def _solve(self, time_s: float, knots: np.ndarray) -> float:
+        """The first move of the plan over ``knots`` from the filter's estimate."""
+        s, est = self.setup, self.estimator
         gg, tgi, q, fan = s.model_inputs(knots, self._start_program(knots))
         res = optimise_program(
             knots - time_s,
-            target,
-            x0,
+            s.reference_at(knots),
+            est.state,
             s.params,
             gg,
             tgi,
@@ -119,7 +123,4 @@ class MPC:
         plan = res.Tgi_C if s.limits.decide == "Tgi" else res.heater
         self.plan, self.plan_t = plan, knots
         self.last_solve = res
-        u = float(plan[0])
-        self.u_last, self.t_last = u, time_s
-        self.estimate = est.as_dict()
-        return u
+        return float(plan[0])
