@@ -273,9 +273,10 @@ def optimise_program(
         ta_input_jacobian(t, gg, tgi, q, F, which, states, ta, p, zoh, H_MAX_S, delta, jt)
         counter["sims"] += n // 2
         m = z.shape[0]
+        # d Ta_i / d z, unweighted: Tgi_k = sum_{j <= k} z_j, so column j sums the columns k >= j
+        dta = np.empty((n, m))
+        dta[:, :n] = np.cumsum(jt[:, ::-1], axis=1)[:, ::-1]
         J = np.zeros((3 * n - 1 + (n - 1 if ror_weight else 0), m))
-        # Tgi_k = sum_{j <= k} z_j: a column j of the tracking block is the sum of columns k >= j
-        J[:n, :n] = w[:, None] * np.cumsum(jt[:, ::-1], axis=1)[:, ::-1]
         active = ((u > hi_T) | (u < lo_T)).astype(float)
         J[n : 2 * n, :n] = LEVEL_PENALTY * lower * active[:, None]
         J[2 * n : 3 * n - 1, 1:n] = smoothness * np.eye(n - 1)
@@ -287,11 +288,11 @@ def optimise_program(
             _, tp, qp, gp, xp = unpack(zp)
             outp = _run(t, gp, tp, qp, F, xp, p, zoh)
             counter["sims"] += 1
-            J[:n, j] = w * (outp[:, 4] - out[:, 4]) / h
+            dta[:, j] = (outp[:, 4] - out[:, 4]) / h
             j += 1
-        if ror_weight:  # d(RoR)/dz: differences of the unweighted tracking rows
-            track = J[:n] / np.where(w == 0, 1.0, w)[:, None]
-            J[3 * n - 1 :] = ror_weight * 60.0 * np.diff(track, axis=0) / dt[:, None]
+        J[:n] = w[:, None] * dta
+        if ror_weight:  # d(RoR)/dz: differences of consecutive rows of d Ta / d z
+            J[3 * n - 1 :] = ror_weight * 60.0 * np.diff(dta, axis=0) / dt[:, None]
         return np.where(np.isfinite(J), J, 0.0)
 
     with _one_blas_thread():
