@@ -244,12 +244,7 @@ def control_bench(quiet: bool = False, horizon_s: float = 300.0, sample_s: float
     _log("standard scenarios: PID and MPC ...", quiet)
     cmp = compare(model, ref, standard_scenarios(), ("pid", "pid-bumpless", "mpc"))
     summary = cmp.summary()
-    bumpless = {r["scenario"]: r["rmse_C"] for r in cmp.rows if r["controller"] == "pid-bumpless"}
-    out["mpc_over_pid_bumpless_disturbed"] = max(
-        r["rmse_C"] / bumpless[r["scenario"]]
-        for r in cmp.rows
-        if r["controller"] == "mpc" and r["scenario"] != "nominal"
-    )
+    out["mpc_over_pid_bumpless_disturbed"] = cmp.worst_ratio("mpc", "pid-bumpless")
     out["pid_bumpless_mean_rmse_C"] = summary["mean_rmse_C"]["pid-bumpless"]
     out["scenarios"] = [
         {k: r[k] for k in ("scenario", "controller", "rmse_C", "max_abs_C", "step_ms_median", "step_ms_p99")}

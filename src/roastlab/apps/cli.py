@@ -685,9 +685,7 @@ def cmd_control(args) -> int:
         if args.json:
             out.write_text(args.json, json.dumps(jsonable(m), indent=1, allow_nan=False) + "\n")
         if args.plot:
-            from ..report.figures import plot_closed_loop
-
-            plot_closed_loop(result, args.plot, outputs=out)
+            result.plot(args.plot, outputs=out)
     return 0
 
 

@@ -86,6 +86,10 @@ class _Episode:
             low=np.float32(self.low), high=np.float32(self.high), shape=(1,), dtype=np.float32
         )
 
+    def reward(self, err_C, du):
+        """-(e / 1 degC)^2 - move_penalty (du / du_max)^2, for one roast or an array of them."""
+        return -(err_C * err_C) - self.move_penalty * (du / self.cap) ** 2
+
 
 def _nominal_sensor():
     from ..io.scenario import Sensor
@@ -150,7 +154,7 @@ if gym is not None:
             self._k += 1
             bt = self._x[4]
             err = bt - ep.ref[self._k]
-            reward = -(err * err) - ep.move_penalty * (du / ep.cap) ** 2
+            reward = ep.reward(err, du)
             seen = bt - ep.frac_delay * (bt - bt_before)
             noise = self.np_random.normal(0.0, ep.sensor.noise_C) if ep.sensor.noise_C else 0.0
             truncated = self._k >= ep.n
@@ -244,7 +248,7 @@ if gym is not None:
             self._k += 1
             bt = self._X[:, 4]
             err = bt - ep.ref[self._k]
-            rewards = -(err * err) - ep.move_penalty * (du / ep.cap) ** 2
+            rewards = ep.reward(err, du)
             obs = self._observe(bt - ep.frac_delay * (bt - bt_before))
             done = self._k >= ep.n
             self._needs_reset = done

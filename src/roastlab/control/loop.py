@@ -37,6 +37,7 @@ from ..io.plants import load_plant
 from ..io.scenario import Scenario, load_scenario
 from ..model.parameters import REGISTRY
 from ..model.rhs import N_STATES, P
+from ..report.figures import ROR_SPAN_S
 from ..sim.kernels import H_MAX_S, step_kernel
 from ..workflows.whatif import crossing_or_projected_s
 from .base import LoopSetup
@@ -47,8 +48,7 @@ from .replay import Replay
 #: The controllers ``roastlab control --controller`` knows, by name: Artisan's PID as Artisan starts
 #: it (integral from 0) and started bumpless (integral at the actuator's position), MPC, replay.
 CONTROLLERS = {"pid": PID, "pid-bumpless": lambda: PID(bumpless=True), "mpc": MPC, "replay": Replay}
-#: Span of the rate-of-rise difference [s] and the time from which it is scored [s].
-ROR_SPAN_S = 30.0
+#: Time from which the rate of rise is scored [s] (its span is the figures' ROR_SPAN_S).
 ROR_FROM_S = 60.0
 SCENARIO_DIR = Path(__file__).parent / "scenarios"
 
@@ -188,10 +188,10 @@ class ClosedLoopResult:
         self.to_frame().to_csv(buf, index=False, float_format="%.6f", lineterminator="\n")
         return buf.getvalue()
 
-    def plot(self, path=None, title: str | None = None):
+    def plot(self, path=None, title: str | None = None, outputs=None):
         from ..report.figures import plot_closed_loop
 
-        return plot_closed_loop(self, path, title)
+        return plot_closed_loop(self, path, title, outputs)
 
 
 def _metrics(t, ref, bt, u_applied, u0, violations, step_ms, end_s) -> dict:
@@ -370,20 +370,22 @@ class Comparison:
         ctrls = list(dict.fromkeys(r["controller"] for r in self.rows))
         for c in ctrls:
             out["mean_rmse_C"][c] = float(np.mean([r["rmse_C"] for r in self.rows if r["controller"] == c]))
-        pid = {r["scenario"]: r["rmse_C"] for r in self.rows if r["controller"] == "pid"}
-        for c in ctrls:
-            if c == "pid" or not pid:
-                continue
-            ratios = [
-                r["rmse_C"] / pid[r["scenario"]]
-                for r in self.rows
-                if r["controller"] == c
-                and r["scenario"] in pid
-                and r["scenario"] != "nominal"
-                and pid[r["scenario"]] > 0
-            ]
-            out["worst_ratio_to_pid_disturbed"][c] = float(max(ratios)) if ratios else None
+        if "pid" in ctrls:
+            for c in ctrls:
+                if c != "pid":
+                    out["worst_ratio_to_pid_disturbed"][c] = self.worst_ratio(c, "pid")
         return out
+
+    def worst_ratio(self, controller: str, baseline: str) -> float | None:
+        """The largest RMSE of ``controller`` over ``baseline``'s on the disturbed scenarios (all but
+        'nominal'); None when no scenario has both."""
+        base = {r["scenario"]: r["rmse_C"] for r in self.rows if r["controller"] == baseline}
+        ratios = [
+            r["rmse_C"] / base[r["scenario"]]
+            for r in self.rows
+            if r["controller"] == controller and r["scenario"] != "nominal" and base.get(r["scenario"], 0) > 0
+        ]
+        return float(max(ratios)) if ratios else None
 
     def table(self) -> str:
         """A plain-text table, one line per scenario and controller."""
