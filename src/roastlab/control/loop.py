@@ -105,7 +105,9 @@ def prepare(model, reference: Batch, scenario: Scenario | None = None, plant=Non
     nominal = model.predict(reference, plant=plant)
     mass_ref = reference.Mb_kg or target_plant.Mb_kg
     mass = mass_ref * pc.mass_factor
-    controller_view = model.predict(reference, plant=plant, batch_kg=mass) if pc.mass_known else nominal
+    # the controller knows a weighed batch; at the reference's own mass that is the nominal run
+    weighed = pc.mass_known and pc.mass_factor != 1.0
+    controller_view = model.predict(reference, plant=plant, batch_kg=mass) if weighed else nominal
     x_model = controller_view.states[0, :N_STATES].copy()
 
     changes: dict = {"batch_kg": mass}
