@@ -15,7 +15,7 @@ import pytest
 import roastlab
 
 SRC = Path(roastlab.__file__).parent
-LAYERS = ["errors", "model", "io", "report", "sim", "evaluate", "fit", "workflows", "control", "apps"]
+LAYERS = ["errors", "model", "io", "report", "sim", "evaluate", "fit", "workflows", "fleet", "control", "apps"]
 RANK = {name: i for i, name in enumerate(LAYERS)}
 
 

@@ -1180,6 +1180,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     _add_fit_commands(sub)
     _add_control_command(sub)
+    from .fleet_cli import add_fleet_command
+
+    add_fleet_command(sub, _Parser)
     return parser
 
 

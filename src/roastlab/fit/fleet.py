@@ -12,6 +12,11 @@ the batches in lock-step so that each iteration is one compiled, parallel popula
    adapted; it stops when a step gains less than ``gain_tol`` (1e-10) of the SSR or moves
    less than 1e-6 of the bounds' span.
 
+Any parameter-vector entry or initial state (except X0, which also sets the dry mass) can be
+free, not only theta: a fleet fit spec may free, say, Kt or Tm0_C per batch. Standard errors
+come from the Jacobian at each batch's optimum, cov = s^2 (J'J)^-1 with s^2 = SSR / (n - k),
+over the components not on a bound (as :mod:`.identify`).
+
 Each batch's whole fit is one compiled routine, and batches run in parallel over the cores
 (numba ``prange``): the work per batch does not depend on how many batches there are, so the
 wall time scales linearly. SciPy has no batched bounded least-squares solver; the step here is the textbook
@@ -23,7 +28,7 @@ from __future__ import annotations
 
 import functools
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numba import njit, parallel_chunksize, prange
@@ -31,19 +36,37 @@ from scipy.stats import qmc
 
 from ..errors import InputError
 from ..evaluate.metrics import fit_percent
-from ..model.parameters import REGISTRY, THETA_NAMES, THETA_START
+from ..model.parameters import REGISTRY, STATE0, THETA_NAMES, THETA_START
 from ..model.rhs import P
 from ..sim.kernels import N_OUT, integrate_into
 from ..sim.population import PackedBatches, predict_ta
 from .identify import FD_STEP
 
-#: Parameter-vector slots of (hgm, hbm, Pbm).
-_THETA_SLOTS = np.array([P[k] for k in THETA_NAMES], dtype=np.int64)
+#: Where a free value goes: a parameter-vector entry or an initial state.
+KIND_PARAM, KIND_STATE = 0, 1
+
+
+def free_slots(names) -> tuple[np.ndarray, np.ndarray]:
+    """(kinds, slots) of registry ``names`` for the compiled fitter; InputError for a name it cannot move."""
+    kinds, slots = [], []
+    for name in names:
+        q = REGISTRY.get(name)
+        if q is None or name == "X0" or (q.slot not in P and q.slot not in STATE0):
+            allowed = ", ".join(n for n in REGISTRY if n != "X0")
+            raise InputError(f"{name!r} cannot be fitted per batch (allowed: {allowed})")
+        if q.slot in P:
+            kinds.append(KIND_PARAM)
+            slots.append(P[q.slot])
+        else:
+            kinds.append(KIND_STATE)
+            slots.append(STATE0[q.slot])
+    return np.array(kinds, dtype=np.int64), np.array(slots, dtype=np.int64)
 
 
 @dataclass
 class FleetResult:
-    """Per-batch theta (nb, 3), SSR (nb,), FIT (nb,), iterations and timing."""
+    """Per-batch values (nb, k) of the free ``params``, their standard errors (NaN on a bound),
+    SSR (nb,), FIT (nb,), samples per batch, iterations and timing."""
 
     names: list[str]
     theta: np.ndarray
@@ -52,10 +75,15 @@ class FleetResult:
     max_iterations: int
     simulations: int
     wall_s: float
+    params: list[str] = field(default_factory=lambda: list(THETA_NAMES))
+    stderr: np.ndarray | None = None
+    n_samples: np.ndarray | None = None
+    MAE: np.ndarray | None = None
+    sims: np.ndarray | None = None
 
     def summary(self) -> dict:
         out = {}
-        for j, name in enumerate(THETA_NAMES):
+        for j, name in enumerate(self.params):
             col = self.theta[:, j]
             out[name] = {
                 "mean": float(col.mean()),
@@ -70,7 +98,7 @@ class FleetResult:
         return {
             "mode": "per-batch",
             "batches": [
-                {"name": n, **{k: float(v) for k, v in zip(THETA_NAMES, th)}, "SSR": float(s), "FIT": float(f)}
+                {"name": n, **{k: float(v) for k, v in zip(self.params, th)}, "SSR": float(s), "FIT": float(f)}
                 for n, th, s, f in zip(self.names, self.theta, self.SSR, self.FIT)
             ],
             "summary": self.summary(),
@@ -81,25 +109,29 @@ class FleetResult:
 
 
 @njit(cache=True, inline="always")
-def _set_theta(z, lo, span, p):
-    """Scaled z in [0, 1] -> theta in its slots of p (model.rhs.PARAM_NAMES)."""
-    for j in range(3):
-        p[_THETA_SLOTS[j]] = lo[j] + z[j] * span[j]
+def _set_free(z, lo, span, kinds, slots, p, x0):
+    """Scaled z in [0, 1]^k -> the free values in their slots of p (model.rhs.PARAM_NAMES) or x0."""
+    for j in range(z.shape[0]):
+        v = lo[j] + z[j] * span[j]
+        if kinds[j] == 0:
+            p[slots[j]] = v
+        else:
+            x0[slots[j]] = v
 
 
 @njit(cache=True)
-def _residual_vec(z, lo, span, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, out):
-    """Residuals T^a - Ta for scaled parameters z in [0, 1]^3, into out[:n]."""
-    _set_theta(z, lo, span, p)
+def _residual_vec(z, lo, span, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, out):
+    """Residuals T^a - Ta for scaled parameters z in [0, 1]^k, into out[:n]."""
+    _set_free(z, lo, span, kinds, slots, p, x0)
     integrate_into(t, Gg, Tgi, Q, F, n, x0, p, zoh, h_max, scratch, 5.0, False)
     for i in range(n):
         out[i] = scratch[i, 4] - Ta[i]
 
 
 @njit(cache=True)
-def _ssr_of(z, lo, span, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, r):
+def _ssr_of(z, lo, span, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, r):
     """SSR of the probe reading (a failed simulation counts as 1e300); r is a work buffer."""
-    _residual_vec(z, lo, span, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, r)
+    _residual_vec(z, lo, span, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, r)
     s = 0.0
     for i in range(n):
         s += r[i] * r[i]
@@ -109,108 +141,133 @@ def _ssr_of(z, lo, span, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, r)
 
 
 @njit(cache=True)
-def _fit_one(t, Gg, Tgi, Q, F, n, Ta, x0, p_in, lo, span, trial, zoh, h_max, max_iter, gain_tol, z_out):
-    """Score the trial points, then projected Levenberg-Marquardt from the best; returns (SSR, sims)."""
+def _jacobian(z, lo, span, kinds, slots, free, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, r0, rp, rm, zt, J):
+    """Residuals r0 at z and their central-difference Jacobian J (n, k) in scaled units; returns sims."""
+    k = z.shape[0]
+    _residual_vec(z, lo, span, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, r0)
+    sims = 1
+    for j in range(k):
+        if not free[j]:
+            for i in range(n):
+                J[i, j] = 0.0
+            continue
+        zt[:] = z
+        zp = min(z[j] + FD_STEP, 1.0)
+        zm = max(z[j] - FD_STEP, 0.0)
+        zt[j] = zp
+        _residual_vec(zt, lo, span, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, rp)
+        zt[j] = zm
+        _residual_vec(zt, lo, span, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, rm)
+        sims += 2
+        for i in range(n):
+            J[i, j] = (rp[i] - rm[i]) / (zp - zm)
+    return sims
+
+
+@njit(cache=True)
+def _normal(J, r0, n, A, g):
+    """A = J'J and g = J'r over the first n residuals."""
+    k = A.shape[0]
+    for a in range(k):
+        g[a] = 0.0
+        for i in range(n):
+            g[a] += J[i, a] * r0[i]
+        for c in range(k):
+            acc = 0.0
+            for i in range(n):
+                acc += J[i, a] * J[i, c]
+            A[a, c] = acc
+
+
+@njit(cache=True)
+def _fit_one(
+    t, Gg, Tgi, Q, F, n, Ta, x0_in, p_in, kinds, slots, lo, span, trial, zoh, h_max, max_iter, gain_tol, z_out, jtj_out
+):
+    """Score the trial points, then projected Levenberg-Marquardt from the best; returns (SSR, sims).
+
+    z_out gets the scaled optimum, jtj_out the Gauss-Newton matrix J'J there (scaled units).
+    """
+    k = lo.shape[0]
     p = p_in.copy()
+    x0 = x0_in.copy()
     scratch = np.empty((t.shape[0], N_OUT))
     rs = np.empty(n)
     best = 1e300
-    z = np.empty(3)
+    z = np.empty(k)
     sims = 0
-    for k in range(trial.shape[0]):
-        s = _ssr_of(trial[k], lo, span, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, rs)
+    for m in range(trial.shape[0]):
+        s = _ssr_of(trial[m], lo, span, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, rs)
         sims += 1
         if s < best:
             best = s
-            z[:] = trial[k]
-    free = np.empty(3, dtype=np.bool_)
-    for j in range(3):
+            z[:] = trial[m]
+    free = np.empty(k, dtype=np.bool_)
+    for j in range(k):
         free[j] = span[j] > 0.0
     r0 = np.empty(n)
     rp = np.empty(n)
     rm = np.empty(n)
-    J = np.empty((n, 3))
-    A = np.empty((3, 3))
-    g = np.empty(3)
-    M = np.empty((3, 3))
-    b = np.empty(3)
-    zt = np.empty(3)
-    pinned = np.empty(3, dtype=np.bool_)
-    fixed_step = np.empty(3)
+    J = np.empty((n, k))
+    A = np.empty((k, k))
+    g = np.empty(k)
+    M = np.empty((k, k))
+    b = np.empty(k)
+    zt = np.empty(k)
+    step = np.zeros(k)
+    pinned = np.empty(k, dtype=np.bool_)
+    fixed_step = np.empty(k)
     lam = 1e-3
     ssr = best
     need_jac = True
     for _it in range(max_iter):
         if need_jac:
-            _residual_vec(z, lo, span, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, r0)
-            sims += 1
-            for j in range(3):
-                if not free[j]:
-                    for i in range(n):
-                        J[i, j] = 0.0
-                    continue
-                zt[:] = z
-                zp = min(z[j] + FD_STEP, 1.0)
-                zm = max(z[j] - FD_STEP, 0.0)
-                zt[j] = zp
-                _residual_vec(zt, lo, span, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, rp)
-                zt[j] = zm
-                _residual_vec(zt, lo, span, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, rm)
-                sims += 2
-                for i in range(n):
-                    J[i, j] = (rp[i] - rm[i]) / (zp - zm)
-            for a in range(3):
-                g[a] = 0.0
-                for i in range(n):
-                    g[a] += J[i, a] * r0[i]
-                for c in range(3):
-                    acc = 0.0
-                    for i in range(n):
-                        acc += J[i, a] * J[i, c]
-                    A[a, c] = acc
+            sims += _jacobian(
+                z, lo, span, kinds, slots, free, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, r0, rp, rm, zt, J
+            )
+            _normal(J, r0, n, A, g)
             need_jac = False
         # damped normal equations (M = A + lam diag(A)). Fixed parameters, those on a bound whose
         # gradient pushes outward, and those whose step would cross a bound are pinned (the last
         # at the bound they hit) and the others re-solved given that move: clipping a step
         # computed as if the bound were not there is what makes projected Gauss-Newton crawl.
-        for a in range(3):
+        for a in range(k):
             pinned[a] = (not free[a]) or (z[a] <= 0.0 and g[a] > 0.0) or (z[a] >= 1.0 and g[a] < 0.0)
             fixed_step[a] = 0.0
-        for _pass in range(3):
-            for a in range(3):
-                for c in range(3):
+        for _pass in range(k):
+            for a in range(k):
+                for c in range(k):
                     M[a, c] = A[a, c]
                 M[a, a] += lam * A[a, a] + 1e-12
                 b[a] = -g[a]
-            for a in range(3):  # move the pinned displacements to the right-hand side
+            for a in range(k):  # move the pinned displacements to the right-hand side
                 if pinned[a]:
-                    for c in range(3):
+                    for c in range(k):
                         if not pinned[c]:
                             b[c] -= M[c, a] * fixed_step[a]
-            for a in range(3):
+            for a in range(k):
                 if pinned[a]:
-                    for c in range(3):
+                    for c in range(k):
                         M[a, c] = 0.0
                         M[c, a] = 0.0
                     M[a, a] = 1.0
                     b[a] = fixed_step[a]
             step = np.linalg.solve(M, b)
             crossed = False
-            for j in range(3):
+            for j in range(k):
                 if not pinned[j] and (z[j] + step[j] < 0.0 or z[j] + step[j] > 1.0):
                     pinned[j] = True
                     fixed_step[j] = (0.0 if z[j] + step[j] < 0.0 else 1.0) - z[j]
                     crossed = True
             if not crossed:
                 break
-        for j in range(3):
+        for j in range(k):
             zt[j] = min(max(z[j] + step[j], 0.0), 1.0)
-        s = _ssr_of(zt, lo, span, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, rs)
+        s = _ssr_of(zt, lo, span, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, rs)
         sims += 1
         if s < ssr:
             gain = (ssr - s) / max(ssr, 1e-300)
             moved = 0.0
-            for j in range(3):
+            for j in range(k):
                 moved = max(moved, abs(zt[j] - z[j]))
             z[:] = zt
             ssr = s
@@ -224,12 +281,20 @@ def _fit_one(t, Gg, Tgi, Q, F, n, Ta, x0, p_in, lo, span, trial, zoh, h_max, max
             lam *= 4.0
             if lam > 1e10:
                 break
+    if need_jac:  # J'J at the optimum, for the standard errors
+        sims += _jacobian(
+            z, lo, span, kinds, slots, free, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, r0, rp, rm, zt, J
+        )
+        _normal(J, r0, n, A, g)
+    jtj_out[:, :] = A
     z_out[:] = z
     return ssr, sims
 
 
 @njit(cache=True, parallel=True)
-def _fit_population(T, GG, TGI, QQ, FF, N, TA, X0, PB, lo, span, trial, zoh, h_max, max_iter, gain_tol, Z, SSR, SIMS):
+def _fit_population(
+    T, GG, TGI, QQ, FF, N, TA, X0, PB, kinds, slots, lo, span, trial, zoh, h_max, max_iter, gain_tol, Z, SSR, SIMS, JTJ
+):
     for b in prange(N.shape[0]):
         ssr, sims = _fit_one(
             T[b],
@@ -241,6 +306,8 @@ def _fit_population(T, GG, TGI, QQ, FF, N, TA, X0, PB, lo, span, trial, zoh, h_m
             TA[b],
             X0[b],
             PB[b],
+            kinds,
+            slots,
             lo,
             span,
             trial,
@@ -249,17 +316,39 @@ def _fit_population(T, GG, TGI, QQ, FF, N, TA, X0, PB, lo, span, trial, zoh, h_m
             max_iter,
             gain_tol,
             Z[b],
+            JTJ[b],
         )
         SSR[b] = ssr
         SIMS[b] = sims
 
 
 @functools.cache
-def _sobol_points(seed: int, n: int) -> np.ndarray:
-    """Scrambled Sobol points in [0, 1)^3, cached: building the generator costs ~1 ms a call."""
-    pts = qmc.Sobol(3, scramble=True, seed=np.random.default_rng(seed)).random(n)
+def _sobol_points(seed: int, n: int, k: int = 3) -> np.ndarray:
+    """Scrambled Sobol points in [0, 1)^k, cached: building the generator costs ~1 ms a call."""
+    pts = qmc.Sobol(k, scramble=True, seed=np.random.default_rng(seed)).random(n)
     pts.setflags(write=False)
     return pts
+
+
+def standard_errors(jtj: np.ndarray, z: np.ndarray, ssr: np.ndarray, n: np.ndarray, span: np.ndarray) -> np.ndarray:
+    """Per-batch standard errors (nb, k) from J'J in scaled units: s^2 (J'J)^-1 over the
+    components off their bounds, s^2 = SSR / (n - k_off); NaN on a bound, fixed or singular."""
+    nb, k = z.shape
+    out = np.full((nb, k), np.nan)
+    off = (z > 1e-9) & (z < 1.0 - 1e-9) & (span > 0)[None, :]
+    for b in range(nb):
+        idx = np.flatnonzero(off[b])
+        dof = int(n[b]) - len(idx)
+        if len(idx) == 0 or dof <= 0:
+            continue
+        sub = jtj[b][np.ix_(idx, idx)]
+        try:
+            cov = np.linalg.inv(sub) * (ssr[b] / dof)
+        except np.linalg.LinAlgError:
+            continue
+        d = np.diag(cov)
+        out[b, idx] = np.where(d >= 0, np.sqrt(np.abs(d)), np.nan) * span[idx]
+    return out
 
 
 def identify_each(
@@ -272,29 +361,38 @@ def identify_each(
     gain_tol: float = 1e-10,
     progress=None,
     chunk: int = 256,
+    names=THETA_NAMES,
+    start: dict | None = None,
 ) -> FleetResult:
-    """Fit theta separately for every batch of ``packed`` (see module docstring).
+    """Fit the free ``names`` (default theta) separately for every batch of ``packed``.
 
-    ``bounds`` changes Table 1's bounds by name, ``fix`` holds components at a value;
-    ``progress(done, total, text)`` is called after every ``chunk`` batches when given.
+    ``bounds`` changes the registry's default bounds by name, ``fix`` holds components at a
+    value, ``start`` is the first trial point by name (default: theta0 for theta components,
+    the bounds' middle for others); ``progress(done, total, text)`` is called after every ``chunk`` batches when given.
     """
     t0 = time.perf_counter()
-    bounds = {**{k: REGISTRY[k].bounds for k in THETA_NAMES}, **(bounds or {})}
+    names = list(names)
+    kinds, slots = free_slots(names)
+    k = len(names)
+    bounds = {**{n: REGISTRY[n].bounds for n in names}, **(bounds or {})}
     fix = dict(fix or {})
-    lo = np.array([fix.get(k, bounds[k][0]) for k in THETA_NAMES], dtype=float)
-    hi = np.array([fix.get(k, bounds[k][1]) for k in THETA_NAMES], dtype=float)
+    lo = np.array([fix.get(n, bounds[n][0]) for n in names], dtype=float)
+    hi = np.array([fix.get(n, bounds[n][1]) for n in names], dtype=float)
     span = hi - lo
     nb = packed.n_batches
     if np.any(~np.isfinite(packed.TA[packed.mask()])):
         raise InputError("per-batch identification needs a measured Ta at every sample")
-    # the same trial points for every batch: theta0 and a scrambled Sobol set, in scaled units
-    trial = _sobol_points(seed, n_trial)
-    start = (np.clip(np.array(THETA_START.as_tuple()), lo, hi) - lo) / np.where(span > 0, span, 1.0)
-    trial = np.clip(np.vstack([start, trial]), 0.0, 1.0)
+    # the same trial points for every batch: the start and a scrambled Sobol set, in scaled units
+    trial = _sobol_points(seed, n_trial, k)
+    theta0 = THETA_START.as_dict()
+    start = {**{n: theta0.get(n, 0.5 * (lo[j] + hi[j])) for j, n in enumerate(names)}, **(start or {})}
+    z0 = (np.clip([start[n] for n in names], lo, hi) - lo) / np.where(span > 0, span, 1.0)
+    trial = np.clip(np.vstack([z0, trial]), 0.0, 1.0)
     trial[:, span == 0] = 0.0
-    Z = np.zeros((nb, 3))
+    Z = np.zeros((nb, k))
     SSR = np.zeros(nb)
     SIMS = np.zeros(nb, dtype=np.int64)
+    JTJ = np.zeros((nb, k, k))
     TA = np.where(packed.mask(), packed.TA, 0.0)
     chunk = max(1, min(nb, chunk)) if progress is not None else nb
     for a in range(0, nb, chunk):
@@ -306,6 +404,8 @@ def identify_each(
                 TA[sl],
                 packed.X0[sl],
                 packed.PB[sl],
+                kinds,
+                slots,
                 lo,
                 span,
                 trial,
@@ -316,10 +416,26 @@ def identify_each(
                 Z[sl],
                 SSR[sl],
                 SIMS[sl],
+                JTJ[sl],
             )
         if progress is not None:
             progress(sl.stop, nb, "batches fitted")
-    theta = lo + Z * span
-    ta = predict_ta(packed, list(THETA_NAMES), theta[None])[0]
+    values = lo + Z * span
+    ta = predict_ta(packed, names, values[None])[0]
     fits = np.array([fit_percent(packed.TA[b, :n], ta[b, :n]) for b, n in enumerate(packed.N)])
-    return FleetResult(list(packed.names), theta, SSR, fits, max_iter, int(SIMS.sum()) + nb, time.perf_counter() - t0)
+    mae = np.nanmean(np.abs(np.where(packed.mask(), ta - packed.TA, np.nan)), axis=1)
+    stderr = standard_errors(JTJ, Z, SSR, packed.N, span)
+    return FleetResult(
+        list(packed.names),
+        values,
+        SSR,
+        fits,
+        max_iter,
+        int(SIMS.sum()) + nb,
+        time.perf_counter() - t0,
+        names,
+        stderr,
+        packed.N.copy(),
+        mae,
+        SIMS + 1,
+    )

@@ -414,3 +414,57 @@ def plot_control_comparison(rows, results, path=None, outputs=None):
     bottom.supylabel("BT - reference [°C]", fontsize=9)
     bottom.supxlabel("time after CHARGE [min]", fontsize=9)
     return _finish(fig, path, "closed-loop comparison (synthetic scenarios)", outputs)
+
+
+def plot_fleet_history(m, path=None, outputs=None):
+    """A machine's identified coefficients batch by batch (:class:`roastlab.fleet.report.MachineHistory`).
+
+    One panel per coefficient: each batch's value with its standard error, the median of each
+    period between changes, outlier batches as red crosses, drift alarms as arrows at the batch
+    that raised them with a dotted line where the change was dated.
+    """
+    params = m.params
+    a = m.analysis
+    fig = new_figure(figsize=(10, 2.3 * len(params) + 0.6), layout="constrained")
+    axes = fig.subplots(len(params), 1, sharex=True, squeeze=False)[:, 0]
+    idx = np.arange(len(m.frame))
+    good = a["good"]
+    small = len(idx) > 2000
+    for ax, p in zip(axes, params):
+        x = m.wide[p].to_numpy(dtype=float)
+        e = m.stderr[p].to_numpy(dtype=float)
+        if small:
+            ax.plot(idx[good], x[good], ".", ms=1.5, color="C0", alpha=0.5, label="batch")
+        else:
+            ax.errorbar(
+                idx[good],
+                x[good],
+                yerr=np.where(np.isfinite(e[good]), e[good], 0),
+                fmt=".",
+                ms=4,
+                color="C0",
+                ecolor="0.7",
+                lw=0.8,
+                label="batch (± std. error)",
+            )
+        if (~good).any():
+            ax.plot(idx[~good], x[~good], "x", color="C3", ms=5, label="outlier")
+        for per in a["periods"]:
+            st = per["values"].get(p)
+            if st:
+                ax.hlines(st["median"], per["first_index"], per["last_index"], color="k", lw=1.2)
+        for al in a["alarms"]:
+            if al["parameter"] != p:
+                continue
+            i = al["batch_index"]
+            mark = "^" if al["direction"] == "up" else "v"
+            ax.plot(i, x[i], mark, color="C1", ms=10, mec="k", label=f"alarm {al['direction']}")
+            if al["change_index"] is not None:
+                ax.axvline(al["change_index"], color="C1", ls=":", lw=1)
+        ax.set_ylabel(p)
+        handles, labels = ax.get_legend_handles_labels()
+        uniq = dict(zip(labels, handles))
+        ax.legend(uniq.values(), uniq.keys(), fontsize=7, loc="upper right")
+    axes[-1].set_xlabel("batch (in order of started_at)")
+    title = f"{m.name} ({m.plant}): {len(idx)} batches, {len(a['alarms'])} alarm(s), {len(a['outliers'])} outlier(s)"
+    return _finish(fig, path, title, outputs)

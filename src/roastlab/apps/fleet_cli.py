@@ -1,0 +1,191 @@
+"""``roastlab fleet``: ingest logs into a DuckDB store, fit every batch, report drift (thin layer)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from ..errors import InputError
+
+
+def _progress(desc):
+    from .cli import _progress as bar
+
+    return bar(desc)
+
+
+def _db_output(db, inputs) -> Path:
+    """The store path: a regular file (or nothing yet), never one of the command's inputs."""
+    from ..io.files import Outputs
+
+    return Outputs(inputs).check(db)
+
+
+def cmd_fleet_ingest(args) -> int:
+    from ..fleet import ingest
+
+    _db_output(args.db, [args.manifest])
+    report = ingest(args.db, args.manifest, progress=_progress("ingest"))
+    for line in report.rejected:
+        print(f"roastlab fleet ingest: rejected: {line}", file=sys.stderr)
+    print(report.summary())
+    return 2 if report.rejected else 0
+
+
+def _specs(values: list[str] | None):
+    from ..fleet import fleet_spec
+
+    if not values:
+        return None
+    specs: dict = {}
+    single = None
+    for v in values:
+        name, sep, path = v.partition("=")
+        if sep and not Path(v).exists():
+            specs[name] = fleet_spec(path)
+        else:
+            if single is not None:
+                raise InputError("give one --spec FIT.toml for every machine, or --spec MACHINE=FIT.toml per machine")
+            single = fleet_spec(v)
+    if single is not None and specs:
+        raise InputError("give one --spec FIT.toml for every machine, or --spec MACHINE=FIT.toml per machine")
+    return single if single is not None else specs
+
+
+def cmd_fleet_fit(args) -> int:
+    from ..fleet import fit_fleet
+
+    if args.workers is not None and args.scheduler:
+        raise InputError("give --workers N or --scheduler ADDRESS, not both", "command line")
+    _db_output(args.db, [])
+    spec = _specs(args.spec)
+    report = fit_fleet(
+        args.db, spec, workers=args.workers, scheduler=args.scheduler, chunk=args.chunk, progress=_progress("fit")
+    )
+    print(report.summary())
+    return 0
+
+
+def cmd_fleet_report(args) -> int:
+    from ..fleet import fleet_report
+    from ..io.files import Outputs
+    from ..io.modelfile import jsonable
+
+    outputs = Outputs([args.db])
+    if args.json:
+        outputs.check(args.json)
+    report = fleet_report(args.db)
+    print(report.table())
+    with outputs as out:
+        if args.json:
+            out.write_text(args.json, json.dumps(jsonable(report.to_json_dict()), indent=1, allow_nan=False) + "\n")
+        if args.plot:
+            report.plot(args.plot, outputs=out)
+    return 0
+
+
+def cmd_fleet_synthetic(args) -> int:
+    from ..fleet.synthetic import make_fleet
+
+    truth = make_fleet(args.out, args.batches, seed=args.seed, progress=_progress("write"))
+    changes = sum(len(m["changes"]) for m in truth["machines"])
+    print(
+        f"SYNTHETIC fleet: {args.batches} batches over {len(truth['machines'])} machines ({changes} injected "
+        f"change(s)) in {args.out}; ingest it with: roastlab fleet ingest --db FLEET.duckdb --manifest "
+        f"{Path(args.out) / 'manifest.csv'}"
+    )
+    return 0
+
+
+def _positive_int(name):
+    def parse(text):
+        try:
+            v = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} must be a whole number, got {text!r}") from None
+        if v < 1:
+            raise argparse.ArgumentTypeError(f"{name} must be at least 1, got {v}")
+        return v
+
+    return parse
+
+
+def add_fleet_command(sub, parser_class) -> None:
+    p = sub.add_parser(
+        "fleet",
+        help="many roasters and years of batches: a DuckDB store, a fit per batch, drift alarms",
+        description="Keep every batch of every machine in one DuckDB file (FLEET.duckdb, no server), fit each "
+        "batch's heat-transfer coefficients, and watch each machine's coefficients for drift (a fouling drum, a "
+        "failing burner or fan, a drifting probe). Schema, detector and thresholds: docs/fleet.md.",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog="examples:\n"
+        "  roastlab fleet synthetic --out fleet-data --batches 1000          # a SYNTHETIC fleet to try it on\n"
+        "  roastlab fleet ingest --db fleet.duckdb --manifest fleet-data/manifest.csv\n"
+        "  roastlab fleet fit    --db fleet.duckdb --workers 2\n"
+        "  roastlab fleet report --db fleet.duckdb --json report.json --plot figures/\n"
+        "manifest.csv columns: path,machine,plant,started_at[,map] (paths relative to the manifest; started_at "
+        "ISO 8601, UTC unless it names a zone).",
+    )
+    fsub = p.add_subparsers(dest="what", metavar="WHAT", parser_class=parser_class)
+    fsub.required = True
+
+    q = fsub.add_parser(
+        "ingest",
+        help="read the logs a manifest lists into the store",
+        description="Read every log a manifest lists into the store, in one transaction. A row that cannot be "
+        "ingested (missing file, unknown plant, bad date, unreadable log) is reported on one line with its line "
+        "number and the others still ingest (exit code 2 if any row was rejected). A file already in the store "
+        "(same SHA-256) is skipped, so ingesting again is a no-op.",
+    )
+    q.add_argument("--db", required=True, metavar="FLEET.duckdb", help="the store (created if missing)")
+    q.add_argument("--manifest", required=True, metavar="MANIFEST.csv", help="CSV: path,machine,plant,started_at[,map]")
+    q.set_defaults(func=cmd_fleet_ingest)
+
+    q = fsub.add_parser(
+        "fit",
+        help="fit every batch not yet fitted (resumable)",
+        description="Fit each batch's coefficients separately (the compiled per-batch fitter) for every batch "
+        "that has no fit with its machine's spec yet. Results are committed chunk by chunk: an interrupted run "
+        "loses at most the chunks in flight and the next run fits only what is missing. Without --workers or "
+        "--scheduler it runs in this process on all cores; the results are identical whichever path runs.",
+    )
+    q.add_argument("--db", required=True, metavar="FLEET.duckdb", help="the store")
+    q.add_argument(
+        "--spec",
+        action="append",
+        metavar="[MACHINE=]FIT.toml",
+        help="what each batch's fit frees and holds (every free parameter is fitted per batch); MACHINE=FIT.toml "
+        "for one machine (repeatable). Default: hgm and hbm free, Pbm held at theta*",
+    )
+    q.add_argument("--workers", type=_positive_int("--workers"), help="start a local Dask cluster of N processes")
+    q.add_argument("--scheduler", metavar="ADDRESS", help="use an existing Dask cluster (e.g. tcp://host:8786)")
+    q.add_argument(
+        "--chunk", type=_positive_int("--chunk"), default=500, help="batches per task and commit (default 500)"
+    )
+    q.set_defaults(func=cmd_fleet_fit)
+
+    q = fsub.add_parser(
+        "report",
+        help="each machine's coefficient history, drift alarms and outlier batches",
+        description="Print each machine's coefficients (median and batch-to-batch spread), its drift alarms "
+        "(self-starting CUSUM, k = 0.5, h = 12) and outlier batches. --json writes the report (per machine: "
+        "alarms [{parameter, batch_index, started_at, direction, ...}], outliers, periods); --plot writes one "
+        "figure per machine.",
+    )
+    q.add_argument("--db", required=True, metavar="FLEET.duckdb", help="the store (read only)")
+    q.add_argument("--json", metavar="REPORT.json", help="write the report as JSON")
+    q.add_argument("--plot", metavar="DIR", help="write <machine>.png coefficient histories into this folder")
+    q.set_defaults(func=cmd_fleet_report)
+
+    q = fsub.add_parser(
+        "synthetic",
+        help="write a SYNTHETIC fleet (seeded; machines with injected drift) to try the commands on",
+        description="Write a synthetic fleet: batch CSVs under OUT/<machine>/, OUT/manifest.csv, OUT/truth.json "
+        "(the injected changes) and a README. Every file says it is synthetic.",
+    )
+    q.add_argument("--out", required=True, metavar="DIR", help="folder to write into")
+    q.add_argument("--batches", type=_positive_int("--batches"), default=1000, help="batches in all (default 1000)")
+    q.add_argument("--seed", type=int, default=14, help="random seed (default 14)")
+    q.set_defaults(func=cmd_fleet_synthetic)

@@ -1,0 +1,148 @@
+"""The fleet report: per machine, each coefficient's history, its drift alarms and outliers."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from .drift import CLIP_Z, CUSUM_H, CUSUM_K, OUTLIER_FIT, OUTLIER_RATIO, WARMUP, analyse, machine_history
+from .store import open_store
+
+
+@dataclass
+class MachineHistory:
+    """One machine's fitted history (``frame`` in time order, ``wide`` values) and its analysis."""
+
+    name: str
+    plant: str
+    spec_id: str
+    frame: object
+    wide: object
+    stderr: object
+    analysis: dict
+
+    @property
+    def params(self) -> list[str]:
+        return list(self.wide.columns)
+
+    def to_json_dict(self) -> dict:
+        a = self.analysis
+        coeffs = {}
+        for p in self.params:
+            x = self.wide[p].to_numpy(dtype=float)[a["good"]]
+            x = x[np.isfinite(x)]
+            med = float(np.median(x)) if len(x) else None
+            spread = float(1.4826 * np.median(np.abs(x - med))) if len(x) else None
+            coeffs[p] = {
+                "median": med,
+                "spread": spread,
+                "spread_percent": None if not med else round(100 * spread / abs(med), 2),
+                "first": float(x[0]) if len(x) else None,
+                "last": float(x[-1]) if len(x) else None,
+            }
+        return {
+            "machine": self.name,
+            "plant": self.plant,
+            "spec_id": self.spec_id,
+            "batches": int(len(self.frame)),
+            "first_started_at": self.frame["started_at"].iloc[0].isoformat() if len(self.frame) else None,
+            "last_started_at": self.frame["started_at"].iloc[-1].isoformat() if len(self.frame) else None,
+            "FIT_median": float(np.nanmedian(self.frame["FIT"])) if len(self.frame) else None,
+            "coefficients": coeffs,
+            "alarms": a["alarms"],
+            "outliers": a["outliers"],
+            "periods": a["periods"],
+        }
+
+
+@dataclass
+class FleetReport:
+    machines: list[MachineHistory]
+    db: str
+
+    def to_json_dict(self) -> dict:
+        return {
+            "db": self.db,
+            "detector": {
+                "method": "self-starting two-sided CUSUM on standardised coefficient residuals (Hawkins 1987)",
+                "k": CUSUM_K,
+                "h": CUSUM_H,
+                "clip_z": CLIP_Z,
+                "warmup_batches": WARMUP,
+                "outlier_FIT_below_percent": OUTLIER_FIT,
+                "outlier_mean_squared_residual_over_median": OUTLIER_RATIO,
+            },
+            "machines": [m.to_json_dict() for m in self.machines],
+        }
+
+    def table(self) -> str:
+        """A readable summary: a line per machine and coefficient, then the alarms."""
+        lines = [f"{'machine':<18} {'batches':>7} {'FIT %':>6}  {'coefficient':<14} {'median':>10} {'spread %':>8}"]
+        for m in self.machines:
+            d = m.to_json_dict()
+            for k, (p, c) in enumerate(d["coefficients"].items()):
+                head = f"{m.name:<18} {d['batches']:>7} {d['FIT_median']:>6.1f}" if k == 0 else " " * 33
+                sp = "" if c["spread_percent"] is None else f"{c['spread_percent']:.1f}"
+                lines.append(f"{head}  {p:<14} {c['median']:>10.4g} {sp:>8}")
+        lines.append("")
+        for m in self.machines:
+            a = m.analysis
+            lines.append(f"{m.name}: {len(a['alarms'])} alarm(s), {len(a['outliers'])} outlier batch(es)")
+            for al in a["alarms"]:
+                lines.append(
+                    f"  {al['parameter']} {al['direction']} at batch {al['batch_index']} ({al['started_at']}), "
+                    f"change from batch {al['change_index']}"
+                )
+        return "\n".join(lines)
+
+    def plot(self, folder, outputs=None) -> list[Path]:
+        """One figure per machine (``<machine>.png``): each coefficient over time, alarms marked.
+
+        Written into ``outputs`` (an :class:`~roastlab.io.files.Outputs`) if given, else all
+        together or none.
+        """
+        from ..io.files import Outputs
+        from ..report.figures import plot_fleet_history
+
+        def run(out):
+            folder_ = out.folder(folder)
+            written = []
+            for m in self.machines:
+                safe = "".join(c if c.isalnum() or c in "-_." else "_" for c in m.name)
+                path = folder_ / f"{safe}.png"
+                plot_fleet_history(m, path, outputs=out)
+                written.append(path)
+            return written
+
+        if outputs is not None:
+            return run(outputs)
+        with Outputs() as out:
+            return run(out)
+
+
+def fleet_report(db) -> FleetReport:
+    """Analyse every machine of the store at ``db`` with the spec of its latest fit."""
+    con = open_store(db, read_only=True)
+    try:
+        rows = con.execute(
+            "SELECT m.machine_id, m.name, m.plant, "
+            "(SELECT f.spec_id FROM fits f JOIN batches b USING (batch_id) WHERE b.machine_id = m.machine_id "
+            " ORDER BY f.fitted_at DESC LIMIT 1) FROM machines m ORDER BY m.machine_id"
+        ).fetchall()
+        if not any(r[3] for r in rows):
+            raise InputError("no fits in the store yet: run 'roastlab fleet fit' first", db)
+        machines = []
+        for mid, name, plant, sid in rows:
+            if sid is None:
+                continue
+            frame, vals = machine_history(con, mid, sid)
+            params = list(dict.fromkeys(vals["parameter"]))
+            res = analyse(frame, vals, params)
+            err = vals.pivot(index="batch_id", columns="parameter", values="stderr").reindex(frame["batch_id"])
+            machines.append(MachineHistory(name, plant, sid, frame, res["wide"][params], err[params], res))
+    finally:
+        con.close()
+    return FleetReport(machines, str(db))

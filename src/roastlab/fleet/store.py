@@ -1,0 +1,390 @@
+"""The fleet store: machines, batches, their series and per-batch fits in one DuckDB file.
+
+DuckDB is an embedded database: the store is one file (``FLEET.duckdb``), no server runs.
+Schema (``SCHEMA_VERSION`` 1; every table is created by :func:`open_store`):
+
+``machines``
+    ``machine_id`` INTEGER key, ``name`` (unique), ``plant`` (a preset name or the plant
+    file's path as the manifest gave it), ``plant_toml`` (the plant file's text, NULL for a
+    preset: the store does not depend on the file staying where it was), ``plant_sha256``.
+``batches``
+    ``batch_id`` BIGINT key, ``machine_id``, ``source`` (the log's path), ``sha256`` (of its
+    bytes, unique: ingesting the same file again is a no-op), ``started_at`` (TIMESTAMPTZ),
+    ``name``, ``green_kg`` (the log's green mass, NULL if it has none), ``n_samples``,
+    ``map`` and ``map_sha256`` (the column map it was read with, NULL for a batch CSV),
+    ``initial_json`` (initial states the log set, e.g. ``{"Tm0_C": 181}``), ``events_json``,
+    ``notes`` (importer warnings), ``ingested_at``.
+``series``
+    one row per sample: ``batch_id``, ``i`` (sample index), ``time_s``, ``Gg_kg_s``, ``Tgi_C``,
+    ``Ta_C``, ``heater``, ``fan``, ``Tb2_C`` (NULL where the log has no such channel). The
+    canonical batch of :class:`roastlab.io.batch.Batch`, after the importer's map.
+``fit_specs``
+    ``spec_id`` (SHA-256 of the spec's canonical JSON), ``spec_json``, ``created_at``.
+``fits``
+    one row per (batch, spec): ``SSR`` [degC^2], ``FIT`` [%], ``MAE`` [degC], ``n_samples``,
+    ``simulations``, ``roastlab_version``, ``fitted_at``.
+``fit_values``
+    one row per (batch, spec, parameter): ``value`` and ``stderr`` (NULL on a bound).
+``models``
+    the machine models: per (machine, spec, period) and parameter, the median and the
+    robust spread (1.4826 MAD) of the good batches' values, with the period's first and last
+    batch; periods end at the drift alarms (:mod:`.drift`). Refreshed by every ``fleet fit``.
+
+Every write is one transaction: an ingest that fails part-way leaves the store as it was.
+"""
+
+from __future__ import annotations
+
+import csv
+import datetime
+import hashlib
+import io
+import json
+import time
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from ..io.files import read_input_bytes, read_input_text
+from ..io.plants import load_plant
+from ..model.plant import plant_from_mapping, preset_names
+
+SCHEMA_VERSION = 1
+MANIFEST_COLUMNS = ("path", "machine", "plant", "started_at")
+SERIES_COLUMNS = ("time_s", "Gg_kg_s", "Tgi_C", "Ta_C", "heater", "fan", "Tb2_C")
+#: Batches written to DuckDB per append (bounded memory, whatever the manifest's length).
+INGEST_CHUNK = 2000
+
+_SCHEMA = """
+CREATE TABLE IF NOT EXISTS meta (key VARCHAR PRIMARY KEY, value VARCHAR);
+CREATE TABLE IF NOT EXISTS machines (
+    machine_id INTEGER PRIMARY KEY, name VARCHAR UNIQUE NOT NULL, plant VARCHAR NOT NULL,
+    plant_toml VARCHAR, plant_sha256 VARCHAR);
+CREATE TABLE IF NOT EXISTS batches (
+    batch_id BIGINT PRIMARY KEY, machine_id INTEGER NOT NULL, source VARCHAR NOT NULL,
+    sha256 VARCHAR UNIQUE NOT NULL, started_at TIMESTAMPTZ NOT NULL, name VARCHAR,
+    green_kg DOUBLE, n_samples INTEGER NOT NULL, map VARCHAR, map_sha256 VARCHAR,
+    initial_json VARCHAR, events_json VARCHAR, notes VARCHAR, ingested_at TIMESTAMPTZ);
+CREATE TABLE IF NOT EXISTS series (
+    batch_id BIGINT NOT NULL, i INTEGER NOT NULL, time_s DOUBLE NOT NULL, Gg_kg_s DOUBLE NOT NULL,
+    Tgi_C DOUBLE NOT NULL, Ta_C DOUBLE, heater DOUBLE, fan DOUBLE, Tb2_C DOUBLE);
+CREATE TABLE IF NOT EXISTS fit_specs (spec_id VARCHAR PRIMARY KEY, spec_json VARCHAR, created_at TIMESTAMPTZ);
+CREATE TABLE IF NOT EXISTS fits (
+    batch_id BIGINT NOT NULL, spec_id VARCHAR NOT NULL, SSR DOUBLE, FIT DOUBLE, MAE DOUBLE,
+    n_samples INTEGER, simulations BIGINT, roastlab_version VARCHAR, fitted_at TIMESTAMPTZ,
+    PRIMARY KEY (batch_id, spec_id));
+CREATE TABLE IF NOT EXISTS fit_values (
+    batch_id BIGINT NOT NULL, spec_id VARCHAR NOT NULL, parameter VARCHAR NOT NULL, value DOUBLE,
+    stderr DOUBLE, PRIMARY KEY (batch_id, spec_id, parameter));
+CREATE TABLE IF NOT EXISTS models (
+    machine_id INTEGER NOT NULL, spec_id VARCHAR NOT NULL, period INTEGER NOT NULL,
+    first_batch_id BIGINT, last_batch_id BIGINT, from_started_at TIMESTAMPTZ, to_started_at TIMESTAMPTZ,
+    n_batches INTEGER, parameter VARCHAR NOT NULL, median DOUBLE, spread DOUBLE);
+"""
+
+
+def _duckdb():
+    try:
+        import duckdb
+    except ImportError:  # an optional extra
+        raise InputError("the fleet store needs DuckDB: pip install 'roastlab[fleet]'") from None
+    return duckdb
+
+
+def open_store(db: str | Path, read_only: bool = False):
+    """Open (creating if needed) the fleet store at ``db``; returns a DuckDB connection."""
+    duckdb = _duckdb()
+    db = Path(db)
+    if read_only and not db.exists():
+        raise InputError("no such fleet store (create it with 'roastlab fleet ingest')", db)
+    if db.exists() and not db.is_file():
+        raise InputError("not a file", db)
+    try:
+        con = duckdb.connect(str(db), read_only=read_only)
+    except duckdb.Error as exc:
+        raise InputError(f"cannot open as a DuckDB fleet store ({str(exc).splitlines()[0]})", db) from None
+    if not read_only:
+        con.execute(_SCHEMA)
+        con.execute("INSERT OR IGNORE INTO meta VALUES ('schema_version', ?)", [str(SCHEMA_VERSION)])
+    try:
+        row = con.execute("SELECT value FROM meta WHERE key = 'schema_version'").fetchone()
+    except duckdb.Error:
+        row = None
+    if row is None or row[0] != str(SCHEMA_VERSION):
+        con.close()
+        raise InputError(f"not a roastlab fleet store of schema version {SCHEMA_VERSION}", db)
+    return con
+
+
+@dataclass
+class IngestReport:
+    """What an ingest did: batches added, files already in the store, rejected manifest rows."""
+
+    added: int = 0
+    already: int = 0
+    machines_added: list[str] = field(default_factory=list)
+    rejected: list[str] = field(default_factory=list)
+    wall_s: float = 0.0
+
+    def summary(self) -> str:
+        s = f"{self.added} batch(es) ingested, {self.already} already in the store"
+        if self.machines_added:
+            s += f"; new machine(s): {', '.join(self.machines_added)}"
+        if self.rejected:
+            s += f"; {len(self.rejected)} row(s) rejected"
+        return s + f" ({self.wall_s:.1f} s)"
+
+
+def _parse_started_at(text: str) -> datetime.datetime:
+    """ISO 8601 date-time; without a zone it is read as UTC."""
+    try:
+        ts = datetime.datetime.fromisoformat(text.strip())
+    except ValueError:
+        raise ValueError(f"started_at {text!r} is not an ISO 8601 date-time (e.g. 2024-03-01T08:30:00+01:00)") from None
+    if ts.tzinfo is None:
+        ts = ts.replace(tzinfo=datetime.UTC)
+    return ts
+
+
+def read_manifest(path: str | Path) -> tuple[list[tuple[int, dict]], list[str]]:
+    """Rows of a manifest CSV as (line number, {column: text}); a missing column is an InputError."""
+    text = read_input_text(path, "manifest")
+    reader = csv.DictReader(io.StringIO(text))
+    header = [h.strip() for h in (reader.fieldnames or [])]
+    missing = [c for c in MANIFEST_COLUMNS if c not in header]
+    if missing:
+        raise InputError(
+            f"missing column(s) {', '.join(missing)} (a manifest has {','.join(MANIFEST_COLUMNS)}[,map])",
+            path,
+            "line 1",
+        )
+    reader.fieldnames = header
+    rows = []
+    for rec in reader:
+        rows.append((reader.line_num, {k: (v or "").strip() for k, v in rec.items() if k is not None}))
+    return rows, header
+
+
+class _Machines:
+    """Machines known to the store or added by this ingest, with their plants checked once."""
+
+    def __init__(self, con, base: Path):
+        self.con = con
+        self.base = base
+        self.known = {
+            name: (mid, plant, sha)
+            for mid, name, plant, sha in con.execute(
+                "SELECT machine_id, name, plant, plant_sha256 FROM machines"
+            ).fetchall()
+        }
+        self.next_id = 1 + max([v[0] for v in self.known.values()], default=0)
+        self.new: list[tuple] = []
+        self._plants: dict[str, tuple] = {}
+
+    def _plant(self, spec: str) -> tuple[str, str | None, str | None]:
+        """(plant as stored, its TOML text or None for a preset, its SHA-256)."""
+        if spec in self._plants:
+            return self._plants[spec]
+        if spec in preset_names():
+            out = (spec, None, None)
+        else:
+            path = Path(spec) if Path(spec).is_absolute() else self.base / spec
+            if not path.exists():
+                raise ValueError(f"unknown plant {spec!r}: neither a preset ({', '.join(preset_names())}) nor a file")
+            text = read_input_text(path, "plant file")
+            load_plant(path)  # checks the geometry; raises InputError naming the file
+            out = (str(path), text, hashlib.sha256(text.encode()).hexdigest())
+        self._plants[spec] = out
+        return out
+
+    def check(self, name: str, plant_spec: str) -> None:
+        """ValueError if the plant is unknown or differs from the one the machine already has."""
+        plant, _text, sha = self._plant(plant_spec)
+        if name in self.known:
+            _mid, known_plant, known_sha = self.known[name]
+            if (sha or plant) != (known_sha or known_plant):
+                raise ValueError(f"machine {name!r} already has plant {known_plant}, not {plant}")
+
+    def resolve(self, name: str, plant_spec: str) -> int:
+        """The machine's id, adding it (with its plant) if the store does not know it yet."""
+        self.check(name, plant_spec)
+        if name in self.known:
+            return self.known[name][0]
+        plant, text, sha = self._plant(plant_spec)
+        mid = self.next_id
+        self.next_id += 1
+        self.known[name] = (mid, plant, sha)
+        self.new.append((mid, name, plant, text, sha))
+        return mid
+
+
+def ingest(db: str | Path, manifest: str | Path, progress=None) -> IngestReport:
+    """Ingest the logs a manifest lists into the store at ``db`` (one transaction).
+
+    The manifest is a CSV with columns ``path,machine,plant,started_at[,map]``: ``path`` and
+    ``map`` relative to the manifest's folder, ``plant`` a preset or a PLANT.toml, ``started_at``
+    ISO 8601 (UTC if it names no zone). A row that cannot be ingested (missing file, unknown
+    plant, bad date, unreadable log) is rejected with one line naming its line number; the
+    others still ingest. A file already in the store (same SHA-256) is skipped.
+    """
+    from ..io.batch import read_batch_csv
+    from ..io.importers import import_log, load_map
+
+    t0 = time.perf_counter()
+    manifest = Path(manifest)
+    rows, _ = read_manifest(manifest)
+    base = manifest.parent
+    report = IngestReport()
+    con = open_store(db)
+    try:
+        con.execute("BEGIN TRANSACTION")
+        machines = _Machines(con, base)
+        seen = {r[0] for r in con.execute("SELECT sha256 FROM batches").fetchall()}
+        next_batch = 1 + (con.execute("SELECT max(batch_id) FROM batches").fetchone()[0] or 0)
+        maps: dict[str, tuple] = {}
+        pending_b: list[tuple] = []
+        pending_s: list[tuple] = []
+        now = datetime.datetime.now(datetime.UTC)
+        for k, (line, row) in enumerate(rows):
+            where = f"line {line}"
+            try:
+                for col in MANIFEST_COLUMNS:
+                    if not row.get(col):
+                        raise ValueError(f"empty {col}")
+                started = _parse_started_at(row["started_at"])
+                machines.check(row["machine"], row["plant"])
+                path = Path(row["path"]) if Path(row["path"]).is_absolute() else base / row["path"]
+                if not path.exists():
+                    raise ValueError(f"file not found: {row['path']}")
+                raw = read_input_bytes(path)
+                sha = hashlib.sha256(raw).hexdigest()
+                if sha in seen:
+                    report.already += 1
+                    continue
+                map_name = row.get("map") or ""
+                if map_name:
+                    if map_name not in maps:
+                        mpath = Path(map_name) if Path(map_name).is_absolute() else base / map_name
+                        mtext = read_input_text(mpath, "map")
+                        maps[map_name] = (load_map(mpath), str(mpath), hashlib.sha256(mtext.encode()).hexdigest())
+                    cmap, map_path, map_sha = maps[map_name]
+                    batch = import_log(path, cmap)
+                elif path.suffix.lower() == ".csv":
+                    batch, map_path, map_sha = read_batch_csv(path), None, None
+                else:
+                    batch, map_path, map_sha = import_log(path, None), None, None
+                mid = machines.resolve(row["machine"], row["plant"])
+            except (InputError, ValueError, OSError) as exc:
+                report.rejected.append(f"{manifest}: {where}: {exc}")
+                continue
+            seen.add(sha)
+            bid = next_batch
+            next_batch += 1
+            pending_b.append(
+                (
+                    bid,
+                    mid,
+                    str(path),
+                    sha,
+                    started,
+                    batch.name,
+                    batch.Mb_kg,
+                    batch.n,
+                    map_path,
+                    map_sha,
+                    json.dumps(batch.initial),
+                    json.dumps(batch.events),
+                    "\n".join(batch.notes) or None,
+                    now,
+                )
+            )
+            pending_s.append((bid, batch))
+            report.added += 1
+            if len(pending_s) >= INGEST_CHUNK:
+                _flush(con, machines, pending_b, pending_s)
+            if progress is not None and (k + 1) % 500 == 0:
+                progress(k + 1, len(rows), "rows read")
+        _flush(con, machines, pending_b, pending_s)
+        con.execute("COMMIT")
+    except BaseException:
+        try:
+            con.execute("ROLLBACK")
+        finally:
+            con.close()
+        raise
+    con.close()
+    report.machines_added = [m[1] for m in machines.new]
+    report.wall_s = time.perf_counter() - t0
+    if progress is not None:
+        progress(len(rows), len(rows), "rows read")
+    return report
+
+
+def _flush(con, machines: _Machines, pending_b: list, pending_s: list) -> None:
+    """Append the buffered machines, batches and series (inside the caller's transaction)."""
+    import pandas as pd
+
+    if machines.new:
+        written = {r[0] for r in con.execute("SELECT machine_id FROM machines").fetchall()}
+        rows = [m for m in machines.new if m[0] not in written]
+        if rows:
+            con.executemany("INSERT INTO machines VALUES (?, ?, ?, ?, ?)", rows)
+    if not pending_b:
+        return
+    bf = pd.DataFrame(
+        pending_b,
+        columns=[
+            "batch_id",
+            "machine_id",
+            "source",
+            "sha256",
+            "started_at",
+            "name",
+            "green_kg",
+            "n_samples",
+            "map",
+            "map_sha256",
+            "initial_json",
+            "events_json",
+            "notes",
+            "ingested_at",
+        ],
+    )
+    con.register("_bf", bf)
+    con.execute("INSERT INTO batches SELECT * FROM _bf")
+    con.unregister("_bf")
+    n = sum(b.n for _, b in pending_s)
+    cols = {"batch_id": np.empty(n, dtype=np.int64), "i": np.empty(n, dtype=np.int32)}
+    for c in SERIES_COLUMNS:
+        cols[c] = np.full(n, np.nan)
+    a = 0
+    for bid, b in pending_s:
+        sl = slice(a, a + b.n)
+        cols["batch_id"][sl] = bid
+        cols["i"][sl] = np.arange(b.n)
+        for c in SERIES_COLUMNS:
+            v = getattr(b, c)
+            if v is not None:
+                cols[c][sl] = v
+        a += b.n
+    sf = pd.DataFrame(cols)
+    con.register("_sf", sf)
+    # NaN (no such channel, or a sparse Tb2 gap) is stored as NULL
+    con.execute(
+        "INSERT INTO series SELECT batch_id, i, time_s, Gg_kg_s, Tgi_C, "
+        + ", ".join(f"CASE WHEN isnan({c}) THEN NULL ELSE {c} END" for c in SERIES_COLUMNS[3:])
+        + " FROM _sf"
+    )
+    con.unregister("_sf")
+    pending_b.clear()
+    pending_s.clear()
+
+
+def plant_of(name: str, plant: str, plant_toml: str | None):
+    """The Plant of a stored machine: its preset, or the plant text kept in the store."""
+    if plant_toml is None:
+        return load_plant(plant)
+    return plant_from_mapping(tomllib.loads(plant_toml), plant, Path(plant).stem)
