@@ -20,10 +20,10 @@ from roastlab.apps.cli import build_parser
 from test_bad_input import GOOD_ALOG, GOOD_ROWS, HEADER, PLANT
 
 #: Options that name a file or folder the command writes.
-OUTPUTS = {"--out", "--json", "--plot", "--predictions", "--save", "--alog"}
+OUTPUTS = {"--out", "--json", "--plot", "--predictions", "--save", "--alog", "--db"}
 #: Options that name a file or folder the command reads.
 INPUTS = {"--model", "--theta", "--plant", "--inputs", "--map", "--spec", "--data", "batches", "log", "plant"}
-INPUTS |= {"--from", "--to", "--reference", "--scenario", "--scenarios"}
+INPUTS |= {"--from", "--to", "--reference", "--scenario", "--scenarios", "--manifest"}
 #: Options that take no path: numbers, names, choices and flags.
 VALUES = {
     "--tgi-offset",
@@ -68,6 +68,10 @@ VALUES = {
     "--controllers",
     "--oracle",
     "--ror-weight",
+    "--workers",
+    "--scheduler",
+    "--chunk",
+    "--batches",
     "--help",
     "-h",
 }
@@ -134,6 +138,7 @@ def _inputs(d: Path) -> None:
     (d / "sc").mkdir()
     (d / "sc" / "s.toml").write_text('name = "quick"\n[actuator]\nsample_s = 20.0\n')
     (d / "ref.csv").write_text(REF_CSV)
+    (d / "manifest.csv").write_text("path,machine,plant,started_at\nds/b1.csv,m1,120kg,2024-01-01T08:00:00\n")
     data = d / "data"
     for name in ("dataset-I", "dataset-V"):
         shutil.copytree(d / "ds", data / name)
@@ -188,6 +193,10 @@ RUNS = {
         "--controllers replay --json {d}/t.json --plot {d}/c.png",
         ["model.json", "plant.toml", "ref.csv", "sc/s.toml"],
     ),
+    ("fleet", "ingest"): ("fleet ingest --db {d}/f.duckdb --manifest {d}/manifest.csv", ["manifest.csv", "ds/b1.csv"]),
+    ("fleet", "fit"): ("fleet fit --db {d}/f.duckdb --spec {d}/spec.toml", ["spec.toml"]),
+    ("fleet", "report"): ("fleet report --db {d}/f.duckdb --json {d}/r.json --plot {d}/figs", []),
+    ("fleet", "synthetic"): ("fleet synthetic --out {d}/syn --batches 5", []),
 }
 
 PARSER = build_parser()

@@ -17,10 +17,17 @@ def _progress(desc):
 
 
 def _db_output(db, inputs) -> Path:
-    """The store path: a regular file (or nothing yet), never one of the command's inputs."""
+    """The store path: a DuckDB file or nothing yet; never one of the command's inputs, never
+    another kind of file (a log or CSV given as --db by mistake is refused, not overwritten)."""
     from ..io.files import Outputs
 
-    return Outputs(inputs).check(db)
+    path = Outputs([p for p in inputs if p]).check(db)
+    if path.exists() and path.stat().st_size > 0:
+        with open(path, "rb") as fh:
+            head = fh.read(12)
+        if head[8:12] != b"DUCK":
+            raise InputError("exists and is not a DuckDB file; refusing to write a fleet store into it", path)
+    return path
 
 
 def cmd_fleet_ingest(args) -> int:
@@ -59,7 +66,7 @@ def cmd_fleet_fit(args) -> int:
 
     if args.workers is not None and args.scheduler:
         raise InputError("give --workers N or --scheduler ADDRESS, not both", "command line")
-    _db_output(args.db, [])
+    _db_output(args.db, [v.partition("=")[2] if "=" in v and not Path(v).exists() else v for v in args.spec or []])
     spec = _specs(args.spec)
     report = fit_fleet(
         args.db, spec, workers=args.workers, scheduler=args.scheduler, chunk=args.chunk, progress=_progress("fit")
@@ -76,6 +83,8 @@ def cmd_fleet_report(args) -> int:
     outputs = Outputs([args.db])
     if args.json:
         outputs.check(args.json)
+    if args.plot:
+        outputs.folder(args.plot)
     report = fleet_report(args.db)
     print(report.table())
     with outputs as out:

@@ -376,6 +376,11 @@ def identify_each(
     k = len(names)
     bounds = {**{n: REGISTRY[n].bounds for n in names}, **(bounds or {})}
     fix = dict(fix or {})
+    stray = sorted(set(fix) - set(names))
+    if stray:
+        raise InputError(
+            f"fix {', '.join(stray)}: not among the fitted names {', '.join(names)} (set it in the packed batches)"
+        )
     lo = np.array([fix.get(n, bounds[n][0]) for n in names], dtype=float)
     hi = np.array([fix.get(n, bounds[n][1]) for n in names], dtype=float)
     span = hi - lo

@@ -35,7 +35,7 @@ import numpy as np
 
 CUSUM_K = 0.5
 CUSUM_H = 12.0
-CLIP_Z = 4.0
+CLIP_Z = 3.0
 #: Values needed before a CUSUM starts (after the start of the history or a change).
 WARMUP = 10
 OUTLIER_FIT = 50.0
@@ -118,19 +118,33 @@ def outlier_reasons(SSR: np.ndarray, FIT: np.ndarray, n: np.ndarray) -> list[str
     return out
 
 
+def _frame(con, sql: str, params: list):
+    """A query's result as a DataFrame (timestamps as UTC), built from NumPy columns."""
+    import pandas as pd
+
+    cols = con.execute(sql, params).fetchnumpy()
+    frame = pd.DataFrame({k: np.ma.filled(v, np.nan) if np.ma.isMaskedArray(v) else v for k, v in cols.items()})
+    for c in frame.columns:
+        if pd.api.types.is_datetime64_any_dtype(frame[c]):
+            frame[c] = pd.to_datetime(frame[c], utc=True)
+    return frame
+
+
 def machine_history(con, machine_id: int, spec_id: str):
     """(batches DataFrame in started_at order, values DataFrame batch x parameter) of one machine."""
-    frame = con.execute(
+    frame = _frame(
+        con,
         "SELECT b.batch_id, b.started_at, b.source, b.name, f.SSR, f.FIT, f.MAE, f.n_samples "
         "FROM batches b JOIN fits f USING (batch_id) WHERE b.machine_id = ? AND f.spec_id = ? "
         "ORDER BY b.started_at, b.batch_id",
         [machine_id, spec_id],
-    ).df()
-    vals = con.execute(
+    )
+    vals = _frame(
+        con,
         "SELECT v.batch_id, v.parameter, v.value, v.stderr FROM fit_values v JOIN batches b USING (batch_id) "
         "WHERE b.machine_id = ? AND v.spec_id = ?",
         [machine_id, spec_id],
-    ).df()
+    )
     return frame, vals
 
 

@@ -355,7 +355,7 @@ def fit_fleet(
             report.already += con.execute(
                 "SELECT count(*) FROM fits f JOIN batches b USING (batch_id) WHERE b.machine_id = ? AND f.spec_id = ?",
                 [mid, sid],
-            ).fetchone()[0]
+            ).fetchall()[0][0]
             total += len(ids)
             work += [(mid, ids[a : a + chunk]) for a in range(0, len(ids), chunk)]
         plants = {mid: plant_of(name, plant, toml) for mid, name, plant, toml in machines}

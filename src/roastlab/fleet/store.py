@@ -106,11 +106,13 @@ def open_store(db: str | Path, read_only: bool = False):
         con = duckdb.connect(str(db), read_only=read_only)
     except duckdb.Error as exc:
         raise InputError(f"cannot open as a DuckDB fleet store ({str(exc).splitlines()[0]})", db) from None
+    con.execute("SET TimeZone = 'UTC'")
     if not read_only:
         con.execute(_SCHEMA)
         con.execute("INSERT OR IGNORE INTO meta VALUES ('schema_version', ?)", [str(SCHEMA_VERSION)])
     try:
-        row = con.execute("SELECT value FROM meta WHERE key = 'schema_version'").fetchone()
+        rows = con.execute("SELECT value FROM meta WHERE key = 'schema_version'").fetchall()
+        row = rows[0] if rows else None
     except duckdb.Error:
         row = None
     if row is None or row[0] != str(SCHEMA_VERSION):
@@ -243,7 +245,7 @@ def ingest(db: str | Path, manifest: str | Path, progress=None) -> IngestReport:
         con.execute("BEGIN TRANSACTION")
         machines = _Machines(con, base)
         seen = {r[0] for r in con.execute("SELECT sha256 FROM batches").fetchall()}
-        next_batch = 1 + (con.execute("SELECT max(batch_id) FROM batches").fetchone()[0] or 0)
+        next_batch = 1 + (con.execute("SELECT max(batch_id) FROM batches").fetchall()[0][0] or 0)
         maps: dict[str, tuple] = {}
         pending_b: list[tuple] = []
         pending_s: list[tuple] = []

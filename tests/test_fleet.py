@@ -1,0 +1,312 @@
+"""The fleet store, per-batch fleet fits (in-process and on Dask), drift alarms and outliers."""
+
+import json
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+duckdb = pytest.importorskip("duckdb")
+
+from roastlab.fleet import fit_fleet, fleet_report, fleet_spec, ingest  # noqa: E402
+from roastlab.fleet.drift import CUSUM_H, cusum_alarms  # noqa: E402
+from roastlab.fleet.synthetic import make_fleet  # noqa: E402
+
+REAL = Path(__file__).resolve().parents[2] / "shared" / "data" / "real"
+
+
+@pytest.fixture(scope="module")
+def fleet(tmp_path_factory):
+    """A SYNTHETIC fleet of 500 batches (100 per machine, three with an injected change), ingested and fitted."""
+    d = tmp_path_factory.mktemp("fleet")
+    truth = make_fleet(d / "data", 500, seed=3)
+    db = d / "f.duckdb"
+    rep = ingest(db, d / "data" / "manifest.csv")
+    assert rep.added == 500 and not rep.rejected
+    fit = fit_fleet(db, chunk=40)
+    assert fit.fitted == 500
+    return d, db, truth
+
+
+def _counts(db):
+    con = duckdb.connect(str(db), read_only=True)
+    try:
+        return {t: con.execute(f"SELECT count(*) FROM {t}").fetchone()[0] for t in ("machines", "batches", "series")}
+    finally:
+        con.close()
+
+
+def _fits(db):
+    con = duckdb.connect(str(db), read_only=True)
+    try:
+        vals = con.execute(
+            "SELECT b.sha256, v.parameter, v.value, v.stderr FROM fit_values v JOIN batches b USING (batch_id) "
+            "ORDER BY b.sha256, v.parameter"
+        ).fetchall()
+        fits = con.execute(
+            "SELECT b.sha256, f.SSR, f.FIT, f.MAE, f.simulations FROM fits f JOIN batches b USING (batch_id) "
+            "ORDER BY b.sha256"
+        ).fetchall()
+        return vals, fits
+    finally:
+        con.close()
+
+
+def test_ingest_stores_every_sample_and_reingest_is_a_no_op(fleet):
+    d, db, _ = fleet
+    before = _counts(db)
+    assert before["machines"] == 5 and before["batches"] == 500
+    con = duckdb.connect(str(db), read_only=True)
+    n_rows = con.execute("SELECT sum(n_samples) FROM batches").fetchone()[0]
+    row = con.execute("SELECT source, initial_json, green_kg FROM batches ORDER BY batch_id LIMIT 1").fetchone()
+    con.close()
+    assert before["series"] == n_rows
+    assert set(json.loads(row[1])) == {"Tm0_C", "X0", "Tb0_C"} and row[2] > 100  # the log's metadata kept
+    rep = ingest(db, d / "data" / "manifest.csv")
+    assert rep.added == 0 and rep.already == 500
+    assert _counts(db) == before
+
+
+def test_a_failed_ingest_leaves_the_store_as_it_was(fleet, tmp_path, monkeypatch):
+    import roastlab.fleet.store as store
+
+    d, db, _ = fleet
+    copy = tmp_path / "copy.duckdb"
+    copy.write_bytes(db.read_bytes())
+    before = _counts(copy)
+    # a second machine's worth of new files, and a failure after the first chunk was appended
+    make_fleet(tmp_path / "more", 50, seed=99)
+    monkeypatch.setattr(store, "INGEST_CHUNK", 10)
+    real_flush = store._flush
+    calls = {"n": 0}
+
+    def failing_flush(*args):
+        calls["n"] += 1
+        if calls["n"] == 3:
+            raise RuntimeError("disk full")
+        return real_flush(*args)
+
+    monkeypatch.setattr(store, "_flush", failing_flush)
+    with pytest.raises(RuntimeError):
+        ingest(copy, tmp_path / "more" / "manifest.csv")
+    assert calls["n"] == 3  # two chunks went into the transaction before it failed
+    assert _counts(copy) == before
+
+
+def test_bad_manifest_rows_are_reported_one_line_each_and_good_rows_ingest(cli, tmp_path):
+    make_fleet(tmp_path / "data", 10, seed=5)
+    lines = (tmp_path / "data" / "manifest.csv").read_text().splitlines()
+    (tmp_path / "data" / "truncated.csv").write_text("time_s,Gg_kg_s,Tgi_C,Ta_C\n0,0.4,400,25\n30,0.4,4")
+    bad = [
+        "roaster-A/missing.csv,roaster-A,120kg,2024-01-01T08:00:00",
+        lines[2].replace(",120kg,", ",200kg,"),
+        lines[3].rsplit(",", 1)[0] + ",yesterday",
+        "truncated.csv,roaster-A,120kg,2024-01-01T09:00:00",
+    ]
+    manifest = tmp_path / "data" / "m.csv"
+    manifest.write_text("\n".join([lines[0], lines[1], *bad, *lines[4:]]) + "\n")
+    code, out, err = cli("fleet", "ingest", "--db", tmp_path / "f.duckdb", "--manifest", manifest)
+    assert code == 2
+    rejected = [e for e in err.splitlines() if "rejected" in e]
+    assert len(rejected) == 4 and "Traceback" not in err
+    for line_no, word in zip((3, 4, 5, 6), ("file not found", "unknown plant", "ISO 8601", "truncated.csv")):
+        hit = [e for e in rejected if f"line {line_no}:" in e]
+        assert hit and word in hit[0], (line_no, rejected)
+    # line 4 is one good file with a bad plant, line 5 one with a bad date: 10 files - 2 rejected ingest
+    assert "8 batch(es) ingested" in out
+    assert _counts(tmp_path / "f.duckdb")["batches"] == 8
+
+
+def test_manifest_without_its_columns_and_a_non_store_db_are_one_line_errors(cli, tmp_path):
+    m = tmp_path / "m.csv"
+    m.write_text("path,machine\nx.csv,a\n")
+    code, _, err = cli("fleet", "ingest", "--db", tmp_path / "f.duckdb", "--manifest", m)
+    assert code == 2 and "plant, started_at" in err and err.count("\n") == 1
+    code, _, err = cli("fleet", "ingest", "--db", m, "--manifest", m)
+    assert code == 2 and "input" in err and err.count("\n") == 1
+    log = tmp_path / "log.csv"
+    log.write_text("time_s,Gg_kg_s,Tgi_C\n0,0.4,400\n")
+    code, _, err = cli("fleet", "fit", "--db", log)
+    assert code == 2 and "not a DuckDB file" in err and log.read_text().startswith("time_s")
+    code, _, err = cli("fleet", "report", "--db", tmp_path / "nothing.duckdb")
+    assert code == 2 and "no such fleet store" in err
+
+
+def test_drift_is_flagged_within_15_batches_and_only_where_injected(fleet):
+    d, db, truth = fleet
+    report = fleet_report(db).to_json_dict()
+    by_name = {m["machine"]: m for m in report["machines"]}
+    for m in truth["machines"]:
+        alarms = by_name[m["name"]]["alarms"]
+        if not m["changes"]:
+            assert alarms == [], (m["name"], alarms)
+            continue
+        for change in m["changes"]:
+            hits = [a for a in alarms if a["parameter"] == change["parameter"]]
+            assert len(hits) == 1, (m["name"], alarms)
+            delay = hits[0]["batch_index"] - change["batch_index"]
+            assert 0 <= delay <= 15, (m["name"], delay)
+            assert hits[0]["direction"] == ("down" if change["factor"] < 1 else "up")
+            assert set(hits[0]) >= {"parameter", "batch_index", "started_at", "direction"}
+
+
+def test_the_self_starting_cusum_holds_its_false_alarm_rate():
+    """In-control series of 20,000 values: no alarm at h = 12 (normal); at most one in 60,000
+    heavy-tailed (Student t, 4 dof) values; a 2-sd step is found within 15 values."""
+    rng = np.random.default_rng(0)
+    for _ in range(3):
+        assert cusum_alarms(1.0 + 0.05 * rng.standard_normal(20000)) == []
+    assert sum(len(cusum_alarms(1.0 + 0.05 * rng.standard_t(4, 20000))) for _ in range(3)) <= 1
+    x = 1.0 + 0.05 * rng.standard_normal(400)
+    x[200:] += 0.1
+    alarms = cusum_alarms(x)
+    assert len(alarms) == 1 and 200 <= alarms[0]["index"] <= 215 and alarms[0]["direction"] == "up"
+    # the threshold matters: a much lower h raises false alarms on the same in-control series
+    assert cusum_alarms(1.0 + 0.05 * rng.standard_normal(20000), h=2.0) != [] and CUSUM_H > 2.0
+
+
+def test_probe_faults_are_outliers_not_drift(tmp_path):
+    """A batch whose probe reading jumps is listed as an outlier, with its reason."""
+    import roastlab.fleet.synthetic as syn
+
+    old = syn.PROBE_FAULT_RATE
+    syn.PROBE_FAULT_RATE = 0.2
+    try:
+        make_fleet(tmp_path / "data", 40, seed=8, machines=syn.MACHINES[:1])
+    finally:
+        syn.PROBE_FAULT_RATE = old
+    db = tmp_path / "f.duckdb"
+    ingest(db, tmp_path / "data" / "manifest.csv")
+    fit_fleet(db)
+    m = fleet_report(db).to_json_dict()["machines"][0]
+    assert len(m["outliers"]) >= 4 and m["alarms"] == []
+    assert all("fit" in o["reason"] or "residual" in o["reason"] for o in m["outliers"])
+
+
+def test_dask_and_in_process_store_identical_fits(fleet, tmp_path):
+    pytest.importorskip("distributed")
+    d, db, _ = fleet
+    other = tmp_path / "dask.duckdb"
+    ingest(other, d / "data" / "manifest.csv")
+    rep = fit_fleet(other, workers=2, chunk=25)
+    assert rep.where.startswith("dask (2 workers)") and rep.fitted == 500
+    assert _fits(other) == _fits(db)
+
+
+def test_population_simulations_on_dask_are_identical():
+    pytest.importorskip("distributed")
+    from distributed import Client, LocalCluster
+
+    from roastlab.io.batch import Batch
+    from roastlab.model.parameters import THETA_START
+    from roastlab.sim.population import pack_batches, simulate_population
+
+    t = np.arange(0, 601, 10.0)
+    b = Batch("b", t, np.full_like(t, 0.4), np.full_like(t, 450.0))
+    pk = pack_batches([b, b], "120kg", THETA_START)
+    values = np.random.default_rng(1).uniform([0.01, 0.01], [0.1, 0.05], (16, 2, 2))  # Monte Carlo sets
+    here = simulate_population(pk, ["hgm", "hbm"], values)
+    with LocalCluster(n_workers=2, threads_per_worker=1, dashboard_address=None, processes=False) as c, Client(c) as cl:
+        there = simulate_population(pk, ["hgm", "hbm"], values, client=cl)
+    np.testing.assert_array_equal(there, here)
+
+
+KILL = textwrap.dedent(
+    """
+    import os, signal, sys
+    from roastlab.fleet import fit_fleet
+
+    def stop(n):
+        if n >= 60:  # three chunks of 20 committed: kill -9, no clean-up at all
+            os.kill(os.getpid(), signal.SIGKILL)
+
+    fit_fleet(sys.argv[1], chunk=20, on_commit=stop)
+    """
+)
+
+
+def test_killed_fit_resumes_without_refitting_or_losing_batches(fleet, tmp_path):
+    d, _, _ = fleet
+    db = tmp_path / "k.duckdb"
+    ingest(db, d / "data" / "manifest.csv")
+    run = subprocess.run([sys.executable, "-c", KILL, str(db)], env={**os.environ}, capture_output=True, timeout=300)
+    assert run.returncode == -9, run.stderr.decode()[-500:]
+    rep = fit_fleet(db, chunk=20)
+    assert rep.already == 60 and rep.fitted == 440
+    con = duckdb.connect(str(db), read_only=True)
+    n, distinct = con.execute("SELECT count(*), count(DISTINCT batch_id) FROM fits").fetchone()
+    con.close()
+    assert n == distinct == 500
+    assert fit_fleet(db).fitted == 0
+
+
+def test_cli_report_writes_json_and_figures(cli, fleet, tmp_path):
+    _, db, _ = fleet
+    code, out, err = cli("fleet", "report", "--db", db, "--json", tmp_path / "r.json", "--plot", tmp_path / "figs")
+    assert code == 0, err
+    doc = json.loads((tmp_path / "r.json").read_text())
+    assert [m["machine"] for m in doc["machines"]] == [f"roaster-{c}" for c in "ABCDE"]
+    assert doc["detector"]["h"] == CUSUM_H
+    assert sorted(p.name for p in (tmp_path / "figs").iterdir()) == [f"roaster-{c}.png" for c in "ABCDE"]
+    assert "hbm down" in out
+
+
+def test_a_fit_spec_frees_other_parameters_per_batch_and_refuses_X0(tmp_path, fleet):
+    from roastlab.errors import InputError
+
+    d, _, _ = fleet
+    spec = tmp_path / "fit.toml"
+    spec.write_text("[free]\nhbm = [0.005, 0.2, 0.02]\nKt = [0.005, 0.2, 0.02]\n")
+    s = fleet_spec(spec)
+    assert s.names == ("hbm", "Kt") and dict(s.fixed)["hgm"] == 0.01
+    db = tmp_path / "s.duckdb"
+    con_rows = (d / "data" / "manifest.csv").read_text().splitlines()[:11]
+    (d / "data" / "ten.csv").write_text("\n".join(con_rows) + "\n")
+    ingest(db, d / "data" / "ten.csv")
+    fit_fleet(db, {"roaster-A": s})
+    con = duckdb.connect(str(db), read_only=True)
+    params = {r[0] for r in con.execute("SELECT DISTINCT parameter FROM fit_values").fetchall()}
+    con.close()
+    assert params == {"hbm", "Kt"}
+    spec.write_text("[free]\nX0 = [0.05, 0.15, 0.1]\n")
+    with pytest.raises(InputError, match="cannot be fitted per batch"):
+        fleet_spec(spec)
+
+
+def test_per_batch_standard_errors_match_the_multi_batch_identifier():
+    """On one batch the compiled fitter's s^2 (J'J)^-1 agrees with identify()'s (SciPy's Jacobian)."""
+    from roastlab.fit.fleet import identify_each
+    from roastlab.fit.identify import build_free_parameters, identify
+    from roastlab.model.parameters import THETA_START
+    from roastlab.sim.population import pack_batches
+    import roastlab
+
+    ds = roastlab.read_dataset(roastlab.default_dataset_root() / "dataset-I")
+    pk = pack_batches(ds.batches[:1], "120kg", (THETA_START.hgm, THETA_START.hbm, 0.5793))
+    each = identify_each(pk, names=["hgm", "hbm"])
+    free, fixed = build_free_parameters({"Pbm": 0.5793}, None)
+    one = identify(pk, free, fixed, seed=0, n_starts=2)
+    for j, name in enumerate(["hgm", "hbm"]):
+        assert each.theta[0, j] == pytest.approx(one.values[name], rel=2e-3)
+        assert each.stderr[0, j] == pytest.approx(one.stderr[name], rel=0.1)
+
+
+@pytest.mark.skipif(not (REAL / "skywalker").is_dir(), reason="real logs not present")
+def test_real_logs_ingest_as_two_machines(tmp_path):
+    root = Path(__file__).resolve().parents[1]
+    rows = ["path,machine,plant,started_at,map"]
+    for f in sorted((REAL / "skywalker").glob("*.alog"))[:3]:
+        rows.append(
+            f"{f},skywalker,{root}/examples/skywalker/plant.toml,2025-01-01T10:00:00,{root}/examples/skywalker/map.toml"
+        )
+    for f in sorted((REAL / "bullet").glob("*.json"))[:3]:
+        rows.append(f"{f},bullet,{root}/examples/bullet/plant.toml,2025-01-02T10:00:00,{root}/examples/bullet/map.toml")
+    (tmp_path / "m.csv").write_text("\n".join(rows) + "\n")
+    before = {f: f.stat().st_mtime_ns for f in (REAL / "skywalker").glob("*.alog")}
+    rep = ingest(tmp_path / "f.duckdb", tmp_path / "m.csv")
+    assert rep.added == 6 and not rep.rejected and sorted(rep.machines_added) == ["bullet", "skywalker"]
+    assert {f: f.stat().st_mtime_ns for f in before} == before
