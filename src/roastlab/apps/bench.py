@@ -67,6 +67,12 @@ TARGETS = {
     "mpc_over_pid_disturbed": ("<=", 0.5),
     "gym_steps_per_s": (">=", 20_000.0),
     "gym_vector_steps_per_s": (">=", 1_000_000.0),
+    "fleet_end_to_end_s": ("<=", 900.0),
+    "fleet_peak_memory_MB": ("<=", 2048.0),
+    "fleet_dask_overhead": ("<=", 0.15),
+    "fleet_cost_per_batch_ratio": ("<=", 1.25),
+    "fleet_worst_detection_delay": ("<=", 15.0),
+    "fleet_false_alarms": ("<=", 0.0),
 }
 
 
@@ -341,6 +347,10 @@ def run(quiet: bool = False, baseline_repeats: int = 5, only: str | None = None)
         res["control"] = control_bench(quiet)
         res["checks"] = check_targets(res)
         return res
+    if only == "fleet":
+        res["fleet"] = fleet_bench(quiet)
+        res["checks"] = check_targets(res)
+        return res
 
     # --- single batch: project vs baseline -------------------------------------------------
     _log("warming up the compiled kernels ...", quiet)
@@ -495,6 +505,18 @@ def check_targets(res: dict) -> dict:
                 "gym_vector_steps_per_s": c["gym_vector_steps_per_s"],
             }
         )
+    if "fleet" in res:
+        f = res["fleet"]
+        values.update(
+            {
+                "fleet_end_to_end_s": f["end_to_end_s"],
+                "fleet_peak_memory_MB": f["peak_memory_MB"],
+                "fleet_dask_overhead": f["dask_overhead"],
+                "fleet_cost_per_batch_ratio": f["cost_per_batch_ratio"],
+                "fleet_worst_detection_delay": f["worst_detection_delay"],
+                "fleet_false_alarms": f["false_alarms"],
+            }
+        )
     out = {}
     for key, (op, target) in TARGETS.items():
         if key not in values:
@@ -550,6 +572,31 @@ def table(res: dict) -> str:
                 f"MPC at most {c['mpc_over_pid_bumpless_disturbed']:.2f}x its RMSE under disturbance",
             )
         )
+    if "fleet" in res:
+        f = res["fleet"]
+        rows.append(
+            (
+                f"fleet {f['batches']:,} batches end to end",
+                f"{f['end_to_end_s']:.0f} s",
+                f"ingest {f['ingest_s']:.0f} s + fit {f['fit_s']:.0f} s ({f['fit_ms_per_batch']:.2f} ms/batch, "
+                f"{f['cost_per_batch_ratio']:.2f}x the cost per batch at {f['dask_batches']:,}); peak {f['peak_memory_MB']:.0f} MB",
+            )
+        )
+        rows.append(
+            (
+                f"fleet Dask 2 workers vs in-process, {f['dask_batches']:,}",
+                f"{f['dask_overhead'] * 100:+.1f} %",
+                f"{f['dask_2_workers_s']:.1f} vs {f['in_process_s']:.1f} s (cluster start included)",
+            )
+        )
+        rows.append(
+            (
+                "fleet drift alarms",
+                f"{f['worst_detection_delay']:.0f} batches",
+                f"worst delay of {len(f['detection_delays'])} injected change(s), {f['missed_changes']} missed, "
+                f"{f['false_alarms']} false alarm(s)",
+            )
+        )
     for size in ("10", "100", "1000") if "identify_scaling" in res else ():
         sc = res["identify_scaling"]
         rows.append(
@@ -561,3 +608,102 @@ def table(res: dict) -> str:
         )
     w = max(len(r[0]) for r in rows)
     return "\n".join(f"{a:<{w}}  {b:>16}  {c}" for a, b, c in rows)
+
+
+_FLEET_CHILD = """
+import json, resource, sys, time
+from roastlab.fleet import fit_fleet, ingest
+t0 = time.perf_counter(); r = ingest(sys.argv[1], sys.argv[2]); t1 = time.perf_counter()
+f = fit_fleet(sys.argv[1]); t2 = time.perf_counter()
+print(json.dumps({"ingest_s": t1 - t0, "fit_s": t2 - t1, "added": r.added, "fitted": f.fitted,
+                  "peak_MB": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
+"""
+
+
+def _fleet_detection(db, truth: dict) -> dict:
+    """Delays of the injected changes' alarms and alarms where nothing was injected."""
+    from ..fleet import fleet_report
+
+    rep = {m["machine"]: m for m in fleet_report(db).to_json_dict()["machines"]}
+    delays, false_alarms, missed = [], 0, 0
+    for m in truth["machines"]:
+        alarms = list(rep[m["name"]]["alarms"])
+        for ch in m["changes"]:
+            hits = [a for a in alarms if a["parameter"] == ch["parameter"] and a["batch_index"] >= ch["batch_index"]]
+            if hits:
+                delays.append(hits[0]["batch_index"] - ch["batch_index"])
+                alarms.remove(hits[0])
+            else:
+                missed += 1
+        false_alarms += len(alarms)
+    return {"delays": delays, "missed": missed, "false_alarms": false_alarms}
+
+
+def fleet_bench(quiet: bool, n_batches: int = 100_000, n_dask: int = 10_000) -> dict:
+    """The fleet targets (issue 14): a SYNTHETIC fleet of ``n_batches`` ingested and fitted end to
+    end in a child process (its peak RSS), drift found on it, and the Dask path with 2 workers
+    against the in-process path on ``n_dask`` batches (the same store, fits cleared between)."""
+    import shutil
+    import tempfile
+
+    import duckdb
+
+    from ..fleet import fit_fleet, ingest
+    from ..fleet.synthetic import make_fleet
+
+    tmp = Path(tempfile.mkdtemp(prefix="roastlab-fleet-bench-"))
+    try:
+        _log(f"fleet: writing a SYNTHETIC fleet of {n_batches:,} batches ...", quiet)
+        truth = make_fleet(tmp / "big", n_batches)
+        _log("fleet: ingest + fit end to end (child process) ...", quiet)
+        t0 = time.perf_counter()
+        out = subprocess.run(
+            [sys.executable, "-c", _FLEET_CHILD, str(tmp / "big.duckdb"), str(tmp / "big" / "manifest.csv")],
+            check=True,
+            capture_output=True,
+            text=True,
+        )
+        wall = time.perf_counter() - t0
+        big = json.loads(out.stdout.strip().splitlines()[-1])
+        detection = _fleet_detection(tmp / "big.duckdb", truth)
+        shutil.rmtree(tmp / "big")
+
+        _log(f"fleet: Dask (2 workers) vs in-process on {n_dask:,} batches ...", quiet)
+        make_fleet(tmp / "small", n_dask, seed=15)
+        ingest(tmp / "small.duckdb", tmp / "small" / "manifest.csv")
+
+        def clear():
+            con = duckdb.connect(str(tmp / "small.duckdb"))
+            con.execute("DELETE FROM fits; DELETE FROM fit_values; DELETE FROM models")
+            con.close()
+
+        walls = {"in-process": [], "dask": []}
+        for _ in range(2):  # alternate, so drift of the machine's speed hits both alike
+            clear()
+            walls["in-process"].append(fit_fleet(tmp / "small.duckdb").wall_s)
+            clear()
+            walls["dask"].append(fit_fleet(tmp / "small.duckdb", workers=2).wall_s)
+        t_in, t_dask = min(walls["in-process"]), min(walls["dask"])
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    per_big = big["fit_s"] / big["fitted"]
+    per_small = t_in / n_dask
+    return {
+        "batches": n_batches,
+        "ingest_s": round(big["ingest_s"], 1),
+        "fit_s": round(big["fit_s"], 1),
+        "end_to_end_s": round(wall, 1),
+        "peak_memory_MB": round(big["peak_MB"], 1),
+        "fit_ms_per_batch": round(1e3 * per_big, 3),
+        "cost_per_batch_ratio": round(per_big / per_small, 3),
+        "dask_batches": n_dask,
+        "in_process_s": round(t_in, 2),
+        "dask_2_workers_s": round(t_dask, 2),
+        "dask_overhead": round(t_dask / t_in - 1.0, 3),
+        "detection_delays": detection["delays"],
+        "worst_detection_delay": float(
+            max(detection["delays"]) if detection["delays"] and not detection["missed"] else 1e9
+        ),
+        "missed_changes": detection["missed"],
+        "false_alarms": detection["false_alarms"],
+    }

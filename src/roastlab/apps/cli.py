@@ -935,7 +935,11 @@ def _add_fit_commands(sub) -> None:
         "and profile transfer (accuracy on synthetic references, against its baselines and a generic SciPy "
         "solver). Takes a few minutes on 2 cores. Needs no MODEL.json: it times the paper's model.",
     )
-    p.add_argument("--only", choices=("transfer", "control"), help="run one section only")
+    p.add_argument(
+        "--only",
+        choices=("transfer", "control", "fleet"),
+        help="run one section only (fleet: 100,000 synthetic batches end to end, ~15 min; not in the default run)",
+    )
     p.add_argument("--json", action="store_true", help="print the figures as JSON (progress goes quiet)")
     p.add_argument("--save", metavar="FILE.json", help="also save the JSON to a file")
     p.set_defaults(func=cmd_bench)

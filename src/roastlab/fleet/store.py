@@ -55,6 +55,8 @@ from ..model.plant import plant_from_mapping, preset_names
 SCHEMA_VERSION = 1
 MANIFEST_COLUMNS = ("path", "machine", "plant", "started_at")
 SERIES_COLUMNS = ("time_s", "Gg_kg_s", "Tgi_C", "Ta_C", "heater", "fan", "Tb2_C")
+#: DuckDB's memory limit for the store's connection.
+DUCKDB_MEMORY = "1GB"
 #: Batches written to DuckDB per append (bounded memory, whatever the manifest's length).
 INGEST_CHUNK = 2000
 
@@ -107,6 +109,9 @@ def open_store(db: str | Path, read_only: bool = False):
     except duckdb.Error as exc:
         raise InputError(f"cannot open as a DuckDB fleet store ({str(exc).splitlines()[0]})", db) from None
     con.execute("SET TimeZone = 'UTC'")
+    # DuckDB's buffer manager takes up to 80 % of RAM by default; a store of years of batches
+    # streams through far less (it spills to a temporary folder beside the file if it must)
+    con.execute(f"SET memory_limit = '{DUCKDB_MEMORY}'")
     if not read_only:
         con.execute(_SCHEMA)
         con.execute("INSERT OR IGNORE INTO meta VALUES ('schema_version', ?)", [str(SCHEMA_VERSION)])

@@ -21,13 +21,17 @@ from __future__ import annotations
 
 import datetime
 import json
+import os
+import shutil
+import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from ..errors import InputError
 from ..io.batch import Batch, write_batch_csv_text
-from ..io.files import Outputs
+from ..io.files import Outputs, _umask
 from ..io.plants import load_plant
 from ..model.parameters import THETA_PAPER, THETA_START
 from ..sim.population import pack_batches, simulate_population
@@ -131,12 +135,17 @@ def make_fleet(
     truth = {"note": NOTE, "seed": seed, "n_batches": n_batches, "sample_s": SAMPLE_S, "jitter": JITTER, "machines": []}
     manifest = ["path,machine,plant,started_at"]
     done = 0
-    with Outputs() as out:
-        root = out.folder(folder)
+    # 100,000 small files: written plainly into a hidden sibling folder that becomes ``folder``
+    # in one rename at the end (all or nothing, without an fsync per file)
+    if folder.exists() and (not folder.is_dir() or any(folder.iterdir())):
+        raise InputError("exists and is not an empty folder; give a new folder for the synthetic fleet", folder)
+    Outputs().folder(folder.parent)
+    root = Path(tempfile.mkdtemp(prefix=f".{folder.name}.", dir=folder.parent))
+    try:
         for machine, count in zip(machines, per):
             if count == 0:
                 continue
-            out.folder(root / machine.name)
+            (root / machine.name).mkdir()
             values, changes = _truth_of(machine, count)
             # roasts every ~3 h of a working day, in order
             gaps = rng.uniform(2.5, 3.5, count) * 3600.0
@@ -145,7 +154,7 @@ def make_fleet(
                 m = min(chunk, count - a)
                 for b in _batches(rng, machine, a, m, values):
                     rel = f"{machine.name}/{b.name}.csv"
-                    out.write_text(root / rel, write_batch_csv_text(b, comment=NOTE))
+                    (root / rel).write_text(write_batch_csv_text(b, comment=NOTE))
                     k = int(b.name.rsplit("-", 1)[1]) - 1
                     manifest.append(f"{rel},{machine.name},{machine.plant},{times[k].isoformat()}")
                 done += m
@@ -162,11 +171,17 @@ def make_fleet(
                     "changes": changes,
                 }
             )
-        out.write_text(root / "manifest.csv", "\n".join(manifest) + "\n")
-        out.write_text(root / "truth.json", json.dumps(truth, indent=2) + "\n")
-        out.write_text(
-            root / "README.md",
+        (root / "manifest.csv").write_text("\n".join(manifest) + "\n")
+        (root / "truth.json").write_text(json.dumps(truth, indent=2) + "\n")
+        (root / "README.md").write_text(
             f"# Synthetic fleet\n\n{NOTE}\n\n{n_batches} batches over {len(machines)} machines, seed {seed}; "
             "`truth.json` lists each machine's coefficients and the changes injected.\n",
         )
+        os.chmod(root, 0o777 & ~_umask())
+        if folder.exists():
+            folder.rmdir()
+        os.replace(root, folder)
+    except BaseException:
+        shutil.rmtree(root, ignore_errors=True)
+        raise
     return truth
