@@ -2,8 +2,10 @@
 
 **Drift: a self-starting two-sided CUSUM** (Hawkins 1987, "Self-starting cusum charts for
 location and scale", The Statistician 36, 299-316; Page 1954 for the CUSUM). A machine's
-values x_1, x_2, ... of one coefficient, in order of ``started_at`` and outliers left out,
-are standardised against the mean and standard deviation of the values *before* them since
+values of one coefficient, in order of ``started_at`` and outliers left out, are taken as
+x_i = log(value) when all are positive (coefficients scatter by a factor, and drift by a
+factor: a 10 % drop is the same shift whatever the level; the per-batch spread of a weakly
+pinned coefficient is skewed on the linear scale), and standardised against the mean and standard deviation of the values *before* them since
 the last change (no reference period to pick, no known sigma):
 
     t_i = (x_i - mean_{i-1}) / (sd_{i-1} sqrt(1 + 1/n)),   z_i = Phi^-1(F_{n-1}(t_i))
@@ -158,7 +160,10 @@ def analyse(frame, vals, params: list[str]) -> dict:
     for p in params:
         x = wide[p].to_numpy(dtype=float)
         keep = np.flatnonzero(good & np.isfinite(x))
-        for a in cusum_alarms(x[keep]):
+        series = x[keep]
+        if len(series) and np.all(series > 0):
+            series = np.log(series)
+        for a in cusum_alarms(series):
             i, c = int(keep[a["index"]]), int(keep[a["change_index"]]) if a["change_index"] < len(keep) else None
             alarms.append(
                 {

@@ -56,7 +56,7 @@ SCHEMA_VERSION = 1
 MANIFEST_COLUMNS = ("path", "machine", "plant", "started_at")
 SERIES_COLUMNS = ("time_s", "Gg_kg_s", "Tgi_C", "Ta_C", "heater", "fan", "Tb2_C")
 #: DuckDB's memory limit for the store's connection.
-DUCKDB_MEMORY = "1GB"
+DUCKDB_MEMORY = "512MB"
 #: Batches written to DuckDB per append (bounded memory, whatever the manifest's length).
 INGEST_CHUNK = 2000
 
