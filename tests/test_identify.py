@@ -9,7 +9,7 @@ from roastlab.io.batch import Batch, read_dataset
 from roastlab.model.parameters import THETA_BOUNDS, THETA_START
 from roastlab.sim.population import pack_batches, predict_ta
 from roastlab.sim.simulate import InitialState
-from roastlab.workflows.datasets import _burner_program
+from roastlab.workflows.datasets import burner_program
 from roastlab.workflows.reproduce import default_dataset_root
 
 DATA = default_dataset_root()
@@ -22,7 +22,7 @@ def noise_free_batches(seed, plant, theta, count=4):
     batches = []
     for i in range(count):
         t = np.arange(int(rng.integers(25, 34))) * 30.0
-        Tgi, _ = _burner_program(rng, t)
+        Tgi, _ = burner_program(rng, t)
         Gg = scale * rng.uniform(0.30, 0.45) * (1 + 0.01 * rng.standard_normal(len(t)))
         batches.append(Batch(f"b{i}", t, Gg, Tgi, np.full(len(t), 30.0)))
     packed = pack_batches(batches, plant, theta, InitialState(Ta0_C=30.0))

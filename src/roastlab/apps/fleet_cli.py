@@ -127,7 +127,9 @@ def add_fleet_command(sub, parser_class) -> None:
         help="many roasters and years of batches: a DuckDB store, a fit per batch, drift alarms",
         description="Keep every batch of every machine in one DuckDB file (FLEET.duckdb, no server), fit each "
         "batch's heat-transfer coefficients, and watch each machine's coefficients for drift (a fouling drum, a "
-        "failing burner or fan, a drifting probe). Schema, detector and thresholds: docs/fleet.md.",
+        "failing burner or fan, a drifting probe). A per-machine fit spec holds the values of the machine's "
+        "MODEL.json (from 'roastlab identify') and frees the coefficients to watch. Schema, detector and "
+        "thresholds: docs/fleet.md.",
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog="examples:\n"
         "  roastlab fleet synthetic --out fleet-data --batches 1000          # a SYNTHETIC fleet to try it on\n"

@@ -265,9 +265,9 @@ def _write(con, spec: FleetSpec, res: dict, version: str) -> None:
 
 
 def _version() -> str:
-    from ..workflows.model import _version
+    from .. import __version__
 
-    return _version()
+    return __version__
 
 
 def _client(workers: int | None, scheduler: str | None):

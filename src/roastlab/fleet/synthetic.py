@@ -31,12 +31,12 @@ import numpy as np
 
 from ..errors import InputError
 from ..io.batch import Batch, write_batch_csv_text
-from ..io.files import Outputs, _umask
+from ..io.files import Outputs, umask_now
 from ..io.plants import load_plant
 from ..model.parameters import THETA_PAPER, THETA_START
 from ..sim.population import pack_batches, simulate_population
 from ..sim.simulate import InitialState
-from ..workflows.datasets import _burner_program
+from ..workflows.datasets import burner_program
 
 SAMPLE_S = 5.0
 JITTER = 0.02
@@ -86,7 +86,7 @@ def _batches(rng, machine: Machine, first: int, count: int, truth: np.ndarray):
     for k in range(count):
         n = int(rng.uniform(12.0, 16.0) * 60 // SAMPLE_S) + 1
         t = np.arange(n) * SAMPLE_S
-        Tgi, _ = _burner_program(rng, t)
+        Tgi, _ = burner_program(rng, t)
         mass = plant.Mb_kg * rng.uniform(0.9, 1.0)
         Gg = rng.uniform(0.30, 0.45) * mass / 120.0 * (1.0 + 0.01 * rng.standard_normal(n))
         true = {
@@ -177,7 +177,7 @@ def make_fleet(
             f"# Synthetic fleet\n\n{NOTE}\n\n{n_batches} batches over {len(machines)} machines, seed {seed}; "
             "`truth.json` lists each machine's coefficients and the changes injected.\n",
         )
-        os.chmod(root, 0o777 & ~_umask())
+        os.chmod(root, 0o777 & ~umask_now())
         if folder.exists():
             folder.rmdir()
         os.replace(root, folder)

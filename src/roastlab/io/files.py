@@ -146,7 +146,8 @@ def _same_file(a: Path, b: Path) -> bool:
     return a.resolve() == b.resolve()
 
 
-def _umask() -> int:
+def umask_now() -> int:
+    """The process umask (read without changing it for good)."""
     mask = os.umask(0o022)
     os.umask(mask)
     return mask
@@ -232,7 +233,7 @@ class Outputs:
                 fh.write(data)
                 fh.flush()
                 os.fsync(fh.fileno())
-            os.chmod(tmp, 0o666 & ~_umask())
+            os.chmod(tmp, 0o666 & ~umask_now())
         except OSError as exc:
             raise InputError(f"cannot write output ({exc.strerror})", out) from None
         return out

@@ -36,7 +36,7 @@ SPECS = {"dataset-I": ("120kg", 5), "dataset-V": ("360kg", 2)}
 NOISE = {"Ta_sigma_C": 1.0, "Gg_rel_sigma": 0.02, "Tgi_sigma_C": 3.0}
 
 
-def _burner_program(rng, t_s: np.ndarray) -> tuple[np.ndarray, dict]:
+def burner_program(rng, t_s: np.ndarray) -> tuple[np.ndarray, dict]:
     """Inlet gas temperature [degC]: a start level, then a step or a ramp down."""
     start = rng.uniform(440.0, 500.0)
     end = rng.uniform(330.0, 420.0)
@@ -58,7 +58,7 @@ def make_batch(rng, plant_name: str, index: int, cold_first: bool) -> tuple[Batc
     minutes = rng.uniform(12.0, 16.0)
     n = int(minutes * 60 // SAMPLE_S) + 1
     t = np.arange(n) * SAMPLE_S
-    Tgi_true, program = _burner_program(rng, t)
+    Tgi_true, program = burner_program(rng, t)
     Gg_level = rng.uniform(0.30, 0.45) * plant.Mb_kg / 120.0
     Gg_true = Gg_level * (1.0 + 0.01 * rng.standard_normal(n))  # small real fluctuations
     X0 = rng.uniform(0.09, 0.12)
