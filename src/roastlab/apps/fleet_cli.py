@@ -108,20 +108,9 @@ def cmd_fleet_synthetic(args) -> int:
     return 0
 
 
-def _positive_int(name):
-    def parse(text):
-        try:
-            v = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{name} must be a whole number, got {text!r}") from None
-        if v < 1:
-            raise argparse.ArgumentTypeError(f"{name} must be at least 1, got {v}")
-        return v
-
-    return parse
-
-
 def add_fleet_command(sub, parser_class) -> None:
+    from .cli import _count_arg
+
     p = sub.add_parser(
         "fleet",
         help="many roasters and years of batches: a DuckDB store, a fit per batch, drift alarms",
@@ -170,10 +159,13 @@ def add_fleet_command(sub, parser_class) -> None:
         help="what each batch's fit frees and holds (every free parameter is fitted per batch); MACHINE=FIT.toml "
         "for one machine (repeatable). Default: hgm and hbm free, Pbm held at theta*",
     )
-    q.add_argument("--workers", type=_positive_int("--workers"), help="start a local Dask cluster of N processes")
+    q.add_argument("--workers", type=_count_arg("--workers", 1, 1024), help="start a local Dask cluster of N processes")
     q.add_argument("--scheduler", metavar="ADDRESS", help="use an existing Dask cluster (e.g. tcp://host:8786)")
     q.add_argument(
-        "--chunk", type=_positive_int("--chunk"), default=500, help="batches per task and commit (default 500)"
+        "--chunk",
+        type=_count_arg("--chunk", 1, 1_000_000),
+        default=500,
+        help="batches per task and commit (default 500)",
     )
     q.set_defaults(func=cmd_fleet_fit)
 
@@ -197,6 +189,8 @@ def add_fleet_command(sub, parser_class) -> None:
         "(the injected changes) and a README. Every file says it is synthetic.",
     )
     q.add_argument("--out", required=True, metavar="DIR", help="folder to write into")
-    q.add_argument("--batches", type=_positive_int("--batches"), default=1000, help="batches in all (default 1000)")
+    q.add_argument(
+        "--batches", type=_count_arg("--batches", 1, 10_000_000), default=1000, help="batches in all (default 1000)"
+    )
     q.add_argument("--seed", type=int, default=14, help="random seed (default 14)")
     q.set_defaults(func=cmd_fleet_synthetic)
