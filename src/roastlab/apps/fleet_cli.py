@@ -8,12 +8,7 @@ import sys
 from pathlib import Path
 
 from ..errors import InputError
-
-
-def _progress(desc):
-    from .cli import _progress as bar
-
-    return bar(desc)
+from .cli import _count_arg, _progress
 
 
 def _db_output(db, inputs) -> Path:
@@ -109,7 +104,6 @@ def cmd_fleet_synthetic(args) -> int:
 
 
 def add_fleet_command(sub, parser_class) -> None:
-    from .cli import _count_arg
 
     p = sub.add_parser(
         "fleet",

@@ -35,6 +35,8 @@ import math
 
 import numpy as np
 
+from .store import filled
+
 CUSUM_K = 0.5
 CUSUM_H = 12.0
 CLIP_Z = 3.0
@@ -42,6 +44,16 @@ CLIP_Z = 3.0
 WARMUP = 10
 OUTLIER_FIT = 50.0
 OUTLIER_RATIO = 10.0
+
+
+def robust_stats(values) -> dict | None:
+    """Median and robust spread (1.4826 x the median absolute deviation) of the finite values."""
+    x = np.asarray(values, dtype=float)
+    x = x[np.isfinite(x)]
+    if not len(x):
+        return None
+    med = float(np.median(x))
+    return {"median": med, "spread": float(1.4826 * np.median(np.abs(x - med)))}
 
 
 def _to_normal(t: float, dof: int) -> float:
@@ -125,7 +137,7 @@ def _frame(con, sql: str, params: list):
     import pandas as pd
 
     cols = con.execute(sql, params).fetchnumpy()
-    frame = pd.DataFrame({k: np.ma.filled(v, np.nan) if np.ma.isMaskedArray(v) else v for k, v in cols.items()})
+    frame = pd.DataFrame({k: filled(v) for k, v in cols.items()})
     for c in frame.columns:
         if pd.api.types.is_datetime64_any_dtype(frame[c]):
             frame[c] = pd.to_datetime(frame[c], utc=True)
@@ -196,13 +208,7 @@ def analyse(frame, vals, params: list[str]) -> dict:
             continue
         sel = good[a:b]
         part = wide.iloc[a:b][sel]
-        stats = {}
-        for p in params:
-            col = part[p].to_numpy(dtype=float)
-            col = col[np.isfinite(col)]
-            if len(col):
-                med = float(np.median(col))
-                stats[p] = {"median": med, "spread": float(1.4826 * np.median(np.abs(col - med)))}
+        stats = {p: st for p in params if (st := robust_stats(part[p].to_numpy(dtype=float)))}
         periods.append({"first_index": a, "last_index": b - 1, "n_batches": int(sel.sum()), "values": stats})
     return {"reasons": reasons, "good": good, "wide": wide, "alarms": alarms, "outliers": outliers, "periods": periods}
 

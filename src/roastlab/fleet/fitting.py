@@ -31,7 +31,7 @@ from ..errors import InputError
 from ..io.batch import Batch
 from ..io.fitspec import FitSpec, load_fit_spec
 from ..model.parameters import REGISTRY, THETA_NAMES, THETA_PAPER, THETA_START, FreeParameter
-from .store import SERIES_COLUMNS, open_store, plant_of
+from .store import SERIES_COLUMNS, filled, open_store, plant_of
 
 #: Batches per task: large enough that shipping and committing are noise against the fitting
 #: (~1-5 ms a batch), small enough that an interruption loses little.
@@ -180,10 +180,7 @@ def _load_chunk(con, ids: list[int]) -> list[Batch]:
         "AND batch_id IN (SELECT unnest(?::BIGINT[])) ORDER BY batch_id, i",
         [ids[0], ids[-1], ids],
     ).fetchnumpy()
-    data = {c: np.asarray(arr[c], dtype=float) if c != "batch_id" else np.asarray(arr[c]) for c in arr}
-    for c in SERIES_COLUMNS:  # masked (NULL) -> NaN
-        a = arr[c]
-        data[c] = np.ma.filled(a.astype(float), np.nan) if np.ma.isMaskedArray(a) else np.asarray(a, dtype=float)
+    data = {c: np.asarray(filled(arr[c]), dtype=float) for c in SERIES_COLUMNS}
     out = []
     a = 0
     for bid, name, source, green_kg, initial_json, n in meta:
@@ -363,8 +360,8 @@ def fit_fleet(
             client, owned = _client(workers, scheduler)
         report.where = "in-process" if client is None else f"dask ({len(client.scheduler_info()['workers'])} workers)"
 
-        def done(res):
-            _write(con, specs[res["machine_id"]], res, version)
+        def done(mid, res):
+            _write(con, specs[mid], res, version)
             report.fitted += len(res["batch_id"])
             report.chunks += 1
             if on_commit is not None:
@@ -374,9 +371,7 @@ def fit_fleet(
 
         if client is None:
             for mid, ids in work:
-                res = fit_chunk(ids, _load_chunk(con, ids), plants[mid], specs[mid])
-                res["machine_id"] = mid
-                done(res)
+                done(mid, fit_chunk(ids, _load_chunk(con, ids), plants[mid], specs[mid]))
         else:
             _run_on_dask(client, con, work, plants, specs, done)
         refresh_models(con, {mid: s.spec_id for mid, s in specs.items()})
@@ -389,12 +384,6 @@ def fit_fleet(
     return report
 
 
-def _tagged(mid, ids, batches, plant, spec):
-    res = fit_chunk(ids, batches, plant, spec, threads=1)
-    res["machine_id"] = mid
-    return res
-
-
 def _run_on_dask(client, con, work, plants, specs, done) -> None:
     """Keep about two chunks per worker in flight; commit each as it returns."""
     from distributed import as_completed
@@ -402,14 +391,22 @@ def _run_on_dask(client, con, work, plants, specs, done) -> None:
     n_workers = max(1, sum(w.get("nthreads", 1) for w in client.scheduler_info()["workers"].values()))
     plant_futures = {mid: client.scatter(p, broadcast=True) for mid, p in plants.items()}
     queue = list(work)
+    machine_of = {}  # future key -> machine id
     ac = as_completed()
-    for _ in range(min(len(queue), 2 * n_workers)):
+
+    def submit():
         mid, ids = queue.pop(0)
-        ac.add(client.submit(_tagged, mid, ids, _load_chunk(con, ids), plant_futures[mid], specs[mid], pure=False))
+        fut = client.submit(
+            fit_chunk, ids, _load_chunk(con, ids), plant_futures[mid], specs[mid], threads=1, pure=False
+        )
+        machine_of[fut.key] = mid
+        ac.add(fut)
+
+    for _ in range(min(len(queue), 2 * n_workers)):
+        submit()
     for fut in ac:
         res = fut.result()
         if queue:
-            mid, ids = queue.pop(0)
-            ac.add(client.submit(_tagged, mid, ids, _load_chunk(con, ids), plant_futures[mid], specs[mid], pure=False))
-        done(res)
+            submit()
+        done(machine_of.pop(fut.key), res)
         fut.release()

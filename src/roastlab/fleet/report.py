@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from .drift import CLIP_Z, CUSUM_H, CUSUM_K, OUTLIER_FIT, OUTLIER_RATIO, WARMUP, analyse, machine_history
+from .drift import CLIP_Z, CUSUM_H, CUSUM_K, OUTLIER_FIT, OUTLIER_RATIO, WARMUP, analyse, machine_history, robust_stats
 from .store import open_store
 
 
@@ -34,8 +34,8 @@ class MachineHistory:
         for p in self.params:
             x = self.wide[p].to_numpy(dtype=float)[a["good"]]
             x = x[np.isfinite(x)]
-            med = float(np.median(x)) if len(x) else None
-            spread = float(1.4826 * np.median(np.abs(x - med))) if len(x) else None
+            st = robust_stats(x) or {"median": None, "spread": None}
+            med, spread = st["median"], st["spread"]
             coeffs[p] = {
                 "median": med,
                 "spread": spread,

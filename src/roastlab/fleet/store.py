@@ -390,6 +390,11 @@ def _flush(con, machines: _Machines, pending_b: list, pending_s: list) -> None:
     pending_s.clear()
 
 
+def filled(column) -> np.ndarray:
+    """A DuckDB ``fetchnumpy`` column with NULLs (a masked array) as NaN; other columns as they are."""
+    return np.ma.filled(column.astype(float), np.nan) if np.ma.isMaskedArray(column) else column
+
+
 def plant_of(name: str, plant: str, plant_toml: str | None):
     """The Plant of a stored machine: its preset, or the plant text kept in the store."""
     if plant_toml is None:

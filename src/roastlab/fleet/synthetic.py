@@ -152,10 +152,9 @@ def make_fleet(
             times = [start + datetime.timedelta(seconds=float(s)) for s in np.cumsum(gaps)]
             for a in range(0, count, chunk):
                 m = min(chunk, count - a)
-                for b in _batches(rng, machine, a, m, values):
+                for k, b in enumerate(_batches(rng, machine, a, m, values), start=a):
                     rel = f"{machine.name}/{b.name}.csv"
                     (root / rel).write_text(write_batch_csv_text(b, comment=NOTE))
-                    k = int(b.name.rsplit("-", 1)[1]) - 1
                     manifest.append(f"{rel},{machine.name},{machine.plant},{times[k].isoformat()}")
                 done += m
                 if progress is not None:
