@@ -254,6 +254,31 @@ CASES = {
         "fit.toml",
         "free.warp: unknown parameter",
     ),
+    "fit spec weights an unknown output": (
+        lambda d: _spec(d, "[free]\nhgm = [0.001, 1, 0.02]\n[weights]\nET = 1.0\n"),
+        "fit.toml",
+        "weights.ET: unknown output (allowed: Ta, Tb2)",
+    ),
+    "fit spec with a negative weight": (
+        lambda d: _spec(d, "[free]\nhgm = [0.001, 1, 0.02]\n[weights]\nTb2 = -1\n"),
+        "fit.toml",
+        "weights.Tb2: must be >= 0",
+    ),
+    "fit spec weights every output 0": (
+        lambda d: _spec(d, "[free]\nhgm = [0.001, 1, 0.02]\n[weights]\nTa = 0\n"),
+        "fit.toml",
+        "every output weight is 0",
+    ),
+    "fit spec weights a second reading the logs lack": (
+        lambda d: _spec(d, "[free]\nhgm = [0.001, 1, 0.02]\n[weights]\nTb2 = 1\n"),
+        "fit.toml",
+        "no batch has a second bean reading",
+    ),
+    "--weight of an unknown output": (
+        lambda d: ["identify", "--plant", "120kg", DATA / "dataset-I", "--out", d / "m.json", "--weight", "BT=1"],
+        "command line",
+        "unknown output 'BT' to weight",
+    ),
     # files and paths
     "missing input file": (
         lambda d: ["simulate", "--plant", "120kg", "--inputs", d / "nope.csv", "--out", d / "out.csv"],

@@ -65,7 +65,7 @@ VALID = {
             },
         }
     ),
-    ".fit.toml": "[free]\nhgm = [0.001, 1.0, 0.02]\nTm0_C = { lower = 60, upper = 300, start = 170, per_batch = true }\n[fixed]\nKt = 0.02\n[initial]\nTb0_C = 22\n",
+    ".fit.toml": "[free]\nhgm = [0.001, 1.0, 0.02]\nTm0_C = { lower = 60, upper = 300, start = 170, per_batch = true }\n[fixed]\nKt = 0.02\n[initial]\nTb0_C = 22\n[weights]\nTa = 1\nTb2 = 0.5\n",
     ".scenario.toml": 'name = "s"\n[plant]\nmass_factor = 1.2\nTm0_offset_C = -30\ntheta_factor = { hgm = 0.8 }\n'
     "[sensor]\nnoise_C = 0.5\ndelay_s = 2\nseed = 7\n[actuator]\nTgi_min_C = 150\nTgi_max_C = 550\nsample_s = 5\n",
 }
@@ -165,6 +165,7 @@ KEYS = {
         "free": st.dictionaries(st.sampled_from(["hgm", "Pbm", "Tm0_C", "Gg_kg_s", "warp"]), VALUES, max_size=3),
         "fixed": st.dictionaries(st.sampled_from(["Kt", "hbm", "warp"]), VALUES, max_size=2),
         "initial": st.dictionaries(st.sampled_from(["Tb0_C", "X0", "warp"]), VALUES, max_size=2),
+        "weights": st.one_of(VALUES, st.dictionaries(st.sampled_from(["Ta", "Tb2", "warp"]), VALUES, max_size=2)),
     },
     ".json": {
         "hgm": VALUES,

@@ -151,17 +151,69 @@ def test_identification_that_cannot_simulate_is_an_error(monkeypatch, fail_when)
     batches = noise_free_batches(5, "120kg", THETA_START, count=2)
     packed = pack_batches(batches, "120kg", THETA_START, InitialState(Ta0_C=30.0))
     free, fixed = build_free_parameters()
-    real = ident.predict_ta
+    real = ident.predict_outputs
     calls = {"n": 0}
 
-    def diverging(packed_, names, values):
+    def diverging(packed_, names, values, with_tb=True):
         calls["n"] += 1
-        out = real(packed_, names, values)
+        ta, tb = real(packed_, names, values, with_tb)
         if fail_when == "always" or calls["n"] > 1:
-            out[:] = np.nan
-        return out
+            ta[:] = np.nan
+        return ta, tb
 
-    monkeypatch.setattr(ident, "predict_ta", diverging)
+    monkeypatch.setattr(ident, "predict_outputs", diverging)
     needle = "at the starting values" if fail_when == "always" else "every batch can be simulated"
     with pytest.raises(ParameterError, match=needle):
         identify(packed, free, fixed, n_trial=8, n_starts=1)
+
+
+def two_output_batches(seed, hbm_probe, hbm_second):
+    """Batches whose Ta is the model's at hbm_probe and whose second bean reading Tb2 is the model's
+    Tb at hbm_second (two channels that disagree, so the weights decide)."""
+    from roastlab.sim.population import simulate_population
+
+    theta_b = (THETA_START.hgm, hbm_second, THETA_START.Pbm)
+    batches = noise_free_batches(seed, "120kg", (THETA_START.hgm, hbm_probe, THETA_START.Pbm), count=3)
+    packed = pack_batches(batches, "120kg", theta_b, InitialState(Ta0_C=30.0))
+    tb = simulate_population(packed)[0, :, :, 0]
+    for i, b in enumerate(batches):
+        b.Tb2_C = tb[i, : b.n].copy()
+        b.Tb2_C[:2] = np.nan  # a sparse channel: not read at the start
+    return batches
+
+
+def test_two_output_fit_weights_decide_between_disagreeing_channels():
+    batches = two_output_batches(7, 0.02, 0.04)
+    packed = pack_batches(batches, "120kg", THETA_START, InitialState(Ta0_C=30.0))
+    free, fixed = build_free_parameters({"hgm": THETA_START.hgm, "Pbm": THETA_START.Pbm})
+    probe = identify(packed, free, fixed, seed=0, n_starts=2)
+    second = identify(packed, free, fixed, seed=0, n_starts=2, weights={"Ta": 0.0, "Tb2": 1.0})
+    both = identify(packed, free, fixed, seed=0, n_starts=2, weights={"Tb2": 1.0})
+    assert probe.values["hbm"] == pytest.approx(0.02, rel=1e-4)
+    assert second.values["hbm"] == pytest.approx(0.04, rel=1e-4)
+    assert 0.02 < both.values["hbm"] < 0.04
+    n_tb2 = sum(int(np.isfinite(b.Tb2_C).sum()) for b in batches)
+    assert set(probe.outputs) == {"Ta"} and second.outputs["Tb2"]["n"] == n_tb2
+    assert both.n_residuals == sum(b.n for b in batches) + n_tb2
+    # the objective is the weighted sum of the outputs' SSRs (eq. 19, one term per output)
+    heavy = identify(packed, free, fixed, seed=0, n_starts=1, weights={"Tb2": 4.0})
+    o = heavy.outputs
+    assert heavy.SSR == pytest.approx(o["Ta"]["SSR"] + 4.0 * o["Tb2"]["SSR"], rel=1e-9)
+    assert abs(heavy.values["hbm"] - 0.04) < abs(both.values["hbm"] - 0.04)  # more weight, closer to Tb2
+
+
+def test_validation_scores_the_second_output_against_tb():
+    import roastlab
+
+    batches = two_output_batches(8, 0.02, 0.03)
+    model = roastlab.FittedModel.paper("120kg").with_values(hbm=0.02)
+    v = model.validate(batches)
+    o = v.outputs["Tb2"]
+    for b, row in zip(batches, o["rows"]):
+        tb = model.predict(b).Tb_C
+        ok = np.isfinite(b.Tb2_C)
+        assert row == pytest.approx(batch_metrics(b.Tb2_C[ok], tb[ok]))
+    js = v.to_json_dict()["outputs"]
+    assert js["Tb2"]["average"]["n"] == sum(int(np.isfinite(b.Tb2_C).sum()) for b in batches)
+    assert js["Ta"]["average"] == v.average
+    assert "second output Tb2" in v.table()

@@ -35,6 +35,7 @@ VALUES = {
     "--starts",
     "--fix",
     "--bounds",
+    "--weight",
     "--estimate-tm0",
     "--per-batch",
     "--name",

@@ -193,3 +193,54 @@ def test_steppable_simulator_matches_batch_simulation():
     for k in range(len(T) - 1):
         sim.step(T[k + 1] - T[k], Gg[k + 1], Tgi[k + 1])
     np.testing.assert_allclose(sim.x, lin.states[-1], atol=1e-9)
+
+
+@pytest.mark.parametrize("mass_kg", [0.2, 0.49, 0.9, 60.0, 120.0])
+def test_bed_depth_is_the_circular_segment_of_the_fill(mass_kg):
+    """Independent number: the segment of height h_bed cut from the drum's circle has the area
+    the batch's bulk volume needs per metre of drum, R^2 acos((R-h)/R) - (R-h) sqrt(2Rh - h^2)."""
+    import dataclasses
+
+    from roastlab.model.constants import GREEN_BULK_DENSITY_KG_M3
+
+    base = load_plant("120kg" if mass_kg > 10 else "360kg")
+    plant = dataclasses.replace(
+        base, Mb_kg=mass_kg, Dch_m=0.2 if mass_kg < 10 else base.Dch_m, Lch_m=0.25 if mass_kg < 10 else base.Lch_m
+    )
+    R, h = plant.Dch_m / 2, plant.bed_depth_m
+    segment = R**2 * math.acos((R - h) / R) - (R - h) * math.sqrt(2 * R * h - h * h)
+    assert segment * plant.Lch_m == pytest.approx(mass_kg / GREEN_BULK_DENSITY_KG_M3, rel=1e-9)
+    half = dataclasses.replace(plant, Mb_kg=GREEN_BULK_DENSITY_KG_M3 * math.pi * R**2 * plant.Lch_m / 2)
+    assert half.bed_depth_m == pytest.approx(R, rel=1e-9)  # a half-full drum: the bed reaches the axis
+
+
+def test_probe_immersion_reads_the_covered_mix_at_steady_state():
+    """At steady state a probe covered over a share c = h_bed / h_probe reads c Tb + (1 - c) Tgo
+    (eq. 17 extended); with h_probe 0 (the paper) or below the bed it reads Tb, bit for bit as eq. 17."""
+    from roastlab.sim.simulate import InitialState, simulate
+
+    plant = load_plant("120kg")
+    t = np.arange(0.0, 40001.0, 50.0)
+    n = len(t)
+    base = {"Qe_gain_kW": 0.5, "tau_heater_s": 20.0}
+
+    def run(**extra):  # much air through a drum heated by the heater: the gas leaves well below the beans
+        return simulate(
+            plant,
+            t,
+            np.full(n, 6.0),
+            np.full(n, 25.0),
+            theta=(0.005, 0.05, 0.6),
+            initial=InitialState(Tb0_C=25.0, Tm0_C=25.0, X0=0.0, He0_kJ_kg=232.0, Ta0_C=25.0),
+            heater=np.full(n, 400.0),
+            values={**base, **extra},
+        )
+
+    half = run(h_probe_m=2 * plant.bed_depth_m)
+    assert half.Tb_C[-1] - half.Tgo_C[-1] > 50  # the gas is much cooler than the beans, so c matters
+    assert half.Ta_C[-1] == pytest.approx(0.5 * half.Tb_C[-1] + 0.5 * half.Tgo_C[-1], abs=1e-3)
+    paper, covered = run(), run(h_probe_m=0.5 * plant.bed_depth_m)
+    assert paper.Ta_C[-1] == pytest.approx(paper.Tb_C[-1], abs=1e-3)
+    assert np.array_equal(paper.states, covered.states)  # c = 1 is eq. 17 exactly
+    # the probe never feeds back (only the adaptive step, which also watches Ta, differs)
+    assert np.allclose(paper.states[:, :4], half.states[:, :4], rtol=0, atol=1e-4)

@@ -14,7 +14,7 @@ import math
 import sys
 from pathlib import Path
 
-from ..errors import InputError, RoastlabError
+from ..errors import InputError, ParameterError, RoastlabError
 
 MODEL_HELP = "fitted model file from 'roastlab identify' (roastlab-model/1; a THETA.json of roastlab 0.1 also loads)"
 
@@ -325,6 +325,7 @@ def cmd_identify(args) -> int:
         starts=args.starts,
         column_map=load_map(args.map) if args.map else None,
         progress=_progress("identify"),
+        weights=_weights_arg(args.weight),
     )
     from ..io.modelfile import model_document_text
 
@@ -333,6 +334,18 @@ def cmd_identify(args) -> int:
     print(result.report())
     print(f"-> {args.out}")
     return 0
+
+
+def _weights_arg(items) -> dict[str, float]:
+    """``--weight OUTPUT=W`` options as checked output weights (errors name the command line)."""
+    from ..fit.identify import check_weights
+
+    given = _parse_assignments(items, "--weight", ranged=False)
+    try:
+        check_weights(given)
+    except ParameterError as exc:
+        raise InputError(f"--weight: {exc.problem}", "command line") from None
+    return given
 
 
 def _identify_per_batch(args, batches, plant_spec, fix, bounds, outputs) -> int:
@@ -886,7 +899,15 @@ def _add_fit_commands(sub) -> None:
     p.add_argument(
         "--spec",
         metavar="FIT.toml",
-        help="fit spec: free parameters (theta, process constants, initial states) with bounds",
+        help="fit spec: free parameters (theta, process constants, initial states) with bounds, output weights",
+    )
+    p.add_argument(
+        "--weight",
+        action="append",
+        metavar="OUTPUT=W",
+        help="weight of a fitted output: Ta (the bean probe, default 1) or Tb2 (a second bean reading read by the "
+        "map's [Tb2], compared with the model's Tb; default 0), e.g. --weight Tb2=0.25 (repeatable; overrides "
+        "the spec's [weights])",
     )
     _add_model_options(p, with_model=False)
     p.set_defaults(func=cmd_identify)

@@ -14,6 +14,8 @@ from .metrics import METRIC_NAMES, absolute_error_moments, average_metrics, batc
 
 #: Predicted states written beside measured and predicted Ta (Ta itself is Ta_pred_C).
 PREDICTED_STATES = ("Tb_C", "Tm_C", "X_kg_kg", "He_kJ_kg")
+#: Fewest samples of a second bean reading for a batch to be scored on it.
+MIN_SECOND_OUTPUT_SAMPLES = 3
 
 
 @dataclass
@@ -29,6 +31,9 @@ class ValidationResult:
     plant: str
     notes: list[str] = field(default_factory=list)
     results: list = field(default_factory=list)  # the SimulationResult of each batch, when known
+    #: Metrics of further outputs: {"Tb2": {"names": [...], "rows": [...]}}, the model's Tb
+    #: against a second measured bean reading, over the batches (and samples) that have one.
+    outputs: dict = field(default_factory=dict)
 
     def __repr__(self) -> str:
         a = self.average
@@ -48,6 +53,8 @@ class ValidationResult:
         for r in self.results:
             cols = {"time_s": r.time_s, "Ta_C": r.Ta_measured_C, "Ta_pred_C": r.Ta_C}
             cols.update({k: r.states[:, j] for j, k in enumerate(PREDICTED_STATES)})
+            if r.Tb2_measured_C is not None:
+                cols["Tb2_C"] = r.Tb2_measured_C
             cols.update({"Tgo_C": r.Tgo_C, "Gg_kg_s": r.Gg_kg_s, "Tgi_C": r.Tgi_C})
             out[r.name] = pd.DataFrame(cols)
         return out
@@ -73,13 +80,26 @@ class ValidationResult:
     def error_moments(self) -> dict:
         return absolute_error_moments(self.errors)
 
+    def output_average(self, name: str) -> dict:
+        """Mean metrics of a further output (e.g. ``"Tb2"``) over the batches that have it."""
+        return average_metrics(self.outputs[name]["rows"])
+
     def to_json_dict(self) -> dict:
-        return {
+        out = {
             "plant": self.plant,
             "batches": [{"name": name, **row} for name, row in zip(self.names, self.rows)],
             "average": self.average,
             "absolute_error": self.error_moments,
         }
+        if self.outputs:  # per output: the probe (the top-level figures) and each further one
+            out["outputs"] = {"Ta": {"compared": "model Ta with the measured bean probe", "average": self.average}}
+            for name, o in self.outputs.items():
+                out["outputs"][name] = {
+                    "compared": o["compared"],
+                    "batches": [{"name": n, **row} for n, row in zip(o["names"], o["rows"])],
+                    "average": self.output_average(name),
+                }
+        return out
 
     def table(self, title: str | None = None) -> str:
         """A readable text table of the metrics (columns sized to their contents)."""
@@ -94,6 +114,13 @@ class ValidationResult:
         lines.append(
             f"|e| over {em['samples']} samples: mean {em['mean_abs_error']:.3f} °C, variance {em['var_abs_error']:.3f} °C²"
         )
+        for name, o in self.outputs.items():
+            avg = self.output_average(name)
+            lines += ["", f"second output {name}: {o['compared']}", head, "-" * len(head)]
+            lines += [
+                f"{n:<{w}}" + "".join(_fmt(k, row[k]) for k in METRIC_NAMES) for n, row in zip(o["names"], o["rows"])
+            ]
+            lines += ["-" * len(head), f"{'average':<{w}}" + "".join(_fmt(k, avg[k]) for k in METRIC_NAMES)]
         return "\n".join(lines)
 
 
@@ -116,4 +143,12 @@ def score(results, plant_name: str) -> ValidationResult:
         states.append(np.column_stack([r.states, r.Tgo_C]))
     out = ValidationResult([r.name for r in results], times, meas, pred, states, rows, str(plant_name))
     out.results = list(results)
+    second = [(r.name, r.Tb2_measured_C, r.Tb_C) for r in results if r.Tb2_measured_C is not None]
+    scored = [(n, y[ok], tb[ok]) for n, y, tb in second if (ok := np.isfinite(y)).sum() >= MIN_SECOND_OUTPUT_SAMPLES]
+    if scored:
+        out.outputs["Tb2"] = {
+            "compared": "model Tb (eq. 15a) with the second measured bean reading",
+            "names": [n for n, _, _ in scored],
+            "rows": [batch_metrics(y, tb) for _, y, tb in scored],
+        }
     return out

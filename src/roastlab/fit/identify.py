@@ -26,8 +26,17 @@ from scipy.optimize import differential_evolution, least_squares
 from scipy.stats import qmc
 
 from ..errors import ParameterError
-from ..model.parameters import FREE_NAMES, REGISTRY, THETA_NAMES, THETA_START, FreeParameter, Theta
-from ..sim.population import PackedBatches, predict_ta
+from ..model.parameters import (
+    DEFAULT_WEIGHTS,
+    FREE_NAMES,
+    OUTPUTS,
+    REGISTRY,
+    THETA_NAMES,
+    THETA_START,
+    FreeParameter,
+    Theta,
+)
+from ..sim.population import PackedBatches, predict_outputs
 
 CORRELATION_WARN = 0.95
 #: Residual given to a sample whose simulation failed (NaN): a very bad fit, not a crash [degC].
@@ -45,7 +54,8 @@ class IdentificationResult:
     values : identified value of every free parameter (per-batch ones as lists);
     fixed : values held fixed; SSR : summed squared residual [degC^2] (eq. 19);
     stderr, correlation : from the Jacobian at the optimum; warnings : human-readable;
-    n_residuals, nfev, wall_s, method, seed, starts : diagnostics.
+    n_residuals, nfev, wall_s, method, seed, starts : diagnostics;
+    outputs : per fitted output {"weight", "n", "SSR" (unweighted, degC^2)}.
     """
 
     values: dict
@@ -62,6 +72,7 @@ class IdentificationResult:
     starts: list[dict] = field(default_factory=list)
     bounds: dict = field(default_factory=dict)
     batches: list[str] = field(default_factory=list)
+    outputs: dict = field(default_factory=dict)
 
     @property
     def theta(self):
@@ -86,15 +97,41 @@ class IdentificationResult:
                 "method": self.method,
                 "seed": self.seed,
                 "batches": self.batches,
+                "outputs": self.outputs,
             }
         )
         return out
 
 
-class Objective:
-    """Residuals of the free parameters over packed batches, evaluated in populations."""
+def check_weights(weights: dict | None) -> dict[str, float]:
+    """The output weights with defaults filled in; unknown names or bad values are refused."""
+    out = dict(DEFAULT_WEIGHTS)
+    for name, w in (weights or {}).items():
+        if name not in OUTPUTS:
+            raise ParameterError(f"unknown output {name!r} to weight (allowed: {', '.join(OUTPUTS)})")
+        try:
+            w = float(w)
+        except (TypeError, ValueError):
+            raise ParameterError(f"the weight of {name} must be a number, got {w!r}") from None
+        if not (np.isfinite(w) and w >= 0.0):
+            raise ParameterError(f"the weight of {name} must be a finite number >= 0, got {w:g}")
+        out[name] = w
+    if not any(w > 0 for w in out.values()):
+        raise ParameterError("every output weight is 0: nothing to fit")
+    return out
 
-    def __init__(self, packed: PackedBatches, free: list[FreeParameter], fixed: dict[str, float]):
+
+class Objective:
+    """Weighted residuals of the free parameters over packed batches, evaluated in populations.
+
+    The residual vector stacks sqrt(w_Ta) (T^a - Ta) over the measured probe samples and, when
+    ``weights["Tb2"] > 0``, sqrt(w_Tb2) (T^b - Tb2) over the samples of the second bean reading,
+    so the summed SSR is the weighted sum of the outputs' SSRs (eq. 19 with one term per output).
+    """
+
+    def __init__(
+        self, packed: PackedBatches, free: list[FreeParameter], fixed: dict[str, float], weights: dict | None = None
+    ):
         self.packed = packed
         self.free = free
         self.fixed = fixed
@@ -110,15 +147,49 @@ class Objective:
         self.lower = np.array([free[j].lower for j, _ in self.layout])
         self.upper = np.array([free[j].upper for j, _ in self.layout])
         self.start = np.array([free[j].start for j, _ in self.layout])
-        mask = packed.mask() & np.isfinite(packed.TA)
-        self.mask = mask
-        self.measured = packed.TA[mask]
-        self.batch_of_residual = np.nonzero(mask)[0]
+        self.weights = check_weights(weights)
+        valid = packed.mask()
+        self.masks = {
+            "Ta": valid & np.isfinite(packed.TA) & (self.weights["Ta"] > 0),
+            "Tb2": valid & np.isfinite(packed.TB2) & (self.weights["Tb2"] > 0),
+        }
+        if self.weights["Tb2"] > 0 and not self.masks["Tb2"].any():
+            raise ParameterError(
+                "the Tb2 output has a weight but no batch has a second bean reading: read the logs with a map that "
+                "has a [Tb2] column, or drop the weight"
+            )
+        self.with_tb = bool(self.masks["Tb2"].any())
+        self.measured = np.concatenate([packed.TA[self.masks["Ta"]], packed.TB2[self.masks["Tb2"]]])
+        counts = {k: int(m.sum()) for k, m in self.masks.items()}
+        self.sqrt_w = np.concatenate([np.full(counts[k], np.sqrt(self.weights[k])) for k in OUTPUTS])
+        self.output_of_residual = np.repeat(np.arange(len(OUTPUTS)), [counts[k] for k in OUTPUTS])
+        self.batch_of_residual = np.concatenate([np.nonzero(self.masks[k])[0] for k in OUTPUTS])
         self.nfev = 0
 
     @property
     def n_residuals(self) -> int:
-        return int(self.mask.sum())
+        return int(self.measured.size)
+
+    def _predicted(self, Z: np.ndarray) -> np.ndarray:
+        """(m, n_residuals) model outputs at the measured samples, in the residuals' order."""
+        ta, tb = predict_outputs(self.packed, self.names, self.values_array(Z), with_tb=self.with_tb)
+        parts = [ta[:, self.masks["Ta"]]]
+        if self.with_tb:
+            parts.append(tb[:, self.masks["Tb2"]])
+        return np.concatenate(parts, axis=1)
+
+    def output_ssr(self, z: np.ndarray) -> dict:
+        """Per fitted output: its weight, sample count and unweighted SSR [degC^2] at ``z``."""
+        r = self.residuals(z) / self.sqrt_w
+        return {
+            k: {
+                "weight": self.weights[k],
+                "n": int(n),
+                "SSR": float(r[self.output_of_residual == j] @ r[self.output_of_residual == j]),
+            }
+            for j, k in enumerate(OUTPUTS)
+            if (n := self.masks[k].sum())
+        }
 
     def values_array(self, Z: np.ndarray) -> np.ndarray:
         """(m, nz) flat vectors -> (m, nb, n_names) parameter values for the kernel."""
@@ -134,13 +205,13 @@ class Objective:
         return V
 
     def residuals_many(self, Z: np.ndarray) -> np.ndarray:
-        """(m, n_residuals) residuals T^a - Ta for m parameter vectors (NaN -> 1e3 degC)."""
+        """(m, n_residuals) weighted residuals (model - measured) for m parameter vectors (a
+        sample whose simulation failed counts as a 1e3 degC error)."""
         Z = np.atleast_2d(Z)
         self.nfev += Z.shape[0]
-        ta = predict_ta(self.packed, self.names, self.values_array(Z))
-        r = ta[:, self.mask] - self.measured[None, :]
+        r = self._predicted(Z) - self.measured[None, :]
         r[~np.isfinite(r)] = FAILED_RESIDUAL_C
-        return r
+        return r * self.sqrt_w[None, :]
 
     def residuals(self, z: np.ndarray) -> np.ndarray:
         return self.residuals_many(z[None, :])[0]
@@ -148,8 +219,7 @@ class Objective:
     def failed_batches(self, z: np.ndarray) -> list[str]:
         """Names of the batches whose simulation at ``z`` is not finite (empty when all run)."""
         self.nfev += 1
-        ta = predict_ta(self.packed, self.names, self.values_array(np.atleast_2d(z)))[0]
-        bad = ~np.isfinite(ta[self.mask])
+        bad = ~np.isfinite(self._predicted(np.atleast_2d(z))[0])
         return [self.packed.names[b] for b in np.unique(self.batch_of_residual[bad])]
 
     def ssr_many(self, Z: np.ndarray) -> np.ndarray:
@@ -261,6 +331,7 @@ def identify(
     n_trial: int = 256,
     n_starts: int = 6,
     progress=None,
+    weights: dict | None = None,
 ) -> IdentificationResult:
     """Minimise the summed SSR (eq. 19) of the packed batches over the free parameters.
 
@@ -272,14 +343,15 @@ def identify(
     seed : makes the search deterministic
     n_trial, n_starts : trial points scored and local polishes run (``"global"``)
     progress : callable ``progress(done, total, text)`` called after each polish, or None
+    weights : {output: weight} over :data:`OUTPUTS` (default Ta 1, Tb2 0: the probe alone)
     """
     if method not in ("global", "de"):
         raise ParameterError(f"unknown method {method!r} (allowed: global, de)")
     fixed = dict(fixed or {})
     t0 = time.perf_counter()
-    obj = Objective(packed, free, fixed)
+    obj = Objective(packed, free, fixed, weights)
     if obj.n_residuals == 0:
-        raise ParameterError("no measured Ta samples to fit")
+        raise ParameterError("no measured samples to fit (no Ta, or every fitted output's weight is 0)")
     nz = len(obj.start)
     failed = obj.failed_batches(obj.start)
     if failed:
@@ -385,4 +457,5 @@ def identify(
         starts=starts_log,
         bounds={lab: [float(obj.lower[k]), float(obj.upper[k])] for k, lab in enumerate(labels)},
         batches=list(packed.names),
+        outputs=obj.output_ssr(z),
     )

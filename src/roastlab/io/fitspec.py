@@ -16,6 +16,10 @@ A fit spec is a TOML file::
     Tb0_C = 22.0
     X0 = 0.11
 
+    [weights]                   # optional: outputs fitted together (default Ta = 1 alone)
+    Ta = 1.0                    # the bean probe, model Ta (eq. 16)
+    Tb2 = 0.25                  # a second bean reading (map [Tb2]), model Tb (eq. 15a)
+
 Names: the theta coefficients ``hgm, hbm, Pbm``, process constants ``A, cm, cw, Ha_R, Het,
 k1, k2, Kt, lam``, the metal mass ``Mm``, the gas flow ``Gg_kg_s``, and initial states
 ``Tb0_C, Tm0_C, X0, He0_kJ_kg, Ta0_C``.
@@ -28,7 +32,16 @@ from pathlib import Path
 
 from ..errors import InputError, ParameterError
 from ..model.limits import LIMITS, check_value
-from ..model.parameters import FREE_NAMES, REGISTRY, STATE0, THETA_NAMES, THETA_PAPER, FreeParameter
+from ..model.parameters import (
+    DEFAULT_WEIGHTS,
+    FREE_NAMES,
+    OUTPUTS,
+    REGISTRY,
+    STATE0,
+    THETA_NAMES,
+    THETA_PAPER,
+    FreeParameter,
+)
 from .files import finite_number, read_toml
 
 ALLOWED = FREE_NAMES
@@ -41,6 +54,7 @@ class FitSpec:
     fixed: dict[str, float]
     initial: dict[str, float] = field(default_factory=dict)
     source: str = ""
+    weights: dict[str, float] = field(default_factory=dict)
 
 
 def _checked(name: str, value: float, path, where) -> float:
@@ -59,9 +73,9 @@ def load_fit_spec(path: str | Path) -> FitSpec:
     """Read and check the fit spec at ``path`` (see the module docstring for the format)."""
     path = Path(path)
     data = read_toml(path)
-    unknown = sorted(set(data) - {"free", "fixed", "initial", "description", "notes"})
+    unknown = sorted(set(data) - {"free", "fixed", "initial", "weights", "description", "notes"})
     if unknown:
-        raise InputError(f"unknown table(s) {', '.join(unknown)} (allowed: free, fixed, initial)", path)
+        raise InputError(f"unknown table(s) {', '.join(unknown)} (allowed: free, fixed, initial, weights)", path)
     free = []
     for name, spec in (data.get("free") or {}).items():
         where = f"free.{name}"
@@ -108,4 +122,17 @@ def load_fit_spec(path: str | Path) -> FitSpec:
         if name not in INITIAL_NAMES:
             raise InputError(f"unknown initial state (allowed: {', '.join(INITIAL_NAMES)})", path, f"initial.{name}")
         initial[name] = _checked(name, finite_number(v, path, f"initial.{name}"), path, f"initial.{name}")
-    return FitSpec(free, fixed, initial, str(path))
+    weights = {}
+    table = data.get("weights") or {}
+    if not isinstance(table, dict):
+        raise InputError("[weights] must be a table of output = weight", path, "weights")
+    for name, v in table.items():
+        if name not in OUTPUTS:
+            raise InputError(f"unknown output (allowed: {', '.join(OUTPUTS)})", path, f"weights.{name}")
+        w = finite_number(v, path, f"weights.{name}")
+        if w < 0:
+            raise InputError(f"must be >= 0, got {w:g}", path, f"weights.{name}")
+        weights[name] = w
+    if weights and not any(w > 0 for w in {**DEFAULT_WEIGHTS, **weights}.values()):
+        raise InputError("every output weight is 0: nothing to fit", path, "weights")
+    return FitSpec(free, fixed, initial, str(path), weights)

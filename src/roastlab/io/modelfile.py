@@ -11,7 +11,8 @@ A model file is JSON::
                           "value": v or null, "per_batch": {batch: v}, "stderr": ...}},
      "moisture": "schwartzberg", "hold": "linear",
      "map": {the column map as TOML-shaped data} or null,
-     "fit": {"SSR": ..., "n_residuals": ..., "method": ..., "seed": ..., "correlation": ..., "warnings": [...]},
+     "fit": {"SSR": ..., "n_residuals": ..., "method": ..., "seed": ..., "correlation": ..., "warnings": [...],
+             "outputs": {"Ta" | "Tb2": {"weight": w, "n": n, "SSR": unweighted}}},
      "metrics": {"batches": [...], "average": {...}},
      "provenance": {"roastlab": version, "created": ISO 8601, "inputs": [{"role", "path", "sha256"}]}
     }

@@ -50,6 +50,13 @@ INPUT_HOLDS = ("linear", "zoh")
 RHO0_KG_M3 = 1.275
 
 
+#: Free-settled bulk density of green coffee [kg/m^3] (0.65-0.75 g/mL as measured in a graduated
+#: cylinder by green-coffee traders; ISO recommends that method). Sets the volume, and so the depth,
+#: of the bean bed in the drum for the probe-immersion extension
+#: (:attr:`roastlab.model.plant.Plant.bed_depth_m`).
+GREEN_BULK_DENSITY_KG_M3 = 680.0
+
+
 @dataclass(frozen=True)
 class ProcessConstants:
     """Fixed process constants (Table 5, left), overridable per plant file.

@@ -44,6 +44,7 @@ LIMITS: dict[str, tuple[float, float, str, str]] = {
     "Gg_fan_kg_s": (-100.0, 100.0, "kg/s/unit", "gas flow per unit of fan setting"),
     "U_shell_kW_m2K": (0.0, 10.0, "kW/(m2 K)", "drum-shell heat-loss coefficient"),
     "T_room_C": (-50.0, 60.0, "degC", "room temperature"),
+    "h_probe_m": (0.0, 10.0, "m", "bean-bed depth that covers the bean probe"),
     # plant geometry (Table 5); from a 50 g sample roaster to a 5 t drum, with room
     "Dch_m": (0.02, 10.0, "m", "chamber diameter"),
     "Lch_m": (0.02, 20.0, "m", "chamber length"),

@@ -188,6 +188,16 @@ def _build_registry() -> dict[str, Quantity]:
             "heat loss of the drum's outer surface to the room per m2 and K (eq. 12 extension)",
         ),
         Quantity("T_room_C", "degC", "actuator", (0.0, 40.0), False, "T_room", "room temperature for the shell loss"),
+        # probe immersion (not in the paper, whose probe is always immersed)
+        Quantity(
+            "h_probe_m",
+            "m",
+            "actuator",
+            (0.0, 0.5),
+            False,
+            "h_probe",
+            "bean-bed depth that covers the bean probe; shallower beds leave part of it in the gas (eq. 17 extension)",
+        ),
         Quantity("Tb0_C", "degC", "initial", (0.0, 60.0), True, "Tb0_C", "bean temperature at CHARGE"),
         Quantity("Tm0_C", "degC", "initial", (20.0, 300.0), False, "Tm0_C", "drum metal temperature at CHARGE"),
         Quantity("X0", "kg/kg", "initial", (0.02, 0.2), True, "X0", "green moisture, dry basis"),
@@ -246,3 +256,12 @@ class FreeParameter:
             raise ParameterError(f"{self.name} must stay > 0 {REGISTRY[self.name].unit}: lower bound {self.lower:g}")
         if not self.lower <= self.start <= self.upper:
             self.start = min(max(self.start, self.lower), self.upper)
+
+
+#: Outputs an identification can fit, each with the measured channel it is compared with.
+#: ``Ta``: the model's probe reading Ta (eq. 16) against the log's bean probe; ``Tb2``: the
+#: model's bean temperature Tb (eq. 15a) against a second bean reading of the log (e.g. an
+#: infrared bean-surface sensor, the map's ``[Tb2]``). Weights multiply each output's squared
+#: residuals in the objective; the default fits Ta alone, as the paper does (eq. 19).
+OUTPUTS = ("Ta", "Tb2")
+DEFAULT_WEIGHTS = {"Ta": 1.0, "Tb2": 0.0}

@@ -15,7 +15,7 @@ from importlib import resources
 from pathlib import Path
 
 from ..errors import InputError
-from .constants import ProcessConstants
+from .constants import GREEN_BULK_DENSITY_KG_M3, ProcessConstants
 from .limits import check_value
 from .rhs import bean_areas_m2, bean_heat_transfer_coefficient_kW_m2K, conductance_ratio_F, dry_mass_kg
 
@@ -96,6 +96,41 @@ class Plant:
         return math.pi * self.Dch_m * (self.Lch_m + self.Dch_m / 2)
 
     @property
+    def fill_fraction(self) -> float:
+        """Share of the drum volume the green batch fills, Mb / (rho_bulk pi D^2/4 L) [-].
+
+        Not in the paper; the bean-bed geometry of the probe-immersion extension, with the
+        free-settled bulk density :data:`~roastlab.model.constants.GREEN_BULK_DENSITY_KG_M3`.
+        """
+        return self.Mb_kg / (GREEN_BULK_DENSITY_KG_M3 * math.pi * self.Dch_m**2 / 4.0 * self.Lch_m)
+
+    @property
+    def bed_depth_m(self) -> float:
+        """Depth of the bean bed at rest in the drum [m]: the height h of the circular segment of
+        the drum's cross-section whose area is the fill fraction (segment angle t with
+        (t - sin t) / (2 pi) = fill, h = D/2 (1 - cos(t/2))); the drum diameter if overfilled.
+
+        Not in the paper; it sets how much of the bean probe the beans cover (probe-immersion
+        extension of eq. 17, :func:`roastlab.model.rhs.probe_coverage`), so a smaller batch in
+        the same drum leaves more of the probe in the gas.
+
+        >>> p = as_plant("120kg")
+        >>> round(p.bed_depth_m / p.Dch_m, 3)   # 120 kg in a 1.1 m x 1.5 m drum (fill ~ 12 %)
+        0.167
+        """
+        fill = self.fill_fraction
+        if fill >= 1.0:
+            return self.Dch_m
+        lo, hi = 0.0, 2.0 * math.pi  # (t - sin t) / (2 pi) rises monotonically from 0 to 1 on [0, 2 pi]
+        for _ in range(80):
+            mid = 0.5 * (lo + hi)
+            if (mid - math.sin(mid)) / (2.0 * math.pi) < fill:
+                lo = mid
+            else:
+                hi = mid
+        return self.Dch_m / 2.0 * (1.0 - math.cos(0.5 * (lo + hi) / 2.0))
+
+    @property
     def Ab_m2(self) -> float:
         """Total bean surface, (Mb/mb) * pi * Db^2 [m^2] (section 3.1)."""
         return self.Mb_kg / self.process.mb * math.pi * self.process.Db**2
@@ -132,6 +167,7 @@ class Plant:
         rows += [
             ("Agm", self.Agm_m2, "m2", "gas-metal area, eq. 7"),
             ("Ashell", self.Ashell_m2, "m2", "outer drum surface (shell-loss extension)"),
+            ("h_bed", self.bed_depth_m, "m", "bean-bed depth at rest (probe-immersion extension)"),
             ("Ab", self.Ab_m2, "m2", "total bean area"),
             ("Agb", self.Agb_m2(Pbm), "m2", f"gas-bean area at Pbm={Pbm:g}"),
             ("Abm", self.Abm_m2(Pbm), "m2", f"metal-bean area at Pbm={Pbm:g}"),

@@ -21,7 +21,10 @@ metal, Qe = Qe_offset + Qe_gain H [kW] (eq. 12/15b's Qe, zero in the paper), and
 the inlet gas temperature Tgi + Tgi_gain H [degC]; the fan setting moves the gas flow
 affinely, Gg Gg_scale + Gg_fan fan [kg/s]. A heat loss of the drum shell to the room,
 U_shell Ashell (Tm - T_room) [kW], leaves the metal (eq. 12; the paper's shell is adiabatic).
-With the gains and U_shell at their default 0 and no heater input the model is the paper's (MODEL.md's check value holds; tests/test_physics.py).
+The probe-immersion extension lets the bean probe see the gas where the bean bed does not cover
+it (eq. 17 extended, :func:`probe_coverage`): a small batch in a large drum reads low when the
+gas is cooler than the beans. With the gains, U_shell and h_probe at their default 0 and no
+heater input the model is the paper's (MODEL.md's check value holds; tests/test_physics.py).
 """
 
 from __future__ import annotations
@@ -72,6 +75,9 @@ PARAM_NAMES = (
     "U_shell",  # heat-loss coefficient of the drum's outer surface [kW/(m2 K)]
     "Ashell",  # outer drum surface exposed to the room [m2] (plant-derived)
     "T_room",  # room temperature the shell loses heat to [degC]
+    # probe immersion (extension; h_probe 0 = the paper's fully immersed probe)
+    "h_bed",  # depth of the bean bed at rest [m] (plant- and batch-derived)
+    "h_probe",  # bed depth that covers the bean probe fully [m]
 )
 P = {name: i for i, name in enumerate(PARAM_NAMES)}
 N_PARAMS = len(PARAM_NAMES)
@@ -81,6 +87,7 @@ I_A, I_CM, I_CW, I_DB, I_HAR, I_HET = (P[k] for k in ("A", "cm", "cw", "Db", "Ha
 I_K1, I_K2, I_KT, I_LAM, I_XEXP, I_GGS = (P[k] for k in ("k1", "k2", "Kt", "lam", "x_exp", "Gg_scale"))
 I_QEG, I_QEO, I_TGIG, I_TAUH, I_GGF = (P[k] for k in ("Qe_gain", "Qe_offset", "Tgi_gain", "tau_heater", "Gg_fan"))
 I_USH, I_ASH, I_TROOM = (P[k] for k in ("U_shell", "Ashell", "T_room"))
+I_HBED, I_HPROBE = P["h_bed"], P["h_probe"]
 #: Smallest gas flow the fan map may give [kg/s] (a fan map fitted below zero is clipped here).
 GG_MIN_KG_S = 1e-6
 
@@ -167,6 +174,31 @@ def shell_loss_kW(Tm, p):
 
 
 @register_jitable
+def probe_coverage(p):
+    """Share c of the bean probe the bean bed covers [-]: min(1, h_bed / h_probe).
+
+    An extension of eq. 17 (the paper's probe is always immersed: c = 1, also when h_probe is
+    0, the default). ``h_bed`` [m] is the depth of the bed at rest, computed from the drum
+    geometry and the batch mass (:attr:`roastlab.model.plant.Plant.bed_depth_m`); ``h_probe``
+    [m] is the bed depth at which the probe is covered, a property of where the probe sits,
+    identified from the logs. Coverage then grows linearly with the bed depth.
+    """
+    h_probe = p[I_HPROBE]
+    return where(h_probe > p[I_HBED], p[I_HBED] / fmax(h_probe, 1e-12), 1.0)
+
+
+@register_jitable
+def probe_rate_C_s(Tb, Ta, Tgo, p):
+    """dTa/dt [degC/s]: eq. 17, Kt (Tb - Ta), with the probe-immersion extension
+    Kt [c (Tb - Ta) + (1 - c) (Tgo - Ta)]: the covered share c of the probe (:func:`probe_coverage`)
+    follows the beans, the rest the gas in the drum, taken at the outlet temperature Tgo
+    (eq. 15e, the well-mixed gas). With c = 1 it is eq. 17 exactly.
+    """
+    c = probe_coverage(p)
+    return p[I_KT] * (c * (Tb - Ta) + (1.0 - c) * (Tgo - Ta))
+
+
+@register_jitable
 def heat_flows(Tb, Tm, X, Gg, Tgi, p):
     """Outlet gas temperature and heat flows at one instant, for the gas the chamber sees.
 
@@ -218,7 +250,7 @@ def derivatives(Tb, Tm, X, He, Ta, H, Gg, Tgi, heater, fan, p):
     cs = 1.099 + 0.007 * Tb  # partial heat capacity of bean solids, section 3.2
     dTb = (Qgb - Qgm + Qbm + Mbd * (Qr + p[I_LAM] * dX)) / (Mbd * (cs + p[I_CW] * X))  # eq. 15a
     dTm = (Qgm - Qbm + heater_power_kW(H, p) - shell_loss_kW(Tm, p)) / (p[I_MM] * p[I_CM])  # eq. 15b, eq. 12's Qe
-    dTa = p[I_KT] * (Tb - Ta)  # eq. 17
+    dTa = probe_rate_C_s(Tb, Ta, Tgo, p)  # eq. 17 (probe immersion: extension)
     dH = (heater - H) / p[I_TAUH]  # actuator lag (extension)
     return dTb, dTm, dX, Qr, dTa, dH
 
@@ -329,5 +361,7 @@ def pack_params(plant, theta, X0: float = 0.1, moisture: str = "schwartzberg") -
         "U_shell": 0.0,
         "Ashell": plant.Ashell_m2,
         "T_room": 22.0,
+        "h_bed": plant.bed_depth_m,
+        "h_probe": 0.0,
     }
     return np.array([values[name] for name in PARAM_NAMES], dtype=np.float64)

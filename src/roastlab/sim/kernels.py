@@ -193,9 +193,12 @@ def simulate_population_kernel(T, GG, TGI, QQ, FF, N, batch_of, X0, PP, zoh, h_m
 
 
 @njit(cache=True, parallel=True)
-def ta_population_kernel(T, GG, TGI, QQ, FF, N, batch_of, X0, PP, zoh, h_max, out_ta):
-    """Like :func:`simulate_population_kernel` but keeps only the probe reading Ta (for fitting)."""
+def ta_population_kernel(T, GG, TGI, QQ, FF, N, batch_of, X0, PP, zoh, h_max, out_ta, out_tb):
+    """Like :func:`simulate_population_kernel` but keeps only the fitted outputs: the probe
+    reading Ta, and the bean temperature Tb when ``out_tb`` has rows (a second bean reading is
+    fitted); pass an empty (0, 0) ``out_tb`` to keep Ta only."""
     nmax = T.shape[1]
+    with_tb = out_tb.shape[0] > 0
     for i in prange(batch_of.shape[0]):
         b = batch_of[i]
         scratch = np.empty((nmax, N_OUT))
@@ -203,6 +206,9 @@ def ta_population_kernel(T, GG, TGI, QQ, FF, N, batch_of, X0, PP, zoh, h_max, ou
         integrate_into(T[b], GG[b], TGI[b], QQ[b], FF[b], n, X0[i], PP[i], zoh, h_max, scratch, 5.0, False)
         for j in range(n):
             out_ta[i, j] = scratch[j, 4]
+        if with_tb:
+            for j in range(n):
+                out_tb[i, j] = scratch[j, 0]
 
 
 @njit(cache=True)

@@ -162,11 +162,18 @@ def run_arrays(packed: PackedBatches, names: list[str], values: np.ndarray):
 
 def predict_ta(packed: PackedBatches, names: list[str], values: np.ndarray) -> np.ndarray:
     """Simulated probe reading for every (value set, batch): shape (m, nb, nmax), NaN-padded."""
+    return predict_outputs(packed, names, values, with_tb=False)[0]
+
+
+def predict_outputs(packed: PackedBatches, names: list[str], values: np.ndarray, with_tb: bool = True):
+    """Simulated probe reading Ta and (``with_tb``) bean temperature Tb for every (value set,
+    batch): two arrays of shape (m, nb, nmax), NaN-padded; Tb is None without ``with_tb``."""
     m, nb = values.shape[0], packed.n_batches
     batch_of, X0, PP = run_arrays(packed, names, values)
-    out = np.full((m * nb, packed.T.shape[1]), np.nan)
-    ta_population_kernel(*packed.inputs, batch_of, X0, PP, packed.zoh, packed.h_max_s, out)
-    return out.reshape(m, nb, -1)
+    ta = np.full((m * nb, packed.T.shape[1]), np.nan)
+    tb = np.full_like(ta, np.nan) if with_tb else np.empty((0, 0))
+    ta_population_kernel(*packed.inputs, batch_of, X0, PP, packed.zoh, packed.h_max_s, ta, tb)
+    return ta.reshape(m, nb, -1), (tb.reshape(m, nb, -1) if with_tb else None)
 
 
 def _population_task(packed, names, values):

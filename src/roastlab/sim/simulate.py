@@ -69,6 +69,8 @@ class SimulationResult:
     params : the parameter vector used
     Ta_measured_C : (n,) array or None, the measured probe reading if the batch had one
     heater, fan : (n,) arrays or None, the logged settings (actuator extension)
+    Tb2_measured_C : (n,) array or None, a second measured bean reading compared with Tb
+        (NaN where not measured), when the batch had one
     """
 
     time_s: np.ndarray
@@ -82,6 +84,7 @@ class SimulationResult:
     meta: dict = field(default_factory=dict)
     heater: np.ndarray | None = None
     fan: np.ndarray | None = None
+    Tb2_measured_C: np.ndarray | None = None
 
     @property
     def uses_actuators(self) -> bool:

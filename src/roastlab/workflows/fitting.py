@@ -86,11 +86,11 @@ class FitResult:
 def _spec_parts(spec, fix, bounds, estimate_tm0):
     if spec is None:
         free, fixed = build_free_parameters(fix, bounds, estimate_tm0=estimate_tm0)
-        return free, fixed, {}, None
+        return free, fixed, {}, None, {}
     spec = spec if isinstance(spec, FitSpec) else load_fit_spec(spec)
     if fix or bounds or estimate_tm0:
         raise InputError("a fit spec sets free and fixed parameters itself; drop fix/bounds/estimate_tm0", spec.source)
-    return spec.free, dict(spec.fixed), dict(spec.initial), spec.source
+    return spec.free, dict(spec.fixed), dict(spec.initial), spec.source, dict(spec.weights)
 
 
 def fit(
@@ -109,6 +109,7 @@ def fit(
     starts: int = 6,
     column_map: ColumnMap | None = None,
     progress=None,
+    weights: dict | None = None,
 ) -> FitResult:
     """Identify a model on batches with measured Ta and return a :class:`FitResult`.
 
@@ -124,6 +125,8 @@ def fit(
     method, seed, starts : search (``"global"`` or ``"de"``), its seed, local polishes
     column_map : the map the logs were read with; kept in the model so it reads new logs alike
     progress : callable ``progress(done, total, text)`` or None
+    weights : {output: weight}: ``Ta`` (the bean probe, default 1) and ``Tb2`` (a second bean
+        reading compared with Tb, default 0); overrides the spec's ``[weights]``
     """
     batches = list(batches)
     if not batches:
@@ -133,7 +136,15 @@ def fit(
             raise InputError("no measured Ta_C column: needed to identify", b.source or b.name)
     plant_file = str(plant) if isinstance(plant, (str, Path)) and str(plant).lower().endswith(".toml") else None
     plant = load_plant(plant)
-    free, fixed, spec_initial, spec_source = _spec_parts(spec, fix, bounds, estimate_tm0)
+    free, fixed, spec_initial, spec_source, spec_weights = _spec_parts(spec, fix, bounds, estimate_tm0)
+    given = dict(weights or {})
+    weights = {**spec_weights, **given}
+    if weights.get("Tb2", 0) > 0 and all(b.Tb2_C is None or not np.isfinite(b.Tb2_C).any() for b in batches):
+        raise InputError(
+            "the Tb2 output has a weight but no batch has a second bean reading: read the logs with a map that has "
+            "a [Tb2] column, or drop the weight",
+            "command line" if "Tb2" in given else spec_source,
+        )
     names_moved = {f.name for f in free} | set(fixed)
     if "Gg_kg_s" not in names_moved and all(np.all(b.Gg_kg_s == PLACEHOLDER_GG_KG_S) for b in batches):
         raise InputError(
@@ -143,7 +154,7 @@ def fit(
         )
     init = {**PAPER_INITIAL, **(initial or {}), **spec_initial}
     packed = pack_batches(batches, plant, THETA_START, InitialState(**init), moisture, hold)
-    ident = identify(packed, free, fixed, method=method, seed=seed, n_starts=starts, progress=progress)
+    ident = identify(packed, free, fixed, method=method, seed=seed, n_starts=starts, progress=progress, weights=weights)
     doc = _document(ident, free, fixed, init, plant, moisture, hold, column_map)
     model = FittedModel(doc)
     validation = model.validate(batches)
@@ -222,5 +233,6 @@ def _document(ident, free, fixed, init, plant, moisture, hold, column_map) -> di
             "batches": ident.batches,
             "correlation": ident.correlation,
             "warnings": ident.warnings,
+            "outputs": ident.outputs,
         },
     }

@@ -292,6 +292,7 @@ class FittedModel:
             )
             res.name, res.meta = b.name, meta
             res.Ta_measured_C = None if b.Ta_C is None else b.Ta_C.copy()
+            res.Tb2_measured_C = None if b.Tb2_C is None else b.Tb2_C.copy()
             bad = ~np.isfinite(res.states)
             if bad.any():
                 i0 = int(np.argwhere(bad)[0][0])
