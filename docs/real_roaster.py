@@ -9,6 +9,7 @@ docs/real-roaster-scaling.png. Needs ../shared/data/real beside the repository.
 
 from __future__ import annotations
 
+import dataclasses
 import re
 import sys
 import time
@@ -42,6 +43,26 @@ def mean(rows, key):
     return average_metrics(rows)[key]
 
 
+def paper_probe_variant(example, fit_b, val_b, column_map, lines):
+    """The same fit with the paper's probe (eq. 17, no immersion term) on Ta alone: the comparison row."""
+    spec = load_fit_spec(example / "fit.toml")
+    spec = dataclasses.replace(spec, free=[f for f in spec.free if f.name != "h_probe_m"], weights={})
+    model = roastlab.fit(fit_b, example / "plant.toml", spec, column_map=column_map).model
+    v_fit, v_val = model.validate(fit_b), model.validate(val_b)
+    lines += [
+        "",
+        "The same fit with the paper's probe (eq. 17, no immersion term) and on Ta alone, for comparison:",
+        "",
+        "| set | Ta FIT % | Ta MAE °C | Tb vs IR FIT % | Tb vs IR MAE °C |",
+        "|---|---|---|---|---|",
+    ]
+    for name, v in (("fit", v_fit), ("held out", v_val)):
+        o = v.output_average("Tb2")
+        lines.append(f"| {name} | {v.average['FIT']:.1f} | {v.average['MAE']:.2f} | {o['FIT']:.1f} | {o['MAE']:.2f} |")
+    lines.append("")
+    return model
+
+
 def machine(title, example, paths, lines):
     """Fit, hold out and compare with the baseline; append markdown to ``lines``; return the model."""
     column_map = load_map(example / "map.toml")
@@ -67,6 +88,24 @@ def machine(title, example, paths, lines):
         f"| held out | {len(val_b)} | {v_val.average['FIT']:.1f} | {v_val.average['MAE']:.2f} "
         f"| {mean(b_val, 'FIT'):.1f} | {mean(b_val, 'MAE'):.2f} |",
         "",
+    ]
+    if v_fit.outputs:
+        weights = result.identification.outputs
+        lines += [
+            "Per output (the model's Ta against the bean probe, its Tb against the second bean reading; "
+            + ", ".join(f"weight {k} {o['weight']:g}" for k, o in weights.items())
+            + "):",
+            "",
+            "| set | Ta FIT % | Ta MAE °C | Tb vs Tb2 FIT % | Tb vs Tb2 MAE °C |",
+            "|---|---|---|---|---|",
+        ]
+        for name, v in (("fit", v_fit), ("held out", v_val)):
+            o = v.output_average("Tb2")
+            lines.append(
+                f"| {name} | {v.average['FIT']:.1f} | {v.average['MAE']:.2f} | {o['FIT']:.1f} | {o['MAE']:.2f} |"
+            )
+        paper_probe_variant(example, fit_b, val_b, column_map, lines)
+    lines += [
         f"First-order baseline on the same inputs: {describe(base)}.",
         "",
         "| parameter | value | std. error | bounds | unit |",
@@ -109,13 +148,18 @@ def scaling(model, column_map, paths, nominal_val, lines):
         "Model fitted on the 490-500 g logs only (above); each other log predicted with its own green "
         "weight and nothing refitted.",
         "",
-        "| batch g | logs | FIT % | MAE °C | MPE % |",
-        "|---|---|---|---|---|",
+        "| batch g | logs | Ta FIT % | Ta MAE °C | Ta MPE % | Tb vs IR FIT % | Tb vs IR MPE % |",
+        "|---|---|---|---|---|---|---|",
     ]
+    second = dict(zip(v.outputs["Tb2"]["names"], v.outputs["Tb2"]["rows"]))
+    by_mass_2: dict[int, list] = {}
+    for p, name in zip(others, v.names):
+        by_mass_2.setdefault(grams(p), []).append(second[name])
     for g in sorted(by_mass):
-        rows = by_mass[g]
+        rows, rows2 = by_mass[g], by_mass_2[g]
         lines.append(
-            f"| {g} | {len(rows)} | {mean(rows, 'FIT'):.1f} | {mean(rows, 'MAE'):.2f} | {mean(rows, 'MPE'):+.2f} |"
+            f"| {g} | {len(rows)} | {mean(rows, 'FIT'):.1f} | {mean(rows, 'MAE'):.2f} | {mean(rows, 'MPE'):+.2f} "
+            f"| {mean(rows2, 'FIT'):.1f} | {mean(rows2, 'MPE'):+.2f} |"
         )
     groups = {
         "200-470 g": [r for g, rs in by_mass.items() if g <= 470 for r in rs],
@@ -129,12 +173,18 @@ def scaling(model, column_map, paths, nominal_val, lines):
                 f"- {name}: mean FIT {mean(rows, 'FIT'):.1f} % ({len(rows)} logs), "
                 f"{mean(rows, 'FIT') - nominal_val[0]:+.1f} points against the held-out 490-500 g logs."
             )
+    ir = [second[n]["FIT"] for n in v.names]
+    lines.append(
+        f"- the model's Tb against the IR reading on these {len(ir)} logs: mean FIT {np.mean(ir):.1f} % "
+        "(no probe model involved)."
+    )
     lines.append("")
 
-    fig, (ax, ax2) = plt.subplots(1, 2, figsize=(11, 4.2), gridspec_kw={"width_ratios": [1, 1.3]})
+    fig, (ax, ax3, ax2) = plt.subplots(1, 3, figsize=(16, 4.4), gridspec_kw={"width_ratios": [1, 1, 1.3]})
     ms = np.array([grams(p) for p in others], dtype=float)
     fits = np.array([r["FIT"] for r in v.rows])
-    ax.scatter(ms, fits, color="C3", label="predicted (batch mass changed)")
+    ax.scatter(ms, fits, color="C3", label="bean probe Ta (batch mass changed)")
+    ax.scatter(ms, [second[n]["FIT"] for n in v.names], color="C1", marker="x", label="IR reading vs model Tb")
     ax.axhline(nominal_val[0], color="C0", ls="--", label=f"held-out 490-500 g ({nominal_val[0]:.1f} %)")
     ax.axhspan(nominal_val[0] - 10, nominal_val[0], color="C0", alpha=0.1, label="target: within 10 points")
     ax.set_xlabel("green batch mass [g]")
@@ -143,6 +193,20 @@ def scaling(model, column_map, paths, nominal_val, lines):
     ax.set_ylim(0, 100)
     ax.legend(fontsize=8, loc="lower center")
     ax.grid(alpha=0.3)
+    # the evidence for probe immersion: probe minus IR reading late in the roast, by batch mass
+    every = load(paths, column_map)
+    gaps = []
+    for b, r in zip(every, model.predict_many(every)):
+        late = slice(int(0.5 * b.n), int(0.95 * b.n))
+        gaps.append((b.Mb_kg * 1000, np.nanmean(b.Ta_C[late] - b.Tb2_C[late]), np.mean(r.Ta_C[late] - r.Tb_C[late])))
+    g = np.array(gaps)
+    ax3.scatter(g[:, 0], g[:, 1], color="k", label="measured: probe - IR reading")
+    ax3.scatter(g[:, 0], g[:, 2], color="C3", marker="^", label="model: Ta - Tb")
+    ax3.set_xlabel("green batch mass [g]")
+    ax3.set_ylabel("mean over the 2nd half of the roast [°C]")
+    ax3.set_title("the probe reads further below the beans in small batches")
+    ax3.legend(fontsize=8)
+    ax3.grid(alpha=0.3)
     pick = [int(np.argmin(ms)), int(np.argmax(ms))]
     for i, color in zip(pick, ("C2", "C4")):
         b, pred = batches[i], v.predicted[i]

@@ -305,12 +305,17 @@ def _uncertainty(obj: Objective, z: np.ndarray, ssr: float, interior: np.ndarray
     covariance says nothing about it, and including it distorts the others. Its standard
     error and correlations are reported as NaN.
     """
-    J = obj.jacobian(z)[:, interior]
+    J_all = obj.jacobian(z)
+    # a parameter the residuals do not move at all (e.g. a covering depth below every bed: the
+    # term is off there) is not determined by the data either: no standard error, like a bound
+    flat = ~np.any(J_all != 0.0, axis=0)
+    interior = interior & ~flat
+    J = J_all[:, interior]
     n, p = J.shape
     full_se = np.full(len(z), np.nan)
     full_corr = np.full((len(z), len(z)), np.nan)
     if p == 0:
-        return full_se, full_corr
+        return full_se, full_corr, flat
     s2 = ssr / max(n - p, 1)
     cov = s2 * np.linalg.pinv(J.T @ J)
     se = np.sqrt(np.clip(np.diag(cov), 0, None))
@@ -319,7 +324,7 @@ def _uncertainty(obj: Objective, z: np.ndarray, ssr: float, interior: np.ndarray
     idx = np.flatnonzero(interior)
     full_se[idx] = se
     full_corr[np.ix_(idx, idx)] = corr
-    return full_se, full_corr
+    return full_se, full_corr, flat
 
 
 def identify(
@@ -412,7 +417,7 @@ def identify(
         )
     span_all = obj.upper - obj.lower
     on_bound = (z - obj.lower <= 1e-4 * span_all) | (obj.upper - z <= 1e-4 * span_all)
-    se, corr = _uncertainty(obj, z, ssr, ~on_bound)
+    se, corr, flat = _uncertainty(obj, z, ssr, ~on_bound)
     labels = [free[j].name if b < 0 else f"{free[j].name}[{packed.names[b]}]" for j, b in obj.layout]
     values: dict = {}
     for k, (j, b) in enumerate(obj.layout):
@@ -431,6 +436,11 @@ def identify(
         elif obj.upper[k] - z[k] <= 1e-4 * span:
             warnings.append(
                 f"{lab} = {z[k]:.6g} is on its upper bound {obj.upper[k]:g}: the optimum may lie outside; no standard error (held by the bound, not the data)"
+            )
+        elif flat[k]:
+            warnings.append(
+                f"{lab} = {z[k]:.6g} has no effect on the fit there (its term is off or saturated): the data do not "
+                "determine it; no standard error (try more starts or another start value)"
             )
     for a in range(nz):
         for b in range(a + 1, nz):
