@@ -190,7 +190,7 @@ def scaling(model, column_map, paths, nominal_val, lines):
     ax.set_xlabel("green batch mass [g]")
     ax.set_ylabel("FIT [%]")
     ax.set_title("Aillio Bullet: model fitted on 490-500 g")
-    ax.set_ylim(0, 100)
+    ax.set_ylim(min(0.0, float(np.min(fits)) - 5.0), 100)  # a log predicted worse than its mean stays in view
     ax.legend(fontsize=8, loc="lower center")
     ax.grid(alpha=0.3)
     # the evidence for probe immersion: probe minus IR reading late in the roast, by batch mass
