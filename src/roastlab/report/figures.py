@@ -138,7 +138,15 @@ def plot_fit(result, path=None, title=None, max_panels: int = 8, outputs=None):
         res = fig.add_subplot(grid[2 * r + 1, c], sharex=ax)
         _profile_panel(ax, result, i)
         t = result.time_s[i] / 60.0
-        res.plot(t, result.measured[i] - result.predicted[i], color="tab:purple", lw=1)
+        res.plot(t, result.measured[i] - result.predicted[i], color="tab:purple", lw=1, label="Ta meas − pred")
+        second = result.results[i].Tb2_measured_C if i < len(result.results) else None
+        if second is not None and "Tb2" in result.outputs:  # the second bean reading and the model's Tb
+            sim = result.results[i]
+            ax.plot(t, sim.Tb_C, color="tab:orange", lw=1.2, label="bean predicted (model Tb)")
+            ax.plot(t, second, ":", color="tab:brown", lw=1.6, label="second bean reading (Tb2)")
+            res.plot(t, second - sim.Tb_C, ":", color="tab:brown", lw=1, label="Tb2 − Tb")
+            res.legend(fontsize=7, loc="lower right")
+            ax.legend(fontsize=8)
         res.axhline(0.0, color="k", lw=0.6)
         res.set_ylabel("residual\nBT meas − pred [°C]", fontsize=8)
         res.set_xlabel("time since CHARGE [min]")
