@@ -310,3 +310,16 @@ def test_real_logs_ingest_as_two_machines(tmp_path):
     rep = ingest(tmp_path / "f.duckdb", tmp_path / "m.csv")
     assert rep.added == 6 and not rep.rejected and sorted(rep.machines_added) == ["bullet", "skywalker"]
     assert {f: f.stat().st_mtime_ns for f in before} == before
+
+
+def test_fleet_spec_refuses_output_weights(tmp_path):
+    """A fleet fit scores the probe alone, so a spec weighting a second reading is refused, not ignored."""
+    from roastlab.errors import InputError
+    from roastlab.fleet.fitting import fleet_spec
+
+    spec = tmp_path / "fit.toml"
+    spec.write_text("[free]\nhbm = [0.002, 0.1, 0.01]\n[weights]\nTb2 = 1.0\n")
+    with pytest.raises(InputError, match="fit.toml.*Ta. alone"):
+        fleet_spec(spec)
+    spec.write_text("[free]\nhbm = [0.002, 0.1, 0.01]\n[weights]\nTa = 1.0\n")
+    assert fleet_spec(spec).names == ("hbm",)

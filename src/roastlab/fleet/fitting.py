@@ -30,7 +30,7 @@ import numpy as np
 from ..errors import InputError
 from ..io.batch import Batch
 from ..io.fitspec import FitSpec, load_fit_spec
-from ..model.parameters import REGISTRY, THETA_NAMES, THETA_PAPER, THETA_START, FreeParameter
+from ..model.parameters import DEFAULT_WEIGHTS, REGISTRY, THETA_NAMES, THETA_PAPER, THETA_START, FreeParameter
 from .store import SERIES_COLUMNS, filled, open_store, plant_of
 
 #: Batches per task: large enough that shipping and committing are noise against the fitting
@@ -87,6 +87,11 @@ def fleet_spec(spec: str | FitSpec | None = None, **options) -> FleetSpec:
     else:
         spec = spec if isinstance(spec, FitSpec) else load_fit_spec(spec)
         free, fixed, initial, source = spec.free, spec.fixed, spec.initial, spec.source
+        if any(w != DEFAULT_WEIGHTS.get(k) for k, w in spec.weights.items()):
+            raise InputError(
+                "fleet fits score the bean probe (Ta) alone: drop the [weights] table, which weights other outputs",
+                source,
+            )
     from ..fit.fleet import free_slots
 
     try:
