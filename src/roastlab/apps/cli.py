@@ -863,7 +863,8 @@ def _add_fit_commands(sub) -> None:
     p = sub.add_parser(
         "identify",
         help="fit a model on batches (eqs. 18-19) and write MODEL.json",
-        description="Minimise the summed SSR of the probe temperature over the given batches within bounds, "
+        description="Minimise the summed SSR of the probe temperature (and, with --weight Tb2=W or a spec's "
+        "[weights], of the model's bean temperature against a second bean reading) over the given batches within bounds, "
         "by a seeded global search (scattered starts polished by bounded least squares) or differential evolution. "
         "Writes the fitted model file (roastlab-model/1): plant, theta and every other fitted or held value with "
         "standard errors and bounds, the initial states, the column map, fit-set metrics and provenance.",
