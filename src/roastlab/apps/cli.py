@@ -80,6 +80,21 @@ def _progress(desc: str):
     return update
 
 
+def json_text(doc) -> str:
+    """A JSON output file's text: NumPy values made plain, NaN refused, one space indent."""
+    from ..io.modelfile import jsonable
+
+    return json.dumps(jsonable(doc), indent=1, allow_nan=False) + "\n"
+
+
+def write_json_and_plot(out, args, doc, figure) -> None:
+    """Write ``--json`` (``doc``) and ``--plot`` (``figure.plot``) through ``out`` when asked for."""
+    if args.json:
+        out.write_text(args.json, json_text(doc))
+    if args.plot:
+        figure.plot(args.plot, outputs=out)
+
+
 def _say(notes) -> None:
     for note in notes:
         print(f"note: {note}", file=sys.stderr)
@@ -299,7 +314,7 @@ def cmd_identify(args) -> int:
 
         doc = {**fit_first_order(batches), "plant": str(plant_spec)}
         with outputs as out:
-            out.write_text(args.out, json.dumps(doc, indent=1, allow_nan=False) + "\n")
+            out.write_text(args.out, json_text(doc))
         print(f"first-order baseline on {len(batches)} batch(es): {describe(doc)}, SSR {doc['SSR']:.1f} -> {args.out}")
         return 0
     fix = _parse_assignments(args.fix, "--fix", ranged=False)
@@ -367,7 +382,7 @@ def _identify_per_batch(args, batches, plant_spec, fix, bounds, outputs) -> int:
     result = identify_each(packed, bounds=bounds, fix=fix, seed=args.seed, progress=_progress("fit per batch"))
     doc = {**result.to_json_dict(), "plant": str(plant_spec), "fixed": sorted(fix)}
     with outputs as out:
-        out.write_text(args.out, json.dumps(doc, indent=1, allow_nan=False) + "\n")
+        out.write_text(args.out, json_text(doc))
     print(
         f"identified theta per batch for {packed.n_batches} batch(es) on plant {plant_spec} in {result.wall_s:.2f} s ({result.simulations} simulations)"
     )
@@ -385,7 +400,6 @@ def _identify_per_batch(args, batches, plant_spec, fix, bounds, outputs) -> int:
 
 def cmd_validate(args) -> int:
     from ..io.files import Outputs
-    from ..io.modelfile import jsonable
     from ..report.figures import check_figure_path, plot_fit
 
     outputs = Outputs(_fit_inputs(args))
@@ -413,7 +427,7 @@ def cmd_validate(args) -> int:
     )
     with outputs as out:
         if args.json:
-            out.write_text(args.json, json.dumps(jsonable(result.to_json_dict()), indent=1, allow_nan=False) + "\n")
+            out.write_text(args.json, json_text(result.to_json_dict()))
         if args.plot:
             plot_fit(result, args.plot, title=f"measured vs predicted BT, plant {result.plant}", outputs=out)
         if args.predictions:
@@ -443,7 +457,6 @@ def _validate_baseline(args, outputs) -> int:
     from ..evaluate.metrics import average_metrics
     from ..evaluate.validate import ValidationResult
     from ..fit.baseline import SETTING_GAINS, describe, validate_first_order
-    from ..io.modelfile import jsonable
     from ..report.figures import plot_fit
 
     if not args.model:
@@ -473,7 +486,7 @@ def _validate_baseline(args, outputs) -> int:
                 "batches": [{"name": n, **r} for n, r in zip(result.names, rows)],
                 "average": average_metrics(rows),
             }
-            out.write_text(args.json, json.dumps(jsonable(doc), indent=1, allow_nan=False) + "\n")
+            out.write_text(args.json, json_text(doc))
         if args.plot:
             plot_fit(result, args.plot, title="measured vs first-order baseline", outputs=out)
     return 0
@@ -538,7 +551,6 @@ def cmd_datasets(args) -> int:
 
 def cmd_whatif(args) -> int:
     from ..io.files import Outputs
-    from ..io.modelfile import jsonable
     from ..report.figures import check_figure_path
     from ..workflows.model import load_model
     from ..workflows.whatif import parse_set, parse_setting_change, whatif
@@ -566,17 +578,13 @@ def cmd_whatif(args) -> int:
     result = whatif(model, batch, setting_changes, **changes)
     print(result.table())
     with outputs as out:
-        if args.json:
-            out.write_text(args.json, json.dumps(jsonable(result.to_json_dict()), indent=1, allow_nan=False) + "\n")
-        if args.plot:
-            result.plot(args.plot, outputs=out)
+        write_json_and_plot(out, args, result.to_json_dict(), result)
     return 0
 
 
 def cmd_transfer(args) -> int:
     from ..fit.program import ProgramLimits
     from ..io.files import Outputs
-    from ..io.modelfile import jsonable
     from ..model.limits import check_value
     from ..report.figures import check_figure_path
     from ..workflows.model import load_model
@@ -636,10 +644,7 @@ def cmd_transfer(args) -> int:
     print(result.summary())
     with outputs as out:
         out.write_text(args.out, result.program_csv_text())
-        if args.json:
-            out.write_text(args.json, json.dumps(jsonable(result.to_json_dict()), indent=1, allow_nan=False) + "\n")
-        if args.plot:
-            result.plot(args.plot, outputs=out)
+        write_json_and_plot(out, args, result.to_json_dict(), result)
         if args.alog:
             out.write_text(args.alog, result.alog_text())
     return 0
@@ -663,7 +668,6 @@ def _control_inputs(args):
 def cmd_control(args) -> int:
     from ..control import load_scenario, make_controller, run_closed_loop
     from ..io.files import Outputs
-    from ..io.modelfile import jsonable
     from ..report.figures import check_figure_path
 
     if args.what == "compare":
@@ -695,17 +699,13 @@ def cmd_control(args) -> int:
     with outputs as out:
         if args.out:
             out.write_text(args.out, result.trace_csv_text())
-        if args.json:
-            out.write_text(args.json, json.dumps(jsonable(m), indent=1, allow_nan=False) + "\n")
-        if args.plot:
-            result.plot(args.plot, outputs=out)
+        write_json_and_plot(out, args, m, result)
     return 0
 
 
 def cmd_control_compare(args) -> int:
     from ..control import compare, make_controller, standard_scenarios
     from ..io.files import Outputs
-    from ..io.modelfile import jsonable
     from ..report.figures import check_figure_path
 
     scenarios = standard_scenarios()
@@ -732,10 +732,7 @@ def cmd_control_compare(args) -> int:
     )
     print(result.table())
     with outputs as out:
-        if args.json:
-            out.write_text(args.json, json.dumps(jsonable(result.to_json_dict()), indent=1, allow_nan=False) + "\n")
-        if args.plot:
-            result.plot(args.plot, outputs=out)
+        write_json_and_plot(out, args, result.to_json_dict(), result)
     return 0
 
 

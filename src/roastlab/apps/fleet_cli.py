@@ -3,12 +3,11 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
 
 from ..errors import InputError
-from .cli import _count_arg, _progress
+from .cli import _count_arg, _progress, write_json_and_plot
 
 
 def _db_output(db, inputs) -> Path:
@@ -73,7 +72,6 @@ def cmd_fleet_fit(args) -> int:
 def cmd_fleet_report(args) -> int:
     from ..fleet import fleet_report
     from ..io.files import Outputs
-    from ..io.modelfile import jsonable
 
     outputs = Outputs([args.db])
     if args.json:
@@ -83,10 +81,7 @@ def cmd_fleet_report(args) -> int:
     report = fleet_report(args.db)
     print(report.table())
     with outputs as out:
-        if args.json:
-            out.write_text(args.json, json.dumps(jsonable(report.to_json_dict()), indent=1, allow_nan=False) + "\n")
-        if args.plot:
-            report.plot(args.plot, outputs=out)
+        write_json_and_plot(out, args, report.to_json_dict(), report)
     return 0
 
 
