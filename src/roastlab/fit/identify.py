@@ -103,6 +103,13 @@ class IdentificationResult:
         return out
 
 
+#: Why a fit weighting Tb2 cannot run on batches that lack the second reading.
+NO_SECOND_READING = (
+    "the Tb2 output has a weight but no batch has a second bean reading: read the logs with a map that has a "
+    "[Tb2] column, or drop the weight"
+)
+
+
 def check_weights(weights: dict | None) -> dict[str, float]:
     """The output weights with defaults filled in; unknown names or bad values are refused."""
     out = dict(DEFAULT_WEIGHTS)
@@ -154,10 +161,7 @@ class Objective:
             "Tb2": valid & np.isfinite(packed.TB2) & (self.weights["Tb2"] > 0),
         }
         if self.weights["Tb2"] > 0 and not self.masks["Tb2"].any():
-            raise ParameterError(
-                "the Tb2 output has a weight but no batch has a second bean reading: read the logs with a map that "
-                "has a [Tb2] column, or drop the weight"
-            )
+            raise ParameterError(NO_SECOND_READING)
         self.with_tb = bool(self.masks["Tb2"].any())
         self.measured = np.concatenate([packed.TA[self.masks["Ta"]], packed.TB2[self.masks["Tb2"]]])
         counts = {k: int(m.sum()) for k, m in self.masks.items()}

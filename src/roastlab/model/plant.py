@@ -118,17 +118,14 @@ class Plant:
         >>> round(p.bed_depth_m / p.Dch_m, 3)   # 120 kg in a 1.1 m x 1.5 m drum (fill ~ 12 %)
         0.167
         """
+        from scipy.optimize import brentq
+
         fill = self.fill_fraction
         if fill >= 1.0:
             return self.Dch_m
-        lo, hi = 0.0, 2.0 * math.pi  # (t - sin t) / (2 pi) rises monotonically from 0 to 1 on [0, 2 pi]
-        for _ in range(80):
-            mid = 0.5 * (lo + hi)
-            if (mid - math.sin(mid)) / (2.0 * math.pi) < fill:
-                lo = mid
-            else:
-                hi = mid
-        return self.Dch_m / 2.0 * (1.0 - math.cos(0.5 * (lo + hi) / 2.0))
+        # (t - sin t) / (2 pi) rises monotonically from 0 to 1 on [0, 2 pi]: one root
+        t = brentq(lambda a: (a - math.sin(a)) / (2.0 * math.pi) - fill, 0.0, 2.0 * math.pi, xtol=1e-14, rtol=1e-15)
+        return self.Dch_m / 2.0 * (1.0 - math.cos(t / 2.0))
 
     @property
     def Ab_m2(self) -> float:

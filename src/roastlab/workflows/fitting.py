@@ -17,7 +17,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..evaluate.validate import ValidationResult
-from ..fit.identify import IdentificationResult, build_free_parameters, identify
+from ..fit.identify import NO_SECOND_READING, IdentificationResult, build_free_parameters, identify
 from ..io.batch import Batch
 from ..io.fitspec import FitSpec, load_fit_spec
 from ..io.importers.mapping import ColumnMap
@@ -140,11 +140,7 @@ def fit(
     given = dict(weights or {})
     weights = {**spec_weights, **given}
     if weights.get("Tb2", 0) > 0 and all(b.Tb2_C is None or not np.isfinite(b.Tb2_C).any() for b in batches):
-        raise InputError(
-            "the Tb2 output has a weight but no batch has a second bean reading: read the logs with a map that has "
-            "a [Tb2] column, or drop the weight",
-            "command line" if "Tb2" in given else spec_source,
-        )
+        raise InputError(NO_SECOND_READING, "command line" if "Tb2" in given else spec_source)
     names_moved = {f.name for f in free} | set(fixed)
     if "Gg_kg_s" not in names_moved and all(np.all(b.Gg_kg_s == PLACEHOLDER_GG_KG_S) for b in batches):
         raise InputError(
