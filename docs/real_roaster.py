@@ -43,6 +43,15 @@ def mean(rows, key):
     return average_metrics(rows)[key]
 
 
+def output_table(v_fit, v_val, lines):
+    """Markdown rows of each output's mean FIT and MAE (Ta vs the probe, Tb vs the second reading)."""
+    lines += ["| set | Ta FIT % | Ta MAE °C | Tb vs Tb2 FIT % | Tb vs Tb2 MAE °C |", "|---|---|---|---|---|"]
+    for name, v in (("fit", v_fit), ("held out", v_val)):
+        o = v.output_average("Tb2")
+        lines.append(f"| {name} | {v.average['FIT']:.1f} | {v.average['MAE']:.2f} | {o['FIT']:.1f} | {o['MAE']:.2f} |")
+    lines.append("")
+
+
 def paper_probe_variant(example, fit_b, val_b, column_map, lines):
     """The same fit with the paper's probe (eq. 17, no immersion term) on Ta alone: the comparison row."""
     spec = load_fit_spec(example / "fit.toml")
@@ -50,16 +59,10 @@ def paper_probe_variant(example, fit_b, val_b, column_map, lines):
     model = roastlab.fit(fit_b, example / "plant.toml", spec, column_map=column_map).model
     v_fit, v_val = model.validate(fit_b), model.validate(val_b)
     lines += [
-        "",
         "The same fit with the paper's probe (eq. 17, no immersion term) and on Ta alone, for comparison:",
         "",
-        "| set | Ta FIT % | Ta MAE °C | Tb vs IR FIT % | Tb vs IR MAE °C |",
-        "|---|---|---|---|---|",
     ]
-    for name, v in (("fit", v_fit), ("held out", v_val)):
-        o = v.output_average("Tb2")
-        lines.append(f"| {name} | {v.average['FIT']:.1f} | {v.average['MAE']:.2f} | {o['FIT']:.1f} | {o['MAE']:.2f} |")
-    lines.append("")
+    output_table(v_fit, v_val, lines)
     return model
 
 
@@ -96,14 +99,8 @@ def machine(title, example, paths, lines):
             + ", ".join(f"weight {k} {o['weight']:g}" for k, o in weights.items())
             + "):",
             "",
-            "| set | Ta FIT % | Ta MAE °C | Tb vs Tb2 FIT % | Tb vs Tb2 MAE °C |",
-            "|---|---|---|---|---|",
         ]
-        for name, v in (("fit", v_fit), ("held out", v_val)):
-            o = v.output_average("Tb2")
-            lines.append(
-                f"| {name} | {v.average['FIT']:.1f} | {v.average['MAE']:.2f} | {o['FIT']:.1f} | {o['MAE']:.2f} |"
-            )
+        output_table(v_fit, v_val, lines)
         paper_probe_variant(example, fit_b, val_b, column_map, lines)
     lines += [
         f"First-order baseline on the same inputs: {describe(base)}.",
