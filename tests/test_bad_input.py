@@ -131,7 +131,7 @@ CASES = {
     "Mb_kg metadata out of range": (
         lambda d: simulate_with(d, "b.csv", "# Mb_kg = -3\n" + HEADER + GOOD_ROWS),
         "b.csv",
-        "line 1: Mb_kg = -3 outside",
+        "line 1: Mb_kg (green batch mass) = -3 kg outside",
     ),
     # logs and maps
     "degF data declared as degC": (
@@ -216,7 +216,7 @@ CASES = {
     "Pbm outside (0, 1) in THETA.json": (
         lambda d: theta_with(d, '{"hgm": 0.01, "hbm": 0.02, "Pbm": 1.3}'),
         "theta.json",
-        "Pbm (bean area touching the metal) = 1.3 - outside the plausible range",
+        "Pbm (bean area touching the metal, section 3.1) = 1.3 - outside the plausible range",
     ),
     "missing theta keys": (lambda d: theta_with(d, '{"hgm": 0.01}'), "theta.json", "missing key(s) hbm, Pbm"),
     "theta wrong JSON type": (
@@ -412,12 +412,12 @@ HOSTILE = {
     "spec fixes a zero metal mass": (
         lambda d: _fit_spec(d, "[free]\nhbm = [0.01, 0.35, 0.02]\n[fixed]\nMm = 0.0\n"),
         "spec.toml",
-        "Mm (drum metal mass) = 0 kg outside",
+        "Mm (drum metal mass in thermal contact, eq. 12) = 0 kg outside",
     ),
     "spec frees a capacity down to zero": (
         lambda d: _fit_spec(d, "[free]\ncm = [0.0, 1.0, 0.4]\n"),
         "spec.toml",
-        "cm (metal specific heat) = 0 kJ/(kg K) outside the plausible range",
+        "lower bound: cm (metal specific heat, eq. 12) = 0 kJ/(kg K) outside the plausible range",
     ),
     "negative moisture": (lambda d: _good_sim(d, "--x0", "-0.1"), "--x0", "X0 (green moisture, dry basis) = -0.1"),
     "absolute-zero drum": (lambda d: _good_sim(d, "--tm0", "-273.15"), "--tm0", "outside the plausible range"),

@@ -124,16 +124,22 @@ def _add_model_options(p: argparse.ArgumentParser, with_model: bool = True) -> N
 
 def _add_initial_options(p: argparse.ArgumentParser) -> None:
     """--tb0, --tm0, --x0: the charge state (read back by :func:`_initial_changes`)."""
+    from ..model.quantities import default
+
     p.add_argument(
-        "--tb0", type=_float_arg("--tb0"), help="initial bean temperature [degC] (default: the model's, else 30)"
+        "--tb0",
+        type=_float_arg("--tb0"),
+        help=f"initial bean temperature [degC] (default: the model's, else {default('Tb0_C'):g})",
     )
     p.add_argument(
         "--tm0",
         type=_float_arg("--tm0"),
-        help="initial drum metal temperature, the preheat [degC] (default: the model's or the log's, else 121)",
+        help=f"initial drum metal temperature, the preheat [degC] (default: the model's or the log's, else {default('Tm0_C'):g})",
     )
     p.add_argument(
-        "--x0", type=_float_arg("--x0"), help="initial moisture [kg/kg dry] (default: the model's, else 0.1)"
+        "--x0",
+        type=_float_arg("--x0"),
+        help=f"initial moisture [kg/kg dry] (default: the model's, else {default('X0'):g})",
     )
 
 

@@ -28,7 +28,7 @@ from ..sim.kernels import H_MAX_S, step_kernel
 from .base import LoopSetup
 
 #: Names of the filter's states: the model's six and the inlet-temperature disturbance.
-NAMES = (*STATE_NAMES, "H", "Tgi_bias_C")
+NAMES = (*STATE_NAMES, "Tgi_bias_C")
 NZ = N_STATES + 1
 #: Standard deviation of the initial guess: Tb, Tm (the drum's stored heat is the unknown), X,
 #: He, Ta, H, d.

@@ -14,8 +14,8 @@ the batches in lock-step so that each iteration is one compiled, parallel popula
 
 Any parameter-vector entry or initial state (except X0, which also sets the dry mass) can be
 free, not only theta: a fleet fit spec may free, say, Kt or Tm0_C per batch. Standard errors
-come from the Jacobian at each batch's optimum, cov = s^2 (J'J)^-1 with s^2 = SSR / (n - k),
-over the components not on a bound (as :mod:`.identify`).
+come from the Jacobian at each batch's optimum by the one rule of :mod:`roastlab.fit.uncertainty`
+(the same as :mod:`.identify`'s).
 
 Each batch's whole fit is one compiled routine, and batches run in parallel over the cores
 (numba ``prange``): the work per batch does not depend on how many batches there are, so the
@@ -40,6 +40,7 @@ from ..model.parameters import REGISTRY, STATE0, THETA_NAMES, THETA_START
 from ..model.rhs import P
 from ..sim.kernels import N_OUT, integrate_into
 from ..sim.population import PackedBatches, predict_ta
+from . import uncertainty
 from .identify import FD_STEP
 
 #: Where a free value goes: a parameter-vector entry or an initial state.
@@ -331,23 +332,18 @@ def _sobol_points(seed: int, n: int, k: int = 3) -> np.ndarray:
 
 
 def standard_errors(jtj: np.ndarray, z: np.ndarray, ssr: np.ndarray, n: np.ndarray, span: np.ndarray) -> np.ndarray:
-    """Per-batch standard errors (nb, k) from J'J in scaled units: s^2 (J'J)^-1 over the
-    components off their bounds, s^2 = SSR / (n - k_off); NaN on a bound, fixed or singular."""
+    """Per-batch standard errors (nb, k) from J'J in scaled units (z in [0, 1] of each bound's
+    span), by the one rule of :mod:`roastlab.fit.uncertainty`: NaN on a bound, fixed (span 0),
+    without effect or with no degrees of freedom left."""
     nb, k = z.shape
     out = np.full((nb, k), np.nan)
-    off = (z > 1e-9) & (z < 1.0 - 1e-9) & (span > 0)[None, :]
+    free = span > 0
+    names = [str(j) for j in range(k)]
     for b in range(nb):
-        idx = np.flatnonzero(off[b])
-        dof = int(n[b]) - len(idx)
-        if len(idx) == 0 or dof <= 0:
-            continue
-        sub = jtj[b][np.ix_(idx, idx)]
-        try:
-            cov = np.linalg.inv(sub) * (ssr[b] / dof)
-        except np.linalg.LinAlgError:
-            continue
-        d = np.diag(cov)
-        out[b, idx] = np.where(d >= 0, np.sqrt(np.abs(d)), np.nan) * span[idx]
+        u = uncertainty.from_normal(
+            jtj[b], z[b], np.where(free, 0.0, z[b]), np.where(free, 1.0, z[b]), ssr[b], n[b], names
+        )
+        out[b] = u.stderr * span
     return out
 
 

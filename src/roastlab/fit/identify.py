@@ -10,10 +10,9 @@ theta* = argmin sum_j SSR_j(theta) within bounds. Two global strategies:
   call, then the same least-squares polish.
 
 Any component can be fixed or re-bounded, and each batch's initial metal temperature can be
-estimated as a nuisance parameter. Uncertainty comes from the Jacobian at the optimum:
-cov = s^2 (J'J)^-1 with s^2 = SSR / (n - p), over the parameters not on a bound (a parameter
-held by a bound gets no standard error). Warnings flag parameters on a bound and pairs
-correlated above 0.95.
+estimated as a nuisance parameter. Uncertainty (standard errors, covariance, correlations,
+AIC and BIC, and which parameters a bound holds) follows the one rule of
+:mod:`roastlab.fit.uncertainty`, from the Jacobian at the optimum.
 """
 
 from __future__ import annotations
@@ -26,6 +25,7 @@ from scipy.optimize import differential_evolution, least_squares
 from scipy.stats import qmc
 
 from ..errors import ParameterError
+from ..model.limits import check_value
 from ..model.parameters import (
     DEFAULT_WEIGHTS,
     FREE_NAMES,
@@ -36,9 +36,11 @@ from ..model.parameters import (
     FreeParameter,
     Theta,
 )
+from ..model.quantities import default
 from ..sim.population import PackedBatches, predict_outputs
+from . import uncertainty
+from .uncertainty import CORRELATION_WARN, Uncertainty  # noqa: F401  (CORRELATION_WARN: re-exported)
 
-CORRELATION_WARN = 0.95
 #: Residual given to a sample whose simulation failed (NaN): a very bad fit, not a crash [degC].
 FAILED_RESIDUAL_C = 1e3
 #: Central-difference step of the Jacobian, in units of each parameter's bound span: large
@@ -73,6 +75,23 @@ class IdentificationResult:
     bounds: dict = field(default_factory=dict)
     batches: list[str] = field(default_factory=list)
     outputs: dict = field(default_factory=dict)
+    uncertainty: Uncertainty | None = None
+
+    @property
+    def aic(self) -> float:
+        """Akaike's information criterion of the fit (:mod:`roastlab.fit.uncertainty`)."""
+        return self.uncertainty.aic if self.uncertainty is not None else float("nan")
+
+    @property
+    def bic(self) -> float:
+        """The Bayesian information criterion of the fit (:mod:`roastlab.fit.uncertainty`)."""
+        return self.uncertainty.bic if self.uncertainty is not None else float("nan")
+
+    @property
+    def covariance(self) -> np.ndarray | None:
+        """(k, k) covariance of the free parameters, in :attr:`correlation` ``names`` order (NaN
+        where not determined)."""
+        return None if self.uncertainty is None else self.uncertainty.covariance
 
     @property
     def theta(self):
@@ -100,6 +119,9 @@ class IdentificationResult:
                 "outputs": self.outputs,
             }
         )
+        if self.uncertainty is not None:
+            u = self.uncertainty.to_dict()
+            out.update({k: u[k] for k in ("covariance", "AIC", "BIC", "k_free")})
         return out
 
 
@@ -264,17 +286,19 @@ def build_free_parameters(
     for name in list(fix) + list(bounds):
         if name not in REGISTRY:
             raise ParameterError(f"unknown parameter {name!r} (allowed: {', '.join(FREE_NAMES)})")
+    # a fixed value is a value the user gives: inside its plausible range (the quantity table)
+    fix = {name: check_value(name, value, "fixed value") for name, value in fix.items()}
     free, fixed = [], {}
     theta0 = THETA_START.as_dict()
     for name in THETA_NAMES:
         if name in fix:
-            fixed[name] = float(fix[name])
+            fixed[name] = fix[name]
             continue
         lo, hi = bounds.get(name, REGISTRY[name].bounds)
         free.append(FreeParameter(name, lo, hi, start.get(name, theta0[name])))
     if estimate_tm0:
         lo, hi = bounds.get("Tm0_C", REGISTRY["Tm0_C"].bounds)
-        free.append(FreeParameter("Tm0_C", lo, hi, start.get("Tm0_C", 121.0), per_batch=True))
+        free.append(FreeParameter("Tm0_C", lo, hi, start.get("Tm0_C", default("Tm0_C")), per_batch=True))
     for p in extra or []:
         free.append(p)
     for name, value in fix.items():
@@ -300,35 +324,6 @@ def _polish(obj: Objective, z0: np.ndarray):
         max_nfev=200,
     )
     return res.x, float(res.fun @ res.fun)
-
-
-def _uncertainty(obj: Objective, z: np.ndarray, ssr: float, interior: np.ndarray):
-    """Standard errors and correlations from J at the optimum, over interior parameters only.
-
-    A parameter on a bound is held there by the constraint, not by the data: the linearised
-    covariance says nothing about it, and including it distorts the others. Its standard
-    error and correlations are reported as NaN.
-    """
-    J_all = obj.jacobian(z)
-    # a parameter the residuals do not move at all (e.g. a covering depth below every bed: the
-    # term is off there) is not determined by the data either: no standard error, like a bound
-    flat = ~np.any(J_all != 0.0, axis=0)
-    interior = interior & ~flat
-    J = J_all[:, interior]
-    n, p = J.shape
-    full_se = np.full(len(z), np.nan)
-    full_corr = np.full((len(z), len(z)), np.nan)
-    if p == 0:
-        return full_se, full_corr, flat
-    s2 = ssr / max(n - p, 1)
-    cov = s2 * np.linalg.pinv(J.T @ J)
-    se = np.sqrt(np.clip(np.diag(cov), 0, None))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        corr = cov / np.outer(se, se)
-    idx = np.flatnonzero(interior)
-    full_se[idx] = se
-    full_corr[np.ix_(idx, idx)] = corr
-    return full_se, full_corr, flat
 
 
 def identify(
@@ -419,10 +414,8 @@ def identify(
             f"no fitted values found at which every batch can be simulated ({', '.join(failed[:3])} fail): "
             "the bounds admit only values for which the model diverges"
         )
-    span_all = obj.upper - obj.lower
-    on_bound = (z - obj.lower <= 1e-4 * span_all) | (obj.upper - z <= 1e-4 * span_all)
-    se, corr, flat = _uncertainty(obj, z, ssr, ~on_bound)
     labels = [free[j].name if b < 0 else f"{free[j].name}[{packed.names[b]}]" for j, b in obj.layout]
+    unc = uncertainty.from_jacobian(obj.jacobian(z), z, obj.lower, obj.upper, ssr, labels)
     values: dict = {}
     for k, (j, b) in enumerate(obj.layout):
         name = free[j].name
@@ -430,39 +423,14 @@ def identify(
             values[name] = float(z[k])
         else:
             values.setdefault(name, [None] * packed.n_batches)[b] = float(z[k])
-    warnings = []
-    for k, lab in enumerate(labels):
-        span = obj.upper[k] - obj.lower[k]
-        if z[k] - obj.lower[k] <= 1e-4 * span:
-            warnings.append(
-                f"{lab} = {z[k]:.6g} is on its lower bound {obj.lower[k]:g}: the optimum may lie outside; no standard error (held by the bound, not the data)"
-            )
-        elif obj.upper[k] - z[k] <= 1e-4 * span:
-            warnings.append(
-                f"{lab} = {z[k]:.6g} is on its upper bound {obj.upper[k]:g}: the optimum may lie outside; no standard error (held by the bound, not the data)"
-            )
-        elif flat[k]:
-            warnings.append(
-                f"{lab} = {z[k]:.6g} has no effect on the fit there (its term is off or saturated): the data do not "
-                "determine it; no standard error (try more starts or another start value)"
-            )
-    for a in range(nz):
-        for b in range(a + 1, nz):
-            if np.isfinite(corr[a, b]) and abs(corr[a, b]) > CORRELATION_WARN:
-                warnings.append(
-                    f"{labels[a]} and {labels[b]} are correlated ({corr[a, b]:+.3f}): the data pin down a combination of them, not each"
-                )
+    unc_doc = unc.to_dict()
     return IdentificationResult(
         values=values,
         fixed=fixed,
         SSR=ssr,
-        stderr={lab: (float(v) if np.isfinite(v) else None) for lab, v in zip(labels, se)},
-        correlation={
-            "names": labels,
-            "matrix": [[None if not np.isfinite(c) else float(round(c, 6)) for c in row] for row in corr],
-            "note": "over parameters not on a bound; null for those on a bound",
-        },
-        warnings=warnings,
+        stderr=unc_doc["stderr"],
+        correlation=unc_doc["correlation"],
+        warnings=unc.warnings(),
         n_residuals=obj.n_residuals,
         nfev=obj.nfev,
         wall_s=time.perf_counter() - t0,
@@ -472,4 +440,5 @@ def identify(
         bounds={lab: [float(obj.lower[k]), float(obj.upper[k])] for k, lab in enumerate(labels)},
         batches=list(packed.names),
         outputs=obj.output_ssr(z),
+        uncertainty=unc,
     )

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, ParameterError
 from ..model.limits import check_array, check_value
 from .files import atomic_write_text, read_input_text, read_toml
 
@@ -249,14 +249,8 @@ def read_batch_csv(path: str | Path, name: str | None = None, require_Ta: bool =
     return batch.validate()
 
 
-#: Metadata a batch CSV may carry in ``# key = value`` comment lines, with allowed ranges.
-COMMENT_METADATA = {
-    "Mb_kg": (1e-4, 1e4),
-    "Tm0_C": (-50.0, 700.0),
-    "Tb0_C": (-50.0, 400.0),
-    "X0": (0.0, 1.0),
-    "Ta0_C": (-50.0, 700.0),
-}
+#: Metadata a batch CSV may carry in ``# key = value`` comment lines (ranges: the quantity table).
+COMMENT_METADATA = ("Mb_kg", "Tm0_C", "Tb0_C", "X0", "Ta0_C")
 #: Of those, the initial states a log set through its map's ``[initial]`` (kept in ``Batch.initial``).
 INITIAL_METADATA = ("Tm0_C", "Tb0_C", "X0", "Ta0_C")
 
@@ -275,10 +269,10 @@ def read_comment_metadata(path: str | Path, text: str | None = None) -> dict[str
         key = key.strip()
         if sep and key in COMMENT_METADATA:
             v = parse_number(value, path, line_no, key)
-            lo, hi = COMMENT_METADATA[key]
-            if not lo <= v <= hi:
-                raise InputError(f"{key} = {v:g} outside {lo:g}..{hi:g}", path, f"line {line_no}")
-            out[key] = v
+            try:
+                out[key] = check_value(key, v)
+            except ParameterError as exc:
+                raise InputError(exc.problem, path, f"line {line_no}") from None
     return out
 
 

@@ -31,12 +31,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import InputError, ParameterError
-from ..model.limits import LIMITS, check_value
+from ..model.limits import check_value
 from ..model.parameters import (
     DEFAULT_WEIGHTS,
     FREE_NAMES,
     OUTPUTS,
-    REGISTRY,
     STATE0,
     THETA_NAMES,
     THETA_PAPER,
@@ -58,15 +57,11 @@ class FitSpec:
 
 
 def _checked(name: str, value: float, path, where) -> float:
-    """A fixed or initial value inside its plausible range (process constants: > 0)."""
-    if name in LIMITS:
-        try:
-            return check_value(name, value)
-        except ParameterError as exc:
-            raise ParameterError(exc.problem, path, where) from None
-    if REGISTRY[name].kind != "theta" and not value > 0:
-        raise ParameterError(f"must be > 0 {REGISTRY[name].unit}, got {value:g}", path, where)
-    return value
+    """A fixed or initial value inside its plausible range (the quantity table)."""
+    try:
+        return check_value(name, value)
+    except ParameterError as exc:
+        raise ParameterError(exc.problem, path, where) from None
 
 
 def load_fit_spec(path: str | Path) -> FitSpec:

@@ -29,7 +29,7 @@ import math
 from pathlib import Path
 
 from ..errors import InputError, ParameterError
-from ..model.limits import LIMITS, check_value
+from ..model.limits import check_value
 from ..model.parameters import REGISTRY, STATE0, THETA_NAMES, Theta
 from ..model.plant import GEOMETRY_KEYS, Plant, plant_from_mapping
 from .files import finite_number, read_input_text
@@ -159,10 +159,7 @@ def check_document(doc: dict, path) -> dict:
         entry["value"] = finite_number(entry.get("value"), path, where)
         if entry.get("how", "fitted") not in PARAMETER_HOW:
             raise InputError(f"how must be one of {', '.join(PARAMETER_HOW)}", path, where)
-        if name in LIMITS:
-            check_value(name, entry["value"], f"{path}: {where}")
-        elif REGISTRY[name].kind not in ("theta", "actuator") and not entry["value"] > 0:
-            raise ParameterError(f"must be > 0 {REGISTRY[name].unit}, got {entry['value']:g}", path, where)
+        check_value(name, entry["value"], f"{path}: {where}")  # the quantity table's plausible range
     try:
         Theta(*(params[k]["value"] for k in THETA_NAMES))
     except ParameterError as exc:

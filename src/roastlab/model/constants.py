@@ -25,6 +25,10 @@ from dataclasses import dataclass
 
 from ..errors import ParameterError
 from .limits import check_value
+from .quantities import defaults
+
+#: Table 5's values, from the one quantity table.
+_D = defaults("process")
 
 #: eq. 2 coefficients alpha_0..alpha_6 of cg(T) in J/(kg K), T in kelvin.
 CG_ALPHA_J_KG_K = (
@@ -59,7 +63,8 @@ GREEN_BULK_DENSITY_KG_M3 = 680.0
 
 @dataclass(frozen=True)
 class ProcessConstants:
-    """Fixed process constants (Table 5, left), overridable per plant file.
+    """Fixed process constants (Table 5, left), overridable per plant file; the defaults are the
+    quantity table's (:mod:`roastlab.model.quantities`).
 
     Attributes
     ----------
@@ -87,17 +92,17 @@ class ProcessConstants:
         Latent heat of vaporisation of bean moisture [kJ/kg] (eq. 8).
     """
 
-    A: float = 116200.0
-    cm: float = 0.418
-    cw: float = 5.0
-    Db: float = 7.65e-3
-    Ha_R: float = 5500.0
-    Het: float = 232.0
-    k1: float = 4320.0
-    k2: float = 9889.0
-    Kt: float = 0.01
-    mb: float = 1.5e-4
-    lam: float = 2790.0
+    A: float = _D["A"]
+    cm: float = _D["cm"]
+    cw: float = _D["cw"]
+    Db: float = _D["Db"]
+    Ha_R: float = _D["Ha_R"]
+    Het: float = _D["Het"]
+    k1: float = _D["k1"]
+    k2: float = _D["k2"]
+    Kt: float = _D["Kt"]
+    mb: float = _D["mb"]
+    lam: float = _D["lam"]
 
     def __post_init__(self) -> None:
         for f in dataclasses.fields(self):

@@ -38,56 +38,56 @@ from numba.extending import register_jitable
 from ..errors import ParameterError
 from .constants import CG_ALPHA_J_KG_K, K1_PRINTED, MOISTURE_LAWS
 
-STATE_NAMES = ("Tb_C", "Tm_C", "X_kg_kg", "He_kJ_kg", "Ta_C")
-#: The actuator extension's state: the heater setting after its first-order lag [setting units].
-HEATER_STATE = "heater_lagged"
-#: Number of states the integrator carries: the paper's five and the lagged heater setting.
-N_STATES = 6
-INPUT_NAMES = ("Gg_kg_s", "Tgi_C", "heater", "fan")
-#: Layout of the parameter vector ``p``.
-PARAM_NAMES = (
-    "hgm",
-    "hbm",
-    "Pbm",  # identified theta [kW/(m2 K)], [kW/(m2 K)], [-]
-    "Agm",
-    "Ab",
-    "Mbd",
-    "Mm",  # plant-derived [m2], [m2], [kg], [kg]
-    "A",
-    "cm",
-    "cw",
-    "Db",
-    "Ha_R",
-    "Het",
-    "k1",
-    "k2",
-    "Kt",
-    "lam",  # process constants
-    "x_exp",  # exponent of X in the moisture law: 2 (Schwartzberg) or 0 (printed)
-    "Gg_scale",  # factor on the gas-flow input [-], 1 = as given (identifies an unlogged constant Gg)
-    # actuator extension (0 = the paper's model)
-    "Qe_gain",  # heat into the drum metal per unit of heater setting [kW/unit]
-    "Qe_offset",  # heat into the drum metal at heater setting 0 [kW]
-    "Tgi_gain",  # rise of the inlet gas temperature per unit of heater setting [degC/unit]
-    "tau_heater",  # first-order lag of the heater's effect [s]
-    "Gg_fan",  # gas flow per unit of fan setting [kg/s per unit]
-    # drum-shell heat loss to the room (extension; 0 = the paper's adiabatic shell)
-    "U_shell",  # heat-loss coefficient of the drum's outer surface [kW/(m2 K)]
-    "Ashell",  # outer drum surface exposed to the room [m2] (plant-derived)
-    "T_room",  # room temperature the shell loses heat to [degC]
-    # probe immersion (extension; h_probe 0 = the paper's fully immersed probe)
-    "h_bed",  # depth of the bean bed at rest [m] (plant- and batch-derived)
-    "h_probe",  # bed depth that covers the bean probe fully [m]
+# The vectors' layout lives in one place (layout.py); re-exported here for the existing imports.
+from .layout import (  # noqa: E402, F401
+    HEATER_STATE,
+    I_A,
+    I_AB,
+    I_AGM,
+    I_ASH,
+    I_CM,
+    I_CW,
+    I_DB,
+    I_GGF,
+    I_GGS,
+    I_HAR,
+    I_HBED,
+    I_HBM,
+    I_HET,
+    I_HGM,
+    I_HPROBE,
+    I_K1,
+    I_K2,
+    I_KT,
+    I_LAM,
+    I_MBD,
+    I_MM,
+    I_PBM,
+    I_QEG,
+    I_QEO,
+    I_TAUH,
+    I_TGIG,
+    I_TROOM,
+    I_USH,
+    I_XEXP,
+    INPUT_NAMES,
+    N_PARAMS,
+    N_STATES,
+    PARAM_NAMES,
+    S_H,
+    S_HE,
+    S_TA,
+    S_TB,
+    S_TM,
+    S_X,
+    STATE_NAMES,
+    U_FAN,
+    U_GG,
+    U_HEATER,
+    U_TGI,
+    P,
 )
-P = {name: i for i, name in enumerate(PARAM_NAMES)}
-N_PARAMS = len(PARAM_NAMES)
-# indices derived from the names (compile-time constants for the kernels)
-I_HGM, I_HBM, I_PBM, I_AGM, I_AB, I_MBD, I_MM = (P[k] for k in ("hgm", "hbm", "Pbm", "Agm", "Ab", "Mbd", "Mm"))
-I_A, I_CM, I_CW, I_DB, I_HAR, I_HET = (P[k] for k in ("A", "cm", "cw", "Db", "Ha_R", "Het"))
-I_K1, I_K2, I_KT, I_LAM, I_XEXP, I_GGS = (P[k] for k in ("k1", "k2", "Kt", "lam", "x_exp", "Gg_scale"))
-I_QEG, I_QEO, I_TGIG, I_TAUH, I_GGF = (P[k] for k in ("Qe_gain", "Qe_offset", "Tgi_gain", "tau_heater", "Gg_fan"))
-I_USH, I_ASH, I_TROOM = (P[k] for k in ("U_shell", "Ashell", "T_room"))
-I_HBED, I_HPROBE = P["h_bed"], P["h_probe"]
+
 #: Smallest gas flow the fan map may give [kg/s] (a fan map fitted below zero is clipped here).
 GG_MIN_KG_S = 1e-6
 
@@ -258,8 +258,8 @@ def derivatives(Tb, Tm, X, He, Ta, H, Gg, Tgi, heater, fan, p):
 @register_jitable
 def outlet_gas_C(x, Gg, Tgi, fan, p):
     """Outlet gas temperature Tgo [degC] at state ``x`` (eq. 15e, effective gas inputs)."""
-    g, T = gas_inputs(Gg, Tgi, x[5], fan, p)
-    return heat_flows(x[0], x[1], x[2], g, T, p)[0]
+    g, T = gas_inputs(Gg, Tgi, x[S_H], fan, p)
+    return heat_flows(x[S_TB], x[S_TM], x[S_X], g, T, p)[0]
 
 
 @register_jitable
@@ -280,10 +280,10 @@ def rhs(t, x, u, p):
 
     Returns an array of the same length as ``x``.
     """
-    H = x[5] if x.shape[0] > 5 else 0.0
-    heater = u[2] if u.shape[0] > 2 else 0.0
-    fan = u[3] if u.shape[0] > 3 else 0.0
-    d = derivatives(x[0], x[1], x[2], x[3], x[4], H, u[0], u[1], heater, fan, p)
+    H = x[S_H] if x.shape[0] > S_H else 0.0
+    heater = u[U_HEATER] if u.shape[0] > U_HEATER else 0.0
+    fan = u[U_FAN] if u.shape[0] > U_FAN else 0.0
+    d = derivatives(x[S_TB], x[S_TM], x[S_X], x[S_HE], x[S_TA], H, u[U_GG], u[U_TGI], heater, fan, p)
     out = np.empty(x.shape[0])
     for i in range(x.shape[0]):
         out[i] = d[i]
@@ -327,6 +327,7 @@ def pack_params(plant, theta, X0: float = 0.1, moisture: str = "schwartzberg") -
     moisture : {"schwartzberg", "printed"}
     """
     from .parameters import as_theta
+    from .quantities import table
 
     th = as_theta(theta)
     if moisture not in MOISTURE_LAWS:
@@ -352,16 +353,10 @@ def pack_params(plant, theta, X0: float = 0.1, moisture: str = "schwartzberg") -
         "Kt": pc.Kt,
         "lam": pc.lam,
         "x_exp": MOISTURE_LAWS[moisture],
-        "Gg_scale": 1.0,
-        "Qe_gain": 0.0,
-        "Qe_offset": 0.0,
-        "Tgi_gain": 0.0,
-        "tau_heater": 1.0,
-        "Gg_fan": 0.0,
-        "U_shell": 0.0,
+        "Gg_scale": 1.0,  # the flow input as given
         "Ashell": plant.Ashell_m2,
-        "T_room": 22.0,
         "h_bed": plant.bed_depth_m,
-        "h_probe": 0.0,
     }
+    # the extensions' defaults (each the paper's model) from the one quantity table
+    values.update({q.slot: q.default for q in table() if q.kind == "extension"})
     return np.array([values[name] for name in PARAM_NAMES], dtype=np.float64)

@@ -11,7 +11,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ParameterError
+from ..model.layout import N_STATES, PAPER_STATE_NAMES, S_H, S_HE, S_TA, S_TB, S_TM, S_X, STATE0, S
 from ..model.limits import check_array, check_value
+from ..model.quantities import default
 from ..model.rhs import (
     HEATER_STATE,
     STATE_NAMES,
@@ -28,24 +30,29 @@ from .kernels import H_MAX_S, I_TGO, NS, simulate_one, step_kernel
 
 @dataclass(frozen=True)
 class InitialState:
-    """Initial state of a batch (paper section 5.1 defaults).
+    """Initial state of a batch (paper section 5.1; defaults from the quantity table).
 
     Tb0_C : charge (bean) temperature [degC]; Tm0_C : drum metal [degC];
     X0 : moisture [kg/kg dry]; He0_kJ_kg : exothermic heat so far [kJ/kg dry];
     Ta0_C : probe reading [degC], ``None`` = the batch's first measured Ta, else Tb0.
     """
 
-    Tb0_C: float = 30.0
-    Tm0_C: float = 121.0
-    X0: float = 0.1
-    He0_kJ_kg: float = 0.0
+    Tb0_C: float = default("Tb0_C")
+    Tm0_C: float = default("Tm0_C")
+    X0: float = default("X0")
+    He0_kJ_kg: float = default("He0_kJ_kg")
     Ta0_C: float | None = None
 
     def vector(self, Ta_measured0: float | None = None, heater0: float = 0.0) -> np.ndarray:
-        """The state vector [Tb, Tm, X, He, Ta, H]; Ta from ``Ta_measured0`` (the log's first
-        reading) if set; the lagged heater H starts at the setting at charge ``heater0`` (settled)."""
+        """The state vector (:data:`roastlab.model.layout.STATE_NAMES`); Ta from ``Ta_measured0`` (the
+        log's first reading) if set, else Tb0; the lagged heater H starts at the setting at charge
+        ``heater0`` (settled)."""
         Ta0 = self.Ta0_C if self.Ta0_C is not None else (Ta_measured0 if Ta_measured0 is not None else self.Tb0_C)
-        return np.array([self.Tb0_C, self.Tm0_C, self.X0, self.He0_kJ_kg, Ta0, heater0], dtype=np.float64)
+        x = np.empty(N_STATES)
+        for name, i in STATE0.items():
+            x[i] = Ta0 if name == "Ta0_C" else getattr(self, name)
+        x[S_H] = heater0
+        return x
 
 
 def check_hold(hold: str) -> bool:
@@ -101,37 +108,38 @@ class SimulationResult:
         """Gas flow [kg/s] and inlet temperature [degC] the chamber saw (after the actuator maps)."""
         _, f = self._settings()
         pairs = [
-            gas_inputs(g, T, H, fi, self.params) for g, T, H, fi in zip(self.Gg_kg_s, self.Tgi_C, self.states[:, 5], f)
+            gas_inputs(g, T, H, fi, self.params)
+            for g, T, H, fi in zip(self.Gg_kg_s, self.Tgi_C, self.states[:, S_H], f)
         ]
         a = np.array(pairs, dtype=float).reshape(-1, 2)
         return a[:, 0], a[:, 1]
 
     @property
     def Tb_C(self) -> np.ndarray:
-        return self.states[:, 0]
+        return self.states[:, S_TB]
 
     @property
     def Tm_C(self) -> np.ndarray:
-        return self.states[:, 1]
+        return self.states[:, S_TM]
 
     @property
     def X_kg_kg(self) -> np.ndarray:
-        return self.states[:, 2]
+        return self.states[:, S_X]
 
     @property
     def He_kJ_kg(self) -> np.ndarray:
-        return self.states[:, 3]
+        return self.states[:, S_HE]
 
     @property
     def Ta_C(self) -> np.ndarray:
-        return self.states[:, 4]
+        return self.states[:, S_TA]
 
     def heat_flows(self) -> dict[str, np.ndarray]:
         """Qgb, Qgm, Qbm [kW] (eqs. 9-11), Qr [kW, whole batch] (eq. 14) and, with actuator
         inputs, the heater's Qe [kW] (eq. 12) and, with a shell loss, Qloss [kW] at each sample."""
         n = len(self.time_s)
         q = np.empty((n, 6))
-        Mbd = self.params[5]
+        Mbd = self.params[P["Mbd"]]
         g, T = self.gas_seen()
         for i in range(n):
             Tb, Tm, X, He, _, H = self.states[i]
@@ -150,13 +158,13 @@ class SimulationResult:
         import pandas as pd
 
         data = {"time_s": self.time_s}
-        for j, name in enumerate(STATE_NAMES):
-            data[name] = self.states[:, j]
+        for name in PAPER_STATE_NAMES:
+            data[name] = self.states[:, S[name]]
         data["Tgo_C"] = self.Tgo_C
         if self.uses_actuators:
             q, f = self._settings()
             g, T = self.gas_seen()
-            data.update({"heater": q, "fan": f, HEATER_STATE: self.states[:, 5], "Gg_seen_kg_s": g, "Tgi_seen_C": T})
+            data.update({"heater": q, "fan": f, HEATER_STATE: self.states[:, S_H], "Gg_seen_kg_s": g, "Tgi_seen_C": T})
         if heat_flows:
             data.update(self.heat_flows())
         return pd.DataFrame(data)
@@ -279,8 +287,8 @@ def _input_array(name: str, values) -> np.ndarray:
 
 
 def _check_initial(x0: np.ndarray) -> None:
-    for name, v in zip(("Tb0_C", "Tm0_C", "X0", "He0_kJ_kg", "Ta0_C"), x0):
-        check_value(name, v, "initial state")
+    for name, i in STATE0.items():
+        check_value(name, x0[i], "initial state")
 
 
 def _check_finite(out: np.ndarray, t: np.ndarray) -> None:
@@ -342,6 +350,7 @@ class Simulator:
 
     @property
     def state(self) -> dict[str, float]:
+        """Every state by name (:data:`roastlab.model.layout.STATE_NAMES`, the lagged heater included)."""
         return {name: float(v) for name, v in zip(STATE_NAMES, self.x)}
 
     def step(self, dt_s: float, Gg_kg_s: float, Tgi_C: float, heater: float = 0.0, fan: float = 0.0) -> np.ndarray:

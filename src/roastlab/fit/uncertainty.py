@@ -1,0 +1,196 @@
+"""The one uncertainty rule of every fit: bounds, covariance, standard errors, AIC and BIC.
+
+Both fitters (:func:`roastlab.fit.identify.identify` over many batches, and the compiled
+per-batch fitter :func:`roastlab.fit.batchfit.identify_each`) call this module, so the same
+batch gets the same verdict from either path.
+
+The linearised covariance at the optimum of a least-squares fit (lmfit's and SciPy's
+``curve_fit`` reading) is
+
+    cov = s^2 (J'J)^+,  s^2 = SSR / (n - k)
+
+over the k parameters the data determine, where J is the Jacobian of the residuals, n the
+number of residuals and ^+ the pseudo-inverse. A parameter is *not* determined by the data,
+and gets no standard error (NaN, ``None`` in JSON), when
+
+* it is held by a bound: within :data:`ON_BOUND_REL` of its bounds' span from a bound (the
+  constraint holds it there, not the data; including it would distort the others), or
+* the residuals do not move with it (its column of J is zero: a term switched off there), or
+* there are no degrees of freedom left (n <= k).
+
+Information criteria for least squares with Gaussian errors of unknown variance (as lmfit
+reports them; Burnham & Anderson 2002, eq. 2.13):
+
+    AIC = n ln(SSR / n) + 2 k,   BIC = n ln(SSR / n) + k ln n
+
+with k the number of free parameters (those on a bound included: they were free to move).
+Lower is better; differences of a few units matter, the absolute value does not.
+
+>>> import numpy as np
+>>> J = np.array([[1.0, 0.0], [1.0, 1.0], [1.0, 2.0]])
+>>> u = from_jacobian(J, z=np.array([0.5, 0.5]), lower=np.zeros(2), upper=np.ones(2), ssr=3.0, names=["a", "b"])
+>>> [round(v, 4) for v in u.stderr]
+[1.5811, 1.2247]
+>>> round(u.aic, 3), round(u.bic, 3)
+(4.0, 2.197)
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+#: A parameter within this share of its bounds' span from a bound is held by the bound.
+ON_BOUND_REL = 1e-4
+#: Pairs correlated above this (in absolute value) get a warning: the data pin a combination.
+CORRELATION_WARN = 0.95
+
+
+def at_bounds(z, lower, upper) -> tuple[np.ndarray, np.ndarray]:
+    """(at_lower, at_upper): where ``z`` is held by its lower or upper bound (:data:`ON_BOUND_REL`).
+
+    Works elementwise on any shape; a fixed component (lower == upper) counts as held by both.
+    """
+    z, lower, upper = (np.asarray(a, dtype=float) for a in (z, lower, upper))
+    tol = ON_BOUND_REL * (upper - lower)
+    return z - lower <= tol, upper - z <= tol
+
+
+def covariance(jtj: np.ndarray, ssr: float, n_residuals: int, determined: np.ndarray) -> np.ndarray:
+    """cov = s^2 (J'J)^+ over the ``determined`` parameters, s^2 = SSR / (n - k); NaN rows and
+    columns elsewhere (and everywhere when n <= k)."""
+    k_all = jtj.shape[0]
+    cov = np.full((k_all, k_all), np.nan)
+    idx = np.flatnonzero(determined)
+    dof = int(n_residuals) - idx.size
+    if idx.size == 0 or dof <= 0 or not np.all(np.isfinite(jtj[np.ix_(idx, idx)])):
+        return cov
+    cov[np.ix_(idx, idx)] = np.linalg.pinv(jtj[np.ix_(idx, idx)]) * (float(ssr) / dof)
+    return cov
+
+
+def standard_errors(cov: np.ndarray) -> np.ndarray:
+    """sqrt(diag(cov)); NaN where the variance is not determined or negative."""
+    d = np.diag(cov)
+    with np.errstate(invalid="ignore"):
+        return np.where(d >= 0.0, np.sqrt(np.where(d >= 0.0, d, 0.0)), np.nan)
+
+
+def information_criteria(ssr: float, n_residuals: int, k_free: int) -> tuple[float, float]:
+    """(AIC, BIC) of a least-squares fit (module docstring); NaN when SSR or n is 0."""
+    n = int(n_residuals)
+    if n <= 0 or not ssr > 0.0:
+        return math.nan, math.nan
+    base = n * math.log(ssr / n)
+    return base + 2.0 * k_free, base + k_free * math.log(n)
+
+
+@dataclass
+class Uncertainty:
+    """The uncertainty of one fit (see the module docstring for each rule).
+
+    names : parameter labels; values : their fitted values; lower, upper : their bounds;
+    stderr : standard errors (NaN where not determined); covariance, correlation : (k, k);
+    at_lower, at_upper, flat : why a parameter has no standard error;
+    ssr : summed (weighted) squared residual; n_residuals : n.
+    """
+
+    names: list[str]
+    values: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+    stderr: np.ndarray
+    covariance: np.ndarray
+    correlation: np.ndarray
+    at_lower: np.ndarray
+    at_upper: np.ndarray
+    flat: np.ndarray
+    ssr: float
+    n_residuals: int
+
+    @property
+    def k_free(self) -> int:
+        return len(self.names)
+
+    @property
+    def aic(self) -> float:
+        return information_criteria(self.ssr, self.n_residuals, self.k_free)[0]
+
+    @property
+    def bic(self) -> float:
+        return information_criteria(self.ssr, self.n_residuals, self.k_free)[1]
+
+    @property
+    def on_bound(self) -> np.ndarray:
+        return self.at_lower | self.at_upper
+
+    def warnings(self) -> list[str]:
+        """Plain-words warnings: parameters on a bound, without effect, or strongly correlated."""
+        out = []
+        for k, lab in enumerate(self.names):
+            z = self.values[k]
+            if self.at_lower[k]:
+                out.append(
+                    f"{lab} = {z:.6g} is on its lower bound {self.lower[k]:g}: the optimum may lie outside; no standard error (held by the bound, not the data)"
+                )
+            elif self.at_upper[k]:
+                out.append(
+                    f"{lab} = {z:.6g} is on its upper bound {self.upper[k]:g}: the optimum may lie outside; no standard error (held by the bound, not the data)"
+                )
+            elif self.flat[k]:
+                out.append(
+                    f"{lab} = {z:.6g} has no effect on the fit there (its term is off or saturated): the data do not "
+                    "determine it; no standard error (try more starts or another start value)"
+                )
+        c = self.correlation
+        for a in range(self.k_free):
+            for b in range(a + 1, self.k_free):
+                if np.isfinite(c[a, b]) and abs(c[a, b]) > CORRELATION_WARN:
+                    out.append(
+                        f"{self.names[a]} and {self.names[b]} are correlated ({c[a, b]:+.3f}): the data pin down a combination of them, not each"
+                    )
+        return out
+
+    def to_dict(self) -> dict:
+        """JSON-safe: standard errors, correlations (null where not determined), AIC, BIC."""
+
+        def num(v):
+            return float(v) if np.isfinite(v) else None
+
+        return {
+            "stderr": {lab: num(v) for lab, v in zip(self.names, self.stderr)},
+            "correlation": {
+                "names": list(self.names),
+                "matrix": [
+                    [None if not np.isfinite(c) else float(round(c, 6)) for c in row] for row in self.correlation
+                ],
+                "note": "over parameters not on a bound; null for those on a bound",
+            },
+            "covariance": [[num(c) for c in row] for row in self.covariance],
+            "on_bound": [lab for lab, b in zip(self.names, self.on_bound) if b],
+            "AIC": num(self.aic),
+            "BIC": num(self.bic),
+            "k_free": self.k_free,
+            "n_residuals": int(self.n_residuals),
+        }
+
+
+def from_normal(jtj, z, lower, upper, ssr: float, n_residuals: int, names) -> Uncertainty:
+    """The :class:`Uncertainty` of a fit from its normal matrix J'J at the optimum ``z``."""
+    jtj = np.asarray(jtj, dtype=float)
+    z, lower, upper = (np.asarray(a, dtype=float) for a in (z, lower, upper))
+    at_lo, at_hi = at_bounds(z, lower, upper)
+    flat = ~(np.abs(np.diag(jtj)) > 0.0)  # a zero column of J: the residuals do not move with it
+    cov = covariance(jtj, ssr, n_residuals, ~(at_lo | at_hi | flat))
+    se = standard_errors(cov)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.outer(se, se)
+    return Uncertainty(list(names), z, lower, upper, se, cov, corr, at_lo, at_hi, flat, float(ssr), int(n_residuals))
+
+
+def from_jacobian(J, z, lower, upper, ssr: float, names) -> Uncertainty:
+    """The :class:`Uncertainty` of a fit from the Jacobian ``J`` (n, k) of its residuals at ``z``."""
+    J = np.asarray(J, dtype=float)
+    return from_normal(J.T @ J, z, lower, upper, ssr, J.shape[0], names)
