@@ -280,7 +280,7 @@ def test_a_fit_spec_frees_other_parameters_per_batch_and_refuses_X0(tmp_path, fl
 def test_per_batch_standard_errors_match_the_multi_batch_identifier():
     """On one batch the compiled fitter's s^2 (J'J)^-1 agrees with identify()'s (SciPy's Jacobian)."""
     import roastlab
-    from roastlab.fit.fleet import identify_each
+    from roastlab.fit.batchfit import identify_each
     from roastlab.fit.identify import build_free_parameters, identify
     from roastlab.model.parameters import THETA_START
     from roastlab.sim.population import pack_batches

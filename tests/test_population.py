@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from roastlab import InitialState, simulate
-from roastlab.fit.fleet import identify_each
+from roastlab.fit.batchfit import identify_each
 from roastlab.fit.identify import build_free_parameters, identify
 from roastlab.io.batch import read_dataset
 from roastlab.model.parameters import THETA_PAPER, THETA_START

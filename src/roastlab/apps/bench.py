@@ -305,7 +305,7 @@ def _peak_memory_child(count: int) -> dict:
     code = (
         "import json, resource, time, sys\n"
         "from roastlab.apps.bench import _fleet_batches\n"
-        "from roastlab.fit.fleet import identify_each\n"
+        "from roastlab.fit.batchfit import identify_each\n"
         "from roastlab.sim.population import pack_batches\n"
         "from roastlab.model.parameters import THETA_START\n"
         f"b = _fleet_batches({count})\n"
@@ -317,7 +317,7 @@ def _peak_memory_child(count: int) -> dict:
 
 
 def run(quiet: bool = False, baseline_repeats: int = 5, only: str | None = None) -> dict:
-    from ..fit.fleet import identify_each
+    from ..fit.batchfit import identify_each
     from ..fit.identify import build_free_parameters, identify
     from ..io.batch import read_dataset
     from ..io.plants import load_plant

@@ -370,7 +370,7 @@ def _weights_arg(items) -> dict[str, float]:
 
 
 def _identify_per_batch(args, batches, plant_spec, fix, bounds, outputs) -> int:
-    from ..fit.fleet import identify_each
+    from ..fit.batchfit import identify_each
     from ..model.parameters import THETA_NAMES, THETA_START
     from ..sim.population import pack_batches
     from ..sim.simulate import InitialState

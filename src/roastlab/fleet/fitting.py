@@ -2,7 +2,7 @@
 
 The batches not yet fitted with a spec are read from the store in chunks (``CHUNK`` batches
 of one machine) and each chunk goes to :func:`fit_chunk`, which packs it and runs the
-compiled per-batch fitter :func:`roastlab.fit.fleet.identify_each`. A chunk's results are
+compiled per-batch fitter :func:`roastlab.fit.batchfit.identify_each`. A chunk's results are
 committed as soon as it returns, so an interrupted run loses at most the chunks in flight,
 and the next run fits only what is missing: nothing is fitted twice.
 
@@ -92,7 +92,7 @@ def fleet_spec(spec: str | FitSpec | None = None, **options) -> FleetSpec:
                 "fleet fits score the bean probe (Ta) alone: drop the [weights] table, which weights other outputs",
                 source,
             )
-    from ..fit.fleet import free_slots
+    from ..fit.batchfit import free_slots
 
     try:
         free_slots([f.name for f in free])
@@ -115,7 +115,7 @@ def fit_chunk(batch_ids, batches: list[Batch], plant, spec: FleetSpec, threads: 
 
     Returns arrays keyed ``batch_id, value, stderr, SSR, FIT, MAE, n, sims`` (one row per batch).
     """
-    from ..fit.fleet import identify_each
+    from ..fit.batchfit import identify_each
     from ..sim.population import pack_batches, run_arrays
     from ..sim.simulate import InitialState
     from ..workflows.model import PAPER_INITIAL

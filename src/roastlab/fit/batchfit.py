@@ -1,4 +1,4 @@
-"""Fleet-scale identification: every batch gets its own theta, all fitted at once.
+"""Per-batch identification, compiled: every batch gets its own theta, all fitted at once.
 
 For many batches (a fleet of roasters, months of logs) the question is often not one theta
 for all but the spread of theta across batches: drift, outliers, machine-to-machine
