@@ -29,8 +29,10 @@ except ImportError:  # pragma: no cover - the rl extra is optional
     gym = None
 
 from ..errors import InputError
+from ..model.layout import S_TA, S_TM
 from ..model.rhs import N_PARAMS, N_STATES
-from ..sim.kernels import H_MAX_S, N_OUT, step_kernel, step_population_kernel
+from ..sim.kernels import H0_S, H_MAX_S, N_OUT, step_population_kernel
+from ..sim.simulate import advance
 from .loop import prepare
 
 ENV_ID = "roastlab/Roast-v0"
@@ -131,13 +133,13 @@ if gym is not None:
             ep = self.ep
             self._x = ep.roaster.x0.copy()
             if ep.tm0_spread:
-                self._x[1] += self.np_random.uniform(-ep.tm0_spread, ep.tm0_spread)
+                self._x[S_TM] += self.np_random.uniform(-ep.tm0_spread, ep.tm0_spread)
             self._k = 0
             self._u = ep.setup.u_initial
-            self._h = 5.0
-            self._bt_prev = self._x[4]
+            self._h = H0_S
+            self._bt_prev = self._x[S_TA]
             noise = self.np_random.normal(0.0, ep.sensor.noise_C) if ep.sensor.noise_C else 0.0
-            return self._obs(self._x[4] + noise), {"bt_C": float(self._x[4])}
+            return self._obs(self._x[S_TA] + noise), {"bt_C": float(self._x[S_TA])}
 
         def step(self, action):
             ep = self.ep
@@ -149,10 +151,10 @@ if gym is not None:
             self._u = u
             vec = ep.inputs[self._k].copy()
             vec[ep.col] = u
-            bt_before = self._x[4]
-            self._x, _, self._h = step_kernel(self._x, vec, vec, ep.dt, self._p, True, H_MAX_S, self._h)
+            bt_before = self._x[S_TA]
+            self._x, _, self._h = advance(self._x, vec, vec, ep.dt, self._p, h_s=self._h)
             self._k += 1
-            bt = self._x[4]
+            bt = self._x[S_TA]
             err = bt - ep.ref[self._k]
             reward = ep.reward(err, du)
             seen = bt - ep.frac_delay * (bt - bt_before)
@@ -193,7 +195,7 @@ if gym is not None:
             self.action_space = spaces.Box(low=ep.low, high=ep.high, shape=(n, 1), dtype=np.float32)
             self._PP = np.ascontiguousarray(np.broadcast_to(ep.roaster.params, (n, N_PARAMS)))
             self._X = np.empty((n, N_STATES))
-            self._H = np.full(n, 5.0)
+            self._H = np.full(n, H0_S)
             self._U = np.empty((n, 4))
             self._u = np.empty(n)
             self._T2 = np.array([0.0, ep.dt])
@@ -216,12 +218,12 @@ if gym is not None:
             ep = self.ep
             self._X[:] = ep.roaster.x0
             if ep.tm0_spread:
-                self._X[:, 1] += self.np_random.uniform(-ep.tm0_spread, ep.tm0_spread, self.num_envs)
-            self._H[:] = 5.0
+                self._X[:, S_TM] += self.np_random.uniform(-ep.tm0_spread, ep.tm0_spread, self.num_envs)
+            self._H[:] = H0_S
             self._u[:] = ep.setup.u_initial
             self._k = 0
             self._needs_reset = False
-            return self._observe(self._X[:, 4])
+            return self._observe(self._X[:, S_TA])
 
         def reset(self, *, seed=None, options=None):
             super().reset(seed=seed)
@@ -241,12 +243,12 @@ if gym is not None:
             self._u = u
             self._U[:] = ep.inputs[self._k]
             self._U[:, ep.col] = u
-            bt_before = self._X[:, 4].copy()
+            bt_before = self._X[:, S_TA].copy()
             step_population_kernel(
                 self._X, self._U, self._PP, True, H_MAX_S, self._H, self._T2, self._UU, self._scratch
             )
             self._k += 1
-            bt = self._X[:, 4]
+            bt = self._X[:, S_TA]
             err = bt - ep.ref[self._k]
             rewards = ep.reward(err, du)
             obs = self._observe(bt - ep.frac_delay * (bt - bt_before))

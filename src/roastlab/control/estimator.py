@@ -9,7 +9,7 @@ different batch). Its state is z = [Tb, Tm, X, He, Ta, H, d] (H: the heater lag 
 extension).
 
 * Predict: the compiled integrator over the one right-hand side
-  (:func:`roastlab.sim.kernels.step_kernel`) carries z over one control interval with the
+  (:func:`roastlab.sim.simulate.advance`) carries z over one control interval with the
   input that was applied (zero-order hold) and Tgi + d; its Jacobian is a forward difference
   per state (seven extra one-interval runs, ~15 us together).
 * Update: the scalar measurement Ta with noise variance ``measurement_noise_C**2``, Joseph form.
@@ -23,8 +23,10 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
+from ..model.layout import S_HE, S_X
 from ..model.rhs import I_HET, N_STATES, STATE_NAMES
-from ..sim.kernels import H_MAX_S, step_kernel
+from ..sim.kernels import H0_S
+from ..sim.simulate import advance
 from .base import LoopSetup
 
 #: Names of the filter's states: the model's six and the inlet-temperature disturbance.
@@ -67,12 +69,12 @@ class ExtendedKalmanFilter:
         self.z = np.zeros(NZ)
         self.z[:N_STATES] = setup.x0 if x0 is None else x0
         self.P = np.diag(self.initial_sd**2)
-        self._h = 5.0
+        self._h = H0_S
 
     def _f(self, z, inputs, dt):
         vec = inputs.copy()
         vec[1] += z[-1]  # the disturbance is an offset of the inlet temperature
-        x, _, h = step_kernel(z[:N_STATES], vec, vec, dt, self.p, True, H_MAX_S, self._h)
+        x, _, h = advance(z[:N_STATES], vec, vec, dt, self.p, h_s=self._h)
         out = np.empty(NZ)
         out[:N_STATES] = x
         out[-1] = z[-1]
@@ -103,8 +105,8 @@ class ExtendedKalmanFilter:
         A = np.eye(NZ)
         A[:, i] -= K
         self.P = A @ self.P @ A.T + self.r * np.outer(K, K)
-        self.z[2] = max(self.z[2], 0.0)
-        self.z[3] = min(max(self.z[3], 0.0), self.p[I_HET])
+        self.z[S_X] = max(self.z[S_X], 0.0)
+        self.z[S_HE] = min(max(self.z[S_HE], 0.0), self.p[I_HET])
 
     @property
     def state(self) -> np.ndarray:

@@ -9,7 +9,7 @@ Every ``sample_s`` seconds from CHARGE to the reference's DROP:
    violation) and holds it over the interval (zero-order hold);
 3. the roaster -- the same model file on the same plant with the scenario's changes (batch
    mass, moisture, drum temperature at CHARGE, coefficients, gas supply) -- advances through the
-   compiled integrator (:func:`roastlab.sim.kernels.step_kernel`, the one right-hand side).
+   compiled integrator (:func:`roastlab.sim.simulate.advance`, the one right-hand side).
 
 Metrics (``METRICS.json``): ``rmse_C`` and ``max_abs_C`` of the true probe reading against the
 reference over the roast; ``ror_rmse_C_per_min`` of the rate of rise (change over 30 s, per
@@ -35,10 +35,12 @@ from ..fit.program import ProgramLimits, optimise_program
 from ..io.batch import Batch
 from ..io.plants import load_plant
 from ..io.scenario import Scenario, load_scenario
+from ..model.layout import S_HE, S_TA, S_TB, S_TM, S_X
 from ..model.parameters import REGISTRY
 from ..model.rhs import N_STATES, P
 from ..report.figures import ROR_SPAN_S
-from ..sim.kernels import H_MAX_S, step_kernel
+from ..sim.kernels import H0_S
+from ..sim.simulate import advance
 from ..workflows.whatif import crossing_or_projected_s
 from .base import LoopSetup
 from .mpc import MPC
@@ -111,8 +113,8 @@ def prepare(model, reference: Batch, scenario: Scenario | None = None, plant=Non
     x_model = controller_view.states[0, :N_STATES].copy()
 
     changes: dict = {"batch_kg": mass}
-    changes["X0"] = pc.X0 if pc.X0 is not None else float(x_model[2])
-    changes["Tm0_C"] = pc.Tm0_C if pc.Tm0_C is not None else float(x_model[1]) + pc.Tm0_offset_C
+    changes["X0"] = pc.X0 if pc.X0 is not None else float(x_model[S_X])
+    changes["Tm0_C"] = pc.Tm0_C if pc.Tm0_C is not None else float(x_model[S_TM]) + pc.Tm0_offset_C
     changes["Tb0_C"] = pc.Tb0_C if pc.Tb0_C is not None else float(x_model[0]) + pc.Tb0_offset_C
     for name, v in pc.theta.items():
         changes[name] = v
@@ -176,10 +178,10 @@ class ClosedLoopResult:
             "measured_C": self.measured_C,
             f"{self.input_name}_requested": self.u_requested,
             f"{self.input_name}_applied": self.u_applied,
-            "Tb_C": self.states[:, 0],
-            "Tm_C": self.states[:, 1],
-            "X_kg_kg": self.states[:, 2],
-            "He_kJ_kg": self.states[:, 3],
+            "Tb_C": self.states[:, S_TB],
+            "Tm_C": self.states[:, S_TM],
+            "X_kg_kg": self.states[:, S_X],
+            "He_kJ_kg": self.states[:, S_HE],
         }
         cols.update(self.estimates)
         return pd.DataFrame(cols)
@@ -247,12 +249,12 @@ def run_closed_loop(model, reference: Batch, controller, scenario: Scenario | st
     violations = 0
     u_prev = setup.u_initial
     x = roaster.x0.copy()
-    h = 5.0
+    h = H0_S
     controller.reset(setup)
     name = getattr(controller, "name", type(controller).__name__)
     for k in range(n):
         seen_t = max(t[k] - sensor.delay_s, 0.0)
-        measured[k] = np.interp(seen_t, t[: k + 1], states[: k + 1, 4]) + noise[k]
+        measured[k] = np.interp(seen_t, t[: k + 1], states[: k + 1, S_TA]) + noise[k]
         c0 = time.perf_counter()
         u = controller.step(float(t[k]), float(measured[k]))
         step_ms[k] = (time.perf_counter() - c0) * 1e3
@@ -277,12 +279,12 @@ def run_closed_loop(model, reference: Batch, controller, scenario: Scenario | st
             break
         vec = setup.input_vector(float(t[k]), applied)
         vec[0] *= roaster.Gg_factor
-        x, _, h = step_kernel(x, vec, vec, dt, roaster.params, True, H_MAX_S, h)
+        x, _, h = advance(x, vec, vec, dt, roaster.params, h_s=h)
         if not np.all(np.isfinite(x)):
             raise RoastlabError(f"the simulated roaster went non-finite at t = {t[k + 1]:g} s under {name!r}")
         states[k + 1] = x
     ref = setup.reference_at(t)
-    bt = states[:, 4]
+    bt = states[:, S_TA]
     metrics = {
         "controller": name,
         "scenario": scenario.name,
@@ -291,8 +293,8 @@ def run_closed_loop(model, reference: Batch, controller, scenario: Scenario | st
         "sample_s": dt,
         **_metrics(t, ref, bt, u_app, setup.u_initial, violations, step_ms, setup.end_s),
         "batch_kg": roaster.mass_kg,
-        "final_Tb_C": float(states[-1, 0]),
-        "final_X_kg_kg": float(states[-1, 2]),
+        "final_Tb_C": float(states[-1, S_TB]),
+        "final_X_kg_kg": float(states[-1, S_X]),
     }
     est_arrays = {k: np.asarray(v + [math.nan] * (n - len(v))) for k, v in estimates.items()}
     if "Tm_C_est" in est_arrays:

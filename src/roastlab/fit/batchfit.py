@@ -36,9 +36,10 @@ from scipy.stats import qmc
 
 from ..errors import InputError
 from ..evaluate.metrics import fit_percent
+from ..model.layout import S_TA
 from ..model.parameters import REGISTRY, STATE0, THETA_NAMES, THETA_START
 from ..model.rhs import P
-from ..sim.kernels import N_OUT, integrate_into
+from ..sim.kernels import H0_S, N_OUT, integrate_into
 from ..sim.population import PackedBatches, predict_ta
 from . import uncertainty
 from .identify import FD_STEP
@@ -124,9 +125,9 @@ def _set_free(z, lo, span, kinds, slots, p, x0):
 def _residual_vec(z, lo, span, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, out):
     """Residuals T^a - Ta for scaled parameters z in [0, 1]^k, into out[:n]."""
     _set_free(z, lo, span, kinds, slots, p, x0)
-    integrate_into(t, Gg, Tgi, Q, F, n, x0, p, zoh, h_max, scratch, 5.0, False)
+    integrate_into(t, Gg, Tgi, Q, F, n, x0, p, zoh, h_max, scratch, H0_S, False)
     for i in range(n):
-        out[i] = scratch[i, 4] - Ta[i]
+        out[i] = scratch[i, S_TA] - Ta[i]
 
 
 @njit(cache=True)

@@ -31,6 +31,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ..errors import InputError
+from ..model.layout import S_TA, S_TM
 from ..sim.kernels import H_MAX_S, simulate_one
 from ..sim.sensitivity import ta_input_jacobian
 
@@ -119,7 +120,7 @@ class ProgramResult:
     @property
     def Tm0_C(self) -> float:
         """Drum temperature at CHARGE [degC] (chosen by the optimiser when it was a decision)."""
-        return float(self.states[0, 1])
+        return float(self.states[0, S_TM])
 
 
 def _run(t, Gg, Tgi, Q, F, x0, p, zoh):
@@ -216,7 +217,7 @@ def optimise_program(
         ub.append(limits.Gg_max_kg_s)
     if tm0_bounds is not None:
         extra_names.append("Tm0")
-        z0.append(float(np.clip(x0[1], *tm0_bounds)))
+        z0.append(float(np.clip(x0[S_TM], *tm0_bounds)))
         lb.append(tm0_bounds[0])
         ub.append(tm0_bounds[1])
     z0 = np.array(z0)
@@ -236,7 +237,7 @@ def optimise_program(
             j += 1
         if tm0_bounds is not None:
             x = x0.copy()
-            x[1] = z[j]
+            x[S_TM] = z[j]
         if which == 1:
             x = x.copy()
             x[5] = u[0]  # the heater's lag starts settled at the first setting, as the simulator does
@@ -256,18 +257,18 @@ def optimise_program(
 
     def residuals(z):
         u, _, _, _, _, out = simulate(z)
-        r_track = w * (out[:, 4] - target)
+        r_track = w * (out[:, S_TA] - target)
         over = np.maximum(u - hi_T, 0.0) - np.maximum(lo_T - u, 0.0)
         parts = [r_track, LEVEL_PENALTY * over, smoothness * z[1:n]]
         if ror_weight:
-            parts.append(ror_weight * 60.0 * (np.diff(out[:, 4]) - np.diff(target)) / dt)
+            parts.append(ror_weight * 60.0 * (np.diff(out[:, S_TA]) - np.diff(target)) / dt)
         r = np.concatenate(parts)
         return np.where(np.isfinite(r), r, 1e6)
 
     def jacobian(z):
         u, tgi, q, gg, x, out = simulate(z)
         jt = np.empty((n, n))
-        ta = np.ascontiguousarray(out[:, 4])
+        ta = np.ascontiguousarray(out[:, S_TA])
         states = np.ascontiguousarray(out[:, :6])
         delta = 1.0 if which == 0 else 1e-2 * (hi_T - lo_T)
         ta_input_jacobian(t, gg, tgi, q, F, which, states, ta, p, zoh, H_MAX_S, delta, jt)
@@ -288,7 +289,7 @@ def optimise_program(
             _, tp, qp, gp, xp = unpack(zp)
             outp = _run(t, gp, tp, qp, F, xp, p, zoh)
             counter["sims"] += 1
-            dta[:, j] = (outp[:, 4] - out[:, 4]) / h
+            dta[:, j] = (outp[:, S_TA] - out[:, S_TA]) / h
             j += 1
         J[:n] = w[:, None] * dta
         if ror_weight:  # d(RoR)/dz: differences of consecutive rows of d Ta / d z
@@ -319,7 +320,7 @@ def optimise_program(
         heater=np.array(q),
         fan=F,
         Gg_kg_s=np.array(gg, dtype=np.float64),
-        Ta_pred_C=out[:, 4].copy(),
+        Ta_pred_C=out[:, S_TA].copy(),
         states=out,
         params=p,
         solve_s=time.perf_counter() - t0_clock,

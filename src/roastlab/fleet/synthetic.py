@@ -33,6 +33,7 @@ from ..errors import InputError
 from ..io.batch import Batch, write_batch_csv_text
 from ..io.files import Outputs, umask_now
 from ..io.plants import load_plant
+from ..model.layout import S_TA
 from ..model.parameters import THETA_PAPER, THETA_START
 from ..sim.population import pack_batches, simulate_population
 from ..sim.simulate import InitialState
@@ -111,7 +112,7 @@ def _batches(rng, machine: Machine, first: int, count: int, truth: np.ndarray):
     packed = pack_batches(batches, plant, THETA_START, InitialState(Tb0_C=25.0, Tm0_C=125.0, X0=0.105))
     out = simulate_population(packed, names, values)[0]
     for i, b in enumerate(batches):
-        ta = out[i, : b.n, 4] + 0.5 * rng.standard_normal(b.n)
+        ta = out[i, : b.n, S_TA] + 0.5 * rng.standard_normal(b.n)
         if rng.random() < PROBE_FAULT_RATE:
             at = int(rng.uniform(0.3, 0.8) * b.n)
             ta[at:] += rng.choice([-1.0, 1.0]) * rng.uniform(40.0, 120.0)

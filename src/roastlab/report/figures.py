@@ -13,6 +13,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..io.files import Outputs
+from ..model.layout import S_TB, S_TM
 
 #: Image formats a figure may be saved as (by the file suffix).
 FIGURE_FORMATS = ("png", "svg", "pdf")
@@ -330,7 +331,7 @@ def plot_closed_loop(r, path=None, title=None, outputs=None):
     ax.plot(t_min, r.measured_C, color="tab:gray", lw=0.8, alpha=0.7, label="probe as read by the controller")
     ax.plot(t_min, r.bt_C, color="tab:blue", lw=1.6, label=f"roaster BT (RMSE {m['rmse_C']:.2f} °C)")
     if "Tb_C_est" in r.estimates:
-        ax.plot(t_min, r.states[:, 0], color="tab:brown", lw=1.0, label="bean Tb (true)")
+        ax.plot(t_min, r.states[:, S_TB], color="tab:brown", lw=1.0, label="bean Tb (true)")
         ax.plot(t_min, r.estimates["Tb_C_est"], color="tab:brown", lw=1.0, ls="--", label="bean Tb (estimated)")
     ax.set_ylabel("temperature [°C]")
     ax.legend(loc="lower right", fontsize=8)
@@ -359,7 +360,7 @@ def plot_closed_loop(r, path=None, title=None, outputs=None):
     ax_u.set_ylabel("Tgi [°C]" if lim.decide == "Tgi" else "heater setting")
     ax_u.legend(loc="upper right", fontsize=7, ncol=2)
     ax_u.grid(alpha=0.3)
-    ax_m.plot(t_min, r.states[:, 1], color="tab:red", lw=1.4, label="drum metal Tm (true)")
+    ax_m.plot(t_min, r.states[:, S_TM], color="tab:red", lw=1.4, label="drum metal Tm (true)")
     if "Tm_C_est" in r.estimates:
         ax_m.plot(t_min, r.estimates["Tm_C_est"], color="tab:red", lw=1.0, ls="--", label="Tm estimated")
     ax_m.set_ylabel("Tm [°C]")

@@ -15,7 +15,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from .kernels import N_OUT, NS, integrate_into
+from ..model.layout import S_TA
+from .kernels import H0_S, N_OUT, NS, integrate_into
 
 
 @njit(cache=True)
@@ -35,11 +36,11 @@ def _column(k, t, Gg, Tgi, Q, F, which, states, ta_base, p, zoh, h_max, delta, j
     x0 = np.empty(NS)
     for i in range(NS):
         x0[i] = states[start, i]
-    integrate_into(t[start:], Gg[start:], tgi, q, F[start:], m, x0, p, zoh, h_max, out, 5.0, False)
+    integrate_into(t[start:], Gg[start:], tgi, q, F[start:], m, x0, p, zoh, h_max, out, H0_S, False)
     for i in range(start):
         jac[i, k] = 0.0
     for i in range(m):
-        jac[start + i, k] = (out[i, 4] - ta_base[start + i]) / delta
+        jac[start + i, k] = (out[i, S_TA] - ta_base[start + i]) / delta
 
 
 @njit(cache=True, parallel=True)

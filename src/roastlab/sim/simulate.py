@@ -25,7 +25,7 @@ from ..model.rhs import (
     reaction_heat_rate_kW_kg,
     shell_loss_kW,
 )
-from .kernels import H_MAX_S, I_TGO, NS, simulate_one, step_kernel
+from .kernels import H0_S, H_MAX_S, I_TGO, NS, simulate_one, step_kernel
 
 
 @dataclass(frozen=True)
@@ -308,6 +308,22 @@ def _u4(Gg_kg_s, Tgi_C, heater=0.0, fan=0.0) -> np.ndarray:
     return u
 
 
+def advance(x, u0, u1, dt_s: float, params, zoh: bool = True, h_max_s: float = H_MAX_S, h_s: float = H0_S):
+    """The one stepper: state ``x`` (:data:`~roastlab.model.layout.STATE_NAMES`) advanced by
+    ``dt_s`` seconds with inputs ``u0`` at the start and ``u1`` at the end (each
+    [Gg kg/s, Tgi degC, heater, fan]; held at ``u1`` when ``zoh``) on the parameter vector
+    ``params``, by the compiled integrator over the one right-hand side.
+
+    ``h_s`` is the integrator's trial step [s]; pass back the one returned to carry the adapted
+    step over, so that stepping equals a batch run. Returns ``(x [new array], Tgo_C, h_s)``.
+    :class:`Simulator`, the closed loop, the estimator and the Gymnasium environment all step
+    through here (the vectorised environment steps many roasts through the population twin,
+    :func:`roastlab.sim.kernels.step_population_kernel`). Inputs are not range-checked here:
+    callers check them once, not per step.
+    """
+    return step_kernel(x, u0, u1, dt_s, params, zoh, h_max_s, h_s)
+
+
 class Simulator:
     """A steppable simulator for closed-loop use (controllers, MPC).
 
@@ -344,7 +360,7 @@ class Simulator:
         _check_initial(self.x)
         self.t_s = 0.0
         self.Tgo_C = float("nan")
-        self._h = 5.0  # the integrator's step size carries over, so stepping equals a batch run
+        self._h = H0_S  # the integrator's step size carries over, so stepping equals a batch run
         # with a linear hold, each step ramps from the previous inputs (u0 before the first)
         self._u_prev: np.ndarray | None = None if u0 is None else _u4(*u0)
 
@@ -364,7 +380,7 @@ class Simulator:
         Tgi_C = check_value("Tgi_C", Tgi_C, "Simulator.step")
         u1 = _u4(Gg_kg_s, Tgi_C, heater, fan)
         u0 = self._u_prev if (self._u_prev is not None and not self.zoh) else u1
-        x, Tgo, h = step_kernel(self.x, u0, u1, dt_s, self.params, self.zoh, self.h_max_s, self._h)
+        x, Tgo, h = advance(self.x, u0, u1, dt_s, self.params, self.zoh, self.h_max_s, self._h)
         if not np.all(np.isfinite(x)):
             raise ParameterError(
                 f"the simulation went non-finite at t = {self.t_s + dt_s:g} s (state kept at {self.t_s:g} s)"
