@@ -5,7 +5,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: test reproduce bench lint clean wheel-check real-roaster
+.PHONY: test test-fast reproduce bench lint clean distclean wheel-check real-roaster
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -15,6 +15,10 @@ $(STAMP): pyproject.toml
 
 test: $(STAMP)
 	$(PY) -m pytest
+
+# The inner loop: every test but those marked slow (make test, which CI runs, has them all).
+test-fast: $(STAMP)
+	$(PY) -m pytest -m "not slow"
 
 reproduce: $(STAMP)
 	$(VENV)/bin/roastlab reproduce --out out/reproduce
@@ -26,9 +30,14 @@ lint: $(STAMP)
 	$(VENV)/bin/ruff check src tests
 	$(VENV)/bin/ruff format --check src tests
 
+# Outputs and caches; the venv stays (distclean removes it too). Compiled kernels need no
+# cleaning: their cache is keyed on a hash of the sources (roastlab.sim.cache).
 clean:
-	rm -rf $(VENV) out .pytest_cache
+	rm -rf out .pytest_cache .hypothesis
 	find src tests -name __pycache__ -type d -exec rm -rf {} +
+
+distclean: clean
+	rm -rf $(VENV)
 
 # The wheel (not an editable install) in a fresh venv runs the main job from outside the repository.
 wheel-check:

@@ -14,15 +14,15 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 from scipy.optimize import least_squares
 
 from ..evaluate.metrics import batch_metrics
+from ..sim.cache import compiled
 
 BOUNDS = {"tau_s": (1.0, 5000.0), "offset_C": (-200.0, 200.0)}
 
 
-@njit(cache=True)
+@compiled
 def first_order_response(t, u, y0, tau, offset):
     """Exact response of tau y' = u(t) + offset - y with u linear between samples."""
     n = t.shape[0]

@@ -31,7 +31,7 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-from numba import njit, parallel_chunksize, prange
+from numba import parallel_chunksize, prange
 from scipy.stats import qmc
 
 from ..errors import InputError
@@ -39,6 +39,7 @@ from ..evaluate.metrics import fit_percent
 from ..model.layout import S_TA
 from ..model.parameters import REGISTRY, STATE0, THETA_NAMES, THETA_START
 from ..model.rhs import P
+from ..sim.cache import compiled
 from ..sim.kernels import H0_S, N_OUT, integrate_into
 from ..sim.population import PackedBatches, predict_ta
 from . import uncertainty
@@ -110,7 +111,7 @@ class FleetResult:
         }
 
 
-@njit(cache=True, inline="always")
+@compiled(inline="always")
 def _set_free(z, lo, span, kinds, slots, p, x0):
     """Scaled z in [0, 1]^k -> the free values in their slots of p (model.rhs.PARAM_NAMES) or x0."""
     for j in range(z.shape[0]):
@@ -121,7 +122,7 @@ def _set_free(z, lo, span, kinds, slots, p, x0):
             x0[slots[j]] = v
 
 
-@njit(cache=True)
+@compiled
 def _residual_vec(z, lo, span, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, out):
     """Residuals T^a - Ta for scaled parameters z in [0, 1]^k, into out[:n]."""
     _set_free(z, lo, span, kinds, slots, p, x0)
@@ -130,7 +131,7 @@ def _residual_vec(z, lo, span, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh
         out[i] = scratch[i, S_TA] - Ta[i]
 
 
-@njit(cache=True)
+@compiled
 def _ssr_of(z, lo, span, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, r):
     """SSR of the probe reading (a failed simulation counts as 1e300); r is a work buffer."""
     _residual_vec(z, lo, span, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, r)
@@ -142,7 +143,7 @@ def _ssr_of(z, lo, span, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_ma
     return s
 
 
-@njit(cache=True)
+@compiled
 def _jacobian(z, lo, span, kinds, slots, free, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, r0, rp, rm, zt, J):
     """Residuals r0 at z and their central-difference Jacobian J (n, k) in scaled units; returns sims."""
     k = z.shape[0]
@@ -166,7 +167,7 @@ def _jacobian(z, lo, span, kinds, slots, free, t, Gg, Tgi, Q, F, n, Ta, x0, p, z
     return sims
 
 
-@njit(cache=True)
+@compiled
 def _normal(J, r0, n, A, g):
     """A = J'J and g = J'r over the first n residuals."""
     k = A.shape[0]
@@ -181,7 +182,7 @@ def _normal(J, r0, n, A, g):
             A[a, c] = acc
 
 
-@njit(cache=True)
+@compiled
 def _fit_one(
     t, Gg, Tgi, Q, F, n, Ta, x0_in, p_in, kinds, slots, lo, span, trial, zoh, h_max, max_iter, gain_tol, z_out, jtj_out
 ):
@@ -293,7 +294,7 @@ def _fit_one(
     return ssr, sims
 
 
-@njit(cache=True, parallel=True)
+@compiled(parallel=True)
 def _fit_population(
     T, GG, TGI, QQ, FF, N, TA, X0, PB, kinds, slots, lo, span, trial, zoh, h_max, max_iter, gain_tol, Z, SSR, SIMS, JTJ
 ):

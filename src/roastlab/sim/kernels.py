@@ -10,7 +10,7 @@ stiff (rate ~6 1/s at 400 degC) and a fixed step would silently lose accuracy.
 
 Against a 1e-10-tolerance SciPy reference the error stays below 1e-3 degC over randomised
 inputs and parameters (tests/test_reference.py). The kernels call
-:func:`roastlab.model.rhs.derivatives` (compiled inline), are cached on disk (``cache=True``) so a
+:func:`roastlab.model.rhs.derivatives` (compiled inline), are cached on disk (:func:`roastlab.sim.cache.compiled`, keyed on the source hash) so a
 second process does not recompile, and the population kernel runs in parallel over cores.
 """
 
@@ -19,9 +19,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
 from ..model.rhs import N_STATES, derivatives, outlet_gas_C
+from .cache import compiled
 
 #: Largest integration step [s].
 H_MAX_S = 30.0
@@ -50,7 +51,7 @@ _B1, _B3, _B4, _B5, _B6 = 35 / 384, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84
 _E1, _E3, _E4, _E5, _E6, _E7 = 71 / 57600, -71 / 16695, 71 / 1920, -17253 / 339200, 22 / 525, -1 / 40
 
 
-@njit(cache=True, inline="always")
+@compiled(inline="always")
 def _f(x, g, T, q, f, p, out):
     d = derivatives(x[0], x[1], x[2], x[3], x[4], x[5], g, T, q, f, p)
     out[0] = d[0]
@@ -61,7 +62,7 @@ def _f(x, g, T, q, f, p, out):
     out[5] = d[5]
 
 
-@njit(cache=True)
+@compiled
 def integrate_into(t, Gg, Tgi, Q, F, n, x0, p, zoh, h_max, out, h0=H0_S, with_tgo=True):
     """Integrate one batch over samples t[0..n-1]; write states and Tgo to out[:n, :N_OUT].
 
@@ -174,7 +175,7 @@ def integrate_into(t, Gg, Tgi, Q, F, n, x0, p, zoh, h_max, out, h0=H0_S, with_tg
     return h
 
 
-@njit(cache=True)
+@compiled
 def simulate_one(t, Gg, Tgi, Q, F, x0, p, zoh, h_max):
     n = t.shape[0]
     out = np.empty((n, N_OUT))
@@ -182,7 +183,7 @@ def simulate_one(t, Gg, Tgi, Q, F, x0, p, zoh, h_max):
     return out
 
 
-@njit(cache=True, parallel=True)
+@compiled(parallel=True)
 def simulate_population_kernel(T, GG, TGI, QQ, FF, N, batch_of, X0, PP, zoh, h_max, out):
     """Simulate ``len(batch_of)`` runs in parallel.
 
@@ -195,7 +196,7 @@ def simulate_population_kernel(T, GG, TGI, QQ, FF, N, batch_of, X0, PP, zoh, h_m
         integrate_into(T[b], GG[b], TGI[b], QQ[b], FF[b], N[b], X0[i], PP[i], zoh, h_max, out[i])
 
 
-@njit(cache=True, parallel=True)
+@compiled(parallel=True)
 def ta_population_kernel(T, GG, TGI, QQ, FF, N, batch_of, X0, PP, zoh, h_max, out_ta, out_tb):
     """Like :func:`simulate_population_kernel` but keeps only the fitted outputs: the probe
     reading Ta, and the bean temperature Tb when ``out_tb`` has rows (a second bean reading is
@@ -214,7 +215,7 @@ def ta_population_kernel(T, GG, TGI, QQ, FF, N, batch_of, X0, PP, zoh, h_max, ou
                 out_tb[i, j] = scratch[j, 0]
 
 
-@njit(cache=True)
+@compiled
 def step_kernel(x, u0, u1, dt, p, zoh, h_max, h0):
     """One step of ``dt`` seconds from state ``x`` (length NS) with inputs ``u0`` at the start
     and ``u1`` at the end (each [Gg, Tgi, heater, fan]); returns (state, Tgo, next step)."""
@@ -228,7 +229,7 @@ def step_kernel(x, u0, u1, dt, p, zoh, h_max, h0):
     return out[1, :NS].copy(), out[1, I_TGO], h
 
 
-@njit(cache=True, parallel=True)
+@compiled(parallel=True)
 def step_population_kernel(X, U, PP, zoh, h_max, H, T2, UU, scratch):
     """Advance many roasts by one interval of ``T2[1]`` seconds in one parallel call.
 

@@ -13,13 +13,14 @@ The restart takes fresh adaptive steps, so a column carries the integrator's loc
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
 from ..model.layout import S_TA
+from .cache import compiled
 from .kernels import H0_S, N_OUT, NS, integrate_into
 
 
-@njit(cache=True)
+@compiled
 def _column(k, t, Gg, Tgi, Q, F, which, states, ta_base, p, zoh, h_max, delta, jac):
     n = t.shape[0]
     start = k
@@ -43,7 +44,7 @@ def _column(k, t, Gg, Tgi, Q, F, which, states, ta_base, p, zoh, h_max, delta, j
         jac[start + i, k] = (out[i, S_TA] - ta_base[start + i]) / delta
 
 
-@njit(cache=True, parallel=True)
+@compiled(parallel=True)
 def ta_input_jacobian(t, Gg, Tgi, Q, F, which, states, ta_base, p, zoh, h_max, delta, jac):
     """jac[i, k] = d Ta(t_i) / d u_k for the run whose states are ``states`` (n x NS).
 

@@ -1,0 +1,58 @@
+"""Compiled code cannot go stale: an edit to the right-hand side alone reaches the cached kernels."""
+
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import roastlab
+from roastlab.sim import cache
+
+SRC = Path(roastlab.__file__).parent
+RUN = (
+    "import numpy as np, roastlab; t = np.arange(0, 901, 30.0); "
+    "print(repr(float(roastlab.simulate('120kg', t, np.full_like(t, 0.4), np.full_like(t, 450.0)).Tb_C[-1])))"
+)
+
+
+def test_every_compiled_module_uses_the_keyed_cache():
+    """numba's own cache=True (keyed on one file) appears nowhere; every module that compiles code or
+    holds code compiled into a kernel lies in a subpackage the hash covers."""
+    for path in SRC.rglob("*.py"):
+        text = path.read_text()
+        rel = path.relative_to(SRC)
+        if path.name != "cache.py":
+            assert not re.search(r"njit\(|cache\s*=\s*True", text), f"{rel}: use roastlab.sim.cache.compiled"
+        if re.search(r"@compiled|register_jitable", text):
+            assert rel.parts[0] in cache.COMPILED_SOURCES, rel
+
+
+def _run(root: Path, cache_home: Path) -> str:
+    env = {"PYTHONPATH": str(root), "XDG_CACHE_HOME": str(cache_home), "PATH": "/usr/bin:/bin"}
+    proc = subprocess.run([sys.executable, "-c", RUN], capture_output=True, text=True, env=env, timeout=300, cwd=root)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    return proc.stdout.strip()
+
+
+@pytest.mark.slow
+def test_an_edit_to_the_right_hand_side_reaches_the_cached_kernels(tmp_path):
+    """A copy of the package, run, edited in rhs.py only (the bean solids' heat capacity doubled),
+    run again with the same cache folder: the answer changes. With numba's per-file cache the
+    kernels in kernels.py would have loaded their stale compiled code and printed the old value."""
+    copy = tmp_path / "src"
+    shutil.copytree(SRC, copy / "roastlab", ignore=shutil.ignore_patterns("__pycache__"))
+    home = tmp_path / "cache"
+    before = _run(copy, home)
+    again = _run(copy, home)  # unchanged: the same value, from the same cache folder
+    assert again == before
+    assert len(list((home / "roastlab" / "numba").iterdir())) == 1
+    rhs = copy / "roastlab" / "model" / "rhs.py"
+    text = rhs.read_text()
+    assert "cs = 1.099 + 0.007 * Tb" in text
+    rhs.write_text(text.replace("cs = 1.099 + 0.007 * Tb", "cs = 2.0 * (1.099 + 0.007 * Tb)"))
+    after = _run(copy, home)
+    assert float(after) < float(before) - 5.0, (before, after)  # twice the heat capacity: cooler beans
+    assert len(list((home / "roastlab" / "numba").iterdir())) == 2
