@@ -1,6 +1,6 @@
 """The architecture as a test: imports point one way, privates stay home, arguments are documented.
 
-Layers, lowest first: errors -> model -> io -> report -> sim -> evaluate -> fit -> workflows -> control -> apps.
+Layers, lowest first: errors -> model -> metrics -> io -> report -> sim -> evaluate -> fit -> workflows -> control -> apps.
 A module may import from its own subpackage and from lower layers only, and never a private
 (underscore) name from another subpackage. Imports inside functions count too.
 """
@@ -15,7 +15,20 @@ import pytest
 import roastlab
 
 SRC = Path(roastlab.__file__).parent
-LAYERS = ["errors", "model", "io", "report", "sim", "evaluate", "fit", "workflows", "fleet", "control", "apps"]
+LAYERS = [
+    "errors",
+    "model",
+    "metrics",
+    "io",
+    "report",
+    "sim",
+    "evaluate",
+    "fit",
+    "workflows",
+    "fleet",
+    "control",
+    "apps",
+]
 RANK = {name: i for i, name in enumerate(LAYERS)}
 
 

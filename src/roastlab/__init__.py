@@ -4,15 +4,21 @@ Implements "A scalable model of a coffee roasting chamber" (Procedia Computer Sc
 2021, doi:10.1016/j.procs.2021.01.362) as read by MODEL.md: the model, a fast simulator,
 identification and validation across plant sizes, applied through one fitted-model object.
 
-Layout (imports point one way: apps -> workflows -> fit -> evaluate -> sim -> report -> io -> model):
+Layout (imports point one way: apps -> control -> fleet -> workflows -> fit -> evaluate -> sim ->
+report -> io -> metrics -> model -> errors; tests/test_layout.py enforces it):
 
-* :mod:`roastlab.model`: constants, plant geometry, the right-hand side, the parameter registry;
+* :mod:`roastlab.model`: the quantity table, the vectors' layout, constants, plant geometry,
+  the right-hand side, the identification registry;
+* :mod:`roastlab.metrics`: rate of rise and crossing times, defined once;
 * :mod:`roastlab.io`: input/output guards, batch files, plants, model files, fit specs, importers;
 * :mod:`roastlab.report`: figures;
 * :mod:`roastlab.sim`: compiled kernels, :func:`simulate`, :class:`Simulator`, populations;
 * :mod:`roastlab.evaluate`: metrics and validation scores;
-* :mod:`roastlab.fit`: the objective, global search, per-batch fleet fits, the baseline;
-* :mod:`roastlab.workflows`: :class:`FittedModel`, :func:`fit`, reproduction, synthetic datasets;
+* :mod:`roastlab.fit`: the objective, global search, the per-batch fitter, uncertainty, the
+  program optimiser, the baseline;
+* :mod:`roastlab.workflows`: :class:`FittedModel`, :func:`fit`, what-if, transfer, reproduction;
+* :mod:`roastlab.fleet`: the fleet store, fleet fits, drift;
+* :mod:`roastlab.control`: controllers, the closed-loop testbench, environments;
 * :mod:`roastlab.apps`: the command line and the benchmark.
 """
 

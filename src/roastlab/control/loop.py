@@ -12,8 +12,8 @@ Every ``sample_s`` seconds from CHARGE to the reference's DROP:
    compiled integrator (:func:`roastlab.sim.simulate.advance`, the one right-hand side).
 
 Metrics (``METRICS.json``): ``rmse_C`` and ``max_abs_C`` of the true probe reading against the
-reference over the roast; ``ror_rmse_C_per_min`` of the rate of rise (change over 30 s, per
-minute) from 1:00 on; ``drop_time_error_s``: when the roaster's BT reaches the reference's DROP
+reference over the roast; ``ror_rmse_C_per_min`` of the rate of rise (the one RoR of
+:mod:`roastlab.metrics.profile`, which the MPC's RoR term uses too) from 1:00 on; ``drop_time_error_s``: when the roaster's BT reaches the reference's DROP
 temperature minus the reference's DROP time (projected from the last two minutes' rate of rise
 when it does not get there; None when it is not rising); ``actuator_travel``: the sum of the
 applied input's changes (degC or setting); ``constraint_violations``: requests clipped by the
@@ -35,13 +35,12 @@ from ..fit.program import ProgramLimits, optimise_program
 from ..io.batch import Batch
 from ..io.plants import load_plant
 from ..io.scenario import Scenario, load_scenario
+from ..metrics.profile import crossing_or_projected_s, rate_of_rise_C_per_min
 from ..model.layout import S_HE, S_TA, S_TB, S_TM, S_X
 from ..model.parameters import REGISTRY
 from ..model.rhs import N_STATES, P
-from ..report.figures import ROR_SPAN_S
 from ..sim.kernels import H0_S
 from ..sim.simulate import advance
-from ..workflows.whatif import crossing_or_projected_s
 from .base import LoopSetup
 from .mpc import MPC
 from .pid import PID
@@ -50,7 +49,7 @@ from .replay import Replay
 #: The controllers ``roastlab control --controller`` knows, by name: Artisan's PID as Artisan starts
 #: it (integral from 0) and started bumpless (integral at the actuator's position), MPC, replay.
 CONTROLLERS = {"pid": PID, "pid-bumpless": lambda: PID(bumpless=True), "mpc": MPC, "replay": Replay}
-#: Time from which the rate of rise is scored [s] (its span is the figures' ROR_SPAN_S).
+#: Time from which the rate of rise is scored [s] (the one RoR of :mod:`roastlab.metrics.profile`).
 ROR_FROM_S = 60.0
 SCENARIO_DIR = Path(__file__).parent / "scenarios"
 
@@ -200,11 +199,8 @@ class ClosedLoopResult:
 
 def _metrics(t, ref, bt, u_applied, u0, violations, step_ms, end_s) -> dict:
     e = bt - ref
-    k = max(1, int(round(ROR_SPAN_S / (t[1] - t[0]))))
-    ror_bt = (bt[k:] - bt[:-k]) / (t[k:] - t[:-k]) * 60.0
-    ror_ref = (ref[k:] - ref[:-k]) / (t[k:] - t[:-k]) * 60.0
-    keep = t[k:] >= ROR_FROM_S
-    ror_e = (ror_bt - ror_ref)[keep]
+    ror_e = rate_of_rise_C_per_min(t, bt) - rate_of_rise_C_per_min(t, ref)
+    ror_e = ror_e[(t >= ROR_FROM_S) & np.isfinite(ror_e)]
     drop = crossing_or_projected_s(t, bt, float(ref[-1]))
     return {
         "rmse_C": float(np.sqrt(np.mean(e**2))),

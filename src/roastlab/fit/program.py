@@ -31,6 +31,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ..errors import InputError
+from ..metrics.profile import ror_operator
 from ..model.layout import S_TA, S_TM
 from ..sim.kernels import H_MAX_S, simulate_one
 from ..sim.sensitivity import ta_input_jacobian
@@ -171,8 +172,9 @@ def optimise_program(
         rate limit then also holds between it and the first knot, over ``t[1] - t[0]``
     Tgi_bias_C : an inlet-temperature offset the model sees on top of ``Tgi_C`` [degC] (an
         estimated disturbance; the decided program and its limits exclude it)
-    ror_weight : weight of the rate-of-rise error [per degC/min] between consecutive knots
-        against the level error [per degC] (0: track the level only)
+    ror_weight : weight of the rate-of-rise error [per degC/min] against the level error
+        [per degC] (0: track the level only); the RoR is the one of
+        :func:`roastlab.metrics.profile.rate_of_rise_C_per_min`, which the control score uses too
     """
     t0_clock = time.perf_counter()
     t = np.ascontiguousarray(t, dtype=np.float64)
@@ -244,6 +246,10 @@ def optimise_program(
         return u, tgi, q, gg, x
 
     cache: dict = {}
+    if ror_weight:  # the one RoR definition as a linear map of the knots' Ta (rows with a RoR)
+        D, valid = ror_operator(t)
+        ror_rows = D[valid].toarray()
+        ror_target = ror_rows @ target
     lower = np.tril(np.ones((n, n)))  # d u_k / d z_j = 1 for j <= k
 
     def simulate(z):
@@ -261,7 +267,7 @@ def optimise_program(
         over = np.maximum(u - hi_T, 0.0) - np.maximum(lo_T - u, 0.0)
         parts = [r_track, LEVEL_PENALTY * over, smoothness * z[1:n]]
         if ror_weight:
-            parts.append(ror_weight * 60.0 * (np.diff(out[:, S_TA]) - np.diff(target)) / dt)
+            parts.append(ror_weight * (ror_rows @ out[:, S_TA] - ror_target))
         r = np.concatenate(parts)
         return np.where(np.isfinite(r), r, 1e6)
 
@@ -277,7 +283,7 @@ def optimise_program(
         # d Ta_i / d z, unweighted: Tgi_k = sum_{j <= k} z_j, so column j sums the columns k >= j
         dta = np.empty((n, m))
         dta[:, :n] = np.cumsum(jt[:, ::-1], axis=1)[:, ::-1]
-        J = np.zeros((3 * n - 1 + (n - 1 if ror_weight else 0), m))
+        J = np.zeros((3 * n - 1 + (ror_rows.shape[0] if ror_weight else 0), m))
         active = ((u > hi_T) | (u < lo_T)).astype(float)
         J[n : 2 * n, :n] = LEVEL_PENALTY * lower * active[:, None]
         J[2 * n : 3 * n - 1, 1:n] = smoothness * np.eye(n - 1)
@@ -292,8 +298,8 @@ def optimise_program(
             dta[:, j] = (outp[:, S_TA] - out[:, S_TA]) / h
             j += 1
         J[:n] = w[:, None] * dta
-        if ror_weight:  # d(RoR)/dz: differences of consecutive rows of d Ta / d z
-            J[3 * n - 1 :] = ror_weight * 60.0 * np.diff(dta, axis=0) / dt[:, None]
+        if ror_weight:  # d(RoR)/dz: the RoR is a linear map of Ta, so its rows map d Ta / d z
+            J[3 * n - 1 :] = ror_weight * (ror_rows @ dta)
         return np.where(np.isfinite(J), J, 0.0)
 
     with _one_blas_thread():

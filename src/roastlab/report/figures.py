@@ -13,12 +13,11 @@ import numpy as np
 
 from ..errors import InputError
 from ..io.files import Outputs
+from ..metrics.profile import ROR_SPAN_S, rate_of_rise_C_per_min  # noqa: F401  (ROR_SPAN_S: re-exported)
 from ..model.layout import S_TB, S_TM
 
 #: Image formats a figure may be saved as (by the file suffix).
 FIGURE_FORMATS = ("png", "svg", "pdf")
-#: Window of the rate-of-rise estimate [s] (Artisan's default delta span is 15 s).
-ROR_SPAN_S = 30.0
 
 
 def check_figure_path(path) -> Path:
@@ -59,20 +58,6 @@ def _finish(fig, path, title, outputs=None):
     if path is not None:
         save_figure(fig, path, outputs)
     return fig
-
-
-def rate_of_rise_C_per_min(time_s, temp_C, span_s: float = ROR_SPAN_S) -> np.ndarray:
-    """Rate of rise [degC/min]: slope of a least-squares line over the last ``span_s`` seconds."""
-    t = np.asarray(time_s, dtype=float)
-    y = np.asarray(temp_C, dtype=float)
-    out = np.full(t.shape, np.nan)
-    for i in range(len(t)):
-        j = np.searchsorted(t, t[i] - span_s)
-        if i - j >= 1:
-            tt, yy = t[j : i + 1], y[j : i + 1]
-            dt = tt - tt.mean()
-            out[i] = 60.0 * float(dt @ (yy - yy.mean()) / (dt @ dt))
-    return out
 
 
 def _events(ax, events: dict | None) -> None:

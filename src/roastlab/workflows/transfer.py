@@ -22,9 +22,9 @@ import numpy as np
 from ..errors import InputError
 from ..fit.program import ProgramLimits, ProgramResult, limit_spans, optimise_program, true_runs
 from ..io.batch import Batch
+from ..metrics.profile import crossing_or_projected_s, crossing_time_s
 from ..model.limits import check_value
 from ..model.plant import Plant
-from .whatif import crossing_or_projected_s, crossing_time_s
 
 #: Probe temperatures [degC] whose crossing times define the phases of the retimed baseline:
 #: end of drying (~150 degC, Artisan's DRY) and start of first crack (~196 degC, FCs).

@@ -16,6 +16,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..io.batch import Batch
+from ..metrics.profile import crossing_or_projected_s, crossing_time_s  # noqa: F401  (re-exported)
 from ..sim.simulate import SimulationResult
 from .model import FittedModel
 
@@ -98,32 +99,6 @@ class WhatIf:
         from ..report.figures import plot_whatif
 
         return plot_whatif(self, path, outputs=outputs)
-
-
-def crossing_time_s(t: np.ndarray, y: np.ndarray, level: float) -> float | None:
-    """First time the rising curve reaches ``level`` after its turning point, interpolated."""
-    start = int(np.argmin(y[: max(2, len(y) // 2)]))  # after the probe's turning point
-    above = np.flatnonzero(y[start:] >= level)
-    if not above.size:
-        return None
-    i = start + int(above[0])
-    if i == 0 or y[i] == y[i - 1]:
-        return float(t[i])
-    return float(t[i - 1] + (level - y[i - 1]) * (t[i] - t[i - 1]) / (y[i] - y[i - 1]))
-
-
-def crossing_or_projected_s(t, y, level, window_s: float = 120.0) -> float | None:
-    """:func:`crossing_time_s`, or when ``y`` never gets there, the time it would at the rate of
-    rise of its last ``window_s`` seconds (what a person reads off a curve that stops short);
-    None when it is not rising."""
-    hit = crossing_time_s(t, y, level)
-    if hit is not None:
-        return hit
-    k = int(np.searchsorted(t, t[-1] - window_s))
-    ror = (y[-1] - y[k]) / max(t[-1] - t[k], 1e-9)
-    if ror <= 1e-6 or y[-1] >= level:
-        return None
-    return float(t[-1] + (level - y[-1]) / ror)
 
 
 def whatif(

@@ -1,0 +1,1 @@
+"""Roast-profile figures defined once (rate of rise, crossing times): :mod:`.profile`."""

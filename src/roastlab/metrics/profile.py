@@ -1,0 +1,107 @@
+"""Roast-profile figures defined once: rate of rise and crossing times.
+
+Every figure, table, score and optimiser of roastlab reads a curve through these functions: the
+figures' RoR axis, the closed-loop score, the rate-of-rise term of the program optimiser (transfer
+and MPC) and the what-if, transfer and control milestone times. So the MPC optimises the same
+rate of rise it is scored on.
+
+**Rate of rise** (RoR) [degC/min], Artisan's convention of a trailing window: at each sample, 60
+times the slope of the least-squares line through the samples of the last :data:`ROR_SPAN_S`
+seconds (that sample included). Artisan's own default "delta span" is 15 s on a 1-3 s sampling;
+roastlab uses 30 s because its control and transfer grids are 5 s, where a 15-s window holds
+three samples and a sensor's noise of 0.5 degC would swing the RoR by +-3 degC/min. A
+least-squares slope, not the difference of the window's ends, so that every sample in the window
+counts and one noisy reading moves the RoR by a fraction of its error. The RoR is a linear map
+of the curve (:func:`ror_operator`), which is what lets the optimiser put it in its residuals with
+an exact Jacobian. The first samples, whose window holds fewer than two points, have no RoR (NaN).
+
+**Crossing time** [s]: the first time the rising curve reaches a temperature after its turning
+point, linearly interpolated between samples (:func:`crossing_time_s`); for a curve that stops
+short, :func:`crossing_or_projected_s` extends it at the RoR of its last two minutes.
+
+>>> import numpy as np
+>>> t = np.arange(0.0, 121.0, 5.0)
+>>> ror = rate_of_rise_C_per_min(t, 100.0 + 0.2 * t)  # 0.2 degC/s = 12 degC/min
+>>> bool(np.isnan(ror[0])), round(float(ror[-1]), 6)
+(True, 12.0)
+>>> crossing_time_s(t, 100.0 + 0.2 * t, 110.0)
+50.0
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy import sparse
+
+#: Window of the rate-of-rise estimate [s] (see the module docstring for why 30 s).
+ROR_SPAN_S = 30.0
+#: Window over which a curve that stops short is extended at its rate of rise [s].
+PROJECTION_WINDOW_S = 120.0
+
+
+def ror_operator(time_s, span_s: float = ROR_SPAN_S) -> tuple[sparse.csr_matrix, np.ndarray]:
+    """(D, valid): the rate of rise as a linear map, ``RoR = D @ temp_C`` [degC/min] where ``valid``.
+
+    Row i holds the least-squares slope weights 60 (t_k - mean t) / sum (t - mean t)^2 over the
+    samples k with t_i - span_s <= t_k <= t_i; ``valid[i]`` is False where that window has fewer
+    than two samples (the row is empty). ``time_s`` must increase.
+    """
+    t = np.asarray(time_s, dtype=float)
+    n = t.size
+    start = np.searchsorted(t, t - span_s, side="left")
+    rows, cols, vals = [], [], []
+    valid = np.zeros(n, dtype=bool)
+    for i in range(n):
+        j = int(start[i])
+        if i - j < 1:
+            continue
+        tt = t[j : i + 1]
+        d = tt - tt.mean()
+        w = 60.0 * d / float(d @ d)
+        rows.append(np.full(w.size, i))
+        cols.append(np.arange(j, i + 1))
+        vals.append(w)
+        valid[i] = True
+    if not rows:
+        return sparse.csr_matrix((n, n)), valid
+    D = sparse.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n))
+    return D, valid
+
+
+def rate_of_rise_C_per_min(time_s, temp_C, span_s: float = ROR_SPAN_S) -> np.ndarray:
+    """Rate of rise [degC/min] of ``temp_C`` [degC] sampled at ``time_s`` [s] (module docstring);
+    NaN where the window holds fewer than two samples."""
+    D, valid = ror_operator(time_s, span_s)
+    out = D @ np.asarray(temp_C, dtype=float)
+    out[~valid] = np.nan
+    return out
+
+
+def crossing_time_s(t, y, level: float) -> float | None:
+    """First time [s] the rising curve ``y`` [degC] reaches ``level`` [degC] after its turning
+    point (the minimum of its first half), linearly interpolated; None if it never does."""
+    t = np.asarray(t, dtype=float)
+    y = np.asarray(y, dtype=float)
+    start = int(np.argmin(y[: max(2, len(y) // 2)]))  # after the probe's turning point
+    above = np.flatnonzero(y[start:] >= level)
+    if not above.size:
+        return None
+    i = start + int(above[0])
+    if i == 0 or y[i] == y[i - 1]:
+        return float(t[i])
+    return float(t[i - 1] + (level - y[i - 1]) * (t[i] - t[i - 1]) / (y[i] - y[i - 1]))
+
+
+def crossing_or_projected_s(t, y, level: float, window_s: float = PROJECTION_WINDOW_S) -> float | None:
+    """:func:`crossing_time_s`, or when ``y`` never gets there, the time it would at the rate of
+    rise of its last ``window_s`` seconds (what a person reads off a curve that stops short);
+    None when it is not rising."""
+    t = np.asarray(t, dtype=float)
+    y = np.asarray(y, dtype=float)
+    hit = crossing_time_s(t, y, level)
+    if hit is not None:
+        return hit
+    ror_C_s = rate_of_rise_C_per_min(t, y, window_s)[-1] / 60.0  # the one RoR, over the longer window
+    if not ror_C_s > 1e-6 or y[-1] >= level:
+        return None
+    return float(t[-1] + (level - y[-1]) / ror_C_s)

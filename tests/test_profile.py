@@ -1,0 +1,47 @@
+"""The one rate of rise and crossing time (roastlab.metrics.profile) against independent numbers."""
+
+import numpy as np
+import pytest
+
+from roastlab.metrics.profile import (
+    ROR_SPAN_S,
+    crossing_or_projected_s,
+    crossing_time_s,
+    rate_of_rise_C_per_min,
+    ror_operator,
+)
+
+
+def test_ror_is_the_least_squares_slope_of_the_trailing_window():
+    """Against NumPy's polyfit window by window, on uneven sampling with noise."""
+    rng = np.random.default_rng(3)
+    t = np.cumsum(rng.uniform(0.5, 4.0, 300))
+    y = 20.0 + 0.15 * t + 5.0 * np.sin(t / 90.0) + rng.normal(0.0, 0.3, t.size)
+    ror = rate_of_rise_C_per_min(t, y)
+    for i in range(t.size):
+        k = t >= t[i] - ROR_SPAN_S
+        k[i + 1 :] = False
+        if k.sum() < 2:
+            assert np.isnan(ror[i])
+        else:
+            assert ror[i] == pytest.approx(60.0 * np.polyfit(t[k], y[k], 1)[0], rel=1e-9, abs=1e-9)
+
+
+def test_ror_of_a_ramp_and_its_operator_is_linear():
+    t = np.arange(0.0, 600.0, 5.0)
+    assert np.allclose(rate_of_rise_C_per_min(t, 3.0 + t / 6.0)[1:], 10.0)  # 1/6 degC/s = 10 degC/min
+    D, valid = ror_operator(t)
+    a, b = np.sin(t / 50.0), np.cos(t / 70.0)
+    assert np.allclose(D @ (2.0 * a + b), 2.0 * (D @ a) + D @ b)
+    assert valid.sum() == t.size - 1
+
+
+def test_crossing_times():
+    t = np.array([0.0, 60.0, 120.0, 180.0])
+    y = np.array([200.0, 90.0, 150.0, 190.0])  # charge drop, turning point, rise
+    assert crossing_time_s(t, y, 120.0) == pytest.approx(90.0)  # after the turning point, not at t = 0
+    assert crossing_time_s(t, y, 250.0) is None
+    # a curve stopping short is extended at its last two minutes' rate of rise (the same RoR, over 120 s)
+    slope = np.polyfit(t[1:], y[1:], 1)[0]  # degC/s over 60..180 s
+    assert crossing_or_projected_s(t, y, 210.0) == pytest.approx(180.0 + 20.0 / slope, rel=1e-9)
+    assert crossing_or_projected_s(t, np.array([200.0, 150.0, 120.0, 100.0]), 250.0) is None
