@@ -158,26 +158,6 @@ def test_second_cli_process_uses_disk_cache(tmp_path, check_inputs):
     assert "HITS 1 MISSES 0" in second, second
 
 
-def test_doctests():
-    import doctest
-    import importlib
-
-    for name in (
-        "roastlab.model.rhs",
-        "roastlab.model.plant",
-        "roastlab.model.limits",
-        "roastlab.io.plants",
-        "roastlab.io.files",
-        "roastlab.sim.simulate",
-        "roastlab.sim.population",
-        "roastlab.evaluate.metrics",
-        "roastlab.workflows.model",
-    ):
-        mod = importlib.import_module(name)
-        failures, tried = doctest.testmod(mod)
-        assert failures == 0 and tried > 0, mod.__name__
-
-
 def test_simulation_result_frame_and_plot(tmp_path):
     from roastlab import simulate
 

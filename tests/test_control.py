@@ -1,6 +1,7 @@
 """Closed-loop control: scenarios, controllers, the estimator, the testbench, the environments."""
 
 import dataclasses
+import importlib.util
 import math
 import warnings
 
@@ -25,6 +26,13 @@ from roastlab.io.batch import Batch
 from roastlab.io.scenario import scenario_from_mapping
 from roastlab.sim.simulate import simulate
 from roastlab.workflows.model import FittedModel
+
+
+def scenario_file(stem: str):
+    """The shipped scenario called ``stem``; fails loudly (not on another scenario) if it is gone."""
+    found = [p for p in standard_scenarios() if p.stem == stem]
+    assert found, f"shipped scenario {stem!r} is gone (have: {', '.join(p.stem for p in standard_scenarios())})"
+    return found[0]
 
 
 @pytest.fixture(scope="module")
@@ -266,7 +274,7 @@ def test_the_filter_finds_the_drum_temperature_no_sensor_shows(model, reference)
 # ----------------------------------------------------------------------------- CLI
 def test_control_command_writes_trace_metrics_and_figure(tmp_path, capsys):
     out = [f"--out={tmp_path}/t.csv", f"--json={tmp_path}/m.json", f"--plot={tmp_path}/f.png"]
-    code = main(["control", "--controller", "mpc", "--scenario", str(standard_scenarios()[4]), *out])
+    code = main(["control", "--controller", "mpc", "--scenario", str(scenario_file("05-cold-drum")), *out])
     assert code == 0
     import json
 
@@ -289,7 +297,7 @@ def test_control_command_writes_trace_metrics_and_figure(tmp_path, capsys):
 def test_control_compare_prints_one_table(tmp_path, capsys):
     folder = tmp_path / "sc"
     folder.mkdir()
-    for p in standard_scenarios()[:2]:
+    for p in (scenario_file("01-nominal"), scenario_file("02-batch-plus-20")):
         (folder / p.name).write_text(p.read_text())
     code = main(
         [
@@ -312,10 +320,16 @@ def test_control_compare_prints_one_table(tmp_path, capsys):
 
 
 # ----------------------------------------------------------------------------- environments
-gym = pytest.importorskip("gymnasium")
+# Each environment test asks for Gymnasium itself: a module-level importorskip here used to skip
+# every test of this file below it (and silently, 40 control tests) when gymnasium was missing.
+needs_gym = pytest.mark.skipif(
+    importlib.util.find_spec("gymnasium") is None, reason="needs gymnasium: pip install 'roastlab[rl]'"
+)
 
 
+@needs_gym
 def test_the_environment_passes_gymnasiums_checker():
+    import gymnasium as gym
     from gymnasium.utils.env_checker import check_env
 
     import roastlab.control  # noqa: F401 - registers roastlab/Roast-v0
@@ -326,6 +340,7 @@ def test_the_environment_passes_gymnasiums_checker():
         check_env(env.unwrapped)
 
 
+@needs_gym
 def test_vector_environment_equals_single_environments():
     from roastlab.control.environment import RoastEnv, RoastVectorEnv
 
@@ -344,6 +359,7 @@ def test_vector_environment_equals_single_environments():
             assert np.allclose(obs, vobs[i], atol=1e-4) and rew == pytest.approx(vrew[i], abs=1e-6)
 
 
+@needs_gym
 def test_episode_ends_at_drop_and_the_vector_env_autoresets():
     from roastlab.control.environment import RoastVectorEnv
 
@@ -392,7 +408,7 @@ def test_the_docs_own_controller_example_runs():
 
 
 def test_mpc_can_also_track_the_rate_of_rise(model, reference):
-    s = load_scenario(standard_scenarios()[6])  # probe noise and delay: the RoR is what suffers
+    s = load_scenario(scenario_file("07-sensor-noise-delay"))  # probe noise and delay: the RoR is what suffers
     plain = run_closed_loop(model, reference, MPC(), s).metrics
     ror = run_closed_loop(model, reference, MPC(ror_weight=2.0), s).metrics
     assert ror["ror_rmse_C_per_min"] < 0.8 * plain["ror_rmse_C_per_min"]

@@ -139,3 +139,77 @@ def test_the_documentation_check_can_fail():
         """Uses a only."""
 
     assert undocumented(f) == ["b"]
+
+
+def _module_name(path: Path) -> str:
+    rel = path.relative_to(SRC).with_suffix("")
+    parts = rel.parts[:-1] if rel.name == "__init__" else rel.parts
+    return ".".join(("roastlab",) + parts)
+
+
+def module_graph() -> dict[str, set[str]]:
+    """Module -> the roastlab modules it imports (imports inside functions included)."""
+    modules = {_module_name(p): p for p in SRC.rglob("*.py") if p.name != "__main__.py"}
+    graph: dict[str, set[str]] = {m: set() for m in modules}
+    for name, path in modules.items():
+        pkg = name.split(".") if path.name == "__init__.py" else name.split(".")[:-1]
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom):
+                if node.level:
+                    base = pkg[: len(pkg) - node.level + 1]
+                    full = base + (node.module.split(".") if node.module else [])
+                elif node.module and node.module.startswith("roastlab"):
+                    full = node.module.split(".")
+                else:
+                    continue
+                for a in node.names:  # "from . import x": x may be a module
+                    target = ".".join(full + [a.name])
+                    graph[name].add(target if target in modules else ".".join(full))
+            elif isinstance(node, ast.Import):
+                graph[name] |= {a.name for a in node.names if a.name.startswith("roastlab.")}
+        graph[name] = {t for t in graph[name] if t in modules and t != name and t != "roastlab"}
+    return graph
+
+
+def import_cycles(graph) -> list[list[str]]:
+    """Every strongly connected group of more than one module (Tarjan's algorithm)."""
+    index, low, stack, on, out = {}, {}, [], set(), []
+
+    def visit(v):
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        for w in graph[v]:
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            group = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                group.append(w)
+                if w == v:
+                    break
+            if len(group) > 1:
+                out.append(sorted(group))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return out
+
+
+def test_no_import_cycles_between_modules():
+    """Not only between packages: no two modules import each other, directly or around a loop
+    (package __init__ re-exports excluded: a package may re-export what its modules define)."""
+    graph = {m: {t for t in ts if not t.endswith("__init__")} for m, ts in module_graph().items()}
+    pkgs = {m for m in graph if (SRC / Path(*m.split(".")[1:]) / "__init__.py").exists()}
+    graph = {m: ts - pkgs for m, ts in graph.items() if m not in pkgs}
+    assert import_cycles(graph) == []
+
+
+def test_the_cycle_finder_finds_a_cycle():
+    assert import_cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]

@@ -15,84 +15,7 @@ import sys
 from pathlib import Path
 
 from ..errors import InputError, ParameterError, RoastlabError
-
-MODEL_HELP = "fitted model file from 'roastlab identify' (roastlab-model/1; a THETA.json of roastlab 0.1 also loads)"
-
-
-class _Parser(argparse.ArgumentParser):
-    """argparse with one-line errors (exit 2) instead of a usage block."""
-
-    def error(self, message: str):  # noqa: D102
-        self.exit(2, f"{self.prog}: error: {message} (see --help)\n")
-
-
-def _float_arg(name: str):
-    def parse(text: str) -> float:
-        try:
-            v = float(text)
-        except (ValueError, OverflowError):
-            raise argparse.ArgumentTypeError(f"{name} must be a number, got {text[:40]!r}") from None
-        if not math.isfinite(v):
-            raise argparse.ArgumentTypeError(f"{name} must be finite, got {text[:40]!r}")
-        return v
-
-    return parse
-
-
-def _seed_arg(text: str) -> int:
-    try:
-        v = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"--seed must be an integer, got {text[:40]!r}") from None
-    if not 0 <= v < 2**32:
-        raise argparse.ArgumentTypeError(f"--seed must be in 0..{2**32 - 1}, got {text[:40]}")
-    return v
-
-
-def _count_arg(name: str, lo: int, hi: int):
-    def parse(text: str) -> int:
-        try:
-            v = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{name} must be an integer, got {text[:40]!r}") from None
-        if not lo <= v <= hi:
-            raise argparse.ArgumentTypeError(f"{name} must be in {lo}..{hi}, got {v}")
-        return v
-
-    return parse
-
-
-def _progress(desc: str):
-    """A progress callback drawing a tqdm bar on a terminal, shown only for work over ~2 s."""
-    from tqdm import tqdm
-
-    state: dict = {}
-
-    def update(done: int, total: int, text: str = "") -> None:
-        bar = state.get("bar")
-        if bar is None:
-            bar = state["bar"] = tqdm(total=total, desc=desc, file=sys.stderr, delay=2.0, disable=None, leave=False)
-        bar.set_postfix_str(text[:60], refresh=False)
-        bar.update(done - bar.n)
-        if done >= total:
-            bar.close()
-
-    return update
-
-
-def json_text(doc) -> str:
-    """A JSON output file's text: NumPy values made plain, NaN refused, one space indent."""
-    from ..io.modelfile import jsonable
-
-    return json.dumps(jsonable(doc), indent=1, allow_nan=False) + "\n"
-
-
-def write_json_and_plot(out, args, doc, figure) -> None:
-    """Write ``--json`` (``doc``) and ``--plot`` (``figure.plot``) through ``out`` when asked for."""
-    if args.json:
-        out.write_text(args.json, json_text(doc))
-    if args.plot:
-        figure.plot(args.plot, outputs=out)
+from .common import MODEL_HELP, Parser, count_arg, float_arg, json_text, progress, seed_arg, write_json_and_plot
 
 
 def _say(notes) -> None:
@@ -104,12 +27,10 @@ def _say(notes) -> None:
 def _add_model_options(p: argparse.ArgumentParser, with_model: bool = True) -> None:
     if with_model:
         p.add_argument("--model", "--theta", dest="model", metavar="MODEL.json", help=MODEL_HELP)
-        p.add_argument("--hgm", type=_float_arg("--hgm"), help="gas-metal coefficient [kW/(m2 K)]; overrides the model")
+        p.add_argument("--hgm", type=float_arg("--hgm"), help="gas-metal coefficient [kW/(m2 K)]; overrides the model")
+        p.add_argument("--hbm", type=float_arg("--hbm"), help="metal-bean coefficient [kW/(m2 K)]; overrides the model")
         p.add_argument(
-            "--hbm", type=_float_arg("--hbm"), help="metal-bean coefficient [kW/(m2 K)]; overrides the model"
-        )
-        p.add_argument(
-            "--pbm", type=_float_arg("--pbm"), help="bean-metal contact fraction in (0, 1); overrides the model"
+            "--pbm", type=float_arg("--pbm"), help="bean-metal contact fraction in (0, 1); overrides the model"
         )
     _add_initial_options(p)
     p.add_argument(
@@ -128,17 +49,17 @@ def _add_initial_options(p: argparse.ArgumentParser) -> None:
 
     p.add_argument(
         "--tb0",
-        type=_float_arg("--tb0"),
+        type=float_arg("--tb0"),
         help=f"initial bean temperature [degC] (default: the model's, else {default('Tb0_C'):g})",
     )
     p.add_argument(
         "--tm0",
-        type=_float_arg("--tm0"),
+        type=float_arg("--tm0"),
         help=f"initial drum metal temperature, the preheat [degC] (default: the model's or the log's, else {default('Tm0_C'):g})",
     )
     p.add_argument(
         "--x0",
-        type=_float_arg("--x0"),
+        type=float_arg("--x0"),
         help=f"initial moisture [kg/kg dry] (default: the model's, else {default('X0'):g})",
     )
 
@@ -345,7 +266,7 @@ def cmd_identify(args) -> int:
         seed=args.seed,
         starts=args.starts,
         column_map=load_map(args.map) if args.map else None,
-        progress=_progress("identify"),
+        progress=progress("identify"),
         weights=_weights_arg(args.weight),
     )
     from ..io.modelfile import model_document_text
@@ -385,7 +306,7 @@ def _identify_per_batch(args, batches, plant_spec, fix, bounds, outputs) -> int:
     packed = pack_batches(
         batches, plant_spec, THETA_START, init, args.moisture or "schwartzberg", args.hold or "linear"
     )
-    result = identify_each(packed, bounds=bounds, fix=fix, seed=args.seed, progress=_progress("fit per batch"))
+    result = identify_each(packed, bounds=bounds, fix=fix, seed=args.seed, progress=progress("fit per batch"))
     doc = {**result.to_json_dict(), "plant": str(plant_spec), "fixed": sorted(fix)}
     with outputs as out:
         out.write_text(args.out, json_text(doc))
@@ -542,7 +463,7 @@ def cmd_import(args) -> int:
 def cmd_reproduce(args) -> int:
     from ..workflows.reproduce import run, summary_table
 
-    summary = run(args.out, args.data, seed=args.seed, progress=_progress("identify"))
+    summary = run(args.out, args.data, seed=args.seed, progress=progress("identify"))
     print(summary_table(summary))
     return 0
 
@@ -734,7 +655,7 @@ def cmd_control_compare(args) -> int:
         raise InputError("no controllers given", "--controllers")
     model, reference = _control_inputs(args)
     result = compare(
-        model, reference, scenarios, controllers, args.plant, oracle=args.oracle, progress=_progress("control compare")
+        model, reference, scenarios, controllers, args.plant, oracle=args.oracle, progress=progress("control compare")
     )
     print(result.table())
     with outputs as out:
@@ -746,9 +667,9 @@ def _add_control_options(p, compare: bool) -> None:
     p.add_argument(
         "--model", "--theta", dest="model", metavar="MODEL.json", help=MODEL_HELP + " (default: the paper's theta*)"
     )
-    p.add_argument("--hgm", type=_float_arg("--hgm"), help="gas-metal coefficient [kW/(m2 K)]; overrides the model")
-    p.add_argument("--hbm", type=_float_arg("--hbm"), help="metal-bean coefficient [kW/(m2 K)]; overrides the model")
-    p.add_argument("--pbm", type=_float_arg("--pbm"), help="bean-metal contact fraction in (0, 1); overrides the model")
+    p.add_argument("--hgm", type=float_arg("--hgm"), help="gas-metal coefficient [kW/(m2 K)]; overrides the model")
+    p.add_argument("--hbm", type=float_arg("--hbm"), help="metal-bean coefficient [kW/(m2 K)]; overrides the model")
+    p.add_argument("--pbm", type=float_arg("--pbm"), help="bean-metal contact fraction in (0, 1); overrides the model")
     p.add_argument("--plant", help="plant preset (120kg, 360kg) or PLANT.toml (default: the model's, else 120kg)")
     p.add_argument(
         "--reference",
@@ -786,7 +707,7 @@ def _add_control_options(p, compare: bool) -> None:
         p.add_argument("--scenario", metavar="S.toml", help="scenario file (default: nominal; see docs/control.md)")
         p.add_argument(
             "--ror-weight",
-            type=_float_arg("--ror-weight"),
+            type=float_arg("--ror-weight"),
             default=0.0,
             help="mpc: also track the reference's rate of rise, this weight per degC/min against 1 per degC "
             "(default 0: the level only)",
@@ -815,7 +736,7 @@ def _add_control_command(sub) -> None:
         "constraint_violations (requests the actuator clipped), step_ms_median/p99 (the controller's own time).",
     )
     _add_control_options(p, compare=False)
-    csub = p.add_subparsers(dest="what", metavar="[compare]", parser_class=_Parser)
+    csub = p.add_subparsers(dest="what", metavar="[compare]", parser_class=Parser)
     csub.required = False
     q = csub.add_parser(
         "compare",
@@ -882,8 +803,8 @@ def _add_fit_commands(sub) -> None:
     p.add_argument(
         "--method", choices=("global", "de"), default="global", help="global search (default) or differential evolution"
     )
-    p.add_argument("--seed", type=_seed_arg, default=0, help="random seed of the search (default 0)")
-    p.add_argument("--starts", type=_count_arg("--starts", 1, 100), default=6, help="local polishes (default 6)")
+    p.add_argument("--seed", type=seed_arg, default=0, help="random seed of the search (default 0)")
+    p.add_argument("--starts", type=count_arg("--starts", 1, 100), default=6, help="local polishes (default 6)")
     p.add_argument(
         "--fix", action="append", metavar="NAME=V", help="hold a parameter fixed, e.g. --fix hgm=0.01 (repeatable)"
     )
@@ -934,7 +855,7 @@ def _add_fit_commands(sub) -> None:
         help="write one CSV per batch: time_s, measured Ta_C, Ta_pred_C, predicted states, inputs as applied",
     )
     p.add_argument(
-        "--tgi-offset", type=_float_arg("--tgi-offset"), help="what-if: add this to the inlet gas / ET [degC]"
+        "--tgi-offset", type=float_arg("--tgi-offset"), help="what-if: add this to the inlet gas / ET [degC]"
     )
     _add_model_options(p)
     p.set_defaults(func=cmd_validate)
@@ -949,7 +870,7 @@ def _add_fit_commands(sub) -> None:
     p.add_argument(
         "--data", metavar="DIR", help="folder holding dataset-I and dataset-V (default: the shipped synthetic data)"
     )
-    p.add_argument("--seed", type=_seed_arg, default=0, help="seed of the identification (default 0)")
+    p.add_argument("--seed", type=seed_arg, default=0, help="seed of the identification (default 0)")
     p.set_defaults(func=cmd_reproduce)
 
     p = sub.add_parser(
@@ -993,8 +914,8 @@ def _add_fit_commands(sub) -> None:
         metavar="SETTING=V@S",
         help="set heater or fan to V from S seconds after CHARGE on, e.g. heater=6@120 (repeatable)",
     )
-    p.add_argument("--tgi", type=_float_arg("--tgi"), help="add this to the inlet gas temperature [degC]")
-    p.add_argument("--batch-kg", type=_float_arg("--batch-kg"), help="green batch mass [kg] (default: the log's)")
+    p.add_argument("--tgi", type=float_arg("--tgi"), help="add this to the inlet gas temperature [degC]")
+    p.add_argument("--batch-kg", type=float_arg("--batch-kg"), help="green batch mass [kg] (default: the log's)")
     _add_initial_options(p)
     p.add_argument("--json", metavar="WHATIF.json", help="write the table as JSON")
     p.add_argument("--plot", metavar="FIG.png", help="overlay measured BT and both predictions (.png/.svg/.pdf)")
@@ -1036,11 +957,11 @@ def _add_fit_commands(sub) -> None:
     p.add_argument("--out", required=True, metavar="PROGRAM.csv", help="where to write the program")
     p.add_argument(
         "--batch-kg",
-        type=_float_arg("--batch-kg"),
+        type=float_arg("--batch-kg"),
         help="green batch on B [kg] (default: B's nominal batch; the reference's when B = A)",
     )
     p.add_argument(
-        "--tb0", type=_float_arg("--tb0"), help="bean temperature at CHARGE on B [degC] (default: the model's, else 30)"
+        "--tb0", type=float_arg("--tb0"), help="bean temperature at CHARGE on B [degC] (default: the model's, else 30)"
     )
     p.add_argument(
         "--tm0",
@@ -1051,7 +972,7 @@ def _add_fit_commands(sub) -> None:
         "--tm0-range", default="60:300", metavar="LO:HI", help="range for --tm0 free [degC] (default 60:300)"
     )
     p.add_argument(
-        "--x0", type=_float_arg("--x0"), help="green moisture on B [kg/kg dry] (default: the model's, else 0.1)"
+        "--x0", type=float_arg("--x0"), help="green moisture on B [kg/kg dry] (default: the model's, else 0.1)"
     )
     p.add_argument(
         "--decide",
@@ -1060,49 +981,49 @@ def _add_fit_commands(sub) -> None:
         help="the input the program sets (default Tgi; heater needs a model and reference with the actuator extension)",
     )
     p.add_argument(
-        "--tgi-min", type=_float_arg("--tgi-min"), default=150.0, help="lowest inlet temperature [degC] (default 150)"
+        "--tgi-min", type=float_arg("--tgi-min"), default=150.0, help="lowest inlet temperature [degC] (default 150)"
     )
     p.add_argument(
-        "--tgi-max", type=_float_arg("--tgi-max"), default=550.0, help="highest inlet temperature [degC] (default 550)"
+        "--tgi-max", type=float_arg("--tgi-max"), default=550.0, help="highest inlet temperature [degC] (default 550)"
     )
     p.add_argument(
         "--tgi-rate",
-        type=_float_arg("--tgi-rate"),
+        type=float_arg("--tgi-rate"),
         default=120.0,
         help="fastest change of the inlet temperature [degC/min] (default 120)",
     )
-    p.add_argument("--heater-min", type=_float_arg("--heater-min"), help="lowest heater setting (default 0)")
+    p.add_argument("--heater-min", type=float_arg("--heater-min"), help="lowest heater setting (default 0)")
     p.add_argument(
         "--heater-max",
-        type=_float_arg("--heater-max"),
+        type=float_arg("--heater-max"),
         help="highest heater setting (default: the reference's largest)",
     )
     p.add_argument(
         "--heater-rate",
-        type=_float_arg("--heater-rate"),
+        type=float_arg("--heater-rate"),
         default=60.0,
         help="fastest heater change [setting/min] (default 60)",
     )
     p.add_argument(
         "--gg",
-        type=_float_arg("--gg"),
+        type=float_arg("--gg"),
         help="fixed gas flow on B [kg/s] (default: A's flow times the batch-mass ratio)",
     )
     p.add_argument(
         "--gg-min",
-        type=_float_arg("--gg-min"),
+        type=float_arg("--gg-min"),
         help="with --gg-max: the optimiser chooses a constant gas flow in this range [kg/s]",
     )
-    p.add_argument("--gg-max", type=_float_arg("--gg-max"), help="see --gg-min")
+    p.add_argument("--gg-max", type=float_arg("--gg-max"), help="see --gg-min")
     p.add_argument(
         "--interval-s",
-        type=_float_arg("--interval-s"),
+        type=float_arg("--interval-s"),
         default=5.0,
         help="spacing of the program's knots [s] (default 5)",
     )
     p.add_argument(
         "--tolerance",
-        type=_float_arg("--tolerance"),
+        type=float_arg("--tolerance"),
         default=2.0,
         help="feasible when max |predicted - target| <= this [degC] (default 2)",
     )
@@ -1135,7 +1056,7 @@ def _add_fit_commands(sub) -> None:
         help="generate the synthetic stand-in datasets",
         description="Generate SYNTHETIC stand-in datasets to fit with 'roastlab identify ... --out MODEL.json'.",
     )
-    dsub = p.add_subparsers(dest="what", metavar="WHAT", parser_class=_Parser)
+    dsub = p.add_subparsers(dest="what", metavar="WHAT", parser_class=Parser)
     dsub.required = True
     q = dsub.add_parser(
         "make-paper",
@@ -1144,7 +1065,7 @@ def _add_fit_commands(sub) -> None:
         "(fit them with 'roastlab identify ... --out MODEL.json').",
     )
     q.add_argument(
-        "--seed", type=_seed_arg, default=PAPER_SEED, help=f"random seed (default {PAPER_SEED}, the shipped data)"
+        "--seed", type=seed_arg, default=PAPER_SEED, help=f"random seed (default {PAPER_SEED}, the shipped data)"
     )
     q.add_argument("--out", default="paper-synthetic", metavar="DIR", help="output folder (default paper-synthetic)")
     q.set_defaults(func=cmd_datasets)
@@ -1153,7 +1074,7 @@ def _add_fit_commands(sub) -> None:
 def build_parser() -> argparse.ArgumentParser:
     from .. import __version__
 
-    parser = _Parser(
+    parser = Parser(
         prog="roastlab",
         description="Simulate, identify and validate the scalable coffee-roasting-chamber model "
         "(Procedia Computer Science 2021) on plants of any size. A fit is one model file (MODEL.json, "
@@ -1170,7 +1091,7 @@ def build_parser() -> argparse.ArgumentParser:
         "Every command: bad input gives one line naming the file and the problem, exit code 2.",
     )
     parser.add_argument("--version", action="version", version=f"roastlab {__version__}")
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
     sub.required = True
 
     p = sub.add_parser(
@@ -1191,7 +1112,7 @@ def build_parser() -> argparse.ArgumentParser:
         "--out", required=True, metavar="OUT.csv", help="where to write the simulated states (.csv or .json)"
     )
     p.add_argument(
-        "--tgi-offset", type=_float_arg("--tgi-offset"), help="what-if: add this to the inlet gas / ET [degC]"
+        "--tgi-offset", type=float_arg("--tgi-offset"), help="what-if: add this to the inlet gas / ET [degC]"
     )
     p.add_argument("--heat-flows", action="store_true", help="also write Qgb, Qgm, Qbm, Qr [kW]")
     p.add_argument("--plot", metavar="FIG.png", help="also save a figure of the simulation (.png/.svg/.pdf)")
@@ -1204,14 +1125,14 @@ def build_parser() -> argparse.ArgumentParser:
         "stores in full, or a preset or PLANT.toml).",
     )
     p.add_argument("plant", help="plant preset (120kg, 360kg) or PLANT.toml path")
-    p.add_argument("--x0", type=_float_arg("--x0"), default=0.1, help="moisture used for Mbd and F (default 0.1)")
+    p.add_argument("--x0", type=float_arg("--x0"), default=0.1, help="moisture used for Mbd and F (default 0.1)")
     p.set_defaults(func=cmd_plant)
 
     _add_fit_commands(sub)
     _add_control_command(sub)
     from .fleet_cli import add_fleet_command
 
-    add_fleet_command(sub, _Parser)
+    add_fleet_command(sub, Parser)
     return parser
 
 

@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 from ..errors import InputError
-from .cli import _count_arg, _progress, write_json_and_plot
+from .common import count_arg, progress, write_json_and_plot
 
 
 def _db_output(db, inputs) -> Path:
@@ -28,7 +28,7 @@ def cmd_fleet_ingest(args) -> int:
     from ..fleet import ingest
 
     _db_output(args.db, [args.manifest])
-    report = ingest(args.db, args.manifest, progress=_progress("ingest"))
+    report = ingest(args.db, args.manifest, progress=progress("ingest"))
     for line in report.rejected:
         print(f"roastlab fleet ingest: rejected: {line}", file=sys.stderr)
     print(report.summary())
@@ -63,7 +63,7 @@ def cmd_fleet_fit(args) -> int:
     _db_output(args.db, [v.partition("=")[2] if "=" in v and not Path(v).exists() else v for v in args.spec or []])
     spec = _specs(args.spec)
     report = fit_fleet(
-        args.db, spec, workers=args.workers, scheduler=args.scheduler, chunk=args.chunk, progress=_progress("fit")
+        args.db, spec, workers=args.workers, scheduler=args.scheduler, chunk=args.chunk, progress=progress("fit")
     )
     print(report.summary())
     return 0
@@ -88,7 +88,7 @@ def cmd_fleet_report(args) -> int:
 def cmd_fleet_synthetic(args) -> int:
     from ..fleet.synthetic import make_fleet
 
-    truth = make_fleet(args.out, args.batches, seed=args.seed, progress=_progress("write"))
+    truth = make_fleet(args.out, args.batches, seed=args.seed, progress=progress("write"))
     changes = sum(len(m["changes"]) for m in truth["machines"])
     print(
         f"SYNTHETIC fleet: {args.batches} batches over {len(truth['machines'])} machines ({changes} injected "
@@ -148,11 +148,11 @@ def add_fleet_command(sub, parser_class) -> None:
         help="what each batch's fit frees and holds (every free parameter is fitted per batch); MACHINE=FIT.toml "
         "for one machine (repeatable). Default: hgm and hbm free, Pbm held at theta*",
     )
-    q.add_argument("--workers", type=_count_arg("--workers", 1, 1024), help="start a local Dask cluster of N processes")
+    q.add_argument("--workers", type=count_arg("--workers", 1, 1024), help="start a local Dask cluster of N processes")
     q.add_argument("--scheduler", metavar="ADDRESS", help="use an existing Dask cluster (e.g. tcp://host:8786)")
     q.add_argument(
         "--chunk",
-        type=_count_arg("--chunk", 1, 1_000_000),
+        type=count_arg("--chunk", 1, 1_000_000),
         default=500,
         help="batches per task and commit (default 500)",
     )
@@ -179,7 +179,7 @@ def add_fleet_command(sub, parser_class) -> None:
     )
     q.add_argument("--out", required=True, metavar="DIR", help="folder to write into")
     q.add_argument(
-        "--batches", type=_count_arg("--batches", 1, 10_000_000), default=1000, help="batches in all (default 1000)"
+        "--batches", type=count_arg("--batches", 1, 10_000_000), default=1000, help="batches in all (default 1000)"
     )
     q.add_argument("--seed", type=int, default=14, help="random seed (default 14)")
     q.set_defaults(func=cmd_fleet_synthetic)

@@ -38,11 +38,6 @@ from .loop import prepare
 ENV_ID = "roastlab/Roast-v0"
 
 
-def _need_gymnasium() -> None:
-    if gym is None:
-        raise InputError("the Gymnasium environment needs gymnasium: pip install 'roastlab[rl]'", "roastlab.control")
-
-
 class _Episode:
     """The parts of a testbench run an environment needs, precomputed on its tick grid."""
 

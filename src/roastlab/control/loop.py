@@ -67,7 +67,7 @@ def make_controller(name: str):
 
 
 @dataclasses.dataclass
-class Plant:
+class SimulatedRoaster:
     """The simulated roaster of one scenario run: parameters, state at CHARGE, gas factor."""
 
     params: np.ndarray
@@ -80,8 +80,10 @@ def _value(p: np.ndarray, name: str) -> float:
     return float(p[P[REGISTRY[name].slot]])
 
 
-def prepare(model, reference: Batch, scenario: Scenario | None = None, plant=None) -> tuple[LoopSetup, Plant]:
-    """The controller's :class:`LoopSetup` and the simulated :class:`Plant` of one scenario.
+def prepare(
+    model, reference: Batch, scenario: Scenario | None = None, plant=None
+) -> tuple[LoopSetup, SimulatedRoaster]:
+    """The controller's :class:`LoopSetup` and the :class:`SimulatedRoaster` of one scenario.
 
     ``model`` is a FittedModel, ``reference`` a Batch with Ta_C (the BT curve to follow) and the
     inputs it was roasted with, ``plant`` the roaster's geometry (default: the model's).
@@ -140,7 +142,7 @@ def prepare(model, reference: Batch, scenario: Scenario | None = None, plant=Non
         Tgi_C=np.asarray(reference.Tgi_C, dtype=float),
         fan=None if reference.fan is None else np.asarray(reference.fan, dtype=float),
     )
-    roaster = Plant(truth.params.copy(), truth.states[0, :N_STATES].copy(), pc.Gg_factor, mass)
+    roaster = SimulatedRoaster(truth.params.copy(), truth.states[0, :N_STATES].copy(), pc.Gg_factor, mass)
     return setup, roaster
 
 
@@ -320,7 +322,7 @@ def run_closed_loop(model, reference: Batch, controller, scenario: Scenario | st
 ORACLE_ITERATIONS = 300
 
 
-def oracle_rmse_C(setup: LoopSetup, roaster: Plant) -> float:
+def oracle_rmse_C(setup: LoopSetup, roaster: SimulatedRoaster) -> float:
     """The BT RMSE of the open-loop program the one program optimiser finds for the roaster itself
     (its true parameters and state, the actuator's limits, :data:`ORACLE_ITERATIONS`): a reference
     for what is reachable in the scenario, not a proven bound (a longer solve can go lower)."""

@@ -14,7 +14,6 @@ from __future__ import annotations
 import numpy as np
 
 METRIC_NAMES = ("n", "SSR", "norm", "MAE", "MPE", "MAPE", "FIT", "rho")
-METRIC_UNITS = {"n": "", "SSR": "°C²", "norm": "°C", "MAE": "°C", "MPE": "%", "MAPE": "%", "FIT": "%", "rho": ""}
 
 
 def fit_percent(measured, predicted) -> float:

@@ -405,7 +405,7 @@ def identify_each(
             _fit_population(
                 *(a[sl] for a in packed.inputs),
                 TA[sl],
-                packed.X0[sl],
+                packed.x0[sl],
                 packed.PB[sl],
                 kinds,
                 slots,

@@ -29,7 +29,7 @@ Lower is better; differences of a few units matter, the absolute value does not.
 >>> import numpy as np
 >>> J = np.array([[1.0, 0.0], [1.0, 1.0], [1.0, 2.0]])
 >>> u = from_jacobian(J, z=np.array([0.5, 0.5]), lower=np.zeros(2), upper=np.ones(2), ssr=3.0, names=["a", "b"])
->>> [round(v, 4) for v in u.stderr]
+>>> [round(float(v), 4) for v in u.stderr]
 [1.5811, 1.2247]
 >>> round(u.aic, 3), round(u.bic, 3)
 (4.0, 2.197)

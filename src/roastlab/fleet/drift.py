@@ -71,9 +71,11 @@ def cusum_alarms(x: np.ndarray, k: float = CUSUM_K, h: float = CUSUM_H, warmup: 
     Returns ``[{"index", "change_index", "direction"}]``: the index where the alarm is raised
     and the estimated first index of the change.
 
+    A step of +30 % at index 40 is raised 5 samples later and dated back to where it began:
+
     >>> x = np.r_[np.full(40, 1.0), np.full(40, 1.3)] + 0.05 * np.sin(np.arange(80) * 1.7)
     >>> [(a["index"], a["change_index"], a["direction"]) for a in cusum_alarms(x)]
-    [(41, 40, 'up')]
+    [(45, 40, 'up')]
     """
     x = np.asarray(x, dtype=float)
     alarms = []

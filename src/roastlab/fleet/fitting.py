@@ -131,7 +131,7 @@ def fit_chunk(batch_ids, batches: list[Batch], plant, spec: FleetSpec, threads: 
     extra = [k for k in fixed if k not in THETA_NAMES]
     if extra:  # held values other than theta: the same name-addressed setter as population runs
         values = np.array([[[fixed[k] for k in extra]] * packed.n_batches])
-        _, packed.X0, packed.PB = run_arrays(packed, extra, values)
+        _, packed.x0, packed.PB = run_arrays(packed, extra, values)
     bounds = {n: (lo, hi) for n, lo, hi in zip(spec.names, spec.lower, spec.upper)}
     r = identify_each(
         packed,

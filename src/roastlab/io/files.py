@@ -290,8 +290,3 @@ def atomic_write_bytes(path: str | Path, data: bytes) -> None:
 
 def atomic_write_text(path: str | Path, text: str) -> None:
     atomic_write_bytes(path, text.encode("utf-8"))
-
-
-def check_output_path(out: str | Path, inputs: list[str | Path]) -> Path:
-    """Refuse an output path that is one of ``inputs`` (or any input read), a folder or a special file."""
-    return Outputs(inputs).check(out)

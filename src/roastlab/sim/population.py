@@ -36,7 +36,7 @@ class PackedBatches:
     fan settings (zeros without the actuator extension); N : (nb,) valid lengths;
     TA : (nb, nmax) measured Ta, NaN-padded (NaN everywhere if not measured);
     TB2 : (nb, nmax) a second bean reading compared with Tb, NaN where not measured;
-    X0 : (nb, 6) initial states; PB : (nb, n_params) parameter vectors at the start theta;
+    x0 : (nb, 6) initial state vectors (X0 is the moisture everywhere else); PB : (nb, n_params) parameter vectors at the start theta;
     Mb : (nb,) green batch mass of each batch's plant [kg] (for Mbd when X0 varies).
     """
 
@@ -45,7 +45,7 @@ class PackedBatches:
     TGI: np.ndarray
     N: np.ndarray
     TA: np.ndarray
-    X0: np.ndarray
+    x0: np.ndarray
     PB: np.ndarray
     Mb: np.ndarray
     names: list[str]
@@ -144,7 +144,7 @@ def run_arrays(packed: PackedBatches, names: list[str], values: np.ndarray):
     run. Returns arrays for m * nb runs ordered (set, batch).
     """
     m, nb = values.shape[0], packed.n_batches
-    X0 = np.repeat(packed.X0[None, :, :], m, axis=0).copy()
+    X0 = np.repeat(packed.x0[None, :, :], m, axis=0).copy()
     PP = np.repeat(packed.PB[None, :, :], m, axis=0).copy()
     for j, name in enumerate(names):
         v = values[:, :, j]
