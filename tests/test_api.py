@@ -122,7 +122,7 @@ def test_results_display_and_plot_without_pyplot():
 
     ds = roastlab.read_dataset(DATA / "dataset-I")
     result = roastlab.fit(ds.batches[:2], "120kg", seed=0, starts=2)
-    assert repr(result).startswith("<FitResult <FittedModel 120kg") and "<table>" in result._repr_html_()
+    assert repr(result).startswith("<FitResult <FittedModel 120kg") and "<table" in result._repr_html_()
     assert "hgm" in result.report() and "std. error" in result.report()
     before = plt.get_fignums()
     fig = result.plot()

@@ -404,7 +404,10 @@ def test_the_docs_own_controller_example_runs():
     block = re.findall(r"```python\n(.*?)```", doc, re.S)[-1]
     namespace: dict = {}
     exec(compile(block, "docs/control.md", "exec"), namespace)  # noqa: S102 - the project's own doc
-    assert namespace["table"].summary()["mean_rmse_C"]["mpc"] < namespace["table"].summary()["mean_rmse_C"]["bang-bang"]
+    assert (
+        namespace["table"].statistics()["mean_rmse_C"]["mpc"]
+        < namespace["table"].statistics()["mean_rmse_C"]["bang-bang"]
+    )
 
 
 def test_mpc_can_also_track_the_rate_of_rise(model, reference):

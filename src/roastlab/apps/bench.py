@@ -249,7 +249,7 @@ def control_bench(quiet: bool = False, horizon_s: float = 300.0, sample_s: float
     out["speedup_vs_casadi"] = out["casadi"]["step_ms_median"] / out["mpc"]["step_ms_median"]
     _log("standard scenarios: PID and MPC ...", quiet)
     cmp = compare(model, ref, standard_scenarios(), ("pid", "pid-bumpless", "mpc"))
-    summary = cmp.summary()
+    summary = cmp.statistics()
     out["mpc_over_pid_bumpless_disturbed"] = cmp.worst_ratio("mpc", "pid-bumpless")
     out["pid_bumpless_mean_rmse_C"] = summary["mean_rmse_C"]["pid-bumpless"]
     out["scenarios"] = [

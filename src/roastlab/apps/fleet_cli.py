@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 from ..errors import InputError
-from .common import count_arg, progress, write_json_and_plot
+from .common import count_arg, json_text, progress
 
 
 def _db_output(db, inputs) -> Path:
@@ -81,7 +81,10 @@ def cmd_fleet_report(args) -> int:
     report = fleet_report(args.db)
     print(report.table())
     with outputs as out:
-        write_json_and_plot(out, args, report.to_json_dict(), report)
+        if args.json:
+            out.write_text(args.json, json_text(report.to_dict()))
+        if args.plot:
+            report.plot_machines(args.plot, outputs=out)
     return 0
 
 

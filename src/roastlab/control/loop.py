@@ -39,6 +39,7 @@ from ..metrics.profile import crossing_or_projected_s, rate_of_rise_C_per_min
 from ..model.layout import S_HE, S_TA, S_TB, S_TM, S_X
 from ..model.parameters import REGISTRY
 from ..model.rhs import N_STATES, P
+from ..report.result import Result, draw_curves
 from ..sim.kernels import H0_S
 from ..sim.simulate import advance
 from .base import LoopSetup
@@ -147,7 +148,7 @@ def prepare(
 
 
 @dataclasses.dataclass
-class ClosedLoopResult:
+class ClosedLoopResult(Result):
     """One closed-loop roast: the trace, the metrics and what was noted."""
 
     controller: str
@@ -193,10 +194,29 @@ class ClosedLoopResult:
         self.to_frame().to_csv(buf, index=False, float_format="%.6f", lineterminator="\n")
         return buf.getvalue()
 
-    def plot(self, path=None, title: str | None = None, outputs=None):
+    def summary(self) -> str:
+        """One line of the run's metrics."""
+        m = self.metrics
+        ror = m.get("ror_rmse_C_per_min")
+        drop = m.get("drop_time_error_s")
+        return (
+            f"{self.controller} on {self.scenario}: BT RMSE {m['rmse_C']:.2f} °C (max {m['max_abs_C']:.2f} °C), "
+            f"RoR RMSE {'-' if ror is None else f'{ror:.2f}'} °C/min, DROP {'-' if drop is None else f'{drop:+.0f}'} s, "
+            f"{m['constraint_violations']} clipped request(s)"
+        )
+
+    def to_json_dict(self) -> dict:
+        """The metrics (``METRICS.json``) and the notes."""
+        return {**self.metrics, "notes": list(self.notes)}
+
+    def _figure(self, path, outputs, title: str | None = None):
         from ..report.figures import plot_closed_loop
 
         return plot_closed_loop(self, path, title, outputs)
+
+    def _draw(self, ax) -> None:
+        t = self.time_s
+        draw_curves(ax, {"reference BT": (t, self.reference_C), "roaster BT": (t, self.bt_C)}, "BT [°C]")
 
 
 def _metrics(t, ref, bt, u_applied, u0, violations, step_ms, end_s) -> dict:
@@ -358,14 +378,51 @@ TABLE = (
 )
 
 
+class _SummaryText(str):
+    """The comparison's summary text; indexing it by a key of :meth:`Comparison.statistics`
+    still works for one release, with a DeprecationWarning (``summary()`` returned that dict)."""
+
+    def __new__(cls, text: str, statistics: dict):
+        obj = super().__new__(cls, text)
+        obj._statistics = statistics
+        return obj
+
+    def __getitem__(self, key):
+        if isinstance(key, str):
+            import warnings
+
+            warnings.warn(
+                "Comparison.summary() is text now; use Comparison.statistics() for the numbers",
+                DeprecationWarning,
+                stacklevel=2,
+            )
+            return self._statistics[key]
+        return super().__getitem__(key)
+
+
 @dataclasses.dataclass
-class Comparison:
+class Comparison(Result):
     """Every controller on every scenario: the metric rows and the runs behind them."""
 
     rows: list[dict]
     results: dict
 
-    def summary(self) -> dict:
+    def summary(self) -> str:
+        """The comparison table (:meth:`table`)."""
+        return _SummaryText(self.table(), self.statistics())
+
+    def to_frame(self):
+        """One row per scenario and controller: the metrics."""
+        import pandas as pd
+
+        return pd.DataFrame(self.rows)
+
+    def _draw(self, ax) -> None:
+        stats = self.statistics()["mean_rmse_C"]
+        ax.bar(list(stats), list(stats.values()), color="tab:blue")
+        ax.set_ylabel("mean BT RMSE over the scenarios [°C]")
+
+    def statistics(self) -> dict:
         """Mean RMSE per controller, and on the disturbed scenarios (all but 'nominal') each
         controller's RMSE over the PID's (Artisan's start), worst case."""
         out: dict = {"mean_rmse_C": {}, "worst_ratio_to_pid_disturbed": {}}
@@ -406,7 +463,7 @@ class Comparison:
             "  ".join(str(c).ljust(w) if i < 2 else str(c).rjust(w) for i, (c, w) in enumerate(zip(row, widths)))
             for row in lines
         ]
-        s = self.summary()
+        s = self.statistics()
         text.append("")
         text.append("mean RMSE: " + ", ".join(f"{c} {v:.2f} °C" for c, v in s["mean_rmse_C"].items()))
         for c, v in s["worst_ratio_to_pid_disturbed"].items():
@@ -415,9 +472,9 @@ class Comparison:
         return "\n".join(text)
 
     def to_json_dict(self) -> dict:
-        return {"rows": self.rows, "summary": self.summary(), "note": "synthetic closed-loop runs on the model"}
+        return {"rows": self.rows, "summary": self.statistics(), "note": "synthetic closed-loop runs on the model"}
 
-    def plot(self, path=None, outputs=None):
+    def _figure(self, path, outputs):
         from ..report.figures import plot_control_comparison
 
         return plot_control_comparison(self.rows, self.results, path, outputs)

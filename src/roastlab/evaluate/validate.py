@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..report.result import Result, draw_curves
 from .metrics import METRIC_NAMES, absolute_error_moments, average_metrics, batch_metrics
 
 #: Predicted states written beside measured and predicted Ta (Ta itself is Ta_pred_C).
@@ -19,7 +20,7 @@ MIN_SECOND_OUTPUT_SAMPLES = 3
 
 
 @dataclass
-class ValidationResult:
+class ValidationResult(Result):
     """Per-batch predictions and metrics of one dataset."""
 
     names: list[str]
@@ -59,14 +60,22 @@ class ValidationResult:
             out[r.name] = pd.DataFrame(cols)
         return out
 
-    def _repr_html_(self) -> str:
-        return f"<p>{repr(self)[1:-1]}</p>" + self.to_frame().to_html(float_format=lambda v: f"{v:.3f}")
+    def summary(self) -> str:
+        """The metrics table (:meth:`table`)."""
+        return self.table()
 
-    def plot(self, path=None, title=None):
-        """Measured vs predicted BT per batch with residuals; returns the Figure."""
+    def _figure(self, path, outputs, title=None):
+        """Measured vs predicted BT per batch with residuals."""
         from ..report.figures import plot_fit
 
-        return plot_fit(self, path, title)
+        return plot_fit(self, path, title, outputs=outputs)
+
+    def _draw(self, ax) -> None:
+        curves = {}
+        for name, t, m, p in list(zip(self.names, self.time_s, self.measured, self.predicted))[:4]:
+            curves[f"{name} measured"] = (t, m)
+            curves[f"{name} predicted"] = (t, p)
+        draw_curves(ax, curves, "BT [°C]")
 
     @property
     def average(self) -> dict:

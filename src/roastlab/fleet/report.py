@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
+from ..report.result import Result
 from .drift import CLIP_Z, CUSUM_H, CUSUM_K, OUTLIER_FIT, OUTLIER_RATIO, WARMUP, analyse, machine_history, robust_stats
 from .store import open_store
 
@@ -59,7 +60,7 @@ class MachineHistory:
 
 
 @dataclass
-class FleetReport:
+class FleetReport(Result):
     machines: list[MachineHistory]
     db: str
 
@@ -77,6 +78,39 @@ class FleetReport:
             },
             "machines": [m.to_json_dict() for m in self.machines],
         }
+
+    def summary(self) -> str:
+        """The report's table (:meth:`table`)."""
+        return self.table()
+
+    def to_frame(self):
+        """One row per machine and coefficient: batches, median FIT, the coefficient's median and spread."""
+        import pandas as pd
+
+        rows = []
+        for m in self.machines:
+            d = m.to_json_dict()
+            for p, c in d["coefficients"].items():
+                row = {"machine": m.name, "batches": d["batches"], "FIT_median": d["FIT_median"], "coefficient": p}
+                rows.append({**row, "median": c["median"], "spread_percent": c["spread_percent"]})
+        return pd.DataFrame(rows)
+
+    def _draw(self, ax) -> None:
+        for m in self.machines:
+            fit = np.asarray(m.frame["FIT"], dtype=float)
+            ax.plot(np.arange(1, fit.size + 1), fit, lw=0.8, label=m.name)
+        ax.set_xlabel("batch")
+        ax.set_ylabel("FIT of each batch's own fit [%]")
+        ax.legend(fontsize=8)
+
+    def _figure(self, path, outputs):
+        """An overview of every machine: each batch's FIT in time order (per-machine coefficient
+        histories: :meth:`plot_machines`)."""
+        from ..report.figures import finish_figure, new_figure
+
+        fig = new_figure(figsize=(8, 4))
+        self._draw(fig.add_subplot(1, 1, 1))
+        return finish_figure(fig, path, f"fleet: {len(self.machines)} machine(s)", outputs)
 
     def table(self) -> str:
         """A readable summary: a line per machine and coefficient, then the alarms."""
@@ -98,7 +132,7 @@ class FleetReport:
                 )
         return "\n".join(lines)
 
-    def plot(self, folder, outputs=None) -> list[Path]:
+    def plot_machines(self, folder, outputs=None) -> list[Path]:
         """One figure per machine (``<machine>.png``): each coefficient over time, alarms marked.
 
         Written into ``outputs`` (an :class:`~roastlab.io.files.Outputs`) if given, else all

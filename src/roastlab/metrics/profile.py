@@ -39,6 +39,18 @@ ROR_SPAN_S = 30.0
 PROJECTION_WINDOW_S = 120.0
 
 
+def mmss(seconds: float | None) -> str:
+    """A time in the roaster's m:ss ("-" when None or not finite).
+
+    >>> mmss(457.4), mmss(-5), mmss(None)
+    ('7:37', '-0:05', '-')
+    """
+    if seconds is None or not np.isfinite(seconds):
+        return "-"
+    s = int(round(abs(float(seconds))))
+    return f"{'-' if seconds < 0 else ''}{s // 60}:{s % 60:02d}"
+
+
 def ror_operator(time_s, span_s: float = ROR_SPAN_S) -> tuple[sparse.csr_matrix, np.ndarray]:
     """(D, valid): the rate of rise as a linear map, ``RoR = D @ temp_C`` [degC/min] where ``valid``.
 

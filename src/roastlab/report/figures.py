@@ -52,7 +52,7 @@ def save_figure(fig, path, outputs: Outputs | None = None) -> None:
             out.write_bytes(path, data)
 
 
-def _finish(fig, path, title, outputs=None):
+def finish_figure(fig, path, title, outputs=None):
     if title:
         fig.suptitle(title)
     if path is not None:
@@ -108,7 +108,7 @@ def plot_simulation(result, path=None, title=None, outputs=None, events=None):
     axes[3].set_xlabel("time since CHARGE [min]")
     axes[3].legend(fontsize=7, ncol=2)
     axes[3].grid(alpha=0.3)
-    return _finish(fig, path, title, outputs)
+    return finish_figure(fig, path, title, outputs)
 
 
 def plot_fit(result, path=None, title=None, max_panels: int = 8, outputs=None):
@@ -139,7 +139,7 @@ def plot_fit(result, path=None, title=None, max_panels: int = 8, outputs=None):
         res.grid(alpha=0.3)
     if len(result.names) > k:
         title = f"{title or ''} (first {k} of {len(result.names)} batches)".strip()
-    return _finish(fig, path, title, outputs)
+    return finish_figure(fig, path, title, outputs)
 
 
 def _profile_panel(ax, result, i, label=None):
@@ -165,7 +165,7 @@ def plot_fig2(ident, valid, path, note="synthetic data", outputs=None):
         _profile_panel(axes[r][1], res, best, f"{right}) {label} {res.names[best]} (best)")
         for ax in axes[r]:
             ax.set_xlabel("time [min]")
-    return _finish(fig, path, f"Temperature profiles, measured vs simulated ({note})", outputs)
+    return finish_figure(fig, path, f"Temperature profiles, measured vs simulated ({note})", outputs)
 
 
 def plot_fig3(ident, valid, path, note="synthetic data", outputs=None):
@@ -191,7 +191,7 @@ def plot_fig3(ident, valid, path, note="synthetic data", outputs=None):
     ax.legend(handles=handles, fontsize=7, loc="upper right")
     ax.set_title(f"Absolute error distribution ({note})")
     ax.grid(alpha=0.3, axis="y")
-    return _finish(fig, path, None, outputs)
+    return finish_figure(fig, path, None, outputs)
 
 
 def plot_whatif(w, path=None, outputs=None):
@@ -237,7 +237,7 @@ def plot_whatif(w, path=None, outputs=None):
     ax2.set_xlabel("time after CHARGE [min]")
     ax2.legend(loc="upper right", fontsize=7, ncol=2)
     ax2.grid(alpha=0.3)
-    return _finish(fig, path, f"what if: {b.name}", outputs)
+    return finish_figure(fig, path, f"what if: {b.name}", outputs)
 
 
 def plot_transfer(r, path=None, outputs=None):
@@ -297,7 +297,7 @@ def plot_transfer(r, path=None, outputs=None):
     ax3.set_xlabel("time after CHARGE [min]")
     ax3.legend(loc="upper right", fontsize=7)
     ax3.grid(alpha=0.3)
-    return _finish(fig, path, f"transfer: {r.reference}", outputs)
+    return finish_figure(fig, path, f"transfer: {r.reference}", outputs)
 
 
 def plot_closed_loop(r, path=None, title=None, outputs=None):
@@ -353,7 +353,7 @@ def plot_closed_loop(r, path=None, title=None, outputs=None):
     ax_m.legend(loc="lower right", fontsize=7)
     ax_m.grid(alpha=0.3)
     title = title or f"{r.controller} on '{r.scenario}'"
-    return _finish(fig, path, title, outputs)
+    return finish_figure(fig, path, title, outputs)
 
 
 def plot_control_comparison(rows, results, path=None, outputs=None):
@@ -407,7 +407,7 @@ def plot_control_comparison(rows, results, path=None, outputs=None):
     axes[0].legend(fontsize=7)
     bottom.supylabel("BT - reference [°C]", fontsize=9)
     bottom.supxlabel("time after CHARGE [min]", fontsize=9)
-    return _finish(fig, path, "closed-loop comparison (synthetic scenarios)", outputs)
+    return finish_figure(fig, path, "closed-loop comparison (synthetic scenarios)", outputs)
 
 
 def plot_fleet_history(m, path=None, outputs=None):
@@ -461,4 +461,4 @@ def plot_fleet_history(m, path=None, outputs=None):
         ax.legend(uniq.values(), uniq.keys(), fontsize=7, loc="upper right")
     axes[-1].set_xlabel("batch (in order of started_at)")
     title = f"{m.name} ({Path(m.plant).name}): {len(idx)} batches, {len(a['alarms'])} alarm(s), {len(a['outliers'])} outlier(s)"
-    return _finish(fig, path, title, outputs)
+    return finish_figure(fig, path, title, outputs)

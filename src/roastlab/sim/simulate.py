@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ParameterError
+from ..metrics.profile import mmss
 from ..model.layout import N_STATES, PAPER_STATE_NAMES, S_H, S_HE, S_TA, S_TB, S_TM, S_X, STATE0, S
 from ..model.limits import check_array, check_value
 from ..model.quantities import default
@@ -25,6 +26,7 @@ from ..model.rhs import (
     reaction_heat_rate_kW_kg,
     shell_loss_kW,
 )
+from ..report.result import Result, draw_curves
 from .kernels import H0_S, H_MAX_S, I_TGO, NS, simulate_one, step_kernel
 
 
@@ -64,7 +66,7 @@ def check_hold(hold: str) -> bool:
 
 
 @dataclass
-class SimulationResult:
+class SimulationResult(Result):
     """States and outputs of one simulated batch, sampled at the input times.
 
     Attributes
@@ -173,13 +175,24 @@ class SimulationResult:
         """The CSV of the CLI contract as text (6 decimals); ``heat_flows`` adds Qgb, Qgm, Qbm, Qr."""
         return self.to_frame(heat_flows=heat_flows).to_csv(index=False, float_format="%.6f", lineterminator="\n")
 
+    def to_json_dict(self, heat_flows: bool = False) -> dict:
+        """``{"name", "columns": {column: values}}`` (6 decimals); ``heat_flows`` adds the heat flows."""
+        frame = self.to_frame(heat_flows=heat_flows)
+        return {"name": self.name, "columns": {c: frame[c].round(6).tolist() for c in frame.columns}}
+
     def to_json_text(self, heat_flows: bool = False) -> str:
         """A JSON object of column arrays as text; ``heat_flows`` adds the heat flows."""
         import json
 
-        frame = self.to_frame(heat_flows=heat_flows)
-        payload = {"name": self.name, "columns": {c: frame[c].round(6).tolist() for c in frame.columns}}
-        return json.dumps(payload, indent=1, allow_nan=False) + "\n"
+        return json.dumps(self.to_json_dict(heat_flows), indent=1, allow_nan=False) + "\n"
+
+    def summary(self) -> str:
+        """One line: the run's length and its end state, in the roaster's words."""
+        return (
+            f"{self.name}: {len(self.time_s)} samples over {mmss(self.time_s[-1] - self.time_s[0])}; at the end "
+            f"BT (probe) {self.Ta_C[-1]:.1f} °C, beans {self.Tb_C[-1]:.1f} °C, drum metal {self.Tm_C[-1]:.1f} °C, "
+            f"moisture {self.X_kg_kg[-1]:.3f} kg/kg dry"
+        )
 
     def to_csv(self, path, heat_flows: bool = False) -> None:
         """Write the CSV of the CLI contract to ``path`` atomically (``heat_flows`` as in :meth:`to_csv_text`)."""
@@ -193,11 +206,17 @@ class SimulationResult:
 
         atomic_write_text(path, self.to_json_text(heat_flows))
 
-    def plot(self, path=None, title: str | None = None):
-        """Figure of BT/ET, rate of rise, moisture and heat flows, titled ``title``; saved to ``path`` if given."""
+    def _figure(self, path, outputs, title: str | None = None, events=None):
+        """BT/ET, rate of rise, moisture and heat flows, titled ``title``."""
         from ..report.figures import plot_simulation
 
-        return plot_simulation(self, path=path, title=title)
+        return plot_simulation(self, path=path, title=title, outputs=outputs, events=events)
+
+    def _draw(self, ax) -> None:
+        t = self.time_s
+        curves = {"BT, probe Ta (model)": (t, self.Ta_C), "beans Tb (model)": (t, self.Tb_C)}
+        curves.update({"drum metal Tm (model)": (t, self.Tm_C), "BT measured": (t, self.Ta_measured_C)})
+        draw_curves(ax, curves)
 
 
 def simulate(

@@ -10,7 +10,6 @@
 from __future__ import annotations
 
 import dataclasses
-import html
 from pathlib import Path
 
 import numpy as np
@@ -23,13 +22,14 @@ from ..io.fitspec import FitSpec, load_fit_spec
 from ..io.importers.mapping import ColumnMap
 from ..io.plants import load_plant
 from ..model.parameters import REGISTRY, STATE0, THETA_NAMES, THETA_START
+from ..report.result import Result
 from ..sim.population import pack_batches
 from ..sim.simulate import InitialState
 from .model import PAPER_INITIAL, PLACEHOLDER_GG_KG_S, FittedModel, provenance
 
 
 @dataclasses.dataclass
-class FitResult:
+class FitResult(Result):
     """What :func:`fit` returns: the model, the identification behind it, its fit-set validation."""
 
     model: FittedModel
@@ -71,16 +71,24 @@ class FitResult:
 
         return pd.DataFrame(self.model.table(), columns=["name", "value", "stderr", "unit", "how"]).set_index("name")
 
-    def plot(self, path=None, title=None):
-        """Fit-set figure (measured vs predicted BT, residuals); saved to ``path`` if given, titled ``title``."""
-        return self.validation.plot(path, title or "fit set: measured vs predicted BT")
+    def summary(self) -> str:
+        """The text report (:meth:`report`)."""
+        return self.report()
+
+    def to_json_dict(self) -> dict:
+        """The identification (values, standard errors, covariance, AIC/BIC) and the fit-set validation."""
+        return {"identification": self.identification.to_json_dict(), "validation": self.validation.to_json_dict()}
+
+    def _figure(self, path, outputs, title=None):
+        """Fit-set figure (measured vs predicted BT, residuals)."""
+        return self.validation.plot(path, outputs=outputs, title=title or "fit set: measured vs predicted BT")
+
+    def _draw(self, ax) -> None:
+        self.validation.plot(ax=ax)
 
     def __repr__(self) -> str:
         a = self.validation.average
         return f"<FitResult {self.model!r}, fit-set FIT {a['FIT']:.2f} %, MAE {a['MAE']:.3f} °C>"
-
-    def _repr_html_(self) -> str:
-        return self.model._repr_html_() + f"<pre>{html.escape(self.report())}</pre>"
 
 
 def _spec_parts(spec, fix, bounds, estimate_tm0):

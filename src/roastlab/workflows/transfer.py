@@ -25,6 +25,7 @@ from ..io.batch import Batch
 from ..metrics.profile import crossing_or_projected_s, crossing_time_s
 from ..model.limits import check_value
 from ..model.plant import Plant
+from ..report.result import Result, draw_curves
 
 #: Probe temperatures [degC] whose crossing times define the phases of the retimed baseline:
 #: end of drying (~150 degC, Artisan's DRY) and start of first crack (~196 degC, FCs).
@@ -44,7 +45,7 @@ def _errors(pred, target) -> dict:
 
 
 @dataclasses.dataclass
-class TransferResult:
+class TransferResult(Result):
     """The program, its predicted curve, the baselines and the metrics of a transfer."""
 
     reference: str
@@ -182,10 +183,25 @@ class TransferResult:
         }
         return repr(profile) + "\n"
 
-    def plot(self, path, outputs=None) -> None:
+    def to_frame(self):
+        """The program on its knots: time, the inputs, the target and the predicted probe."""
+        import pandas as pd
+
+        pr = self.program
+        cols = {"time_s": pr.time_s, "Gg_kg_s": pr.Gg_kg_s, "Tgi_C": pr.Tgi_C}
+        if self.actuators:
+            cols["heater"] = pr.heater
+        cols.update({"target_C": self.target_C, "Ta_pred_C": pr.Ta_pred_C})
+        return pd.DataFrame(cols)
+
+    def _figure(self, path, outputs):
         from ..report.figures import plot_transfer
 
-        plot_transfer(self, path, outputs=outputs)
+        return plot_transfer(self, path, outputs=outputs)
+
+    def _draw(self, ax) -> None:
+        t = self.time_s
+        draw_curves(ax, {"reference BT": (t, self.target_C), "predicted BT": (t, self.program.Ta_pred_C)}, "BT [°C]")
 
 
 def _grid_batch(ref: Batch, interval_s: float) -> Batch:

@@ -17,6 +17,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..io.batch import Batch
 from ..metrics.profile import crossing_or_projected_s, crossing_time_s  # noqa: F401  (re-exported)
+from ..report.result import Result, draw_curves
 from ..sim.simulate import SimulationResult
 from .model import FittedModel
 
@@ -72,7 +73,7 @@ def parse_set(text: str) -> SettingChange:
 
 
 @dataclass
-class WhatIf:
+class WhatIf(Result):
     """The log, its prediction as run and with the changes, and the comparison table."""
 
     batch: Batch
@@ -92,13 +93,29 @@ class WhatIf:
             lines.append(f"{r['what'] + ' [' + r['unit'] + ']':50s}{fa:>10s}{fc:>10s}{fd:>10s}")
         return "\n".join(lines)
 
+    def summary(self) -> str:
+        """The comparison table (:meth:`table`)."""
+        return self.table()
+
     def to_json_dict(self) -> dict:
         return {"batch": self.batch.name, "changes": self.changes, "rows": self.rows}
 
-    def plot(self, path=None, outputs=None):
+    def to_frame(self):
+        """One row per figure of the table: what, unit, as run, changed."""
+        import pandas as pd
+
+        return pd.DataFrame(self.rows)
+
+    def _figure(self, path, outputs):
         from ..report.figures import plot_whatif
 
         return plot_whatif(self, path, outputs=outputs)
+
+    def _draw(self, ax) -> None:
+        t = self.as_run.time_s
+        curves = {"BT measured": (t, self.batch.Ta_C), "BT as run (model)": (t, self.as_run.Ta_C)}
+        curves["BT changed (model)"] = (t, self.changed.Ta_C)
+        draw_curves(ax, curves, "BT [°C]")
 
 
 def whatif(
