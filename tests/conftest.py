@@ -22,7 +22,7 @@ def real_data():
 @pytest.fixture
 def cli(tmp_path):
     """Run the CLI in-process; returns (exit code, stdout, stderr)."""
-    from roastlab.apps.cli import main
+    from roastlab.cli import main
 
     def run(*args, capsys=None):
         import contextlib

@@ -138,7 +138,7 @@ def test_negative_geometry(cli, tmp_path, check_inputs):
 def test_second_cli_process_uses_disk_cache(tmp_path, check_inputs):
     """The compiled kernel is loaded from numba's on-disk cache in a fresh process."""
     code = (
-        "import sys; from roastlab.apps.cli import main; main(sys.argv[1:]);"
+        "import sys; from roastlab.cli import main; main(sys.argv[1:]);"
         "from roastlab.sim.kernels import simulate_population_kernel as f; print('HITS', sum(f.stats.cache_hits.values()), 'MISSES', sum(f.stats.cache_misses.values()))"
     )
     args = [
@@ -185,7 +185,7 @@ def test_batch_green_weight_overrides_plant(cli, tmp_path, check_inputs):
 
 
 def test_every_subcommand_help_names_the_model_file():
-    from roastlab.apps.cli import build_parser
+    from roastlab.cli import build_parser
 
     parser = build_parser()
     assert "MODEL.json" in parser.format_help()

@@ -8,7 +8,7 @@ import warnings
 import numpy as np
 import pytest
 
-from roastlab.apps.cli import main
+from roastlab.cli import main
 from roastlab.control import (
     MPC,
     PID,

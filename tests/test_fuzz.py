@@ -398,7 +398,7 @@ NAME_CHARS = st.characters(blacklist_characters="/\x00", blacklist_categories=("
 def test_fuzz_control_characters_in_names_stay_data(name):
     """A log named with newlines, tabs, escapes or any Unicode imports into a batch CSV whose
     header and rows are the same as for a plain name: the name never becomes structure."""
-    from roastlab.apps.cli import main
+    from roastlab.cli import main
     from roastlab.io.batch import read_batch_csv as read
 
     with tempfile.TemporaryDirectory() as tmp:

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from roastlab.apps.cli import build_parser
+from roastlab.cli import build_parser
 from test_bad_input import GOOD_ALOG, GOOD_ROWS, HEADER, PLANT
 
 #: Options that name a file or folder the command writes.
@@ -113,7 +113,7 @@ SMALL_PLANT = "Mb_kg = 0.2\nDch_m = 0.16\nLch_m = 0.2\nHflap_m = 0.02\nSflap_m =
 @pytest.fixture(scope="module")
 def model_text(tmp_path_factory):
     """A model file fitted on the small log with the map (made once per module)."""
-    from roastlab.apps.cli import main
+    from roastlab.cli import main
 
     d = tmp_path_factory.mktemp("model")
     _inputs(d)

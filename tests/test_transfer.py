@@ -7,7 +7,6 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from roastlab.apps.bench import random_reference
 from roastlab.fit.program import ProgramLimits, limit_spans
 from roastlab.io.batch import read_batch_csv, write_batch_csv
 from roastlab.io.importers.artisan import read_alog
@@ -15,6 +14,7 @@ from roastlab.model.plant import as_plant
 from roastlab.model.rhs import P, pack_params
 from roastlab.sim.kernels import H_MAX_S, simulate_one
 from roastlab.sim.sensitivity import ta_input_jacobian
+from roastlab.workflows.datasets import random_reference
 from roastlab.workflows.transfer import transfer
 
 

@@ -1,1 +1,1 @@
-"""roastlab.apps"""
+"""Deprecated location of the command line (now :mod:`roastlab.cli`)."""

@@ -148,3 +148,23 @@ def _make_paper_into(outputs: Outputs, folder: Path, rng, seed: int, written: li
     )
     outputs.write_text(folder / "README.md", readme)
     written.append(folder / "README.md")
+
+
+def random_reference(rng, plant: str, minutes: float = 15.0, interval_s: float = 5.0):
+    """A noise-free SYNTHETIC reference on ``plant`` with the paper's model: an inlet program
+    through random levels (380-500 degC every 2 min, at most 60 degC/min), a constant flow
+    scaled with the batch. Returns (model, Batch)."""
+    from ..io.batch import Batch
+    from ..io.plants import load_plant
+    from .model import FittedModel
+
+    model = FittedModel.paper(plant)
+    t = np.arange(0.0, minutes * 60.0 + 1e-9, interval_s)
+    knots = np.arange(0.0, t[-1] + 120.0, 120.0)
+    Tgi = np.interp(t, knots, rng.uniform(380.0, 500.0, len(knots)))
+    step = 60.0 / 60.0 * interval_s
+    for k in range(1, len(t)):
+        Tgi[k] = Tgi[k - 1] + np.clip(Tgi[k] - Tgi[k - 1], -step, step)
+    Gg = np.full(len(t), rng.uniform(0.30, 0.45) * load_plant(plant).Mb_kg / 120.0)
+    ta = model.predict(Batch("reference", t, Gg, Tgi), Ta0_C=25.0).Ta_C
+    return model, Batch(f"synthetic-{plant}", t, Gg, Tgi, ta.copy())

@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 from ..errors import InputError
-from .common import count_arg, json_text, progress
+from .common import Parser, count_arg, json_text, progress
 
 
 def _db_output(db, inputs) -> Path:
@@ -101,7 +101,9 @@ def cmd_fleet_synthetic(args) -> int:
     return 0
 
 
-def add_fleet_command(sub, parser_class) -> None:
+def add_parsers(sub) -> None:
+    """Register ``roastlab fleet`` and its subcommands on the subparsers ``sub``."""
+    parser_class = Parser
 
     p = sub.add_parser(
         "fleet",

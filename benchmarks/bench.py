@@ -45,7 +45,8 @@ from pathlib import Path
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from ..model.rhs import rhs
+from roastlab.model.rhs import rhs
+from roastlab.workflows.datasets import random_reference
 
 TARGETS = {
     "transfer_rmse_C": ("<=", 0.5),
@@ -87,26 +88,6 @@ def baseline_simulate(t, Gg, Tgi, x0, p):
     return sol.y.T
 
 
-def random_reference(rng, plant: str, minutes: float = 15.0, interval_s: float = 5.0):
-    """A noise-free SYNTHETIC reference on ``plant`` with the paper's model: an inlet program
-    through random levels (380-500 degC every 2 min, at most 60 degC/min), a constant flow
-    scaled with the batch. Returns (model, Batch)."""
-    from ..io.batch import Batch
-    from ..io.plants import load_plant
-    from ..workflows.model import FittedModel
-
-    model = FittedModel.paper(plant)
-    t = np.arange(0.0, minutes * 60.0 + 1e-9, interval_s)
-    knots = np.arange(0.0, t[-1] + 120.0, 120.0)
-    Tgi = np.interp(t, knots, rng.uniform(380.0, 500.0, len(knots)))
-    step = 60.0 / 60.0 * interval_s
-    for k in range(1, len(t)):
-        Tgi[k] = Tgi[k - 1] + np.clip(Tgi[k] - Tgi[k - 1], -step, step)
-    Gg = np.full(len(t), rng.uniform(0.30, 0.45) * load_plant(plant).Mb_kg / 120.0)
-    ta = model.predict(Batch("reference", t, Gg, Tgi), Ta0_C=25.0).Ta_C
-    return model, Batch(f"synthetic-{plant}", t, Gg, Tgi, ta.copy())
-
-
 TRANSFER_CASES = (
     ("120kg", "360kg", None),
     ("360kg", "120kg", None),
@@ -119,7 +100,7 @@ def transfer_bench(quiet: bool = False, seed: int = 2026, scipy_simulations: int
     """The transfer figures (see the module docstring)."""
     from scipy.optimize import minimize
 
-    from ..workflows.transfer import transfer
+    from roastlab.workflows.transfer import transfer
 
     rng = np.random.default_rng(seed)
     cases, results = [], []
@@ -216,10 +197,10 @@ def _steps_per_second(step, reset, seconds: float = 2.0) -> float:
 def control_bench(quiet: bool = False, horizon_s: float = 300.0, sample_s: float = 10.0) -> dict:
     """MPC against CasADi + IPOPT on the same problem (same run), the standard scenarios' RMSE for
     MPC and PID, and the Gymnasium environments' step rates."""
-    from ..control import MPC, compare, run_closed_loop, standard_reference, standard_scenarios
-    from ..control.casadi_mpc import CasadiMPC
-    from ..io.scenario import scenario_from_mapping
-    from ..workflows.model import FittedModel
+    from roastlab.control import MPC, compare, run_closed_loop, standard_reference, standard_scenarios
+    from roastlab.control.casadi_mpc import CasadiMPC
+    from roastlab.io.scenario import scenario_from_mapping
+    from roastlab.workflows.model import FittedModel
 
     model = FittedModel.paper("120kg")
     ref = standard_reference()
@@ -262,7 +243,7 @@ def control_bench(quiet: bool = False, horizon_s: float = 300.0, sample_s: float
     _log("Gymnasium environments ...", quiet)
     import gymnasium
 
-    from ..control.environment import RoastVectorEnv
+    from roastlab.control.environment import RoastVectorEnv
 
     env = gymnasium.make("roastlab/Roast-v0")
     action = np.array([400.0], dtype=np.float32)
@@ -294,7 +275,7 @@ def _log(msg: str, quiet: bool) -> None:
 
 
 def _fleet_batches(count: int, seed: int = 7):
-    from ..workflows.datasets import make_batch
+    from roastlab.workflows.datasets import make_batch
 
     rng = np.random.default_rng(seed)
     return [make_batch(rng, "120kg", i + 1, cold_first=(i % 5 == 0))[0] for i in range(count)]
@@ -317,14 +298,14 @@ def _peak_memory_child(count: int) -> dict:
 
 
 def run(quiet: bool = False, baseline_repeats: int = 5, only: str | None = None) -> dict:
-    from ..fit.batchfit import identify_each
-    from ..fit.identify import build_free_parameters, identify
-    from ..io.batch import read_dataset
-    from ..io.plants import load_plant
-    from ..model.parameters import THETA_PAPER, THETA_START
-    from ..sim.population import pack_batches, simulate_population
-    from ..sim.simulate import InitialState, simulate
-    from ..workflows.reproduce import default_dataset_root
+    from roastlab.fit.batchfit import identify_each
+    from roastlab.fit.identify import build_free_parameters, identify
+    from roastlab.io.batch import read_dataset
+    from roastlab.io.plants import load_plant
+    from roastlab.model.parameters import THETA_PAPER, THETA_START
+    from roastlab.sim.population import pack_batches, simulate_population
+    from roastlab.sim.simulate import InitialState, simulate
+    from roastlab.workflows.reproduce import default_dataset_root
 
     root = default_dataset_root()
     ds = read_dataset(root / "dataset-I")
@@ -622,7 +603,7 @@ print(json.dumps({"ingest_s": t1 - t0, "fit_s": t2 - t1, "added": r.added, "fitt
 
 def _fleet_detection(db, truth: dict) -> dict:
     """Delays of the injected changes' alarms and alarms where nothing was injected."""
-    from ..fleet import fleet_report
+    from roastlab.fleet import fleet_report
 
     rep = {m["machine"]: m for m in fleet_report(db).to_json_dict()["machines"]}
     delays, false_alarms, missed = [], 0, 0
@@ -648,8 +629,8 @@ def fleet_bench(quiet: bool, n_batches: int = 100_000, n_dask: int = 10_000) -> 
 
     import duckdb
 
-    from ..fleet import fit_fleet, ingest
-    from ..fleet.synthetic import make_fleet
+    from roastlab.fleet import fit_fleet, ingest
+    from roastlab.fleet.synthetic import make_fleet
 
     tmp = Path(tempfile.mkdtemp(prefix="roastlab-fleet-bench-"))
     try:

@@ -1,0 +1,281 @@
+"""What every command of the ``roastlab`` command line shares: the parser class, argument types, the
+progress bar, the JSON and figure outputs, and the model, batch and initial-state options."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from pathlib import Path
+
+from ..errors import InputError, ParameterError, RoastlabError
+
+MODEL_HELP = "fitted model file from 'roastlab identify' (roastlab-model/1; a THETA.json of roastlab 0.1 also loads)"
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse with one-line errors (exit 2) instead of a usage block."""
+
+    def error(self, message: str):  # noqa: D102
+        self.exit(2, f"{self.prog}: error: {message} (see --help)\n")
+
+
+def float_arg(name: str):
+    def parse(text: str) -> float:
+        try:
+            v = float(text)
+        except (ValueError, OverflowError):
+            raise argparse.ArgumentTypeError(f"{name} must be a number, got {text[:40]!r}") from None
+        if not math.isfinite(v):
+            raise argparse.ArgumentTypeError(f"{name} must be finite, got {text[:40]!r}")
+        return v
+
+    return parse
+
+
+def seed_arg(text: str) -> int:
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"--seed must be an integer, got {text[:40]!r}") from None
+    if not 0 <= v < 2**32:
+        raise argparse.ArgumentTypeError(f"--seed must be in 0..{2**32 - 1}, got {text[:40]}")
+    return v
+
+
+def count_arg(name: str, lo: int, hi: int):
+    def parse(text: str) -> int:
+        try:
+            v = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} must be an integer, got {text[:40]!r}") from None
+        if not lo <= v <= hi:
+            raise argparse.ArgumentTypeError(f"{name} must be in {lo}..{hi}, got {v}")
+        return v
+
+    return parse
+
+
+def progress(desc: str):
+    """A progress callback drawing a tqdm bar on a terminal, shown only for work over ~2 s."""
+    from tqdm import tqdm
+
+    state: dict = {}
+
+    def update(done: int, total: int, text: str = "") -> None:
+        bar = state.get("bar")
+        if bar is None:
+            bar = state["bar"] = tqdm(total=total, desc=desc, file=sys.stderr, delay=2.0, disable=None, leave=False)
+        bar.set_postfix_str(text[:60], refresh=False)
+        bar.update(done - bar.n)
+        if done >= total:
+            bar.close()
+
+    return update
+
+
+def json_text(doc) -> str:
+    """A JSON output file's text: NumPy values made plain, NaN refused, one space indent."""
+    from ..io.modelfile import jsonable
+
+    return json.dumps(jsonable(doc), indent=1, allow_nan=False) + "\n"
+
+
+def write_json_and_plot(out, args, doc, figure) -> None:
+    """Write ``--json`` (``doc``) and ``--plot`` (``figure.plot``) through ``out`` when asked for."""
+    if args.json:
+        out.write_text(args.json, json_text(doc))
+    if args.plot:
+        figure.plot(args.plot, outputs=out)
+
+
+def say(notes) -> None:
+    for note in notes:
+        print(f"note: {note}", file=sys.stderr)
+
+
+# ----------------------------------------------------------------------------- shared options
+def add_model_options(p: argparse.ArgumentParser, with_model: bool = True) -> None:
+    if with_model:
+        p.add_argument("--model", "--theta", dest="model", metavar="MODEL.json", help=MODEL_HELP)
+        p.add_argument("--hgm", type=float_arg("--hgm"), help="gas-metal coefficient [kW/(m2 K)]; overrides the model")
+        p.add_argument("--hbm", type=float_arg("--hbm"), help="metal-bean coefficient [kW/(m2 K)]; overrides the model")
+        p.add_argument(
+            "--pbm", type=float_arg("--pbm"), help="bean-metal contact fraction in (0, 1); overrides the model"
+        )
+    add_initial_options(p)
+    p.add_argument(
+        "--moisture",
+        choices=("schwartzberg", "printed"),
+        help="moisture law, eq. 13 (default: the model's, else schwartzberg)",
+    )
+    p.add_argument(
+        "--hold", choices=("linear", "zoh"), help="input hold between samples (default: the model's, else linear)"
+    )
+
+
+def add_initial_options(p: argparse.ArgumentParser) -> None:
+    """--tb0, --tm0, --x0: the charge state (read back by :func:`initial_changes`)."""
+    from ..model.quantities import default
+
+    p.add_argument(
+        "--tb0",
+        type=float_arg("--tb0"),
+        help=f"initial bean temperature [degC] (default: the model's, else {default('Tb0_C'):g})",
+    )
+    p.add_argument(
+        "--tm0",
+        type=float_arg("--tm0"),
+        help=f"initial drum metal temperature, the preheat [degC] (default: the model's or the log's, else {default('Tm0_C'):g})",
+    )
+    p.add_argument(
+        "--x0",
+        type=float_arg("--x0"),
+        help=f"initial moisture [kg/kg dry] (default: the model's, else {default('X0'):g})",
+    )
+
+
+def initial_changes(args) -> dict:
+    from ..model.limits import check_value
+
+    changes = {}
+    for opt, name in (("tb0", "Tb0_C"), ("tm0", "Tm0_C"), ("x0", "X0")):
+        v = getattr(args, opt, None)
+        if v is not None:
+            changes[name] = check_value(name, v, f"--{opt}")
+    return changes
+
+
+def model_from_args(args, plant_spec):
+    """The model of a command: --model (or the paper's theta*), with --hgm/--hbm/--pbm and variants applied."""
+    from ..workflows.model import FittedModel, load_model
+
+    if getattr(args, "model", None):
+        model = load_model(args.model)
+    else:
+        if plant_spec is None:
+            raise InputError("--plant is required without --model", "command line")
+        model = FittedModel.paper(plant_spec)
+    overrides = {
+        k: getattr(args, o)
+        for k, o in (("hgm", "hgm"), ("hbm", "hbm"), ("Pbm", "pbm"))
+        if getattr(args, o, None) is not None
+    }
+    if overrides:
+        model = model.with_values(**overrides)
+        try:
+            model.theta  # noqa: B018 - validates the overridden theta
+        except RoastlabError as exc:
+            raise InputError(str(exc), "command line") from None
+    for key in ("moisture", "hold"):
+        if getattr(args, key, None):
+            model.doc[key] = getattr(args, key)
+            setattr(model, key, getattr(args, key))
+    return model
+
+
+def parse_assignments(items, option: str, ranged: bool):
+    """Parse ``name=value`` (or ``name=lo:hi`` when ``ranged``) options."""
+    out = {}
+    for item in items or []:
+        name, sep, text = item.partition("=")
+        if not sep or not name:
+            raise InputError(
+                f"{option} expects NAME={'LO:HI' if ranged else 'VALUE'}, got {item[:60]!r}", "command line"
+            )
+        if ranged:
+            out[name.strip()] = range_arg(text, f"{option} {name[:30]}")
+            continue
+        try:
+            value = float(text)
+        except (ValueError, OverflowError):
+            raise InputError(f"{option} {name[:30]}: cannot read {text[:40]!r} as a number", "command line") from None
+        if not math.isfinite(value):
+            raise InputError(f"{option} {name[:30]}: values must be finite", "command line")
+        out[name.strip()] = value
+    return out
+
+
+def range_arg(text: str, label: str) -> tuple[float, float]:
+    """``LO:HI`` as two finite floats with LO < HI; ``label`` names the option in errors."""
+    lo, sep, hi = text.partition(":")
+    try:
+        if not sep:
+            raise ValueError
+        value = (float(lo), float(hi))
+    except (ValueError, OverflowError):
+        raise InputError(f"{label}: cannot read {text[:40]!r} as LO:HI", "command line") from None
+    if not all(math.isfinite(v) for v in value):
+        raise InputError(f"{label}: values must be finite", "command line")
+    if not value[0] < value[1]:
+        raise InputError(f"{label}: inverted or empty bounds {value[0]:g}:{value[1]:g} (need LO < HI)", "command line")
+    return value
+
+
+def load_batches(args, model=None):
+    """The BATCH arguments as batches, and the plant spec to use (--plant, else the dataset's)."""
+    from ..io.batch import expand_batch_args
+    from ..workflows.model import load_log
+
+    if getattr(args, "map", None) or (
+        model is not None and model.column_map is not None and not any(Path(p).is_dir() for p in args.batches)
+    ):
+        cmap = args.map if args.map else model.column_map
+        if all(Path(p).suffix.lower() == ".csv" for p in args.batches) and not args.map:
+            batches, dataset_plant = expand_batch_args(args.batches, require_Ta=True)
+        else:
+            batches, dataset_plant = [load_log(p, cmap) for p in args.batches], None
+        for b in batches:
+            for note in b.notes:
+                print(f"warning: {b.source}: {note}", file=sys.stderr)
+    else:
+        batches, dataset_plant = expand_batch_args(args.batches, require_Ta=True)
+    return batches, args.plant or dataset_plant
+
+
+def fit_inputs(args) -> list:
+    return [*args.batches, args.map, getattr(args, "spec", None), args.plant, getattr(args, "model", None)]
+
+
+def weights_arg(items) -> dict[str, float]:
+    """``--weight OUTPUT=W`` options as checked output weights (errors name the command line)."""
+    from ..fit.identify import check_weights
+
+    given = parse_assignments(items, "--weight", ranged=False)
+    try:
+        check_weights(given)
+    except ParameterError as exc:
+        raise InputError(f"--weight: {exc.problem}", "command line") from None
+    return given
+
+
+FIT_HELP = "batch CSVs (time_s,Gg_kg_s,Tgi_C,Ta_C) and/or dataset folders with a dataset.toml; raw logs with --map"
+
+
+def add_batch_options(p, baseline_help: str) -> None:
+    """Options shared by identify and validate: the batches, their plant, a map, the baseline."""
+    p.add_argument("batches", nargs="+", metavar="BATCH", help=FIT_HELP)
+    p.add_argument("--plant", help="plant preset or PLANT.toml (default: the model's plant, else the dataset's)")
+    p.add_argument(
+        "--map",
+        metavar="MAP.toml",
+        help="the BATCH arguments are raw logs (Artisan .alog/.csv, CSV, Parquet) read with this column map",
+    )
+    p.add_argument("--baseline", choices=("first-order",), help=baseline_help)
+
+
+def read_inputs(path, map_path, model):
+    """A batch CSV, or a raw log read with --map or with the map the model was fitted with."""
+    from ..workflows.model import load_log
+
+    if map_path:
+        return load_log(path, map_path)
+    cmap = None if model is None else model.column_map
+    suffix = Path(path).suffix.lower()
+    raw_csv = suffix == ".csv" and cmap is not None and cmap.format in ("artisan-csv", "csv")
+    if raw_csv or suffix in (".alog", ".json", ".parquet", ".pq"):
+        if cmap is None:
+            raise InputError("a raw log needs a column map: the model has none, pass --map MAP.toml", path)
+        return load_log(path, cmap)
+    return load_log(path)

@@ -1,0 +1,303 @@
+"""``roastlab identify`` and ``roastlab validate``: fit a model file to logs, score it on others."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from ..errors import InputError
+from .common import (
+    add_batch_options,
+    add_model_options,
+    count_arg,
+    fit_inputs,
+    float_arg,
+    initial_changes,
+    json_text,
+    load_batches,
+    model_from_args,
+    parse_assignments,
+    progress,
+    say,
+    seed_arg,
+    weights_arg,
+)
+
+
+def cmd_identify(args) -> int:
+    from ..io.files import Outputs
+
+    outputs = Outputs(fit_inputs(args))
+    outputs.check(args.out)
+    batches, plant_spec = load_batches(args)
+    if plant_spec is None:
+        raise InputError("--plant is required unless a dataset folder names its plant", "command line")
+    if args.baseline:
+        from ..fit.baseline import describe, fit_first_order
+
+        doc = {**fit_first_order(batches), "plant": str(plant_spec)}
+        with outputs as out:
+            out.write_text(args.out, json_text(doc))
+        print(f"first-order baseline on {len(batches)} batch(es): {describe(doc)}, SSR {doc['SSR']:.1f} -> {args.out}")
+        return 0
+    fix = parse_assignments(args.fix, "--fix", ranged=False)
+    bounds = parse_assignments(args.bounds, "--bounds", ranged=True)
+    if args.per_batch:
+        return _identify_per_batch(args, batches, plant_spec, fix, bounds, outputs)
+    from ..io.importers import load_map
+    from ..workflows.fitting import fit
+
+    initial = initial_changes(args)
+    result = fit(
+        batches,
+        plant_spec,
+        args.spec,
+        fix=fix,
+        bounds=bounds,
+        estimate_tm0=args.estimate_tm0,
+        initial=initial,
+        moisture=args.moisture or "schwartzberg",
+        hold=args.hold or "linear",
+        method=args.method,
+        seed=args.seed,
+        starts=args.starts,
+        column_map=load_map(args.map) if args.map else None,
+        progress=progress("identify"),
+        weights=weights_arg(args.weight),
+    )
+    from ..io.modelfile import model_document_text
+
+    with outputs as out:
+        out.write_text(args.out, model_document_text(result.model.to_document()))
+    print(result.report())
+    print(f"-> {args.out}")
+    return 0
+
+
+def _identify_per_batch(args, batches, plant_spec, fix, bounds, outputs) -> int:
+    from ..fit.batchfit import identify_each
+    from ..model.parameters import THETA_NAMES, THETA_START
+    from ..sim.population import pack_batches
+    from ..sim.simulate import InitialState
+    from ..workflows.model import PAPER_INITIAL
+
+    unknown = sorted((set(fix) | set(bounds)) - set(THETA_NAMES))
+    if unknown or args.estimate_tm0 or args.spec:
+        raise InputError(
+            "--per-batch fits hgm, hbm, Pbm only (no --spec, no --estimate-tm0, no other parameters)", "command line"
+        )
+    init = InitialState(**{**PAPER_INITIAL, **initial_changes(args)})
+    packed = pack_batches(
+        batches, plant_spec, THETA_START, init, args.moisture or "schwartzberg", args.hold or "linear"
+    )
+    result = identify_each(packed, bounds=bounds, fix=fix, seed=args.seed, progress=progress("fit per batch"))
+    doc = {**result.to_json_dict(), "plant": str(plant_spec), "fixed": sorted(fix)}
+    with outputs as out:
+        out.write_text(args.out, json_text(doc))
+    print(
+        f"identified theta per batch for {packed.n_batches} batch(es) on plant {plant_spec} in {result.wall_s:.2f} s ({result.simulations} simulations)"
+    )
+    if packed.n_batches <= 20:
+        print(f"{'batch':<20}{'hgm':>9}{'hbm':>9}{'Pbm':>9}{'SSR':>12}{'FIT %':>9}")
+        for name, th, ssr, fit in zip(result.names, result.theta, result.SSR, result.FIT):
+            print(f"{name[:20]:<20}{th[0]:>9.4f}{th[1]:>9.4f}{th[2]:>9.4f}{ssr:>12.3f}{fit:>9.2f}")
+    summ = result.summary()
+    for name in THETA_NAMES:
+        v = summ[name]
+        print(f"{name}: mean {v['mean']:.4f}, std {v['std']:.4f}, range [{v['min']:.4f}, {v['max']:.4f}]")
+    print(f"FIT: mean {summ['FIT']['mean']:.2f} %, worst {summ['FIT']['min']:.2f} % -> {args.out}")
+    return 0
+
+
+def cmd_validate(args) -> int:
+    from ..io.files import Outputs
+    from ..report.figures import check_figure_path, plot_fit
+
+    outputs = Outputs(fit_inputs(args))
+    for target in (args.json, args.plot):
+        if target:
+            outputs.check(target)
+    if args.plot:
+        check_figure_path(args.plot)
+    if args.predictions:
+        outputs.folder(args.predictions, create=False)
+    if args.baseline:
+        return _validate_baseline(args, outputs)
+    model = model_from_args(args, args.plant)
+    batches, plant_spec = load_batches(args, model)
+    changes = initial_changes(args)
+    if args.tgi_offset is not None:
+        changes["Tgi_offset_C"] = args.tgi_offset
+    result = model.validate(batches, plant=plant_spec, **changes)
+    say(result.notes)
+    th = model.theta
+    print(
+        result.table(
+            f"validation on plant {result.plant}, theta = hgm {th.hgm:.4f}, hbm {th.hbm:.4f}, Pbm {th.Pbm:.4f}"
+        )
+    )
+    with outputs as out:
+        if args.json:
+            out.write_text(args.json, json_text(result.to_json_dict()))
+        if args.plot:
+            plot_fit(result, args.plot, title=f"measured vs predicted BT, plant {result.plant}", outputs=out)
+        if args.predictions:
+            written = set()
+            for name, frame in result.frames().items():
+                stem = _safe_stem(name, written)
+                out.write_text(
+                    Path(args.predictions) / f"{stem}.csv",
+                    frame.to_csv(index=False, float_format="%.6f", lineterminator="\n"),
+                )
+    if args.predictions:
+        print(f"wrote {len(result.names)} prediction CSV(s) to {args.predictions}")
+    return 0
+
+
+def _safe_stem(name: str, taken: set) -> str:
+    """A file stem from a batch name: no path separators or control characters, unique."""
+    stem = "".join(c if (c.isalnum() or c in "-_.") else "_" for c in name)[:80].strip(".") or "batch"
+    base, k = stem, 2
+    while stem in taken:
+        stem, k = f"{base}-{k}", k + 1
+    taken.add(stem)
+    return stem
+
+
+def _validate_baseline(args, outputs) -> int:
+    from ..evaluate.metrics import average_metrics
+    from ..evaluate.validate import ValidationResult
+    from ..fit.baseline import SETTING_GAINS, describe, validate_first_order
+    from ..report.figures import plot_fit
+
+    if not args.model:
+        raise InputError(
+            "--baseline first-order needs --model BASELINE.json from 'identify --baseline first-order'", "command line"
+        )
+    params = _read_baseline_json(args.model)
+    batches, plant_spec = load_batches(args)
+    preds, rows = validate_first_order(batches, params)
+    result = ValidationResult(
+        [b.name for b in batches],
+        [b.time_s for b in batches],
+        [b.Ta_C for b in batches],
+        preds,
+        [],
+        rows,
+        str(plant_spec),
+    )
+    print(result.table(f"first-order baseline ({describe(params)})"))
+    with outputs as out:
+        if args.json:
+            doc = {
+                "baseline": "first-order",
+                "tau_s": params["tau_s"],
+                "offset_C": params["offset_C"],
+                **{k: params[k] for k in SETTING_GAINS.values() if k in params},
+                "batches": [{"name": n, **r} for n, r in zip(result.names, rows)],
+                "average": average_metrics(rows),
+            }
+            out.write_text(args.json, json_text(doc))
+        if args.plot:
+            plot_fit(result, args.plot, title="measured vs first-order baseline", outputs=out)
+    return 0
+
+
+def _read_baseline_json(path) -> dict:
+    from ..io.files import read_input_text
+    from ..io.modelfile import parse_json_document
+
+    data = parse_json_document(read_input_text(path, "JSON"), path)
+    if not isinstance(data, dict):
+        raise InputError("expected a JSON object", path)
+    if data.get("baseline") != "first-order":
+        raise InputError("not a first-order baseline file (from 'identify --baseline first-order')", path)
+    from ..fit.baseline import SETTING_GAINS
+
+    optional = [k for k in SETTING_GAINS.values() if k in data]
+    for key in ("tau_s", "offset_C", *optional):
+        v = data.get(key)
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+            raise InputError("missing or not a finite number", path, f"key {key}")
+    if not data["tau_s"] > 0:
+        raise InputError("tau_s must be > 0", path, "key tau_s")
+    return data
+
+
+def add_parsers(sub) -> None:
+    """Register this module's command(s) on the ``roastlab`` subparsers ``sub``."""
+    p = sub.add_parser(
+        "identify",
+        help="fit a model on batches (eqs. 18-19) and write MODEL.json",
+        description="Minimise the summed SSR of the probe temperature (and, with --weight Tb2=W or a spec's "
+        "[weights], of the model's bean temperature against a second bean reading) over the given batches within bounds, "
+        "by a seeded global search (scattered starts polished by bounded least squares) or differential evolution. "
+        "Writes the fitted model file (roastlab-model/1): plant, theta and every other fitted or held value with "
+        "standard errors and bounds, the initial states, the column map, fit-set metrics and provenance.",
+        epilog="example: roastlab identify --plant 120kg dataset-I/ --out model.json",
+    )
+    add_batch_options(
+        p,
+        "fit the first-order baseline dBT/dt = (Tgi + offset [+ k_h heater + k_f fan] - BT)/tau instead "
+        "(Tgi = ET on an ET map; the settings when the map reads heater/fan)",
+    )
+    p.add_argument("--out", required=True, metavar="MODEL.json", help="where to write the model file")
+    p.add_argument(
+        "--method", choices=("global", "de"), default="global", help="global search (default) or differential evolution"
+    )
+    p.add_argument("--seed", type=seed_arg, default=0, help="random seed of the search (default 0)")
+    p.add_argument("--starts", type=count_arg("--starts", 1, 100), default=6, help="local polishes (default 6)")
+    p.add_argument(
+        "--fix", action="append", metavar="NAME=V", help="hold a parameter fixed, e.g. --fix hgm=0.01 (repeatable)"
+    )
+    p.add_argument(
+        "--bounds", action="append", metavar="NAME=LO:HI", help="change bounds, e.g. --bounds hbm=0.01:0.5 (repeatable)"
+    )
+    p.add_argument(
+        "--estimate-tm0",
+        action="store_true",
+        help="estimate each batch's initial metal temperature as a nuisance parameter",
+    )
+    p.add_argument(
+        "--per-batch",
+        action="store_true",
+        help="fit a separate theta to every batch (fleet mode; writes a per-batch table, not a model file)",
+    )
+    p.add_argument(
+        "--spec",
+        metavar="FIT.toml",
+        help="fit spec: free parameters (theta, process constants, initial states) with bounds, output weights",
+    )
+    p.add_argument(
+        "--weight",
+        action="append",
+        metavar="OUTPUT=W",
+        help="weight of a fitted output: Ta (the bean probe, default 1) or Tb2 (a second bean reading read by the "
+        "map's [Tb2], compared with the model's Tb; default 0), e.g. --weight Tb2=0.25 (repeatable; overrides "
+        "the spec's [weights])",
+    )
+    add_model_options(p, with_model=False)
+    p.set_defaults(func=cmd_identify)
+
+    p = sub.add_parser(
+        "validate",
+        help="apply a model file to batches and report the paper's metrics",
+        description="Apply MODEL.json (all of it: theta, fitted flow and constants, initial states; default: the "
+        "paper's theta*) to each batch and report n, SSR, ||e||, MAE, MPE, MAPE, FIT, rho per batch and on average.",
+        epilog="example: roastlab validate --model model.json --plant 360kg dataset-V/ --predictions pred/",
+    )
+    add_batch_options(
+        p, "validate the first-order baseline (--model BASELINE.json from 'identify --baseline first-order')"
+    )
+    p.add_argument("--json", metavar="METRICS.json", help="write the metrics as JSON")
+    p.add_argument("--plot", metavar="FIG.png", help="plot measured vs predicted BT with residuals (.png/.svg/.pdf)")
+    p.add_argument(
+        "--predictions",
+        metavar="DIR",
+        help="write one CSV per batch: time_s, measured Ta_C, Ta_pred_C, predicted states, inputs as applied",
+    )
+    p.add_argument(
+        "--tgi-offset", type=float_arg("--tgi-offset"), help="what-if: add this to the inlet gas / ET [degC]"
+    )
+    add_model_options(p)
+    p.set_defaults(func=cmd_validate)

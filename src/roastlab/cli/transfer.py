@@ -1,0 +1,201 @@
+"""``roastlab transfer``: the program that gives a reference curve on another plant or batch size."""
+
+from __future__ import annotations
+
+import argparse
+
+from ..errors import InputError
+from .common import (
+    MODEL_HELP,
+    float_arg,
+    range_arg,
+    read_inputs,
+    say,
+    write_json_and_plot,
+)
+
+
+def cmd_transfer(args) -> int:
+    from ..fit.program import ProgramLimits
+    from ..io.files import Outputs
+    from ..model.limits import check_value
+    from ..report.figures import check_figure_path
+    from ..workflows.model import load_model
+    from ..workflows.transfer import transfer
+
+    outputs = Outputs([args.reference, args.model, args.map, args.plant_from, args.plant_to])
+    for target in (args.out, args.json, args.plot, args.alog):
+        if target:
+            outputs.check(target)
+    if args.plot:
+        check_figure_path(args.plot)
+    if args.gg is not None and (args.gg_min is not None or args.gg_max is not None):
+        raise InputError(
+            "--gg fixes the flow; --gg-min/--gg-max let the optimiser choose it: give one or the other", "command line"
+        )
+    model = load_model(args.model)
+    reference = read_inputs(args.reference, args.map, model)
+    say(reference.notes)
+    initial = {}
+    for opt, name in (("tb0", "Tb0_C"), ("x0", "X0")):
+        if getattr(args, opt) is not None:
+            initial[name] = check_value(name, getattr(args, opt), f"--{opt}")
+    tm0_free = None
+    if args.tm0 is not None:
+        if args.tm0.strip().lower() == "free":
+            tm0_free = range_arg(args.tm0_range, "--tm0-range")
+        else:
+            try:
+                initial["Tm0_C"] = check_value("Tm0_C", float(args.tm0), "--tm0")
+            except ValueError:
+                raise InputError(f"expected a temperature [degC] or 'free', got {args.tm0!r}", "--tm0") from None
+    if args.decide == "heater":
+        if reference.heater is None:
+            raise InputError(
+                "--decide heater needs a reference with a heater setting (a map with [heater])", args.reference
+            )
+        top = float(max(reference.heater))
+        low = 0.0 if args.heater_min is None else args.heater_min
+        high = (top if top > 0 else 1.0) if args.heater_max is None else args.heater_max
+        limits = ProgramLimits(low, high, args.heater_rate, args.gg_min, args.gg_max, decide="heater")
+    else:
+        limits = ProgramLimits(args.tgi_min, args.tgi_max, args.tgi_rate, args.gg_min, args.gg_max)
+    result = transfer(
+        model,
+        reference,
+        args.plant_from,
+        args.plant_to,
+        limits=limits,
+        batch_kg=args.batch_kg,
+        gg_kg_s=args.gg,
+        interval_s=args.interval_s,
+        tm0_free=tm0_free,
+        tolerance_C=args.tolerance,
+        initial=initial,
+    )
+    say(result.metrics["notes"])
+    print(result.summary())
+    with outputs as out:
+        out.write_text(args.out, result.program_csv_text())
+        write_json_and_plot(out, args, result.to_json_dict(), result)
+        if args.alog:
+            out.write_text(args.alog, result.alog_text())
+    return 0
+
+
+def add_parsers(sub) -> None:
+    """Register this module's command(s) on the ``roastlab`` subparsers ``sub``."""
+    p = sub.add_parser(
+        "transfer",
+        help="compute the input program that reproduces a roast on another plant or batch size",
+        description="Find the inlet-gas program (or, with --decide heater, the heater program) that makes the "
+        "model's bean probe on plant B (--to) follow the reference roast's BT from CHARGE to DROP on plant A "
+        "(--from), within level and rate limits. The model's carried-over values (theta, process constants) are "
+        "applied on B. Prints the fit of the program against two baselines computed in the same run: B with A's "
+        "inputs unchanged, and A's inputs retimed by the phase times that run gives (what a person does with "
+        "Artisan's Transposer). An unreachable target is not an error: the best program is written, 'feasible' "
+        "is false and the output says where and which limit holds it back. A batch-size change on one machine "
+        "is --to = --from with --batch-kg.",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog="outputs:\n"
+        "  PROGRAM.csv   time_s,Gg_kg_s,Tgi_C[,heater,fan],Ta_pred_C with the charge state as '# key = value'\n"
+        "                lines: 'roastlab simulate --model M --plant B --inputs PROGRAM.csv' reproduces Ta_pred_C\n"
+        "  METRICS.json  rmse_C, max_abs_C, feasible, solve_s, the baselines, the limits the program sits on\n"
+        "  BACKGROUND.alog  an Artisan profile to load as background (BT predicted, program as Burner/Air events)\n\n"
+        "examples:\n"
+        "  roastlab transfer --model model.json --from 120kg --to 360kg --reference batch1.csv --out program.csv\n"
+        "  roastlab transfer --model model.json --from 120kg --to 120kg --batch-kg 84 --reference batch1.csv \\\n"
+        "      --out program.csv --tm0 free --plot transfer.png --alog background.alog",
+    )
+    p.add_argument("--model", required=True, metavar="MODEL.json", help=MODEL_HELP)
+    p.add_argument(
+        "--from", dest="plant_from", metavar="PLANT_A", help="plant the reference was roasted on (default: the model's)"
+    )
+    p.add_argument(
+        "--to", dest="plant_to", metavar="PLANT_B", help="plant to compute the program for (default: PLANT_A)"
+    )
+    p.add_argument(
+        "--reference", required=True, metavar="REF", help="batch CSV (time_s,Gg_kg_s,Tgi_C,Ta_C) or a log (with --map)"
+    )
+    p.add_argument("--map", metavar="MAP.toml", help="column map for a raw-log reference (default: the model's own)")
+    p.add_argument("--out", required=True, metavar="PROGRAM.csv", help="where to write the program")
+    p.add_argument(
+        "--batch-kg",
+        type=float_arg("--batch-kg"),
+        help="green batch on B [kg] (default: B's nominal batch; the reference's when B = A)",
+    )
+    p.add_argument(
+        "--tb0", type=float_arg("--tb0"), help="bean temperature at CHARGE on B [degC] (default: the model's, else 30)"
+    )
+    p.add_argument(
+        "--tm0",
+        metavar="C|free",
+        help="drum temperature at CHARGE on B [degC], or 'free' to let the optimiser choose it (the preheat)",
+    )
+    p.add_argument(
+        "--tm0-range", default="60:300", metavar="LO:HI", help="range for --tm0 free [degC] (default 60:300)"
+    )
+    p.add_argument(
+        "--x0", type=float_arg("--x0"), help="green moisture on B [kg/kg dry] (default: the model's, else 0.1)"
+    )
+    p.add_argument(
+        "--decide",
+        choices=("Tgi", "heater"),
+        default="Tgi",
+        help="the input the program sets (default Tgi; heater needs a model and reference with the actuator extension)",
+    )
+    p.add_argument(
+        "--tgi-min", type=float_arg("--tgi-min"), default=150.0, help="lowest inlet temperature [degC] (default 150)"
+    )
+    p.add_argument(
+        "--tgi-max", type=float_arg("--tgi-max"), default=550.0, help="highest inlet temperature [degC] (default 550)"
+    )
+    p.add_argument(
+        "--tgi-rate",
+        type=float_arg("--tgi-rate"),
+        default=120.0,
+        help="fastest change of the inlet temperature [degC/min] (default 120)",
+    )
+    p.add_argument("--heater-min", type=float_arg("--heater-min"), help="lowest heater setting (default 0)")
+    p.add_argument(
+        "--heater-max",
+        type=float_arg("--heater-max"),
+        help="highest heater setting (default: the reference's largest)",
+    )
+    p.add_argument(
+        "--heater-rate",
+        type=float_arg("--heater-rate"),
+        default=60.0,
+        help="fastest heater change [setting/min] (default 60)",
+    )
+    p.add_argument(
+        "--gg",
+        type=float_arg("--gg"),
+        help="fixed gas flow on B [kg/s] (default: A's flow times the batch-mass ratio)",
+    )
+    p.add_argument(
+        "--gg-min",
+        type=float_arg("--gg-min"),
+        help="with --gg-max: the optimiser chooses a constant gas flow in this range [kg/s]",
+    )
+    p.add_argument("--gg-max", type=float_arg("--gg-max"), help="see --gg-min")
+    p.add_argument(
+        "--interval-s",
+        type=float_arg("--interval-s"),
+        default=5.0,
+        help="spacing of the program's knots [s] (default 5)",
+    )
+    p.add_argument(
+        "--tolerance",
+        type=float_arg("--tolerance"),
+        default=2.0,
+        help="feasible when max |predicted - target| <= this [degC] (default 2)",
+    )
+    p.add_argument("--json", metavar="METRICS.json", help="write the metrics, baselines and limits as JSON")
+    p.add_argument(
+        "--plot", metavar="FIG.png", help="target vs predicted BT, the program with its limits, the baselines"
+    )
+    p.add_argument(
+        "--alog", metavar="BACKGROUND.alog", help="write an Artisan background profile of the prediction and program"
+    )
+    p.set_defaults(func=cmd_transfer)
