@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 from ..errors import InputError
@@ -75,37 +74,28 @@ def cmd_identify(args) -> int:
 
 
 def _identify_per_batch(args, batches, plant_spec, fix, bounds, outputs) -> int:
-    from ..fit.batchfit import identify_each
-    from ..model.parameters import THETA_NAMES, THETA_START
-    from ..sim.population import pack_batches
-    from ..sim.simulate import InitialState
-    from ..workflows.model import PAPER_INITIAL
+    from ..workflows.fitting import fit_per_batch
 
-    unknown = sorted((set(fix) | set(bounds)) - set(THETA_NAMES))
-    if unknown or args.estimate_tm0 or args.spec:
-        raise InputError(
-            "--per-batch fits hgm, hbm, Pbm only (no --spec, no --estimate-tm0, no other parameters)", "command line"
-        )
-    init = InitialState(**{**PAPER_INITIAL, **initial_changes(args)})
-    packed = pack_batches(
-        batches, plant_spec, THETA_START, init, args.moisture or "schwartzberg", args.hold or "linear"
+    if args.estimate_tm0 or args.spec:
+        raise InputError("--per-batch fits hgm, hbm, Pbm only (no --spec, no --estimate-tm0)", "command line")
+    result = fit_per_batch(
+        batches,
+        plant_spec,
+        fix=fix,
+        bounds=bounds,
+        initial=initial_changes(args),
+        moisture=args.moisture or "schwartzberg",
+        hold=args.hold or "linear",
+        seed=args.seed,
+        progress=progress("fit per batch"),
     )
-    result = identify_each(packed, bounds=bounds, fix=fix, seed=args.seed, progress=progress("fit per batch"))
     doc = {**result.to_json_dict(), "plant": str(plant_spec), "fixed": sorted(fix)}
     with outputs as out:
         out.write_text(args.out, json_text(doc))
     print(
-        f"identified theta per batch for {packed.n_batches} batch(es) on plant {plant_spec} in {result.wall_s:.2f} s ({result.simulations} simulations)"
+        f"identified theta per batch for {len(result.names)} batch(es) on plant {plant_spec} in {result.wall_s:.2f} s ({result.simulations} simulations)"
     )
-    if packed.n_batches <= 20:
-        print(f"{'batch':<20}{'hgm':>9}{'hbm':>9}{'Pbm':>9}{'SSR':>12}{'FIT %':>9}")
-        for name, th, ssr, fit in zip(result.names, result.theta, result.SSR, result.FIT):
-            print(f"{name[:20]:<20}{th[0]:>9.4f}{th[1]:>9.4f}{th[2]:>9.4f}{ssr:>12.3f}{fit:>9.2f}")
-    summ = result.summary()
-    for name in THETA_NAMES:
-        v = summ[name]
-        print(f"{name}: mean {v['mean']:.4f}, std {v['std']:.4f}, range [{v['min']:.4f}, {v['max']:.4f}]")
-    print(f"FIT: mean {summ['FIT']['mean']:.2f} %, worst {summ['FIT']['min']:.2f} % -> {args.out}")
+    print(f"{result.summary()} -> {args.out}")
     return 0
 
 
@@ -165,63 +155,23 @@ def _safe_stem(name: str, taken: set) -> str:
 
 
 def _validate_baseline(args, outputs) -> int:
-    from ..evaluate.metrics import average_metrics
-    from ..evaluate.validate import ValidationResult
-    from ..fit.baseline import SETTING_GAINS, describe, validate_first_order
+    from ..fit.baseline import baseline_document, describe, load_baseline, validation_of_first_order
     from ..report.figures import plot_fit
 
     if not args.model:
         raise InputError(
             "--baseline first-order needs --model BASELINE.json from 'identify --baseline first-order'", "command line"
         )
-    params = _read_baseline_json(args.model)
+    params = load_baseline(args.model)
     batches, plant_spec = load_batches(args)
-    preds, rows = validate_first_order(batches, params)
-    result = ValidationResult(
-        [b.name for b in batches],
-        [b.time_s for b in batches],
-        [b.Ta_C for b in batches],
-        preds,
-        [],
-        rows,
-        str(plant_spec),
-    )
+    result = validation_of_first_order(batches, params, str(plant_spec))
     print(result.table(f"first-order baseline ({describe(params)})"))
     with outputs as out:
         if args.json:
-            doc = {
-                "baseline": "first-order",
-                "tau_s": params["tau_s"],
-                "offset_C": params["offset_C"],
-                **{k: params[k] for k in SETTING_GAINS.values() if k in params},
-                "batches": [{"name": n, **r} for n, r in zip(result.names, rows)],
-                "average": average_metrics(rows),
-            }
-            out.write_text(args.json, json_text(doc))
+            out.write_text(args.json, json_text(baseline_document(params, result)))
         if args.plot:
             plot_fit(result, args.plot, title="measured vs first-order baseline", outputs=out)
     return 0
-
-
-def _read_baseline_json(path) -> dict:
-    from ..io.files import read_input_text
-    from ..io.modelfile import parse_json_document
-
-    data = parse_json_document(read_input_text(path, "JSON"), path)
-    if not isinstance(data, dict):
-        raise InputError("expected a JSON object", path)
-    if data.get("baseline") != "first-order":
-        raise InputError("not a first-order baseline file (from 'identify --baseline first-order')", path)
-    from ..fit.baseline import SETTING_GAINS
-
-    optional = [k for k in SETTING_GAINS.values() if k in data]
-    for key in ("tau_s", "offset_C", *optional):
-        v = data.get(key)
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-            raise InputError("missing or not a finite number", path, f"key {key}")
-    if not data["tau_s"] > 0:
-        raise InputError("tau_s must be > 0", path, "key tau_s")
-    return data
 
 
 def add_parsers(sub) -> None:

@@ -61,6 +61,8 @@ def cmd_plant(args) -> int:
 
 def add_parsers(sub) -> None:
     """Register this module's command(s) on the ``roastlab`` subparsers ``sub``."""
+    from ..model.quantities import default
+
     p = sub.add_parser(
         "simulate",
         help="simulate one batch with a model file (default: the paper's theta*)",
@@ -92,5 +94,6 @@ def add_parsers(sub) -> None:
         "stores in full, or a preset or PLANT.toml).",
     )
     p.add_argument("plant", help="plant preset (120kg, 360kg) or PLANT.toml path")
-    p.add_argument("--x0", type=float_arg("--x0"), default=0.1, help="moisture used for Mbd and F (default 0.1)")
+    x0 = default("X0")
+    p.add_argument("--x0", type=float_arg("--x0"), default=x0, help=f"moisture used for Mbd and F (default {x0:g})")
     p.set_defaults(func=cmd_plant)

@@ -54,10 +54,9 @@ def cmd_transfer(args) -> int:
             raise InputError(
                 "--decide heater needs a reference with a heater setting (a map with [heater])", args.reference
             )
-        top = float(max(reference.heater))
-        low = 0.0 if args.heater_min is None else args.heater_min
-        high = (top if top > 0 else 1.0) if args.heater_max is None else args.heater_max
-        limits = ProgramLimits(low, high, args.heater_rate, args.gg_min, args.gg_max, decide="heater")
+        limits = ProgramLimits.for_heater(
+            reference.heater, args.heater_min, args.heater_max, args.heater_rate, args.gg_min, args.gg_max
+        )
     else:
         limits = ProgramLimits(args.tgi_min, args.tgi_max, args.tgi_rate, args.gg_min, args.gg_max)
     result = transfer(
@@ -85,6 +84,8 @@ def cmd_transfer(args) -> int:
 
 def add_parsers(sub) -> None:
     """Register this module's command(s) on the ``roastlab`` subparsers ``sub``."""
+    from ..model.quantities import default
+
     p = sub.add_parser(
         "transfer",
         help="compute the input program that reproduces a roast on another plant or batch size",
@@ -136,7 +137,9 @@ def add_parsers(sub) -> None:
         "--tm0-range", default="60:300", metavar="LO:HI", help="range for --tm0 free [degC] (default 60:300)"
     )
     p.add_argument(
-        "--x0", type=float_arg("--x0"), help="green moisture on B [kg/kg dry] (default: the model's, else 0.1)"
+        "--x0",
+        type=float_arg("--x0"),
+        help=f"green moisture on B [kg/kg dry] (default: the model's, else {default('X0'):g})",
     )
     p.add_argument(
         "--decide",

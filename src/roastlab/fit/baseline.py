@@ -101,3 +101,49 @@ def validate_first_order(batches, params: dict):
         preds.append(y)
         rows.append(batch_metrics(b.Ta_C, y))
     return preds, rows
+
+
+def validation_of_first_order(batches, params: dict, plant: str = ""):
+    """The baseline on each batch as a :class:`~roastlab.evaluate.validate.ValidationResult`."""
+    from ..evaluate.validate import ValidationResult
+
+    preds, rows = validate_first_order(batches, params)
+    names = [b.name for b in batches]
+    return ValidationResult(names, [b.time_s for b in batches], [b.Ta_C for b in batches], preds, [], rows, plant)
+
+
+def baseline_document(params: dict, result) -> dict:
+    """The baseline's validation as JSON: its values, per-batch metrics and their average."""
+    from ..evaluate.metrics import average_metrics
+
+    return {
+        "baseline": "first-order",
+        "tau_s": params["tau_s"],
+        "offset_C": params["offset_C"],
+        **{k: params[k] for k in SETTING_GAINS.values() if k in params},
+        "batches": [{"name": n, **r} for n, r in zip(result.names, result.rows)],
+        "average": average_metrics(result.rows),
+    }
+
+
+def load_baseline(path) -> dict:
+    """A first-order baseline file (from ``identify --baseline first-order``), checked."""
+    import math
+
+    from ..errors import InputError
+    from ..io.files import read_input_text
+    from ..io.modelfile import parse_json_document
+
+    data = parse_json_document(read_input_text(path, "JSON"), path)
+    if not isinstance(data, dict):
+        raise InputError("expected a JSON object", path)
+    if data.get("baseline") != "first-order":
+        raise InputError("not a first-order baseline file (from 'identify --baseline first-order')", path)
+    optional = [k for k in SETTING_GAINS.values() if k in data]
+    for key in ("tau_s", "offset_C", *optional):
+        v = data.get(key)
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+            raise InputError("missing or not a finite number", path, f"key {key}")
+    if not data["tau_s"] > 0:
+        raise InputError("tau_s must be > 0", path, "key tau_s")
+    return data

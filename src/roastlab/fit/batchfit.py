@@ -37,6 +37,7 @@ from scipy.stats import qmc
 from ..errors import InputError
 from ..evaluate.metrics import fit_percent
 from ..model.layout import S_TA
+from ..model.limits import check_value
 from ..model.parameters import REGISTRY, STATE0, THETA_NAMES, THETA_START
 from ..model.rhs import P
 from ..sim.cache import compiled
@@ -84,7 +85,22 @@ class FleetResult:
     MAE: np.ndarray | None = None
     sims: np.ndarray | None = None
 
-    def summary(self) -> dict:
+    def summary(self, max_rows: int = 20) -> str:
+        """A table of the per-batch values (up to ``max_rows`` batches) and their statistics."""
+        lines = []
+        if len(self.names) <= max_rows:
+            lines.append(f"{'batch':<20}" + "".join(f"{p:>9}" for p in self.params) + f"{'SSR':>12}{'FIT %':>9}")
+            for name, th, ssr, fit in zip(self.names, self.theta, self.SSR, self.FIT):
+                lines.append(f"{name[:20]:<20}" + "".join(f"{v:>9.4f}" for v in th) + f"{ssr:>12.3f}{fit:>9.2f}")
+        stats = self.statistics()
+        for name in self.params:
+            v = stats[name]
+            lines.append(f"{name}: mean {v['mean']:.4f}, std {v['std']:.4f}, range [{v['min']:.4f}, {v['max']:.4f}]")
+        lines.append(f"FIT: mean {stats['FIT']['mean']:.2f} %, worst {stats['FIT']['min']:.2f} %")
+        return "\n".join(lines)
+
+    def statistics(self) -> dict:
+        """Mean, standard deviation and range of each fitted value over the batches; mean and worst FIT."""
         out = {}
         for j, name in enumerate(self.params):
             col = self.theta[:, j]
@@ -104,7 +120,7 @@ class FleetResult:
                 {"name": n, **{k: float(v) for k, v in zip(self.params, th)}, "SSR": float(s), "FIT": float(f)}
                 for n, th, s, f in zip(self.names, self.theta, self.SSR, self.FIT)
             ],
-            "summary": self.summary(),
+            "summary": self.statistics(),
             "max_iterations": self.max_iterations,
             "simulations": self.simulations,
             "wall_s": round(self.wall_s, 3),
@@ -373,7 +389,7 @@ def identify_each(
     kinds, slots = free_slots(names)
     k = len(names)
     bounds = {**{n: REGISTRY[n].bounds for n in names}, **(bounds or {})}
-    fix = dict(fix or {})
+    fix = {n: check_value(n, v, "fixed value") for n, v in (fix or {}).items()}  # the quantity table's range
     stray = sorted(set(fix) - set(names))
     if stray:
         raise InputError(

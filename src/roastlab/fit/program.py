@@ -92,6 +92,17 @@ class ProgramLimits:
                 f"Gg limits must satisfy 0 < min < max, got {self.Gg_min_kg_s:g}..{self.Gg_max_kg_s:g} kg/s", "limits"
             )
 
+    @classmethod
+    def for_heater(cls, heater, low=None, high=None, rate_per_min: float = 120.0, gg_min=None, gg_max=None):
+        """Heater limits for a reference whose logged setting is ``heater``: ``low`` default 0 and
+        ``high`` default the reference's own highest setting (1 if it never rose above 0)."""
+        if heater is None:
+            raise InputError("deciding the heater needs a reference with a heater setting (a map with [heater])")
+        top = float(np.max(heater))
+        low = 0.0 if low is None else low
+        high = (top if top > 0 else 1.0) if high is None else high
+        return cls(low, high, rate_per_min, gg_min, gg_max, decide="heater")
+
     @property
     def gg_free(self) -> bool:
         return self.Gg_min_kg_s is not None

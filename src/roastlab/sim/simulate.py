@@ -242,7 +242,7 @@ def simulate(
     plant : Plant or preset name
     time_s, Gg_kg_s, Tgi_C : arrays of the input samples [s], [kg/s], [degC]
     theta : Theta, (hgm, hbm, Pbm) or None for the paper's theta*
-    initial : InitialState, default the paper's [30, 121, 0.1, 0, Ta(0)]
+    initial : InitialState, default the paper's section 5.1 state (the quantity table's defaults, Ta0 from the log)
     Ta_measured_C : measured probe reading; its first value sets Ta(0) unless given
     moisture : ``"schwartzberg"`` (default) or ``"printed"`` (eq. 13 variants)
     hold : ``"linear"`` (default) or ``"zoh"`` input hold between samples

@@ -240,3 +240,32 @@ def _document(ident, free, fixed, init, plant, moisture, hold, column_map) -> di
             "outputs": ident.outputs,
         },
     }
+
+
+def fit_per_batch(
+    batches: list[Batch],
+    plant,
+    *,
+    fix: dict | None = None,
+    bounds: dict | None = None,
+    initial: dict | None = None,
+    moisture: str = "schwartzberg",
+    hold: str = "linear",
+    seed: int = 0,
+    progress=None,
+):
+    """A separate theta = (hgm, hbm, Pbm) for every batch (the compiled per-batch fitter,
+    :func:`roastlab.fit.batchfit.identify_each`), from the paper's initial state with ``initial``
+    changes; returns its :class:`~roastlab.fit.batchfit.FleetResult`.
+
+    ``fix`` and ``bounds`` name theta components only; ``moisture``, ``hold``, ``seed`` and
+    ``progress`` as in :func:`fit`.
+    """
+    from ..fit.batchfit import identify_each
+
+    unknown = sorted((set(fix or {}) | set(bounds or {})) - set(THETA_NAMES))
+    if unknown:
+        raise InputError(f"a per-batch fit frees hgm, hbm, Pbm only, not {', '.join(unknown)}")
+    init = InitialState(**{**PAPER_INITIAL, **(initial or {})})
+    packed = pack_batches(batches, plant, THETA_START, init, moisture, hold)
+    return identify_each(packed, bounds=bounds, fix=fix, seed=seed, progress=progress)

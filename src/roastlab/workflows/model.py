@@ -34,15 +34,16 @@ from ..io.modelfile import model_document_text, read_model_document
 from ..io.plants import load_plant
 from ..model.parameters import REGISTRY, STATE0, THETA_NAMES, THETA_PAPER, THETA_UNITS, Theta
 from ..model.plant import Plant
+from ..model.quantities import default
 from ..model.rhs import P
 from ..sim.kernels import I_TGO, NS
 from ..sim.population import pack_batches, run_arrays, simulate_population
 from ..sim.simulate import InitialState, SimulationResult
 
-#: Initial state of the paper's section 5.1 (Ta0 from the log's first reading).
-PAPER_INITIAL = {"Tb0_C": 30.0, "Tm0_C": 121.0, "X0": 0.1, "He0_kJ_kg": 0.0}
+#: Initial state of the paper's section 5.1 (Ta0 from the log's first reading): the quantity table's defaults.
+PAPER_INITIAL = {name: default(name) for name in ("Tb0_C", "Tm0_C", "X0", "He0_kJ_kg")}
 #: Gas flow written by a map with ``[Gg] identify = true`` and scaled by a fitted Gg_kg_s [kg/s].
-PLACEHOLDER_GG_KG_S = 1.0
+PLACEHOLDER_GG_KG_S = default("Gg_kg_s")
 
 
 def _version() -> str:
