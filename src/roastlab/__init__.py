@@ -4,7 +4,7 @@ Implements "A scalable model of a coffee roasting chamber" (Procedia Computer Sc
 2021, doi:10.1016/j.procs.2021.01.362) as read by MODEL.md: the model, a fast simulator,
 identification and validation across plant sizes, applied through one fitted-model object.
 
-Layout (imports point one way: apps -> control -> fleet -> workflows -> fit -> evaluate -> sim ->
+Layout (imports point one way: cli -> control -> fleet -> workflows -> fit -> evaluate -> sim ->
 report -> io -> metrics -> model -> errors; tests/test_layout.py enforces it):
 
 * :mod:`roastlab.model`: the quantity table, the vectors' layout, constants, plant geometry,
@@ -19,7 +19,8 @@ report -> io -> metrics -> model -> errors; tests/test_layout.py enforces it):
 * :mod:`roastlab.workflows`: :class:`FittedModel`, :func:`fit`, what-if, transfer, reproduction;
 * :mod:`roastlab.fleet`: the fleet store, fleet fits, drift;
 * :mod:`roastlab.control`: controllers, the closed-loop testbench, environments;
-* :mod:`roastlab.apps`: the command line and the benchmark.
+* :mod:`roastlab.cli`: the command line, one module per command (``roastlab.apps.cli`` is a
+  deprecated alias); the benchmark is ``benchmarks/bench.py`` in a checkout.
 """
 
 __version__ = "0.2.0"
