@@ -65,7 +65,7 @@ def test_skywalker_fit_and_validate(cli, real_data, tmp_path):
     for key in ("hgm", "hbm", "Pbm", "Gg_kg_s", "Kt", "Qe_gain_kW", "Tgi_gain_C", "tau_heater_s"):
         assert doc["parameters"][key]["how"] == "fitted", key
     assert doc["initial"]["Tm0_C"] == {"how": "from log", "field": "ET"} and doc["map"]["Gg"] == {"identify": True}
-    assert doc["map"]["heater"] == {"column": "Burner", "unit": "percent"}
+    assert doc["map"]["heater"] == {"column": "Burner", "unit": "percent", "step": 5.0}
     metrics = tmp_path / "m.json"
     code, out, err = cli("validate", *common, "--model", theta, *val_logs, "--json", metrics)
     assert code == 0, err

@@ -21,7 +21,7 @@ def cmd_transfer(args) -> int:
     from ..model.limits import check_value
     from ..report.figures import check_figure_path
     from ..workflows.model import load_model
-    from ..workflows.transfer import transfer
+    from ..workflows.transfer import default_limits, transfer
 
     outputs = Outputs([args.reference, args.model, args.map, args.plant_from, args.plant_to])
     for target in (args.out, args.json, args.plot, args.alog):
@@ -49,13 +49,18 @@ def cmd_transfer(args) -> int:
                 initial["Tm0_C"] = check_value("Tm0_C", float(args.tm0), "--tm0")
             except ValueError:
                 raise InputError(f"expected a temperature [degC] or 'free', got {args.tm0!r}", "--tm0") from None
-    if args.decide == "heater":
+    decide = args.decide or default_limits(model).decide
+    if decide == "heater":
         if reference.heater is None:
             raise InputError(
                 "--decide heater needs a reference with a heater setting (a map with [heater])", args.reference
             )
-        limits = ProgramLimits.for_heater(
-            reference.heater, args.heater_min, args.heater_max, args.heater_rate, args.gg_min, args.gg_max
+        cmap = model.column_map
+        actuator = cmap.actuator("heater") if cmap is not None and cmap.heater else None
+        if actuator is None:
+            raise InputError("--decide heater needs a model whose map declares the heater ([heater])", args.model)
+        limits = ProgramLimits.for_actuator(
+            actuator, args.heater_min, args.heater_max, args.heater_rate, args.gg_min, args.gg_max
         )
     else:
         limits = ProgramLimits(args.tgi_min, args.tgi_max, args.tgi_rate, args.gg_min, args.gg_max)
@@ -84,6 +89,7 @@ def cmd_transfer(args) -> int:
 
 def add_parsers(sub) -> None:
     """Register this module's command(s) on the ``roastlab`` subparsers ``sub``."""
+    from ..model.actuators import MIN_HOLD_S
     from ..model.quantities import default
 
     p = sub.add_parser(
@@ -102,7 +108,11 @@ def add_parsers(sub) -> None:
         "  PROGRAM.csv   time_s,Gg_kg_s,Tgi_C[,heater,fan],Ta_pred_C with the charge state as '# key = value'\n"
         "                lines: 'roastlab simulate --model M --plant B --inputs PROGRAM.csv' reproduces Ta_pred_C\n"
         "  METRICS.json  rmse_C, max_abs_C, feasible, solve_s, the baselines, the limits the program sits on\n"
-        "  BACKGROUND.alog  an Artisan profile to load as background (BT predicted, program as Burner/Air events)\n\n"
+        "  BACKGROUND.alog  an Artisan profile to load as background: BT predicted, ET the model's, the\n"
+        "                reference's CHARGE/DRY/FCs/DROP marks, the program as Burner/Air events\n\n"
+        "A heater program is rounded to the machine's settings (the map's [heater] min, max, step) and held\n"
+        f"at least {MIN_HOLD_S:g} s between changes: the runnable program; the continuous one's error is printed "
+        "beside it.\n\n"
         "examples:\n"
         "  roastlab transfer --model model.json --from 120kg --to 360kg --reference batch1.csv --out program.csv\n"
         "  roastlab transfer --model model.json --from 120kg --to 120kg --batch-kg 84 --reference batch1.csv \\\n"
@@ -144,8 +154,8 @@ def add_parsers(sub) -> None:
     p.add_argument(
         "--decide",
         choices=("Tgi", "heater"),
-        default="Tgi",
-        help="the input the program sets (default Tgi; heater needs a model and reference with the actuator extension)",
+        help="the input the program sets (default: the heater, on the machine's steps, where the model's map "
+        "reads a heater and the inlet is room air; else Tgi)",
     )
     p.add_argument(
         "--tgi-min", type=float_arg("--tgi-min"), default=150.0, help="lowest inlet temperature [degC] (default 150)"
@@ -159,17 +169,16 @@ def add_parsers(sub) -> None:
         default=120.0,
         help="fastest change of the inlet temperature [degC/min] (default 120)",
     )
-    p.add_argument("--heater-min", type=float_arg("--heater-min"), help="lowest heater setting (default 0)")
     p.add_argument(
-        "--heater-max",
-        type=float_arg("--heater-max"),
-        help="highest heater setting (default: the reference's largest)",
+        "--heater-min", type=float_arg("--heater-min"), help="lowest heater setting (default: the map's [heater] min)"
+    )
+    p.add_argument(
+        "--heater-max", type=float_arg("--heater-max"), help="highest heater setting (default: the map's [heater] max)"
     )
     p.add_argument(
         "--heater-rate",
         type=float_arg("--heater-rate"),
-        default=60.0,
-        help="fastest heater change [setting/min] (default 60)",
+        help="fastest heater change [setting/min] (default: the map's [heater] rate_per_min)",
     )
     p.add_argument(
         "--gg",

@@ -32,6 +32,7 @@ from scipy.optimize import least_squares
 
 from ..errors import InputError
 from ..metrics.profile import ror_operator
+from ..model.actuators import MIN_HOLD_S, Actuator
 from ..model.layout import S_TA, S_TM
 from ..sim.kernels import H_MAX_S, simulate_one
 from ..sim.sensitivity import ta_input_jacobian
@@ -77,6 +78,8 @@ class ProgramLimits:
     Gg_min_kg_s: float | None = None
     Gg_max_kg_s: float | None = None
     decide: str = "Tgi"
+    #: the machine's control when deciding it (its steps make the runnable program); None: continuous
+    actuator: Actuator | None = None
 
     def __post_init__(self) -> None:
         if self.decide not in DECISIONS:
@@ -93,15 +96,23 @@ class ProgramLimits:
             )
 
     @classmethod
-    def for_heater(cls, heater, low=None, high=None, rate_per_min: float = 120.0, gg_min=None, gg_max=None):
-        """Heater limits for a reference whose logged setting is ``heater``: ``low`` default 0 and
-        ``high`` default the reference's own highest setting (1 if it never rose above 0)."""
-        if heater is None:
-            raise InputError("deciding the heater needs a reference with a heater setting (a map with [heater])")
-        top = float(np.max(heater))
-        low = 0.0 if low is None else low
-        high = (top if top > 0 else 1.0) if high is None else high
-        return cls(low, high, rate_per_min, gg_min, gg_max, decide="heater")
+    def for_actuator(
+        cls, actuator, low=None, high=None, rate_per_min=None, gg_min=None, gg_max=None
+    ) -> ProgramLimits:
+        """Limits for deciding a machine's control (:class:`roastlab.model.actuators.Actuator`,
+        as the map declares it): its range, rate and steps unless overridden, so a program is
+        called infeasible because of the machine, not because of a default."""
+        if actuator is None:
+            raise InputError("deciding the heater needs a model whose map reads a heater setting ([heater])", "limits")
+        return cls(
+            actuator.low if low is None else low,
+            actuator.high if high is None else high,
+            actuator.rate_per_min if rate_per_min is None else rate_per_min,
+            gg_min,
+            gg_max,
+            decide=actuator.name,
+            actuator=actuator,
+        )
 
     @property
     def gg_free(self) -> bool:
@@ -109,7 +120,7 @@ class ProgramLimits:
 
     @property
     def unit(self) -> str:
-        return DECISIONS[self.decide]
+        return self.actuator.unit if self.actuator is not None else DECISIONS[self.decide]
 
 
 @dataclass
@@ -128,6 +139,7 @@ class ProgramResult:
     iterations: int
     simulations: int
     notes: list[str] = field(default_factory=list)
+    zoh: bool = False
 
     @property
     def Tm0_C(self) -> float:
@@ -344,6 +356,73 @@ def optimise_program(
         iterations=int(sol.nfev),
         simulations=counter["sims"],
         notes=notes,
+        zoh=zoh,
+    )
+
+
+def runnable_program(
+    program: ProgramResult, target_C, actuator: Actuator, hold_s: float = MIN_HOLD_S, passes: int = 2
+) -> ProgramResult:
+    """The continuous heater ``program`` made one a person (or Artisan) can run: the settings the
+    machine has (``actuator``'s steps), changed at most every ``hold_s`` seconds.
+
+    Each ``hold_s`` window takes the nearest setting to the continuous program's mean over it,
+    so the heat it delivers matches; then, ``passes`` times over the windows, a window's setting
+    moves one step up or down where that brings the predicted probe closer to ``target_C`` (sum
+    of squares). The same compiled model, parameters and charge state as the continuous program.
+    A continuous actuator (no step) returns ``program`` unchanged.
+    """
+    if not actuator.stepped:
+        return program
+    t0_clock = time.perf_counter()
+    t = program.time_s
+    u = program.heater
+    window = np.floor((t - t[0]) / hold_s + 1e-9).astype(int)
+    n_win = int(window[-1]) + 1
+    levels = actuator.quantise([u[window == k].mean() for k in range(n_win)])
+    x0 = program.states[0].copy()
+    target = np.asarray(target_C, dtype=float)
+    sims = 0
+
+    def run(lv):
+        nonlocal sims
+        q = lv[window]
+        x = x0.copy()
+        x[5] = q[0]  # the heater's lag starts settled at the first setting, as the simulator does
+        sims += 1
+        return q, _run(t, program.Gg_kg_s, program.Tgi_C, q, program.fan, x, program.params, program.zoh)
+
+    q, out = run(levels)
+    best = float(np.sum((out[:, S_TA] - target) ** 2))
+    for _ in range(passes):
+        improved = False
+        for k in range(n_win):
+            for d in (actuator.step, -actuator.step):
+                trial = levels.copy()
+                trial[k] = actuator.quantise(trial[k] + d)
+                if trial[k] == levels[k]:
+                    continue
+                qt, ot = run(trial)
+                sse = float(np.sum((ot[:, S_TA] - target) ** 2))
+                if sse < best - 1e-9:
+                    levels, q, out, best, improved = trial, qt, ot, sse, True
+                    break
+        if not improved:
+            break
+    return ProgramResult(
+        time_s=t,
+        Tgi_C=program.Tgi_C,
+        heater=q,
+        fan=program.fan,
+        Gg_kg_s=program.Gg_kg_s,
+        Ta_pred_C=out[:, S_TA].copy(),
+        states=out,
+        params=program.params,
+        solve_s=program.solve_s + time.perf_counter() - t0_clock,
+        iterations=program.iterations,
+        simulations=program.simulations + sims,
+        notes=list(program.notes),
+        zoh=program.zoh,
     )
 
 
@@ -355,7 +434,9 @@ def true_runs(mask) -> list[tuple[int, int]]:
 
 
 def limit_spans(t, u, limits: ProgramLimits) -> list[dict]:
-    """Time ranges where the program ``u`` sits on a limit: ``[{"limit", "from_s", "to_s"}, ...]``.
+    """Time ranges where the program ``u`` sits on a limit:
+    ``[{"limit", "from_s", "to_s", "holds_back"}, ...]`` (``holds_back`` "up": the limit keeps
+    the program from heating more; "down": from heating less).
 
     Levels: within 0.01 % of the range of the floor or ceiling at a knot. Rate: an interval
     whose change is within 1 % of the largest the rate limit allows.
@@ -376,7 +457,10 @@ def limit_spans(t, u, limits: ProgramLimits) -> list[dict]:
     flags[f"{name} falling at its {limits.rate_per_min:g} {unit}/min rate limit"] = down
     spans = []
     for name, mask in flags.items():
+        # the direction the limit holds the program back: a ceiling or a rising rate keeps it
+        # from heating more ("up"), a floor or a falling rate from heating less ("down")
+        side = "up" if ("ceiling" in name or "rising" in name) else "down"
         for k, j in true_runs(mask):
             start = t[k - 1] if "rate" in name and k > 0 else t[k]
-            spans.append({"limit": name, "from_s": float(start), "to_s": float(t[j])})
+            spans.append({"limit": name, "from_s": float(start), "to_s": float(t[j]), "holds_back": side})
     return sorted(spans, key=lambda s: s["from_s"])

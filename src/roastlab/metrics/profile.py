@@ -37,6 +37,12 @@ from scipy import sparse
 ROR_SPAN_S = 30.0
 #: Window over which a curve that stops short is extended at its rate of rise [s].
 PROJECTION_WINDOW_S = 120.0
+#: Bean temperature of DRY END (yellowing) when the log marks none [degC]: Artisan's default
+#: phase boundary between drying and Maillard.
+DRY_END_C = 150.0
+#: Bean-probe temperature of first crack when the log marks none [degC] (Artisan's default FCs
+#: phase boundary; the log's own FCs mark is used where there is one).
+FIRST_CRACK_C = 196.0
 
 
 def mmss(seconds: float | None) -> str:
@@ -117,3 +123,67 @@ def crossing_or_projected_s(t, y, level: float, window_s: float = PROJECTION_WIN
     if not ror_C_s > 1e-6 or y[-1] >= level:
         return None
     return float(t[-1] + (level - y[-1]) / ror_C_s)
+
+
+def turning_point(t, y) -> tuple[float | None, float | None]:
+    """(time [s], temperature [degC]) of the turning point: the minimum of the curve's first
+    half, after the charge drop (None, None for an empty or all-missing curve)."""
+    t = np.asarray(t, dtype=float)
+    y = np.asarray(y, dtype=float)
+    half = y[: max(2, len(y) // 2)]
+    if not np.any(np.isfinite(half)):
+        return None, None
+    i = int(np.nanargmin(half))
+    return float(t[i]), float(y[i])
+
+
+def milestone_levels(t, y, events: dict | None = None) -> dict[str, float]:
+    """The temperatures [degC] that mark DRY END and first crack on this curve: the curve's own
+    reading at the log's DRY / FCs marks where it has them, else :data:`DRY_END_C` and
+    :data:`FIRST_CRACK_C`. Other curves (predictions, a changed roast) are then judged by when
+    they reach the same temperatures (:func:`milestones`)."""
+    t = np.asarray(t, dtype=float)
+    y = np.asarray(y, dtype=float)
+    ok = np.isfinite(y)
+    levels = {"DRY": DRY_END_C, "FCs": FIRST_CRACK_C}
+    for name in levels:
+        at = (events or {}).get(name)
+        if at is not None and ok.sum() >= 2 and t[ok][0] <= at <= t[ok][-1]:
+            levels[name] = round(float(np.interp(at, t[ok], y[ok])), 1)
+    return levels
+
+
+def milestones(t, y, levels: dict[str, float]) -> dict[str, float | None]:
+    """A roaster's milestones of one curve [s, degC, %]: ``TP_s``, ``TP_C`` (turning point),
+    ``DRY_s`` and ``FCs_s`` (when the curve reaches ``levels["DRY"]`` / ``levels["FCs"]``,
+    :func:`crossing_time_s`), ``DROP_s`` and ``DROP_C`` (the curve's end), ``development_s``
+    (DROP - FCs) and ``DTR_pct`` (development time ratio, 100 development / DROP). Missing
+    where the curve never gets there (None).
+
+    >>> t = np.arange(0.0, 601.0, 5.0)
+    >>> y = 100.0 + 0.2 * np.abs(t - 60.0) - 0.1 * 60  # a V: turning point at 1:00
+    >>> m = milestones(t, y, {"DRY": 150.0, "FCs": 190.0})
+    >>> m["TP_s"], round(m["FCs_s"]), m["development_s"], round(m["DTR_pct"], 1)
+    (60.0, 540, 60.0, 10.0)
+    """
+    t = np.asarray(t, dtype=float)
+    y = np.asarray(y, dtype=float)
+    ok = np.isfinite(y)
+    tt, yy = t[ok], y[ok]
+    tp_s, tp_c = turning_point(tt, yy)
+    dry = crossing_time_s(tt, yy, levels["DRY"]) if tt.size >= 2 else None
+    fcs = crossing_time_s(tt, yy, levels["FCs"]) if tt.size >= 2 else None
+    drop_s = float(t[-1]) if t.size else None
+    drop_c = float(y[-1]) if y.size and np.isfinite(y[-1]) else None
+    dev = None if fcs is None or drop_s is None else drop_s - fcs
+    dtr = None if dev is None or not drop_s else 100.0 * dev / drop_s
+    return {
+        "TP_s": tp_s,
+        "TP_C": tp_c,
+        "DRY_s": dry,
+        "FCs_s": fcs,
+        "DROP_s": drop_s,
+        "DROP_C": drop_c,
+        "development_s": dev,
+        "DTR_pct": dtr,
+    }

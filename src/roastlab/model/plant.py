@@ -102,7 +102,13 @@ class Plant:
         Not in the paper; the bean-bed geometry of the probe-immersion extension, with the
         free-settled bulk density :data:`~roastlab.model.constants.GREEN_BULK_DENSITY_KG_M3`.
         """
-        return self.Mb_kg / (GREEN_BULK_DENSITY_KG_M3 * math.pi * self.Dch_m**2 / 4.0 * self.Lch_m)
+        return self.Mb_kg / self.capacity_kg
+
+    @property
+    def capacity_kg(self) -> float:
+        """Green beans the drum holds when full, rho_bulk pi D^2/4 L [kg] (fill fraction 1);
+        not in the paper, it bounds the batch masses a what-if or transfer may ask for."""
+        return GREEN_BULK_DENSITY_KG_M3 * math.pi * self.Dch_m**2 / 4.0 * self.Lch_m
 
     @property
     def bed_depth_m(self) -> float:

@@ -20,21 +20,25 @@ import math
 import numpy as np
 
 from ..errors import InputError
-from ..fit.program import ProgramLimits, ProgramResult, limit_spans, optimise_program, true_runs
+from ..fit.program import (
+    ProgramLimits,
+    ProgramResult,
+    limit_spans,
+    optimise_program,
+    runnable_program,
+    true_runs,
+)
 from ..io.batch import Batch
-from ..metrics.profile import crossing_or_projected_s, crossing_time_s
+from ..metrics.profile import DRY_END_C, FIRST_CRACK_C, crossing_or_projected_s, crossing_time_s, mmss
+from ..model.actuators import MIN_HOLD_S
+from ..model.layout import I_QEG, I_TGIG, S_TM
 from ..model.limits import check_value
 from ..model.plant import Plant
 from ..report.result import Result, draw_curves
 
 #: Probe temperatures [degC] whose crossing times define the phases of the retimed baseline:
 #: end of drying (~150 degC, Artisan's DRY) and start of first crack (~196 degC, FCs).
-PHASE_LEVELS_C = (150.0, 196.0)
-
-
-def _fmt_time(s: float) -> str:
-    s = int(round(s))
-    return f"{s // 60}:{s % 60:02d}"
+PHASE_LEVELS_C = (DRY_END_C, FIRST_CRACK_C)
 
 
 def _errors(pred, target) -> dict:
@@ -61,6 +65,14 @@ class TransferResult(Result):
     metrics: dict
     model_fits_flow: bool = False
     actuators: bool = False
+    #: the optimiser's continuous program, when ``program`` is it rounded to the machine's settings
+    continuous: ProgramResult | None = None
+    #: the reference's event marks [s from CHARGE] (CHARGE, DRY, FCs, DROP ...)
+    events: dict = dataclasses.field(default_factory=dict)
+    #: what ET is on the target machine: "Tgi" (inlet gas) or "Tm" (drum)
+    et_source: str = "Tgi"
+    #: the machine's fan (for the background's Air events), when the map declares one
+    fan_actuator: object = None
 
     # ------------------------------------------------------------------ text outputs
     def summary(self) -> str:
@@ -70,7 +82,11 @@ class TransferResult(Result):
             f"{len(self.time_s)} knots every {self.time_s[1] - self.time_s[0]:g} s"
         )
         rows = [head, "", f"{'program':<24} {'RMSE °C':>9} {'max |e| °C':>11}"]
-        rows.append(f"{'optimised':<24} {m['rmse_C']:>9.3f} {m['max_abs_C']:>11.3f}")
+        label = "runnable (machine steps)" if "runnable" in m else "optimised"
+        rows.append(f"{label:<24} {m['rmse_C']:>9.3f} {m['max_abs_C']:>11.3f}")
+        if "continuous" in m and m["continuous"]["rmse_C"] is not None:
+            c = m["continuous"]
+            rows.append(f"{'continuous (optimiser)':<24} {c['rmse_C']:>9.3f} {c['max_abs_C']:>11.3f}")
         for key, label in (
             ("baseline_same_inputs", "A's inputs unchanged"),
             ("baseline_retimed", "A's inputs retimed"),
@@ -87,6 +103,12 @@ class TransferResult(Result):
             f"solved in {m['solve_s']:.2f} s ({m['simulations']} simulations)"
         )
         rows += [f"  {s}" for s in m["explanation"]]
+        if m.get("Tm0_chosen"):
+            rows.append(f"drum at CHARGE (chosen by the optimiser): {m['Tm0_C']:.0f} °C")
+        if "runnable" in m:
+            r = m["runnable"]
+            rows.append(f"program ({r['what']}):")
+            rows.append("  " + ", ".join(f"{c['setting']} at {mmss(c['time_s'])}" for c in r["changes"]))
         return "\n".join(rows)
 
     def to_json_dict(self) -> dict:
@@ -115,34 +137,65 @@ class TransferResult(Result):
             out.write(",".join(vals) + "\n")
         return out.getvalue()
 
+    def background_events(self) -> list[tuple[int, str, float, str]]:
+        """The program as Artisan special events: ``(sample index, type, value, label)`` with
+        Artisan's types (``Burner`` for the heater or the decided inlet temperature, ``Air`` for
+        the fan or a chosen gas flow) and values in the machine's units (a level as the level,
+        the inlet temperature and a flow as % of their range in 5 % steps), one event per real
+        change, at most one every :data:`~roastlab.model.actuators.MIN_HOLD_S` seconds for what
+        the optimiser decided (a held, logged setting keeps its own changes)."""
+        from ..model.actuators import Actuator
+
+        pr, lim = self.program, self.limits
+        t = pr.time_s
+        series = []  # (type, values, actuator for labels, thin?)
+        if lim.decide == "heater":
+            act = lim.actuator or Actuator("heater", "percent", lim.low, lim.high)
+            series.append(("Burner", pr.heater, act, lim.actuator is None or not lim.actuator.stepped))
+        else:
+            pct = Actuator("heater", "percent", 0.0, 100.0, 5.0)
+            series.append(("Burner", pct.quantise(100.0 * (pr.Tgi_C - lim.low) / (lim.high - lim.low)), pct, True))
+        if self.actuators and np.any(pr.fan != 0):
+            fan = self.fan_actuator or Actuator("fan", "percent", 0.0, 100.0)
+            series.append(("Air", pr.fan, fan, False))
+        elif lim.gg_free:
+            pct = Actuator("fan", "percent", 0.0, 100.0, 5.0)
+            span = lim.Gg_max_kg_s - lim.Gg_min_kg_s
+            series.append(("Air", pct.quantise(100.0 * (pr.Gg_kg_s - lim.Gg_min_kg_s) / span), pct, True))
+        out = []
+        for etype, values, act, thin in series:
+            last_v, last_t = None, -np.inf
+            for i, v in enumerate(np.asarray(values, dtype=float)):
+                if thin:
+                    v = float(act.quantise(v))
+                if last_v is not None and (v == last_v or (thin and t[i] - last_t < MIN_HOLD_S)):
+                    continue
+                out.append((i, etype, v, act.label(v) if act.unit == "level" else f"{etype} {v:g}"))
+                last_v, last_t = v, t[i]
+        return sorted(out, key=lambda e: e[0])
+
     def alog_text(self) -> str:
         """An Artisan profile (Python-literal .alog, as Artisan writes) to load as a background:
-        BT = the predicted probe, ET = the program's inlet temperature, CHARGE and DROP marks,
-        the program as Burner events (0-100 % of the decided input's range) and Air events (gas
-        flow as 0-100 % of its range, or 50 % when fixed), in Artisan's value encoding."""
+        BT the predicted probe, ET the model's ET (the inlet gas or the drum, as the machine's
+        map defines ET), the reference's event marks (CHARGE, DRY, FCs, ..., DROP) and the
+        program as events (:meth:`background_events`) in Artisan's value encoding."""
+        from ..io.importers.artisan import EVENT_NAMES
+
         pr = self.program
         lim = self.limits
-        u = pr.Tgi_C if lim.decide == "Tgi" else pr.heater
-        burner = np.clip(np.round(100.0 * (u - lim.low) / (lim.high - lim.low)), 0, 100)
-        if lim.gg_free:
-            air = np.clip(
-                np.round(100.0 * (pr.Gg_kg_s - lim.Gg_min_kg_s) / (lim.Gg_max_kg_s - lim.Gg_min_kg_s)), 0, 100
-            )
-        else:
-            air = np.full(len(u), 50.0)
-        idx, types, vals, strings = [], [], [], []
-        last = {0: None, 3: None}
-        for i in range(len(u)):
-            for etype, series in ((3, burner), (0, air)):
-                v = float(series[i])
-                if last[etype] is None or abs(v - last[etype]) >= 1.0:
-                    idx.append(i)
-                    types.append(etype)
-                    vals.append(v / 10.0 + 1.0)  # Artisan's internal event encoding
-                    strings.append(f"{'Burner' if etype == 3 else 'Air'} {int(v)}%")
-                    last[etype] = v
-        n = len(pr.time_s)
+        t = pr.time_s
+        etypes = ["Air", "Drum", "Damper", "Burner", "--"]
+        events = self.background_events()
+        n = len(t)
+        timeindex = [0] * 8
+        for k, name in enumerate(EVENT_NAMES):
+            at = self.events.get(name)
+            if at is not None and t[0] <= at <= t[-1] and name != "CHARGE":
+                timeindex[k] = int(np.argmin(np.abs(t - at)))
+        timeindex[EVENT_NAMES.index("DROP")] = n - 1
+        et = pr.states[:, S_TM] if self.et_source == "Tm" else pr.Tgi_C
         now = _dt.datetime.now(_dt.UTC)
+        decided = lim.actuator.describe() if lim.actuator is not None else f"{lim.decide} {lim.low:g}..{lim.high:g} {lim.unit}"
         profile = {
             "recording_version": "roastlab",
             "version": "2.8.4",
@@ -156,23 +209,24 @@ class TransferResult(Result):
             "beans": "",
             "roastingnotes": (
                 f"Computed by roastlab transfer from {self.reference} ({self.plant_from} -> {self.plant_to}, "
-                f"{self.batch_kg:g} kg). BT is the model's prediction, ET the program's inlet temperature; "
-                f"Burner = {lim.decide} as 0-100 % of {lim.low:g}..{lim.high:g} {lim.unit}."
+                f"{self.batch_kg:g} kg). BT is the model's prediction, ET the model's "
+                f"{'drum temperature' if self.et_source == 'Tm' else 'inlet gas temperature'}; "
+                f"Burner events = the decided {decided}."
             ),
             "roastdate": now.strftime("%a %b %d %Y"),
             "roastisodate": now.strftime("%Y-%m-%d"),
             "roasttime": now.strftime("%H:%M:%S"),
             "roastepoch": int(now.timestamp()),
-            "samplinginterval": float(pr.time_s[1] - pr.time_s[0]),
-            "timex": [round(float(t), 3) for t in pr.time_s],
-            "temp1": [round(float(v), 2) for v in pr.Tgi_C],
+            "samplinginterval": float(t[1] - t[0]),
+            "timex": [round(float(v), 3) for v in t],
+            "temp1": [round(float(v), 2) for v in et],
             "temp2": [round(float(v), 2) for v in pr.Ta_pred_C],
-            "timeindex": [0, 0, 0, 0, 0, 0, n - 1, 0],
-            "specialevents": idx,
-            "specialeventstype": types,
-            "specialeventsvalue": vals,
-            "specialeventsStrings": strings,
-            "etypes": ["Air", "Drum", "Damper", "Burner", "--"],
+            "timeindex": timeindex,
+            "specialevents": [int(e[0]) for e in events],
+            "specialeventstype": [etypes.index(e[1]) for e in events],
+            "specialeventsvalue": [round(float(e[2]) / 10.0 + 1.0, 4) for e in events],  # Artisan's encoding
+            "specialeventsStrings": [e[3] for e in events],
+            "etypes": etypes,
             "weight": [round(self.batch_kg, 6), 0.0, "Kg"],
             "extradevices": [],
             "extratimex": [],
@@ -202,6 +256,26 @@ class TransferResult(Result):
     def _draw(self, ax) -> None:
         t = self.time_s
         draw_curves(ax, {"reference BT": (t, self.target_C), "predicted BT": (t, self.program.Ta_pred_C)}, "BT [°C]")
+
+
+def default_limits(model) -> ProgramLimits:
+    """The input a program decides for ``model`` by default: the heater, on the machine's own
+    settings (:meth:`ProgramLimits.for_actuator`), where the model's map reads a heater and
+    the inlet is room air (an induction or electric drum); the inlet gas temperature with
+    :class:`ProgramLimits`' defaults otherwise (the paper's gas roaster)."""
+    cmap = getattr(model, "column_map", None)
+    if cmap is not None and cmap.heater is not None and cmap.inlet_is_constant:
+        return ProgramLimits.for_actuator(cmap.actuator("heater"))
+    return ProgramLimits()
+
+
+def _et_source(cmap) -> str:
+    """What ET is on this machine, for the background's ET curve: the inlet gas where the map
+    reads ET as the inlet (``[Tgi] column = "ET"``), else the drum (the Skywalker's and the
+    Bullet's ET is the drum's temperature, as their maps' [initial] Tm0_C says)."""
+    if cmap is not None and cmap.Tgi.get("column") == "ET":
+        return "Tgi"
+    return "Tm" if cmap is not None and cmap.inlet_is_constant else "Tgi"
 
 
 def _grid_batch(ref: Batch, interval_s: float) -> Batch:
@@ -274,7 +348,7 @@ def transfer(
     """
     from ..io.plants import load_plant
 
-    limits = limits or ProgramLimits()
+    limits = limits or default_limits(model)
     src = reference.source or reference.name
     if reference.Ta_C is None:
         raise InputError("the reference has no bean-probe curve (Ta_C): nothing to transfer", src)
@@ -293,12 +367,23 @@ def transfer(
     if limits.decide == "heater" and reference.heater is None:
         raise InputError("the program is to decide the heater, but the reference has no heater setting", src)
     same_plant = pa == pb
+    cmap = model.column_map
+    if limits.decide == "Tgi" and same_plant and cmap is not None and cmap.inlet_is_constant and cmap.heater:
+        raise InputError(
+            f"this machine's inlet is room air (the map's [Tgi] constant_C = {cmap.Tgi['constant_C']:g}): "
+            "a program cannot set it; decide the heater (the default for this model)",
+            "--decide Tgi",
+        )
     mass_a = reference.Mb_kg or pa.Mb_kg
     mass_b = (
         check_value("batch_kg", batch_kg, "--batch-kg")
         if batch_kg is not None
         else (mass_a if same_plant else pb.Mb_kg)
     )
+    if batch_kg is not None:
+        from .model import check_batch_mass
+
+        check_batch_mass(mass_b, pb)
     grid = _grid_batch(reference, interval_s)
     ta0 = float(grid.Ta_C[0])
     changes = dict(initial or {})
@@ -313,6 +398,12 @@ def transfer(
         grid_b.Gg_kg_s = res_a.Gg_kg_s.copy()
     res_same = model.predict(grid_b, plant=pb, **changes)
     p_b = res_same.params
+    if limits.decide == "heater" and p_b[I_QEG] == 0.0 and p_b[I_TGIG] == 0.0:
+        raise InputError(
+            f"the heater has no effect on {pb.name}: its gains (Qe_gain_kW, Tgi_gain_C) are 0 there "
+            "(plant-specific values do not carry over to another plant); decide Tgi",
+            "--decide heater",
+        )
     x0 = res_same.states[0].copy()
     # on its own plant a model that fitted a constant flow applies it; elsewhere that value is dropped
     fits_flow = same_plant and "Gg_kg_s" in model.parameters
@@ -337,7 +428,10 @@ def transfer(
         zoh=model.hold == "zoh",
         tm0_bounds=tm0_free,
     )
-    # what the Python simulator says for the program (the check that PROGRAM.csv reproduces it)
+    continuous = program
+    if limits.actuator is not None and limits.actuator.stepped:
+        # the machine's settings, changed a few times a minute: the program a roaster can run
+        program = runnable_program(continuous, target, limits.actuator)
     err = _errors(program.Ta_pred_C, target)
 
     # baseline 2: A's inputs retimed by the phase times baseline 1 gives on B
@@ -391,6 +485,7 @@ def transfer(
         "on_limits": spans,
         "Gg_kg_s": float(np.mean(program.Gg_kg_s)),
         "Tm0_C": program.Tm0_C,
+        "Tm0_chosen": tm0_free is not None,
         "reference_own_inputs_on_A": own,
         "baseline_same_inputs": base_same,
         "baseline_retimed": base_ret,
@@ -400,6 +495,17 @@ def transfer(
         "explanation": explanation,
         "notes": list(res_same.meta.get("notes", [])) + program.notes,
     }
+    if program is not continuous:
+        act = limits.actuator
+        steps = np.flatnonzero(np.diff(program.heater)) + 1
+        metrics["runnable"] = {
+            "what": f"{act.describe()}, held at least {MIN_HOLD_S:g} s between changes",
+            "changes": [{"time_s": float(t[k]), "setting": act.label(program.heater[k])} for k in [0, *steps]],
+        }
+        metrics["continuous"] = {
+            **_errors(continuous.Ta_pred_C, target),
+            "what": "the optimiser's continuous program, before rounding to the machine's settings",
+        }
     return TransferResult(
         reference=reference.name,
         plant_from=pa.name,
@@ -414,32 +520,38 @@ def transfer(
         metrics=metrics,
         model_fits_flow=fits_flow,
         actuators=grid.heater is not None or grid.fan is not None,
+        continuous=continuous,
+        events=dict(reference.events),
+        et_source=_et_source(cmap),
+        fan_actuator=cmap.actuator("fan") if cmap is not None and cmap.fan else None,
     )
 
 
 def _explain(t, e, spans, tol, plant, mass, feasible) -> list[str]:
-    """Where the program misses the target by more than ``tol`` and the limits active then."""
+    """Where the program misses the target by more than ``tol`` and the limits that hold it back
+    in the direction of the miss (below the target: a ceiling or a rising rate; above it: a
+    floor or a falling rate), so an explanation never contradicts the error it explains."""
     out = []
     bad = np.abs(e) > tol
     if feasible:
         if spans:
             out.append(
-                "on a limit: "
-                + "; ".join(f"{s['limit']} {_fmt_time(s['from_s'])}-{_fmt_time(s['to_s'])}" for s in spans)
+                "on a limit: " + "; ".join(f"{s['limit']} {mmss(s['from_s'])}-{mmss(s['to_s'])}" for s in spans)
             )
         return out
     for i, j in true_runs(bad):
         worst = int(i + np.argmax(np.abs(e[i : j + 1])))
-        side = "below" if e[worst] < 0 else "above"
-        active = [s for s in spans if s["from_s"] <= t[j] and s["to_s"] >= t[i] - 60.0]
-        why = (
-            "; ".join(f"{s['limit']} from {_fmt_time(s['from_s'])} to {_fmt_time(s['to_s'])}" for s in active)
-            if active
-            else "no limit active: the target's shape is not reachable with this model"
-        )
-        verb = "cannot heat that fast" if side == "below" else "cannot cool that fast"
-        out.append(
-            f"{_fmt_time(t[i])}-{_fmt_time(t[j])}: predicted BT up to {abs(e[worst]):.1f} °C {side} the target; "
-            f"{why}" + (f": the {mass:g} kg batch on {plant} {verb}" if active else "")
-        )
+        below = e[worst] < 0
+        need = "up" if below else "down"
+        active = [
+            s for s in spans if s["holds_back"] == need and s["from_s"] <= t[j] and s["to_s"] >= t[i] - 60.0
+        ]
+        side = "below" if below else "above"
+        if active:
+            why = "; ".join(f"{s['limit']} from {mmss(s['from_s'])} to {mmss(s['to_s'])}" for s in active)
+            verb = "cannot heat that fast" if below else "cannot cool that fast"
+            why += f": the {mass:g} kg batch on {plant} {verb}"
+        else:
+            why = "no limit holds the program back here: the model cannot follow the target's shape"
+        out.append(f"{mmss(t[i])}-{mmss(t[j])}: predicted BT up to {abs(e[worst]):.1f} °C {side} the target; {why}")
     return out

@@ -63,6 +63,7 @@ from pathlib import Path
 import numpy as np
 
 from ...errors import InputError
+from ...model.actuators import UNIT_DEFAULTS, Actuator
 from ...model.limits import check_value
 from ...model.pitot import gas_flow_pitot_kg_s
 from ..batch import Batch, read_table
@@ -71,8 +72,8 @@ from .artisan import read_alog, read_artisan_csv
 from .roastime import read_roastime
 
 FORMATS = ("auto", "alog", "artisan-csv", "roastime", "csv", "parquet")
-#: Units a logged setting may be given in, and the plausible range of each.
-SETTING_UNITS = {"percent": (0.0, 100.0), "level": (0.0, 20.0), "kW": (0.0, 1e4)}
+#: Units a logged setting may be given in, and the plausible range of each (the actuator table's).
+SETTING_UNITS = {unit: (lo, hi) for unit, (lo, hi, _, _) in UNIT_DEFAULTS.items()}
 #: Initial states a map may take from the log.
 INITIAL_FROM_LOG = ("Tm0_C", "Tb0_C", "X0")
 TIME_UNITS = {"s": 1.0, "min": 60.0, "ms": 1e-3}
@@ -132,6 +133,16 @@ class ColumnMap:
         """True if the map reads heater or fan settings (the actuator extension)."""
         return self.heater is not None or self.fan is not None
 
+    def actuator(self, name: str) -> Actuator | None:
+        """The ``heater`` or ``fan`` control this map declares (levels, step, rate), or None."""
+        spec = getattr(self, name)
+        return None if spec is None else Actuator.from_spec(name, spec)
+
+    @property
+    def inlet_is_constant(self) -> bool:
+        """True if the inlet gas is a constant (room air drawn into an induction or electric drum)."""
+        return "constant_C" in self.Tgi
+
     @property
     def identifies_flow(self) -> bool:
         """True if the map writes a 1 kg/s placeholder flow for the fit to scale (``[Gg] identify``)."""
@@ -143,8 +154,8 @@ TABLE_KEYS = {
     "time": {"column", "unit"},
     "Ta": {"column", "unit", "offset_C"},
     "Tgi": {"column", "unit", "offset_C", "constant_C"},
-    "heater": {"column", "unit"},
-    "fan": {"column", "unit"},
+    "heater": {"column", "unit", "min", "max", "step", "rate_per_min"},
+    "fan": {"column", "unit", "min", "max", "step", "rate_per_min"},
     "Tb2": {"column", "unit", "offset_C", "start_s"},
     "initial": set(INITIAL_FROM_LOG),
     "Gg": {"column", "unit", "density_kg_m3", "constant_kg_s", "identify", "pitot"},
@@ -237,14 +248,12 @@ def map_from_mapping(data: dict, path: str | Path) -> ColumnMap:
     for key in ("heater", "fan"):
         if key in data:
             t = _table(data, key, path)
-            setattr(
-                m,
-                key,
-                {
-                    "column": _check_str(t, "column", path, key),
-                    "unit": _check_str(t, "unit", path, key, required=False, choices=tuple(SETTING_UNITS)) or "percent",
-                },
-            )
+            spec = {
+                "column": _check_str(t, "column", path, key),
+                "unit": _check_str(t, "unit", path, key, required=False, choices=tuple(SETTING_UNITS)) or "percent",
+            }
+            spec.update(_actuator_levels(t, spec["unit"], path, key))
+            setattr(m, key, spec)
     if "initial" in data:
         t = _table(data, "initial", path)
         m.initial = {k: _check_str(t, k, path, "initial") for k in t}
@@ -285,6 +294,25 @@ def map_from_mapping(data: dict, path: str | Path) -> ColumnMap:
                 }
             }
     return m
+
+
+def _actuator_levels(table: dict, unit: str, path, key: str) -> dict:
+    """The optional ``min``, ``max``, ``step``, ``rate_per_min`` of a ``[heater]``/``[fan]`` table,
+    checked against the unit's plausible range (:data:`SETTING_UNITS`)."""
+    lo_u, hi_u = SETTING_UNITS[unit]
+    out = {}
+    for name in ("min", "max", "step", "rate_per_min"):
+        v = _check_num(table, name, path, key)
+        if v is not None:
+            out[name] = v
+    lo, hi = out.get("min", lo_u), out.get("max", hi_u)
+    if not lo_u <= lo < hi <= hi_u:
+        raise InputError(f"min {lo:g} and max {hi:g} must satisfy {lo_u:g} <= min < max <= {hi_u:g} for unit {unit!r}", path, key)
+    if "step" in out and not 0 < out["step"] <= hi - lo:
+        raise InputError(f"step must be > 0 and at most max - min ({hi - lo:g}), got {out['step']:g}", path, f"{key}.step")
+    if "rate_per_min" in out and not out["rate_per_min"] > 0:
+        raise InputError(f"rate_per_min must be > 0, got {out['rate_per_min']:g}", path, f"{key}.rate_per_min")
+    return out
 
 
 def _missing(path, key):

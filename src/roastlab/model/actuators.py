@@ -1,0 +1,88 @@
+"""What a roaster's controls can be set to: levels, steps and how fast they may change.
+
+A program a roaster can run is made of the settings the machine has: the Aillio Bullet's power
+P0-P9 and fan F0-F12 are whole steps, an Artisan slider is a percentage a roaster moves in
+5 % steps, a gas valve or an electric element may be continuous (kW). Transfer and MPC decide
+programs on these levels, the Artisan background writes them as events, the what-if names the
+unit of a change. The column map declares a machine's controls (``[heater]`` / ``[fan]`` with
+``unit`` and optionally ``min``, ``max``, ``step``, ``rate_per_min``); what it leaves out comes
+from :data:`UNIT_DEFAULTS`, the one table of defaults per unit.
+
+>>> a = Actuator("heater", "level", 0.0, 9.0, 1.0)
+>>> a.label(7), a.quantise([6.6, 9.4, -1.0]).tolist()
+('P7', [7.0, 9.0, 0.0])
+>>> Actuator("fan", "percent", 0, 100, 5).label(35)
+'35 %'
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+#: Per unit: (lowest, highest, step or None for continuous, fastest change per minute).
+#: A percentage slider moves in 5 % steps; a level knob in whole steps; kW is continuous.
+UNIT_DEFAULTS: dict[str, tuple[float, float, float | None, float]] = {
+    "percent": (0.0, 100.0, 5.0, 60.0),
+    "level": (0.0, 20.0, 1.0, 12.0),
+    "kW": (0.0, 1e4, None, 1e4),
+}
+#: How a setting's value reads to a roaster, per control and unit ("P7", "F3", "35 %").
+_PREFIX = {("heater", "level"): "P", ("fan", "level"): "F"}
+#: Shortest time a runnable program holds a setting before the next change [s]: a person at
+#: the machine (or Artisan's playback) acts a few times a minute at most.
+MIN_HOLD_S = 30.0
+
+
+@dataclass(frozen=True)
+class Actuator:
+    """One control of a roaster: ``name`` ("heater" or "fan"), its ``unit`` ("percent",
+    "level", "kW"), the range ``low``..``high`` in that unit, the ``step`` between settings the
+    machine offers (None: continuous) and the fastest change ``rate_per_min`` [unit/min]."""
+
+    name: str
+    unit: str
+    low: float
+    high: float
+    step: float | None = None
+    rate_per_min: float | None = None
+
+    @classmethod
+    def from_spec(cls, name: str, spec: dict) -> Actuator:
+        """The actuator a map table declares (``unit``, optional ``min``/``max``/``step``/
+        ``rate_per_min``), the rest from :data:`UNIT_DEFAULTS`."""
+        unit = spec.get("unit", "percent")
+        low, high, step, rate = UNIT_DEFAULTS[unit]
+        return cls(
+            name,
+            unit,
+            float(spec.get("min", low)),
+            float(spec.get("max", high)),
+            spec.get("step", step),
+            float(spec.get("rate_per_min", rate)),
+        )
+
+    @property
+    def stepped(self) -> bool:
+        return self.step is not None and self.step > 0
+
+    def quantise(self, values) -> np.ndarray:
+        """``values`` clipped to the range and rounded to the nearest setting the machine has."""
+        v = np.clip(np.asarray(values, dtype=float), self.low, self.high)
+        if not self.stepped:
+            return v
+        return np.clip(self.low + np.round((v - self.low) / self.step) * self.step, self.low, self.high)
+
+    def label(self, value: float) -> str:
+        """The setting as a roaster reads it: "P7", "F3", "35 %", "2.5 kW"."""
+        prefix = _PREFIX.get((self.name, self.unit))
+        if prefix:
+            return f"{prefix}{value:g}"
+        return f"{value:g} %" if self.unit == "percent" else f"{value:g} {self.unit}"
+
+    def describe(self) -> str:
+        """``heater P0-P9 in steps of 1`` / ``fan 0-100 % in 5 % steps``."""
+        if self.stepped:
+            return f"{self.name} {self.label(self.low)}-{self.label(self.high)} in steps of {self.step:g}"
+        return f"{self.name} {self.label(self.low)}-{self.label(self.high)} (continuous)"
