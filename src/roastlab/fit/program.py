@@ -96,9 +96,7 @@ class ProgramLimits:
             )
 
     @classmethod
-    def for_actuator(
-        cls, actuator, low=None, high=None, rate_per_min=None, gg_min=None, gg_max=None
-    ) -> ProgramLimits:
+    def for_actuator(cls, actuator, low=None, high=None, rate_per_min=None, gg_min=None, gg_max=None) -> ProgramLimits:
         """Limits for deciding a machine's control (:class:`roastlab.model.actuators.Actuator`,
         as the map declares it): its range, rate and steps unless overridden, so a program is
         called infeasible because of the machine, not because of a default."""

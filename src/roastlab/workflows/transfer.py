@@ -195,7 +195,11 @@ class TransferResult(Result):
         timeindex[EVENT_NAMES.index("DROP")] = n - 1
         et = pr.states[:, S_TM] if self.et_source == "Tm" else pr.Tgi_C
         now = _dt.datetime.now(_dt.UTC)
-        decided = lim.actuator.describe() if lim.actuator is not None else f"{lim.decide} {lim.low:g}..{lim.high:g} {lim.unit}"
+        decided = (
+            lim.actuator.describe()
+            if lim.actuator is not None
+            else f"{lim.decide} {lim.low:g}..{lim.high:g} {lim.unit}"
+        )
         profile = {
             "recording_version": "roastlab",
             "version": "2.8.4",
@@ -535,17 +539,13 @@ def _explain(t, e, spans, tol, plant, mass, feasible) -> list[str]:
     bad = np.abs(e) > tol
     if feasible:
         if spans:
-            out.append(
-                "on a limit: " + "; ".join(f"{s['limit']} {mmss(s['from_s'])}-{mmss(s['to_s'])}" for s in spans)
-            )
+            out.append("on a limit: " + "; ".join(f"{s['limit']} {mmss(s['from_s'])}-{mmss(s['to_s'])}" for s in spans))
         return out
     for i, j in true_runs(bad):
         worst = int(i + np.argmax(np.abs(e[i : j + 1])))
         below = e[worst] < 0
         need = "up" if below else "down"
-        active = [
-            s for s in spans if s["holds_back"] == need and s["from_s"] <= t[j] and s["to_s"] >= t[i] - 60.0
-        ]
+        active = [s for s in spans if s["holds_back"] == need and s["from_s"] <= t[j] and s["to_s"] >= t[i] - 60.0]
         side = "below" if below else "above"
         if active:
             why = "; ".join(f"{s['limit']} from {mmss(s['from_s'])} to {mmss(s['to_s'])}" for s in active)

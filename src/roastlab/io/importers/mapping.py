@@ -307,9 +307,13 @@ def _actuator_levels(table: dict, unit: str, path, key: str) -> dict:
             out[name] = v
     lo, hi = out.get("min", lo_u), out.get("max", hi_u)
     if not lo_u <= lo < hi <= hi_u:
-        raise InputError(f"min {lo:g} and max {hi:g} must satisfy {lo_u:g} <= min < max <= {hi_u:g} for unit {unit!r}", path, key)
+        raise InputError(
+            f"min {lo:g} and max {hi:g} must satisfy {lo_u:g} <= min < max <= {hi_u:g} for unit {unit!r}", path, key
+        )
     if "step" in out and not 0 < out["step"] <= hi - lo:
-        raise InputError(f"step must be > 0 and at most max - min ({hi - lo:g}), got {out['step']:g}", path, f"{key}.step")
+        raise InputError(
+            f"step must be > 0 and at most max - min ({hi - lo:g}), got {out['step']:g}", path, f"{key}.step"
+        )
     if "rate_per_min" in out and not out["rate_per_min"] > 0:
         raise InputError(f"rate_per_min must be > 0, got {out['rate_per_min']:g}", path, f"{key}.rate_per_min")
     return out
