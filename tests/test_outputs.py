@@ -53,6 +53,7 @@ VALUES = {
     "--batch-kg",
     "--tm0-range",
     "--decide",
+    "--units",
     "--tgi-min",
     "--tgi-max",
     "--tgi-rate",

@@ -17,6 +17,7 @@ from .common import (
 
 def cmd_whatif(args) -> int:
     from ..io.files import Outputs
+    from ..io.importers.mapping import load_map
     from ..report.figures import check_figure_path
     from ..workflows.model import load_model
     from ..workflows.whatif import parse_set, parse_setting_change, whatif
@@ -27,10 +28,15 @@ def cmd_whatif(args) -> int:
             outputs.check(target)
     if args.plot:
         check_figure_path(args.plot)
+    model = load_model(args.model)
+    cmap = load_map(args.map) if args.map else model.column_map
+    units = {k: (getattr(cmap, k) or {}).get("unit", "") for k in ("heater", "fan")} if cmap is not None else {}
     setting_changes = [
-        parse_setting_change(name, getattr(args, name)) for name in ("heater", "fan") if getattr(args, name)
+        parse_setting_change(name, getattr(args, name), units.get(name, ""))
+        for name in ("heater", "fan")
+        if getattr(args, name)
     ]
-    setting_changes += [parse_set(text) for text in args.set or []]
+    setting_changes += [parse_set(text, units) for text in args.set or []]
     changes = initial_changes(args)
     if args.tgi is not None:
         changes["Tgi_offset_C"] = args.tgi
@@ -38,11 +44,11 @@ def cmd_whatif(args) -> int:
         from ..model.limits import check_value
 
         changes["batch_kg"] = check_value("batch_kg", args.batch_kg, "--batch-kg")
-    model = load_model(args.model)
     batch = read_inputs(args.log, args.map, model)
     say(batch.notes)
-    result = whatif(model, batch, setting_changes, **changes)
-    print(result.table())
+    actuators = {k: cmap.actuator(k) for k in ("heater", "fan") if cmap is not None and getattr(cmap, k)}
+    result = whatif(model, batch, setting_changes, actuators=actuators, **changes)
+    print(result.table(units=args.units))
     with outputs as out:
         write_json_and_plot(out, args, result.to_json_dict(), result)
     return 0
@@ -53,30 +59,42 @@ def add_parsers(sub) -> None:
     p = sub.add_parser(
         "whatif",
         help="predict a logged roast as run and with changed settings, batch or charge state",
-        description="Apply MODEL.json to LOG twice, as logged and with the changes, and print the predicted BT at "
-        "the logged DROP time and the times to reach 150 degC, 170 degC and the logged first-crack temperature, "
-        "with the change in each. Settings (heater, fan) exist when the model's map reads them (the actuator "
-        "extension); --tgi works on any model.",
+        description="Apply MODEL.json to LOG twice, as logged and with the changes, and print the roaster's "
+        "milestones (turning point, DRY END, first crack, temperature at DROP, development time and ratio) as "
+        "measured, as run by the model and with the changes, with the change and the model's own error on this "
+        "log. Judged on the beans (the model's bean temperature; the log's second bean reading as 'measured' "
+        "where it has one), the probe BT below: a batch-size change also changes how deep the probe sits in the "
+        "bed. DRY END and first crack are when a curve reaches the temperature the log marks them at. A note "
+        "says where a change is within the model's own error. Settings (heater, fan) exist when the model's map "
+        "reads them, in the map's units (percent, level); --tgi works on any model.",
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog="examples:\n"
-        "  roastlab whatif roast.alog --model model.json --heater +1 --plot whatif.png\n"
-        "  roastlab whatif roast.json --model bullet.json --set heater=6@120 --fan -2\n"
-        "  roastlab whatif roast.json --model bullet.json --batch-kg 0.8 --tm0 260",
+        "  roastlab whatif roast.alog --model model.json --heater +5 --plot whatif.png\n"
+        "  roastlab whatif roast.json --model bullet.json --heater +1@4:00    # one step more from 4:00 on\n"
+        "  roastlab whatif roast.json --model bullet.json --set heater=6@2:00 --fan -2\n"
+        "  roastlab whatif roast.json --model bullet.json --batch-kg 0.8 --tm0 260 --units F",
     )
     p.add_argument("log", metavar="LOG", help="the roast log (read with the model's map, or --map)")
     p.add_argument("--model", required=True, metavar="MODEL.json", help=MODEL_HELP)
     p.add_argument("--map", metavar="MAP.toml", help="column map for LOG (default: the model's own)")
-    p.add_argument("--heater", metavar="+D|xF", help="shift (+1, -2) or scale (x1.1) the logged heater setting")
-    p.add_argument("--fan", metavar="+D|xF", help="shift (+1, -2) or scale (x1.1) the logged fan setting")
+    p.add_argument(
+        "--heater",
+        metavar="+D[@T]|xF[@T]",
+        help="shift (+1, -2) or scale (x1.1) the logged heater setting, from CHARGE or from time T (m:ss or s), "
+        "in the map's unit (percent or level)",
+    )
+    p.add_argument("--fan", metavar="+D[@T]|xF[@T]", help="as --heater, for the fan setting")
     p.add_argument(
         "--set",
         action="append",
-        metavar="SETTING=V@S",
-        help="set heater or fan to V from S seconds after CHARGE on, e.g. heater=6@120 (repeatable)",
+        metavar="SETTING=V@T",
+        help="set heater or fan to V from time T (m:ss or s) on, e.g. heater=6@2:00; with a sign it is relative: "
+        "heater=+1@4:00 (repeatable)",
     )
     p.add_argument("--tgi", type=float_arg("--tgi"), help="add this to the inlet gas temperature [degC]")
     p.add_argument("--batch-kg", type=float_arg("--batch-kg"), help="green batch mass [kg] (default: the log's)")
     add_initial_options(p)
-    p.add_argument("--json", metavar="WHATIF.json", help="write the table as JSON")
+    p.add_argument("--units", choices=("C", "F"), default="C", help="temperatures in the table in C or F (default C)")
+    p.add_argument("--json", metavar="WHATIF.json", help="write the table as JSON (temperatures in degC, times in s)")
     p.add_argument("--plot", metavar="FIG.png", help="overlay measured BT and both predictions (.png/.svg/.pdf)")
     p.set_defaults(func=cmd_whatif)

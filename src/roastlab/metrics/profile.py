@@ -187,3 +187,13 @@ def milestones(t, y, levels: dict[str, float]) -> dict[str, float | None]:
         "development_s": dev,
         "DTR_pct": dtr,
     }
+
+
+def display_temp(temp_C: float, units: str = "C") -> float:
+    """A temperature [degC] in the display unit ("C" or "F")."""
+    return temp_C * 9.0 / 5.0 + 32.0 if units == "F" else temp_C
+
+
+def display_temp_delta(delta_C: float, units: str = "C") -> float:
+    """A temperature difference [K] in the display unit ("C" or "F")."""
+    return delta_C * 9.0 / 5.0 if units == "F" else delta_C

@@ -14,10 +14,14 @@ from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 
-from ..errors import InputError
+from ..errors import InputError, ParameterError
 from .constants import GREEN_BULK_DENSITY_KG_M3, ProcessConstants
 from .limits import check_value
 from .rhs import bean_areas_m2, bean_heat_transfer_coefficient_kW_m2K, conductance_ratio_F, dry_mass_kg
+
+#: A batch may be this far below or above a plant's nominal batch (factor): outside it, it is
+#: another machine's batch (a log read on the wrong plant, or a change with a unit slip).
+BATCH_RANGE_FACTOR = (1 / 20, 5.0)
 
 GEOMETRY_KEYS = ("Mb_kg", "Dch_m", "Lch_m", "Hflap_m", "Sflap_m", "Mm_kg")
 _GEOMETRY_DOC = {
@@ -109,6 +113,23 @@ class Plant:
         """Green beans the drum holds when full, rho_bulk pi D^2/4 L [kg] (fill fraction 1);
         not in the paper, it bounds the batch masses a what-if or transfer may ask for."""
         return GREEN_BULK_DENSITY_KG_M3 * math.pi * self.Dch_m**2 / 4.0 * self.Lch_m
+
+    def batch_fits(self, mass_kg: float) -> bool:
+        """True when a green batch of ``mass_kg`` can be roasted here: within
+        :data:`BATCH_RANGE_FACTOR` of the nominal batch and no more than the drum holds."""
+        lo, hi = BATCH_RANGE_FACTOR
+        return lo * self.Mb_kg <= mass_kg <= min(hi * self.Mb_kg, self.capacity_kg)
+
+    def check_batch_mass(self, mass_kg: float) -> None:
+        """Refuse a requested green batch of ``mass_kg`` this plant cannot take, naming its range and
+        capacity (:meth:`batch_fits`)."""
+        if not self.batch_fits(mass_kg):
+            lo, hi = BATCH_RANGE_FACTOR
+            raise ParameterError(
+                f"a {mass_kg:g} kg batch is far outside {self.name}'s range: nominal {self.Mb_kg:g} kg, "
+                f"{lo * self.Mb_kg:.3g}-{min(hi * self.Mb_kg, self.capacity_kg):.3g} kg accepted "
+                f"(the drum holds {self.capacity_kg:.3g} kg of green beans)"
+            )
 
     @property
     def bed_depth_m(self) -> float:

@@ -13,7 +13,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..io.files import Outputs
-from ..metrics.profile import ROR_SPAN_S, rate_of_rise_C_per_min  # noqa: F401  (ROR_SPAN_S: re-exported)
+from ..metrics.profile import ROR_SPAN_S, mmss, rate_of_rise_C_per_min, turning_point
 from ..model.layout import S_TB, S_TM
 
 #: Image formats a figure may be saved as (by the file suffix).
@@ -60,12 +60,58 @@ def finish_figure(fig, path, title, outputs=None):
     return fig
 
 
-def _events(ax, events: dict | None) -> None:
-    for name, t in (events or {}).items():
-        if t is None or not np.isfinite(t):
+def _events(ax, events: dict | None, color="0.55") -> None:
+    """Event marks (CHARGE, DRY, FCs, DROP ...) as labelled vertical lines, Artisan-style; labels
+    of marks closer than ~a fifth of a minute-axis tick alternate in height so they never overlap."""
+    marks = sorted((t, name) for name, t in (events or {}).items() if t is not None and np.isfinite(t))
+    lo, hi = ax.get_xlim() if ax.has_data() else (0.0, 1.0)
+    span = max(hi - lo, 1e-9)
+    last_x, level = -np.inf, 0
+    for t, name in marks:
+        x = t / 60.0
+        level = (level + 1) % 3 if x - last_x < 0.06 * span else 0
+        ax.axvline(x, color=color, lw=0.8, ls=":")
+        right = x > lo + 0.88 * span  # a mark near the right edge is labelled on its left
+        ax.annotate(
+            f"{name} {mmss(t)}",
+            (x, 1.0 - 0.09 * level),
+            xycoords=("data", "axes fraction"),
+            fontsize=7,
+            va="top",
+            ha="right" if right else "left",
+            xytext=(-2 if right else 2, -2),
+            textcoords="offset points",
+            color="0.3",
+        )
+        last_x = x
+
+
+def time_axis(ax, label: str = "time after CHARGE [m:ss]") -> None:
+    """The roaster's time axis: data in minutes, ticks written m:ss."""
+    from matplotlib.ticker import FuncFormatter, MultipleLocator
+
+    ax.xaxis.set_major_locator(MultipleLocator(1.0))
+    ax.xaxis.set_major_formatter(FuncFormatter(lambda x, _: mmss(60.0 * x)))
+    ax.set_xlabel(label)
+
+
+def ror_limits(ax, time_s, *curves) -> None:
+    """Clip a rate-of-rise axis [degC/min] to the roast's range after the turning point, so the
+    charge drop (-100 degC/min and below) does not flatten the curves that matter."""
+    t = np.asarray(time_s, dtype=float)
+    vals = []
+    for bt in curves:
+        if bt is None:
             continue
-        ax.axvline(t / 60.0, color="0.6", lw=0.8, ls=":")
-        ax.annotate(name, (t / 60.0, 1.0), xycoords=("data", "axes fraction"), fontsize=7, rotation=90, va="top")
+        tp_s, _ = turning_point(t, bt)
+        ror = rate_of_rise_C_per_min(t, bt)
+        after = (t >= (tp_s or 0.0) + ROR_SPAN_S) & np.isfinite(ror)
+        vals.append(ror[after])
+    v = np.concatenate(vals) if vals else np.array([])
+    if v.size:
+        top = float(np.percentile(v, 99))
+        bottom = float(np.percentile(v, 1))
+        ax.set_ylim(min(0.0, bottom) - 2.0, max(top, 5.0) * 1.15 + 1.0)
 
 
 def plot_simulation(result, path=None, title=None, outputs=None, events=None):
@@ -195,32 +241,42 @@ def plot_fig3(ident, valid, path, note="synthetic data", outputs=None):
 
 
 def plot_whatif(w, path=None, outputs=None):
-    """Measured BT, the model's BT for the log as run and with the changes, the settings below.
+    """Artisan-style: measured BT, the model's probe BT and bean temperature as run and with the
+    changes, the log's event marks; below, BT's rate of rise (clipped to the roast after the
+    turning point); bottom, the settings as run and changed. Times in m:ss.
 
     ``w`` is a :class:`roastlab.workflows.whatif.WhatIf`.
     """
     b = w.batch
-    t_min = b.time_s / 60.0
-    fig = new_figure(figsize=(9, 7), layout="constrained")
-    ax, ax2 = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1.3]})
+    t = b.time_s
+    t_min = t / 60.0
+    fig = new_figure(figsize=(9, 8.5), layout="constrained")
+    ax, ax_r, ax2 = fig.subplots(3, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1.3, 1.1]})
     if b.Ta_C is not None:
-        ax.plot(t_min, b.Ta_C, ".", ms=3, color="0.3", label="BT measured")
-    ax.plot(t_min, w.as_run.Ta_C, color="tab:blue", lw=1.8, label="BT predicted, as run")
-    ax.plot(
-        t_min,
-        w.changed.Ta_C,
-        color="tab:orange",
-        lw=1.8,
-        label="BT predicted, " + ("; ".join(w.changes) or "no change"),
-    )
-    for r in w.rows[1:]:
-        for value, color in ((r["as_run"], "tab:blue"), (r["changed"], "tab:orange")):
-            if value is not None:
-                ax.axvline(value / 60.0, color=color, lw=0.6, ls=":")
-    _events(ax, b.events)
-    ax.set_ylabel("bean temperature BT [°C]")
-    ax.legend(loc="lower right", fontsize=8)
+        ax.plot(t_min, b.Ta_C, ".", ms=3, color="0.3", label="BT measured (probe)")
+    if b.Tb2_C is not None:
+        ax.plot(t_min, b.Tb2_C, ".", ms=2, color="tab:brown", alpha=0.5, label="beans measured (second reading)")
+    change = "; ".join(w.changes) or "no change"
+    ax.plot(t_min, w.as_run.Ta_C, color="tab:blue", lw=1.8, label="BT model, as run")
+    ax.plot(t_min, w.changed.Ta_C, color="tab:orange", lw=1.8, label=f"BT model, {change}")
+    ax.plot(t_min, w.as_run.Tb_C, color="tab:blue", lw=1.0, ls="--", label="beans model (Tb), as run")
+    ax.plot(t_min, w.changed.Tb_C, color="tab:orange", lw=1.0, ls="--", label="beans model (Tb), changed")
+    ax.set_ylabel("temperature [°C]")
+    ax.legend(loc="lower right", fontsize=7)
     ax.grid(alpha=0.3)
+    ax.set_xlim(t_min[0], t_min[-1])
+    _events(ax, b.events)
+    for bt, color, label in (
+        (b.Ta_C, "0.3", "measured"),
+        (w.as_run.Ta_C, "tab:blue", "as run"),
+        (w.changed.Ta_C, "tab:orange", "changed"),
+    ):
+        if bt is not None:
+            ax_r.plot(t_min, rate_of_rise_C_per_min(t, bt), color=color, lw=1.0, label=f"BT RoR {label}")
+    ror_limits(ax_r, t, b.Ta_C, w.as_run.Ta_C, w.changed.Ta_C)
+    ax_r.set_ylabel(f"RoR [°C/min]\n({ROR_SPAN_S:g} s)")
+    ax_r.legend(loc="upper right", fontsize=7, ncol=3)
+    ax_r.grid(alpha=0.3)
     shown = False
     for name, color in (("heater", "tab:red"), ("fan", "tab:green")):
         before = getattr(b, name)
@@ -234,7 +290,7 @@ def plot_whatif(w, path=None, outputs=None):
         ax2.plot(t_min, w.as_run.Tgi_C, color="tab:red", label="inlet gas Tgi as run")
         ax2.plot(t_min, w.changed.Tgi_C, color="tab:red", ls="--", label="inlet gas Tgi changed")
     ax2.set_ylabel("setting" if shown else "Tgi [°C]")
-    ax2.set_xlabel("time after CHARGE [min]")
+    time_axis(ax2)
     ax2.legend(loc="upper right", fontsize=7, ncol=2)
     ax2.grid(alpha=0.3)
     return finish_figure(fig, path, f"what if: {b.name}", outputs)

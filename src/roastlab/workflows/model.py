@@ -86,29 +86,6 @@ class Applied:
     notes: list[str]
 
 
-#: A batch may be this far below or above a plant's nominal batch (factor): outside it, it is
-#: another machine's batch (a log read on the wrong plant, or a change with a unit slip).
-BATCH_RANGE_FACTOR = (1 / 20, 5.0)
-
-
-def batch_mass_fits(mass_kg: float, plant: Plant) -> bool:
-    """True when a green batch of ``mass_kg`` can be roasted on ``plant``: within
-    :data:`BATCH_RANGE_FACTOR` of its nominal batch and no more than its drum holds."""
-    lo, hi = BATCH_RANGE_FACTOR
-    return lo * plant.Mb_kg <= mass_kg <= min(hi * plant.Mb_kg, plant.capacity_kg)
-
-
-def check_batch_mass(mass_kg: float, plant: Plant) -> None:
-    """Refuse a requested batch mass the plant cannot take, naming its range and capacity."""
-    if not batch_mass_fits(mass_kg, plant):
-        lo, hi = BATCH_RANGE_FACTOR
-        raise ParameterError(
-            f"a {mass_kg:g} kg batch is far outside {plant.name}'s range: nominal {plant.Mb_kg:g} kg, "
-            f"{lo * plant.Mb_kg:.3g}-{min(hi * plant.Mb_kg, plant.capacity_kg):.3g} kg accepted "
-            f"(the drum holds {plant.capacity_kg:.3g} kg of green beans)"
-        )
-
-
 class FittedModel:
     """A fitted model (see module docstring). Build with :func:`load_model`, :func:`fit` or
     :meth:`paper`; apply with :meth:`predict` / :meth:`validate`; store with :meth:`save`.
@@ -233,7 +210,7 @@ class FittedModel:
             self._check_batch(b, params, target)
             b = self._changed_inputs(b, changes)
             if "batch_kg" in changes:
-                check_batch_mass(b.Mb_kg, target)
+                target.check_batch_mass(b.Mb_kg)
             ready.append(b)
         for name in STATE0:
             if name in changes:
@@ -263,7 +240,7 @@ class FittedModel:
             )
         if "Gg_kg_s" not in params and placeholder and self.column_map is not None and self.column_map.identifies_flow:
             raise InputError("the batch's gas flow is a 1 kg/s placeholder and the model has no fitted flow", src)
-        if b.Mb_kg and not batch_mass_fits(b.Mb_kg, plant):
+        if b.Mb_kg and not plant.batch_fits(b.Mb_kg):
             raise InputError(
                 f"batch of {b.Mb_kg:g} kg on plant {plant.name} (nominal {plant.Mb_kg:g} kg): wrong plant for this log?",
                 src,

@@ -385,9 +385,7 @@ def transfer(
         else (mass_a if same_plant else pb.Mb_kg)
     )
     if batch_kg is not None:
-        from .model import check_batch_mass
-
-        check_batch_mass(mass_b, pb)
+        pb.check_batch_mass(mass_b)
     grid = _grid_batch(reference, interval_s)
     ta0 = float(grid.Ta_C[0])
     changes = dict(initial or {})

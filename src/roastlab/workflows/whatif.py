@@ -1,38 +1,66 @@
 """What if: a logged roast, a fitted model and changes -> the prediction as run and as changed.
 
-Changes act on what a roaster controls: a setting shifted or scaled (heater, fan), a setting
-set from a time on (``heater=6@120``), the inlet gas temperature (``Tgi_offset_C``), the batch
-mass (``batch_kg``) and the drum's temperature at charge (``Tm0_C``). Both predictions go
-through :meth:`FittedModel.predict`, the one place a model meets data.
+Changes act on what a roaster controls: a setting shifted or scaled (heater, fan), from CHARGE
+or from a time (``+1@4:00``), a setting set from a time on (``heater=6@2:00``; ``heater=+1@4:00``
+is relative), the inlet gas temperature (``Tgi_offset_C``), the batch mass (``batch_kg``) and
+the drum's temperature at charge (``Tm0_C``). Both predictions go through
+:meth:`FittedModel.predict`, the one place a model meets data. The table has three columns per
+milestone (measured, as run, changed) and the model's own error on the log beside the change,
+judged on the beans (a batch-size change moves the probe's immersion too), the probe below.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..errors import ParameterError
 from ..io.batch import Batch
-from ..metrics.profile import crossing_or_projected_s, crossing_time_s  # noqa: F401  (re-exported)
+from ..metrics.profile import (  # noqa: F401  (re-exported)
+    crossing_or_projected_s,
+    crossing_time_s,
+    display_temp,
+    display_temp_delta,
+    milestone_levels,
+    milestones,
+    mmss,
+)
 from ..report.result import Result, draw_curves
 from ..sim.simulate import SimulationResult
 from .model import FittedModel
 
-#: Bean temperatures whose crossing times the table reports [degC].
-MILESTONES_C = (150.0, 170.0)
+#: The milestone rows of a what-if table, in order: (key of :func:`milestones`, label, kind).
+ROWS = (
+    ("TP_s", "turning point", "time"),
+    ("TP_C", "turning-point temperature", "temp"),
+    ("DRY_s", "DRY END", "time"),
+    ("FCs_s", "first crack", "time"),
+    ("DROP_C", "temperature at DROP", "temp"),
+    ("development_s", "development time (FCs to DROP)", "time"),
+    ("DTR_pct", "development time ratio", "pct"),
+)
+#: Rows that need first crack within the roast (not when it is projected past DROP).
+DEVELOPMENT = ("development_s", "DTR_pct")
+#: The two readings a what-if compares: the beans (what it judges) and the bean probe (what the
+#: roaster's BT shows); the probe's immersion in the bed changes with the batch mass, so across
+#: batch sizes it can move against the beans.
+READINGS = {"beans": "beans (model Tb; measured: a second bean reading where logged)", "probe": "probe BT (model Ta)"}
 
 
 @dataclass
 class SettingChange:
-    """One change of a logged setting: ``+d`` / ``-d`` (shift), ``xf`` (scale) or ``=v@t`` (set from t)."""
+    """One change of a logged setting from ``from_s`` [s after CHARGE] on: ``shift`` (add
+    ``value``), ``scale`` (multiply) or ``set`` (the setting becomes ``value``); ``unit`` is the
+    setting's unit as the map declares it ("percent", "level", ...)."""
 
     setting: str
     how: str  # "shift" | "scale" | "set"
     value: float
     from_s: float = 0.0
+    unit: str = ""
 
     def apply(self, t: np.ndarray, series: np.ndarray) -> np.ndarray:
         out = series.copy()
@@ -46,65 +74,184 @@ class SettingChange:
         return out
 
     def __str__(self) -> str:
+        steps = " step" if abs(self.value) == 1 else " steps"
+        unit = {"percent": " %", "level": steps, "": ""}.get(self.unit, f" {self.unit}")
+        when = f" from {mmss(self.from_s)}" if self.from_s > 0 else ""
         if self.how == "set":
-            return f"{self.setting} = {self.value:g} from {self.from_s:g} s"
-        return f"{self.setting} {'x' if self.how == 'scale' else '+' if self.value >= 0 else ''}{self.value:g}"
+            unit = {"percent": " %", "level": ""}.get(self.unit, unit)
+            return f"{self.setting} = {self.value:g}{unit}{when or ' from CHARGE'}"
+        if self.how == "scale":
+            return f"{self.setting} x{self.value:g}{when}"
+        return f"{self.setting} {self.value:+g}{unit}{when}"
 
 
-_CHANGE = re.compile(r"^\s*(x|\*)?\s*([+-]?\d+(?:\.\d*)?(?:[eE][+-]?\d+)?)\s*$")
-_SET = re.compile(r"^\s*(heater|fan)\s*=\s*([+-]?\d+(?:\.\d*)?)\s*@\s*(\d+(?:\.\d*)?)\s*$")
+_NUMBER = r"(\d+(?:\.\d*)?(?:[eE][+-]?\d+)?)"
+_WHEN = r"(?:\s*@\s*(\d+(?::\d{1,2})?(?:\.\d*)?))?"
+_CHANGE = re.compile(r"^\s*(x|\*|[+-])?\s*" + _NUMBER + _WHEN + r"\s*$")
+_SET = re.compile(r"^\s*(heater|fan)\s*=\s*([+-])?\s*" + _NUMBER + _WHEN + r"\s*$")
 
 
-def parse_setting_change(setting: str, text: str) -> SettingChange:
-    """``"+1"``, ``"-2"`` (shift) or ``"x1.1"`` (scale) for ``setting``."""
+def parse_time_s(text: str | None) -> float:
+    """A time after CHARGE as seconds (``"240"``) or the roaster's m:ss (``"4:00"``) -> [s]."""
+    if not text:
+        return 0.0
+    if ":" in text:
+        m, sec = text.split(":", 1)
+        return 60.0 * float(m) + float(sec)
+    return float(text)
+
+
+def parse_setting_change(setting: str, text: str, unit: str = "") -> SettingChange:
+    """``"+1"``, ``"-2"`` (shift), ``"x1.1"`` (scale), each optionally from a time: ``"+1@4:00"``
+    (m:ss) or ``"+1@240"`` (s). A number with no sign or ``x`` is refused: a relative change
+    needs its ``+``/``-``; a setting's new value goes through ``--set``."""
     m = _CHANGE.match(text)
-    if not m:
-        raise ParameterError(f"--{setting} {text!r}: give a shift such as +1 or -2, or a factor such as x1.1")
+    if not m or not m.group(1):
+        raise ParameterError(
+            f"--{setting} {text!r}: give a shift such as +1 or -2, or a factor such as x1.1, "
+            "optionally from a time: +1@4:00 (to set a value use --set)"
+        )
+    sign = m.group(1)
     value = float(m.group(2))
-    return SettingChange(setting, "scale" if m.group(1) else "shift", value)
+    if sign in ("x", "*"):
+        return SettingChange(setting, "scale", value, parse_time_s(m.group(3)), unit)
+    return SettingChange(setting, "shift", -value if sign == "-" else value, parse_time_s(m.group(3)), unit)
 
 
-def parse_set(text: str) -> SettingChange:
-    """``"heater=6@120"``: the setting becomes 6 from 120 s after CHARGE on."""
+def parse_set(text: str, units: dict | None = None) -> SettingChange:
+    """``"heater=6@2:00"``: the setting becomes 6 from 2:00 after CHARGE on; with an explicit
+    sign, ``"heater=+1@4:00"``, it is a change relative to the log (+1 from 4:00)."""
     m = _SET.match(text)
     if not m:
-        raise ParameterError(f"--set {text!r}: expected SETTING=VALUE@SECONDS, e.g. heater=6@120 (heater or fan)")
-    return SettingChange(m.group(1), "set", float(m.group(2)), float(m.group(3)))
+        raise ParameterError(
+            f"--set {text!r}: expected SETTING=VALUE@TIME, e.g. heater=6@2:00 (absolute) or heater=+1@4:00 "
+            "(relative; heater or fan, TIME as m:ss or seconds)"
+        )
+    name, sign, value = m.group(1), m.group(2), float(m.group(3))
+    unit = (units or {}).get(name, "")
+    when = parse_time_s(m.group(4))
+    if sign:
+        return SettingChange(name, "shift", -value if sign == "-" else value, when, unit)
+    return SettingChange(name, "set", value, when, unit)
+
+
+COLUMNS = ("measured", "as_run", "changed")
+
+
+def _fmt(value, kind: str, units: str) -> str:
+    if value is None or not np.isfinite(value):
+        return "-"
+    if kind == "time":
+        return mmss(value)
+    if kind == "pct":
+        return f"{value:.1f}"
+    return f"{display_temp(value, units):.1f}"
+
+
+def _fmt_delta(a, b, kind: str, units: str) -> str:
+    if a is None or b is None or not (np.isfinite(a) and np.isfinite(b)):
+        return "-"
+    d = b - a
+    if kind == "time":
+        return ("+" if d >= 0 else "-") + mmss(abs(d))
+    if kind == "pct":
+        return f"{d:+.1f}"
+    return f"{display_temp_delta(d, units):+.1f}"
 
 
 @dataclass
 class WhatIf(Result):
-    """The log, its prediction as run and with the changes, and the comparison table."""
+    """The log, its prediction as run and with the changes, and the milestone table: one row
+    per milestone and reading (beans, probe) with the measured value, the model as run, the
+    model with the changes, the change, and the model's own error on this log."""
 
     batch: Batch
     as_run: SimulationResult
     changed: SimulationResult
     changes: list[str]
     rows: list[dict]
+    levels: dict = field(default_factory=dict)
 
-    def table(self) -> str:
+    def table(self, units: str = "C") -> str:
+        """The milestone table as text; ``units`` "C" or "F" for temperatures."""
+        u = "°F" if units == "F" else "°C"
         lines = [f"what if ({'; '.join(self.changes) or 'no change'}) on {self.batch.name}"]
-        lines.append(f"{'':50s}{'as run':>10s}{'changed':>10s}{'change':>10s}")
-        for r in self.rows:
-            a, c = r["as_run"], r["changed"]
-            fa = "-" if a is None else f"{a:.1f}"
-            fc = "-" if c is None else f"{c:.1f}"
-            fd = "-" if a is None or c is None else f"{c - a:+.1f}"
-            lines.append(f"{r['what'] + ' [' + r['unit'] + ']':50s}{fa:>10s}{fc:>10s}{fd:>10s}")
+        lines.append("judged on the beans (the model's bean temperature); the probe BT, what the roaster sees, below")
+        head = f"{'':40s}{'measured':>10s}{'as run':>10s}{'changed':>10s}{'change':>10s}{'model err':>11s}"
+        for reading, title in READINGS.items():
+            lines += ["", title, head]
+            for r in (r for r in self.rows if r["reading"] == reading):
+                kind = r["kind"]
+                unit = {"time": "m:ss", "temp": u, "pct": "%"}[kind]
+                what = f"  {r['what']} [{unit}]"
+                cells = {k: _fmt(r[k], kind, units) + ("*" if k in r["projected"] else "") for k in COLUMNS}
+                lines.append(
+                    f"{what:40s}{cells['measured']:>10s}{cells['as_run']:>10s}{cells['changed']:>10s}"
+                    f"{_fmt_delta(r['as_run'], r['changed'], kind, units):>10s}"
+                    f"{_fmt_delta(r['measured'], r['as_run'], kind, units):>11s}"
+                )
+        lv = self.levels
+        lines.append("")
+        lines.append(
+            "DRY END and first crack: when a curve reaches the temperature the log marks them at "
+            + ", ".join(
+                f"{name} {display_temp(lv[r][name], units):.1f} {u} ({r})"
+                for r in ("probe", "beans")
+                for name in ("DRY", "FCs")
+                if name in lv.get(r, {})
+            )
+        )
+        if any(r["projected"] for r in self.rows):
+            lines.append("* past the logged DROP: where the curve would reach it at the rate of rise of its last 2 min")
+        lines += [f"note: {w}" for w in self.warnings()]
         return "\n".join(lines)
+
+    def warnings(self) -> list[str]:
+        """What the table alone would hide: milestones a curve reaches only past DROP, and rows
+        where the change is smaller than the model's own error on this log (the change may be
+        real, but this log cannot confirm the model that close)."""
+        out = []
+        for r in self.rows:
+            level = self.levels.get(r["reading"], {}).get("FCs")
+            for col in r["projected"]:
+                who = "the model as run" if col == "as_run" else "the changed roast"
+                out.append(
+                    f"{r['reading']}: {who} reaches the first-crack temperature ({level:.1f} °C) only after the "
+                    f"logged DROP (at {mmss(r[col])}, projected){': it runs cooler than this log late in the roast' if col == 'as_run' else ''}"
+                )
+            a, c, m = r["as_run"], r["changed"], r["measured"]
+            if a is None or c is None or m is None or r["key"].startswith("TP"):
+                continue
+            if abs(c - a) < abs(a - m):
+                unit = {"time": "s", "temp": "°C", "pct": "points"}[r["kind"]]
+                out.append(
+                    f"{r['reading']} {r['what']}: the change ({c - a:+.1f} {unit}) is within the model's own error "
+                    f"on this log ({a - m:+.1f} {unit})"
+                )
+        return out
 
     def summary(self) -> str:
         """The comparison table (:meth:`table`)."""
         return self.table()
 
     def to_json_dict(self) -> dict:
-        return {"batch": self.batch.name, "changes": self.changes, "rows": self.rows}
+        return {
+            "batch": self.batch.name,
+            "changes": self.changes,
+            "judged_on": "beans",
+            "levels_C": self.levels,
+            "rows": self.rows,
+            "warnings": self.warnings(),
+        }
 
     def to_frame(self):
-        """One row per figure of the table: what, unit, as run, changed."""
+        """One row per milestone and reading: measured, as run, changed, change, model error."""
         import pandas as pd
 
-        return pd.DataFrame(self.rows)
+        df = pd.DataFrame(self.rows)
+        df["change"] = df["changed"] - df["as_run"]
+        df["model_error"] = df["as_run"] - df["measured"]
+        return df
 
     def _figure(self, path, outputs):
         from ..report.figures import plot_whatif
@@ -122,12 +269,19 @@ def whatif(
     model: FittedModel,
     batch: Batch,
     setting_changes: list[SettingChange] = (),
+    *,
+    actuators: dict | None = None,
     **changes,
 ) -> WhatIf:
-    """Predict ``batch`` as logged and with the changes; compare at the roast's milestones.
+    """Predict ``batch`` as logged and with the changes; compare the roaster's milestones
+    (:func:`roastlab.metrics.profile.milestones`) on the beans and on the probe.
 
     ``setting_changes`` change the logged heater/fan series; ``changes`` are those of
-    :meth:`FittedModel.apply` (``Tgi_offset_C``, ``batch_kg``, ``Tm0_C`` ...).
+    :meth:`FittedModel.apply` (``Tgi_offset_C``, ``batch_kg``, ``Tm0_C`` ...). A changed
+    setting must stay within the machine's range (``actuators``: name -> Actuator, default
+    the model's map's :meth:`~roastlab.io.importers.mapping.ColumnMap.actuator`). The probe's
+    milestones are judged at the temperatures the log marks (its DRY and FCs); the beans' at
+    the model's bean temperature at those marks as run.
     """
     changed_batch = batch
     labels = [str(c) for c in setting_changes]
@@ -135,32 +289,59 @@ def whatif(
         series = getattr(changed_batch, c.setting)
         if series is None:
             raise ParameterError(f"the log has no {c.setting} setting (its map reads none), so it cannot change")
-        changed_batch = dataclasses.replace(changed_batch, **{c.setting: c.apply(batch.time_s, series)})
-    names = {"Tgi_offset_C": "Tgi {:+g} degC", "batch_kg": "batch {:g} kg", "Tm0_C": "drum at charge {:g} degC"}
+        new = c.apply(batch.time_s, series)
+        act = (actuators or {}).get(c.setting)
+        if act is None and actuators is None and model.column_map is not None and getattr(model.column_map, c.setting):
+            act = model.column_map.actuator(c.setting)
+        if act is not None and (new.min() < act.low - 1e-9 or new.max() > act.high + 1e-9):
+            if c.how == "set":
+                raise ParameterError(
+                    f"{c}: outside the machine's {c.setting} range {act.label(act.low)}-{act.label(act.high)}"
+                )
+            new = np.clip(new, act.low, act.high)  # a shift past the knob's end stays at the end
+            labels[labels.index(str(c))] += f" (held within {act.label(act.low)}-{act.label(act.high)})"
+        changed_batch = dataclasses.replace(changed_batch, **{c.setting: new})
+    names = {"Tgi_offset_C": "Tgi {:+g} °C", "batch_kg": "batch {:g} kg", "Tm0_C": "drum at charge {:g} °C"}
     labels += [names.get(k, k + " = {:g}").format(float(v)) for k, v in changes.items()]
     as_run = model.predict(batch)
     changed = model.predict(changed_batch, **changes)
     t = batch.time_s
-    rows = [
-        {
-            "what": "BT at the logged DROP time",
-            "unit": "degC",
-            "as_run": float(as_run.Ta_C[-1]),
-            "changed": float(changed.Ta_C[-1]),
-        }
-    ]
-    levels = list(MILESTONES_C)
-    fc = batch.events.get("FCs")
-    if fc is not None and batch.Ta_C is not None and t[0] <= fc <= t[-1]:
-        levels.append(round(float(np.interp(fc, t, batch.Ta_C)), 1))
-    for k, level in enumerate(levels):
-        what = f"time to BT {level:g} degC" + (" (logged first crack)" if k >= len(MILESTONES_C) else "")
-        rows.append(
-            {
-                "what": what,
-                "unit": "s",
-                "as_run": crossing_time_s(t, as_run.Ta_C, level),
-                "changed": crossing_time_s(t, changed.Ta_C, level),
-            }
-        )
-    return WhatIf(batch, as_run, changed, labels, rows)
+    events = batch.events
+    measured = {"probe": batch.Ta_C, "beans": batch.Tb2_C}
+    model_curves = {"probe": (as_run.Ta_C, changed.Ta_C), "beans": (as_run.Tb_C, changed.Tb_C)}
+    levels = {
+        "probe": milestone_levels(t, batch.Ta_C, events) if batch.Ta_C is not None else {},
+        "beans": milestone_levels(t, as_run.Tb_C, events),
+    }
+    if not levels["probe"]:
+        levels["probe"] = milestone_levels(t, as_run.Ta_C, events)
+    rows = []
+    for reading in READINGS:
+        lv = levels[reading]
+        ms_meas = milestones(t, measured[reading], lv) if measured[reading] is not None else {}
+        ms_run, ms_chg = (milestones(t, y, lv) for y in model_curves[reading])
+        projected = {}
+        for name, ms, y in (
+            ("as_run", ms_run, model_curves[reading][0]),
+            ("changed", ms_chg, model_curves[reading][1]),
+        ):
+            if ms["FCs_s"] is None:  # a model curve that stops short: where it would get there
+                ms["FCs_s"] = crossing_or_projected_s(t, y, lv["FCs"])
+                projected[name] = ms["FCs_s"] is not None
+        for key, what, kind in ROWS:
+            if reading == "beans" and key.startswith("TP"):
+                continue  # the beans only warm: the turning point is the probe's (charge drop)
+            rows.append(
+                {
+                    "reading": reading,
+                    "key": key,
+                    "what": what,
+                    "kind": kind,
+                    "unit": {"time": "s", "temp": "degC", "pct": "%"}[kind],
+                    "measured": ms_meas.get(key),
+                    "as_run": ms_run[key] if not (key in DEVELOPMENT and projected.get("as_run")) else None,
+                    "changed": ms_chg[key] if not (key in DEVELOPMENT and projected.get("changed")) else None,
+                    "projected": [k for k, v in projected.items() if v] if key == "FCs_s" else [],
+                }
+            )
+    return WhatIf(batch, as_run, changed, labels, rows, levels)
