@@ -95,8 +95,8 @@ BAD_SCENARIOS = {
     "Tm0 and its offset": ("[plant]\nTm0_C = 100\nTm0_offset_C = 5\n", "not both"),
     "unknown theta name": ("[plant]\ntheta = { hgx = 0.1 }\n", "unknown value"),
     "theta factor zero": ("[plant]\ntheta_factor = { hgm = 0 }\n", "outside the plausible range"),
-    "heater key when deciding Tgi": ("[actuator]\nheater_min = 0\n", "decide"),
-    "heater decision without limits": ('[actuator]\ndecide = "heater"\n', "needs"),
+    "heater key when deciding Tgi": ('[actuator]\ndecide = "Tgi"\nheater_min = 0\n', "decide"),
+    "keys of both inputs": ("[actuator]\nheater_min = 0\nTgi_min_C = 200\n", "decide"),
     "bad decision": ('[actuator]\ndecide = "fan"\n', "must be"),
     "zero rate": ("[actuator]\nTgi_rate_C_per_min = 0\n", "outside the plausible range"),
     "NaN noise": ("[sensor]\nnoise_C = nan\n", "finite"),
@@ -116,6 +116,32 @@ def test_bad_scenario_is_one_line_and_exit_2(case, tmp_path, capsys):
     code = main(["control", "--scenario", str(path), "--controller", "pid"])
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1 and words in err[0], err
+
+
+def test_a_scenario_by_name_or_a_missing_file_says_so(capsys):
+    code = main(["control", "--scenario", "no-such-scenario", "--controller", "pid"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "no such file" in err[0] and "cold-drum" in err[0], err
+    code = main(["control", "--scenario", "/nonexistent/cold.toml", "--controller", "pid"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "file not found" in err[0], err
+    from roastlab.control.loop import find_scenario
+
+    assert find_scenario("cold-drum") == scenario_file("05-cold-drum")
+
+
+def test_the_controller_decides_the_models_own_control(model, reference, tmp_path, capsys):
+    """No [actuator] decision: the paper's gas roaster gets Tgi; deciding a heater the model's map
+    does not have is one line, exit 2 (a Bullet model decides its heater: test_real_roaster)."""
+    from roastlab.control.loop import prepare
+
+    setup, _ = prepare(model, reference)
+    assert setup.limits.decide == "Tgi"
+    path = tmp_path / "h.toml"
+    path.write_text('[actuator]\ndecide = "heater"\n')
+    code = main(["control", "--scenario", str(path), "--controller", "pid"])
+    err = [line for line in capsys.readouterr().err.strip().splitlines() if not line.startswith("note:")]
+    assert code == 2 and len(err) == 1 and "[heater]" in err[0], err
 
 
 # ----------------------------------------------------------------------------- controllers

@@ -253,6 +253,9 @@ def test_cli_report_writes_json_and_figures(cli, fleet, tmp_path):
     assert doc["detector"]["h"] == CUSUM_H
     assert sorted(p.name for p in (tmp_path / "figs").iterdir()) == [f"roaster-{c}.png" for c in "ABCDE"]
     assert "hbm down" in out
+    from roastlab.fleet.drift import WARMUP
+
+    assert f"drift watched from batch {WARMUP} on" in out  # the report says when the detector starts
 
 
 def test_a_fit_spec_frees_other_parameters_per_batch_and_refuses_X0(tmp_path, fleet):

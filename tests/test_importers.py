@@ -113,6 +113,15 @@ def test_json_alog_and_missing_samples(tmp_path):
     assert any("incomplete" in note for note in b.notes)
 
 
+def test_an_artisan_log_without_a_map_reads_bt_and_et(tmp_path):
+    """Artisan's own channel names are the default for an Artisan log: BT the probe, ET the inlet."""
+    p = tmp_path / "plain.alog"
+    p.write_text(fake_alog())
+    b = import_log(p, None)
+    assert b.Ta_C[0] == pytest.approx(130.0 - 0.2 * 5) and b.Tgi_C[0] == pytest.approx(150.0 + 0.4 * 5)
+    assert any("no map" in note and "BT" in note for note in b.notes)
+
+
 def test_artisan_csv_export(tmp_path):
     rows = [
         "Date:01.01.2026\tUnit:C\tCHARGE:00:06\tTP:\tDRYe:\tFCs:\tFCe:\tSCs:\tSCe:\tDROP:03:00\tCOOL:",

@@ -35,6 +35,7 @@ def _control_inputs(args):
 
 def cmd_control(args) -> int:
     from ..control import load_scenario, make_controller, run_closed_loop
+    from ..control.loop import find_scenario
     from ..io.files import Outputs
     from ..report.figures import check_figure_path
 
@@ -53,7 +54,7 @@ def cmd_control(args) -> int:
         from ..control import MPC
 
         controller = MPC(ror_weight=args.ror_weight)
-    scenario = load_scenario(args.scenario) if args.scenario else None
+    scenario = load_scenario(find_scenario(args.scenario)) if args.scenario else None
     model, reference = _control_inputs(args)
     result = run_closed_loop(model, reference, controller, scenario, args.plant)
     m = result.metrics
@@ -145,7 +146,12 @@ def _add_control_options(p, compare: bool) -> None:
             "started at the actuator's position; mpc: model predictive control with a Kalman filter; "
             "replay: the reference's own inputs (default mpc)",
         )
-        p.add_argument("--scenario", metavar="S.toml", help="scenario file (default: nominal; see docs/control.md)")
+        p.add_argument(
+            "--scenario",
+            metavar="S.toml",
+            help="scenario file, or a shipped scenario by name (cold-drum, hot-drum, ...; default: nominal; "
+            "see docs/control.md)",
+        )
         p.add_argument(
             "--ror-weight",
             type=float_arg("--ror-weight"),

@@ -89,7 +89,7 @@ def cmd_transfer(args) -> int:
 
 def add_parsers(sub) -> None:
     """Register this module's command(s) on the ``roastlab`` subparsers ``sub``."""
-    from ..model.actuators import MIN_HOLD_S
+    from ..model.actuators import MIN_HOLD_S, TGI_LIMITS
     from ..model.quantities import default
 
     p = sub.add_parser(
@@ -158,16 +158,22 @@ def add_parsers(sub) -> None:
         "reads a heater and the inlet is room air; else Tgi)",
     )
     p.add_argument(
-        "--tgi-min", type=float_arg("--tgi-min"), default=150.0, help="lowest inlet temperature [degC] (default 150)"
+        "--tgi-min",
+        type=float_arg("--tgi-min"),
+        default=TGI_LIMITS[0],
+        help=f"lowest inlet temperature [degC] (default {TGI_LIMITS[0]:g})",
     )
     p.add_argument(
-        "--tgi-max", type=float_arg("--tgi-max"), default=550.0, help="highest inlet temperature [degC] (default 550)"
+        "--tgi-max",
+        type=float_arg("--tgi-max"),
+        default=TGI_LIMITS[1],
+        help=f"highest inlet temperature [degC] (default {TGI_LIMITS[1]:g})",
     )
     p.add_argument(
         "--tgi-rate",
         type=float_arg("--tgi-rate"),
-        default=120.0,
-        help="fastest change of the inlet temperature [degC/min] (default 120)",
+        default=TGI_LIMITS[2],
+        help=f"fastest change of the inlet temperature [degC/min] (default {TGI_LIMITS[2]:g})",
     )
     p.add_argument(
         "--heater-min", type=float_arg("--heater-min"), help="lowest heater setting (default: the map's [heater] min)"

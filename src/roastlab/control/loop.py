@@ -60,6 +60,19 @@ def standard_scenarios() -> list[Path]:
     return sorted(SCENARIO_DIR.glob("*.toml"))
 
 
+def find_scenario(name_or_path) -> Path:
+    """A scenario file: a path that exists, or a shipped scenario by name, with or without its
+    number (``cold-drum``, ``05-cold-drum``); else one error listing the shipped names."""
+    path = Path(name_or_path)
+    if path.exists() or path.suffix.lower() == ".toml" or len(path.parts) > 1:
+        return path
+    for p in standard_scenarios():
+        if str(name_or_path) in (p.stem, p.stem.split("-", 1)[-1]):
+            return p
+    names = ", ".join(p.stem.split("-", 1)[-1] for p in standard_scenarios())
+    raise InputError(f"no such file, and no shipped scenario of that name (shipped: {names})", str(name_or_path))
+
+
 def make_controller(name: str):
     """A controller by name (``pid``, ``mpc``, ``replay``) with its defaults."""
     if name not in CONTROLLERS:
@@ -100,9 +113,9 @@ def prepare(
             f"{act.sample_s:g} s control intervals",
             src,
         )
-    if act.decide == "heater" and reference.heater is None:
-        raise InputError("the scenario decides the heater, but the reference has no heater setting", src)
-    limits = ProgramLimits(act.low, act.high, act.rate_per_min, decide=act.decide)
+    limits = ProgramLimits.for_model(model.column_map, act.decide, act.low, act.high, act.rate_per_min)
+    if limits.decide == "heater" and reference.heater is None:
+        raise InputError("the controller decides the heater, but the reference has no heater setting", src)
     target_plant = load_plant(plant) if plant is not None else model.plant
     if target_plant is None:
         raise InputError("the model names no plant geometry: give the plant (--plant)", model.source)
@@ -128,7 +141,7 @@ def prepare(
 
     t = np.asarray(reference.time_s, dtype=np.float64) - reference.time_s[0]
     gg = np.asarray(controller_view.Gg_kg_s if act.Gg_kg_s is None else np.full(t.shape, act.Gg_kg_s), dtype=float)
-    ref_u = np.asarray(reference.Tgi_C if act.decide == "Tgi" else reference.heater, dtype=float)
+    ref_u = np.asarray(reference.Tgi_C if limits.decide == "Tgi" else reference.heater, dtype=float)
     u0 = float(np.clip(ref_u[0], limits.low, limits.high))
     setup = LoopSetup(
         time_s=t,

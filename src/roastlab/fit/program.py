@@ -32,7 +32,7 @@ from scipy.optimize import least_squares
 
 from ..errors import InputError
 from ..metrics.profile import ror_operator
-from ..model.actuators import MIN_HOLD_S, Actuator
+from ..model.actuators import MIN_HOLD_S, TGI_LIMITS, Actuator
 from ..model.layout import S_TA, S_TM
 from ..sim.kernels import H_MAX_S, simulate_one
 from ..sim.sensitivity import ta_input_jacobian
@@ -72,9 +72,9 @@ class ProgramLimits:
     (the heater setting of the actuator extension, in the map's units).
     """
 
-    low: float = 150.0
-    high: float = 550.0
-    rate_per_min: float = 120.0
+    low: float = TGI_LIMITS[0]
+    high: float = TGI_LIMITS[1]
+    rate_per_min: float = TGI_LIMITS[2]
     Gg_min_kg_s: float | None = None
     Gg_max_kg_s: float | None = None
     decide: str = "Tgi"
@@ -110,6 +110,26 @@ class ProgramLimits:
             gg_max,
             decide=actuator.name,
             actuator=actuator,
+        )
+
+    @classmethod
+    def for_model(cls, column_map, decide=None, low=None, high=None, rate_per_min=None) -> ProgramLimits:
+        """The limits for the control a program decides on the machine a model's ``column_map``
+        describes. ``decide`` None: the heater, on the machine's own settings
+        (:meth:`for_actuator`), where the map reads a heater and the inlet is room air (an
+        induction or electric drum); the inlet gas temperature otherwise (the paper's gas
+        roaster). ``low``, ``high``, ``rate_per_min`` override the machine's or the defaults."""
+        has_heater = column_map is not None and column_map.heater is not None
+        if decide is None:
+            decide = "heater" if has_heater and column_map.inlet_is_constant else "Tgi"
+        if decide == "heater":
+            if not has_heater:
+                raise InputError("deciding the heater needs a model whose map reads a heater setting ([heater])")
+            return cls.for_actuator(column_map.actuator("heater"), low, high, rate_per_min)
+        return cls(
+            TGI_LIMITS[0] if low is None else low,
+            TGI_LIMITS[1] if high is None else high,
+            TGI_LIMITS[2] if rate_per_min is None else rate_per_min,
         )
 
     @property

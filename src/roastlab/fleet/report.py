@@ -124,7 +124,13 @@ class FleetReport(Result):
         lines.append("")
         for m in self.machines:
             a = m.analysis
-            lines.append(f"{m.name}: {len(a['alarms'])} alarm(s), {len(a['outliers'])} outlier batch(es)")
+            n = len(m.frame)
+            warm = (
+                f"; still warming up: the drift detector watches from batch {WARMUP} on, this machine has {n}"
+                if n <= WARMUP
+                else f" (drift watched from batch {WARMUP} on)"
+            )
+            lines.append(f"{m.name}: {len(a['alarms'])} alarm(s), {len(a['outliers'])} outlier batch(es){warm}")
             for al in a["alarms"]:
                 lines.append(
                     f"  {al['parameter']} {al['direction']} at batch {al['batch_index']} ({al['started_at']}), "

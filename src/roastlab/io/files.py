@@ -131,6 +131,8 @@ def read_toml(path: str | Path) -> dict:
 
     try:
         return tomllib.loads(read_input_text(path, "TOML text", CONFIG_MAX_BYTES))
+    except InputError:  # missing, a folder, too big: the reader's own one line
+        raise
     except tomllib.TOMLDecodeError as exc:
         raise InputError(f"not valid TOML ({str(exc)[:120]})", path) from None
     except (RecursionError, MemoryError, OverflowError, ValueError):

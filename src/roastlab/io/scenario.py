@@ -23,11 +23,13 @@ A scenario file (every key optional; an empty file is the nominal scenario)::
     seed = 7             # noise seed (the same seed gives the same run)
 
     [actuator]           # what the controller moves and how far and fast it may
-    decide = "Tgi"       # "Tgi" (inlet gas temperature, the paper's input) or "heater"
+    decide = "Tgi"       # "Tgi" (inlet gas temperature, the paper's input) or "heater"; left out:
+                         # the model's own control (the heater on a machine whose inlet is room air)
     Tgi_min_C = 150.0    # level limits [degC] ...
     Tgi_max_C = 550.0
     Tgi_rate_C_per_min = 120.0     # ... and rate limit [degC/min]
-    heater_min = 0.0     # with decide = "heater": the heater setting's limits (map units)
+    heater_min = 0.0     # with decide = "heater": the heater setting's limits (map units;
+                         # default: the machine's, from the model's map [heater])
     heater_max = 9.0
     heater_rate_per_min = 20.0
     Gg_kg_s = 0.4        # fixed gas flow [kg/s] (default: the reference's)
@@ -44,6 +46,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import InputError, ParameterError
+from ..model.actuators import TGI_LIMITS
 from ..model.limits import check_value
 from ..model.parameters import REGISTRY, STATE0
 from .files import finite_number, read_toml
@@ -80,7 +83,7 @@ KEYS = {
 #: Values a scenario may set on the plant (registry parameters, not initial states).
 PLANT_VALUES = tuple(k for k in REGISTRY if k not in STATE0)
 #: Default actuator limits for the inlet gas temperature: (min, max [degC], rate [degC/min]).
-TGI_DEFAULTS = (150.0, 550.0, 120.0)
+TGI_DEFAULTS = TGI_LIMITS
 
 
 @dataclass(frozen=True)
@@ -110,13 +113,15 @@ class Sensor:
 
 @dataclass(frozen=True)
 class Actuator:
-    """The decided input (``"Tgi"`` or ``"heater"``), its level and rate limits (per minute), the
-    fixed gas flow [kg/s] (None: the reference's) and the control interval [s]."""
+    """The decided input (``"Tgi"`` or ``"heater"``; None: the model's own control, see
+    :meth:`roastlab.fit.program.ProgramLimits.for_model`), its level and rate limits (per
+    minute; None: the machine's, as the model's map declares them, or :data:`TGI_DEFAULTS`),
+    the fixed gas flow [kg/s] (None: the reference's) and the control interval [s]."""
 
-    decide: str = "Tgi"
-    low: float = TGI_DEFAULTS[0]
-    high: float = TGI_DEFAULTS[1]
-    rate_per_min: float = TGI_DEFAULTS[2]
+    decide: str | None = None
+    low: float | None = None
+    high: float | None = None
+    rate_per_min: float | None = None
     Gg_kg_s: float | None = None
     sample_s: float = 5.0
 
@@ -220,13 +225,18 @@ def _sensor(data: dict, path) -> Sensor:
 
 def _actuator(data: dict, path) -> Actuator:
     t = _table(data, "actuator", path)
-    decide = _text(t.get("decide", "Tgi"), path, "actuator.decide")
-    if decide not in ("Tgi", "heater"):
+    implied = (
+        "heater" if any(k.startswith("heater_") for k in t) else "Tgi" if any(k.startswith("Tgi_") for k in t) else None
+    )
+    decide = _text(t["decide"], path, "actuator.decide") if "decide" in t else implied
+    if decide not in ("Tgi", "heater", None):
         raise InputError(f"must be 'Tgi' or 'heater', got {decide!r}", path, "actuator.decide")
-    other = "heater" if decide == "Tgi" else "Tgi"
-    stray = sorted(k for k in t if k.startswith(other + "_"))
-    if stray:
-        raise InputError(f"{', '.join(stray)} given but decide = {decide!r}", path, "actuator")
+    if decide is not None:
+        other = "heater" if decide == "Tgi" else "Tgi"
+        stray = sorted(k for k in t if k.startswith(other + "_"))
+        if stray:
+            raise InputError(f"{', '.join(stray)} given but decide = {decide!r}", path, "actuator")
+    low = high = rate = None
     if decide == "Tgi":
         low = _value(t, "Tgi_min_C", path, "actuator", "Tgi_C")
         high = _value(t, "Tgi_max_C", path, "actuator", "Tgi_C")
@@ -235,15 +245,12 @@ def _actuator(data: dict, path) -> Actuator:
         high = TGI_DEFAULTS[1] if high is None else high
         rate = TGI_DEFAULTS[2] if rate is None else rate
         names = ("Tgi_min_C", "Tgi_max_C")
-    else:
-        missing = [k for k in ("heater_min", "heater_max", "heater_rate_per_min") if k not in t]
-        if missing:
-            raise InputError(f"decide = 'heater' needs {', '.join(missing)}", path, "actuator")
+    elif decide == "heater":  # what is not given comes from the machine (the model's map)
         low = _value(t, "heater_min", path, "actuator", "heater")
         high = _value(t, "heater_max", path, "actuator", "heater")
         rate = _value(t, "heater_rate_per_min", path, "actuator", "rate_per_min")
         names = ("heater_min", "heater_max")
-    if not low < high:
+    if low is not None and high is not None and not low < high:
         raise InputError(f"limits inverted or empty: {names[0]} {low:g} >= {names[1]} {high:g}", path, "actuator")
     sample = _value(t, "sample_s", path, "actuator")
     return Actuator(

@@ -30,6 +30,9 @@ UNIT_DEFAULTS: dict[str, tuple[float, float, float | None, float]] = {
 }
 #: How a setting's value reads to a roaster, per control and unit ("P7", "F3", "35 %").
 _PREFIX = {("heater", "level"): "P", ("fan", "level"): "F"}
+#: The inlet gas temperature as a decided input (the paper's gas roaster): lowest and highest
+#: [degC] and fastest change [degC/min] a program may use unless told otherwise.
+TGI_LIMITS = (150.0, 550.0, 120.0)
 #: Shortest time a runnable program holds a setting before the next change [s]: a person at
 #: the machine (or Artisan's playback) acts a few times a minute at most.
 MIN_HOLD_S = 30.0

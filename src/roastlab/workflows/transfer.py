@@ -263,14 +263,8 @@ class TransferResult(Result):
 
 
 def default_limits(model) -> ProgramLimits:
-    """The input a program decides for ``model`` by default: the heater, on the machine's own
-    settings (:meth:`ProgramLimits.for_actuator`), where the model's map reads a heater and
-    the inlet is room air (an induction or electric drum); the inlet gas temperature with
-    :class:`ProgramLimits`' defaults otherwise (the paper's gas roaster)."""
-    cmap = getattr(model, "column_map", None)
-    if cmap is not None and cmap.heater is not None and cmap.inlet_is_constant:
-        return ProgramLimits.for_actuator(cmap.actuator("heater"))
-    return ProgramLimits()
+    """The input a program decides for ``model`` by default (:meth:`ProgramLimits.for_model`)."""
+    return ProgramLimits.for_model(getattr(model, "column_map", None))
 
 
 def _et_source(cmap) -> str:

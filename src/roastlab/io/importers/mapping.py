@@ -395,7 +395,21 @@ def _resample(time_s: np.ndarray, columns: dict[str, np.ndarray], step: float, p
 def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None) -> Batch:
     """Read any supported log with a column map into a validated canonical :class:`Batch`."""
     path = Path(path)
-    cmap = cmap or ColumnMap(source="default map")
+    default_notes = []
+    if cmap is None:
+        cmap = ColumnMap(source="default map")
+        if path.exists() and _detect_format(path, "auto") in ("alog", "artisan-csv"):
+            # Artisan's own channel names: BT the bean probe, ET the environment (taken as the inlet)
+            cmap = ColumnMap(
+                source="default Artisan map",
+                Ta={"column": "BT", "unit": "C"},
+                Tgi={"column": "ET", "unit": "C"},
+                Gg={"identify": True},
+            )
+            default_notes.append(
+                "no map: read as Artisan's defaults, BT = bean probe (Ta), ET = inlet (Tgi), gas flow unknown "
+                "(a 1 kg/s placeholder); give --map for anything else"
+            )
     if not path.exists():
         raise InputError("file not found", path)
     fmt = _detect_format(path, cmap.format)
@@ -513,7 +527,7 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
         raise InputError("fewer than 2 complete samples after dropping missing values", path)
     time_s, Ta, Tgi, Gg = time_s[ok], Ta[ok], Tgi[ok], Gg[ok]
     series = {k: v[ok] for k, v in series.items()}
-    notes = []
+    notes = list(default_notes)
     if ok.sum() < ok.size:
         notes.append(f"dropped {ok.size - ok.sum()} incomplete sample(s) (missing values)")
     jumps = np.flatnonzero(np.abs(np.diff(Ta)) > MAX_JUMP_C)
