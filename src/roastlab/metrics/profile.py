@@ -197,3 +197,30 @@ def display_temp(temp_C: float, units: str = "C") -> float:
 def display_temp_delta(delta_C: float, units: str = "C") -> float:
     """A temperature difference [K] in the display unit ("C" or "F")."""
     return delta_C * 9.0 / 5.0 if units == "F" else delta_C
+
+
+#: Share of the roast after the turning point during which the drum metal may run colder than
+#: the beans before a fit is called physically implausible [-]. In a drum roaster the drum
+#: heats the beans: metal below the beans for most of the roast means the fit found another
+#: path for the heat than the machine has.
+METAL_BELOW_BEANS_SHARE = 0.5
+
+
+def implausible_states(result) -> list[str]:
+    """What a simulation's states say that a drum roaster cannot do (empty when nothing):
+    the drum metal colder than the beans for more than :data:`METAL_BELOW_BEANS_SHARE` of the
+    roast after the turning point. ``result`` has ``time_s``, ``Ta_C``, ``Tb_C``, ``Tm_C``."""
+    t = np.asarray(result.time_s, dtype=float)
+    tp_s, _ = turning_point(t, result.Ta_C)
+    after = t >= (tp_s or 0.0)
+    if after.sum() < 2:
+        return []
+    below = np.asarray(result.Tm_C)[after] < np.asarray(result.Tb_C)[after]
+    if below.mean() > METAL_BELOW_BEANS_SHARE:
+        tm, tb = np.asarray(result.Tm_C)[after], np.asarray(result.Tb_C)[after]
+        return [
+            f"drum metal colder than the beans for {100 * below.mean():.0f} % of the roast after the turning point "
+            f"(metal {tm.min():.0f}-{tm.max():.0f} °C, beans {tb.min():.0f}-{tb.max():.0f} °C): physically "
+            "implausible for a drum roaster, the fit found another path for the heat"
+        ]
+    return []

@@ -13,7 +13,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..io.files import Outputs
-from ..metrics.profile import ROR_SPAN_S, mmss, rate_of_rise_C_per_min, turning_point
+from ..metrics.profile import ROR_SPAN_S, implausible_states, mmss, rate_of_rise_C_per_min, turning_point
 from ..model.layout import S_TB, S_TM
 
 #: Image formats a figure may be saved as (by the file suffix).
@@ -125,16 +125,33 @@ def plot_simulation(result, path=None, title=None, outputs=None, events=None):
         ax.plot(t_min, result.Ta_measured_C, "k.", ms=3, label="BT measured (log)")
     ax.plot(t_min, result.Tb_C, label="bean core (model Tb)", color="tab:brown")
     ax.plot(t_min, result.Tm_C, label="drum metal (model Tm)", color="tab:gray")
-    ax.plot(t_min, result.Tgi_C, "--", label="ET / inlet gas as applied (model Tgi)", color="tab:red")
+    _, tgi_seen = result.gas_seen()
+    ax.plot(t_min, tgi_seen, "--", label="inlet gas the model sees (Tgi, heater included)", color="tab:red")
     ax.plot(t_min, result.Tgo_C, ":", label="outlet gas (model Tgo)", color="tab:red")
     ax.set_ylabel("temperature [°C]")
     ax.legend(fontsize=7, ncol=2, loc="lower right")
     ax.grid(alpha=0.3)
+    ax.set_xlim(t_min[0], t_min[-1])
     _events(ax, events)
+    for warning in implausible_states(result):
+        import textwrap
+
+        note = ax.text(
+            0.01,
+            0.98,
+            textwrap.fill("warning: " + warning, 95),
+            transform=ax.transAxes,
+            fontsize=7,
+            color="tab:red",
+            va="top",
+            bbox={"facecolor": "white", "alpha": 0.8, "lw": 0},
+        )
+        note.set_in_layout(False)
     ror = axes[1]
     ror.plot(t_min, rate_of_rise_C_per_min(result.time_s, result.Ta_C), color="tab:orange", label="RoR predicted")
     if result.Ta_measured_C is not None:
         ror.plot(t_min, rate_of_rise_C_per_min(result.time_s, result.Ta_measured_C), "k-", lw=0.8, label="RoR measured")
+    ror_limits(ror, result.time_s, result.Ta_C, result.Ta_measured_C)
     ror.set_ylabel(f"BT rate of rise\n[°C/min, {ROR_SPAN_S:g} s]")
     ror.legend(fontsize=7)
     ror.grid(alpha=0.3)
@@ -151,7 +168,7 @@ def plot_simulation(result, path=None, title=None, outputs=None, events=None):
     for key, style in (("Qgb_kW", "-"), ("Qgm_kW", "--"), ("Qbm_kW", "-."), ("Qr_kW", ":")):
         axes[3].plot(t_min, q[key], style, label=labels[key])
     axes[3].set_ylabel("heat flow [kW]")
-    axes[3].set_xlabel("time since CHARGE [min]")
+    time_axis(axes[3])
     axes[3].legend(fontsize=7, ncol=2)
     axes[3].grid(alpha=0.3)
     return finish_figure(fig, path, title, outputs)
@@ -181,7 +198,7 @@ def plot_fit(result, path=None, title=None, max_panels: int = 8, outputs=None):
             ax.legend(fontsize=8)
         res.axhline(0.0, color="k", lw=0.6)
         res.set_ylabel("residual\nBT meas − pred [°C]", fontsize=8)
-        res.set_xlabel("time since CHARGE [min]")
+        time_axis(res)
         res.grid(alpha=0.3)
     if len(result.names) > k:
         title = f"{title or ''} (first {k} of {len(result.names)} batches)".strip()
@@ -313,7 +330,8 @@ def plot_transfer(r, path=None, outputs=None):
         r.program.Ta_pred_C,
         color="tab:blue",
         lw=1.6,
-        label=f"predicted on {r.plant_to}, optimised program (RMSE {m['rmse_C']:.2f} °C)",
+        label=f"predicted on {r.plant_to}, {'runnable' if 'runnable' in m else 'optimised'} program "
+        f"(RMSE {m['rmse_C']:.2f} °C)",
     )
     styles = {"A's inputs unchanged": ("tab:orange", "--"), "A's inputs retimed": ("tab:green", ":")}
     keys = {"A's inputs unchanged": "baseline_same_inputs", "A's inputs retimed": "baseline_retimed"}
@@ -330,6 +348,8 @@ def plot_transfer(r, path=None, outputs=None):
     )
     ax.legend(loc="lower right", fontsize=8)
     ax.grid(alpha=0.3)
+    ax.set_xlim(t_min[0], t_min[-1])
+    _events(ax, {k: v for k, v in r.events.items() if k != "CHARGE"})
 
     u = r.program.Tgi_C if lim.decide == "Tgi" else r.program.heater
     span = lim.high - lim.low
@@ -341,16 +361,21 @@ def plot_transfer(r, path=None, outputs=None):
     for name, inp in r.baseline_inputs.items():
         color, ls = styles[name]
         ax2.plot(t_min, inp, color=color, ls=ls, lw=1.0, label=name)
-    ax2.plot(t_min, u, color="tab:blue", lw=1.6, label="optimised program")
+    if r.continuous is not None and r.continuous is not r.program:
+        uc = r.continuous.Tgi_C if lim.decide == "Tgi" else r.continuous.heater
+        ax2.plot(t_min, uc, color="tab:blue", lw=0.8, alpha=0.5, label="continuous (before rounding)")
+        ax2.step(t_min, u, where="post", color="tab:blue", lw=1.6, label="runnable program (machine steps)")
+    else:
+        ax2.plot(t_min, u, color="tab:blue", lw=1.6, label="optimised program")
     ax2.set_ylim(lim.low - 0.08 * span, lim.high + 0.08 * span)
-    ax2.set_ylabel("Tgi [°C]" if lim.decide == "Tgi" else "heater setting")
+    ax2.set_ylabel("Tgi [°C]" if lim.decide == "Tgi" else f"heater [{lim.unit}]")
     ax2.legend(loc="upper right", fontsize=7, ncol=2)
     ax2.grid(alpha=0.3)
 
     ax3.axhspan(-m["tolerance_C"], m["tolerance_C"], color="tab:blue", alpha=0.1, lw=0, label="tolerance")
     ax3.plot(t_min, r.program.Ta_pred_C - r.target_C, color="tab:blue", lw=1.2, label="predicted - target")
     ax3.set_ylabel("error [°C]")
-    ax3.set_xlabel("time after CHARGE [min]")
+    time_axis(ax3)
     ax3.legend(loc="upper right", fontsize=7)
     ax3.grid(alpha=0.3)
     return finish_figure(fig, path, f"transfer: {r.reference}", outputs)
@@ -379,6 +404,7 @@ def plot_closed_loop(r, path=None, title=None, outputs=None):
     ax.grid(alpha=0.3)
     ax_r.plot(t_min, rate_of_rise_C_per_min(r.time_s, r.reference_C), color="0.2", lw=1.8, label="reference")
     ax_r.plot(t_min, rate_of_rise_C_per_min(r.time_s, r.bt_C), color="tab:blue", lw=1.2, label="roaster")
+    ror_limits(ax_r, r.time_s, r.reference_C, r.bt_C)
     ax_r.set_ylabel("RoR [°C/min]")
     ax_r.legend(loc="upper right", fontsize=7)
     ax_r.grid(alpha=0.3)
@@ -405,7 +431,7 @@ def plot_closed_loop(r, path=None, title=None, outputs=None):
     if "Tm_C_est" in r.estimates:
         ax_m.plot(t_min, r.estimates["Tm_C_est"], color="tab:red", lw=1.0, ls="--", label="Tm estimated")
     ax_m.set_ylabel("Tm [°C]")
-    ax_m.set_xlabel("time after CHARGE [min]")
+    time_axis(ax_m)
     ax_m.legend(loc="lower right", fontsize=7)
     ax_m.grid(alpha=0.3)
     title = title or f"{r.controller} on '{r.scenario}'"

@@ -21,6 +21,7 @@ from ..io.batch import Batch
 from ..io.fitspec import FitSpec, load_fit_spec
 from ..io.importers.mapping import ColumnMap
 from ..io.plants import load_plant
+from ..metrics.profile import implausible_states
 from ..model.parameters import REGISTRY, STATE0, THETA_NAMES, THETA_START
 from ..report.result import Result
 from ..sim.population import pack_batches
@@ -162,6 +163,12 @@ def fit(
     doc = _document(ident, free, fixed, init, plant, moisture, hold, column_map)
     model = FittedModel(doc)
     validation = model.validate(batches)
+    # a fit whose states a drum roaster cannot have is reported, not hidden (metrics.profile)
+    odd = [f"{r.name}: {w}" for r in validation.results for w in implausible_states(r)]
+    if odd:
+        summary = odd[0] if len(odd) == 1 else f"{odd[0]} (and {len(odd) - 1} more batch(es) alike)"
+        ident.warnings.append(summary)
+        doc["fit"]["warnings"] = ident.warnings
     doc["metrics"] = {
         "batches": [{"name": n, **r} for n, r in zip(validation.names, validation.rows)],
         "average": validation.average,
