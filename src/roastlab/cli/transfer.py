@@ -49,7 +49,7 @@ def cmd_transfer(args) -> int:
                 initial["Tm0_C"] = check_value("Tm0_C", float(args.tm0), "--tm0")
             except ValueError:
                 raise InputError(f"expected a temperature [degC] or 'free', got {args.tm0!r}", "--tm0") from None
-    decide = args.decide or default_limits(model).decide
+    decide = args.decide or default_limits(model, args.plant_from, args.plant_to).decide
     if decide == "heater":
         if reference.heater is None:
             raise InputError(

@@ -369,7 +369,7 @@ def plot_transfer(r, path=None, outputs=None):
         ax2.plot(t_min, u, color="tab:blue", lw=1.6, label="optimised program")
     ax2.set_ylim(lim.low - 0.08 * span, lim.high + 0.08 * span)
     ax2.set_ylabel("Tgi [°C]" if lim.decide == "Tgi" else f"heater [{lim.unit}]")
-    ax2.legend(loc="upper right", fontsize=7, ncol=2)
+    ax2.legend(loc="lower left", fontsize=7, ncol=2, framealpha=0.9)
     ax2.grid(alpha=0.3)
 
     ax3.axhspan(-m["tolerance_C"], m["tolerance_C"], color="tab:blue", alpha=0.1, lw=0, label="tolerance")

@@ -262,8 +262,17 @@ class TransferResult(Result):
         draw_curves(ax, {"reference BT": (t, self.target_C), "predicted BT": (t, self.program.Ta_pred_C)}, "BT [°C]")
 
 
-def default_limits(model) -> ProgramLimits:
-    """The input a program decides for ``model`` by default (:meth:`ProgramLimits.for_model`)."""
+def default_limits(model, plant_from=None, plant_to=None) -> ProgramLimits:
+    """The input a program decides for ``model`` by default: on the model's own machine, the
+    control its map has (:meth:`ProgramLimits.for_model`: the heater on a machine whose inlet is
+    room air); on another plant, whose controls the map does not describe, the inlet gas
+    temperature (the paper's input)."""
+    from ..io.plants import load_plant
+
+    pa = load_plant(plant_from) if plant_from is not None else model.plant
+    pb = load_plant(plant_to) if plant_to is not None else pa
+    if pa != pb:
+        return ProgramLimits()
     return ProgramLimits.for_model(getattr(model, "column_map", None))
 
 
@@ -346,7 +355,7 @@ def transfer(
     """
     from ..io.plants import load_plant
 
-    limits = limits or default_limits(model)
+    limits = limits or default_limits(model, plant_from, plant_to)
     src = reference.source or reference.name
     if reference.Ta_C is None:
         raise InputError("the reference has no bean-probe curve (Ta_C): nothing to transfer", src)
