@@ -276,3 +276,17 @@ def test_skywalker_whatif_set_and_tm0(cli, real_data, tmp_path):
     assert code == 2 and "--set" in err and err.count("\n") == 1
     code, out, err = cli("whatif", logs[2], "--model", model, "--set", "heater=+10@240")
     assert code == 0 and "heater +10 % from 4:00" in out, err
+
+
+def test_bullet_control_decides_the_heater_on_its_steps(cli, bullet_model, tmp_path):
+    """No scenario: the controller moves the Bullet's heater (its inlet is room air), P0-P9 steps."""
+    import pandas as pd
+
+    ref = REAL_DATA / "bullet" / "bullet_2020-10-04_2352_490g.json"
+    code, out, err = cli(
+        "control", "--model", bullet_model, "--reference", ref, "--controller", "pid", "--out", tmp_path / "t.csv"
+    )
+    assert code == 0, err
+    trace = pd.read_csv(tmp_path / "t.csv", comment="#")
+    applied = trace["heater_applied"].to_numpy()
+    assert set(np.unique(applied)) <= set(range(10)) and len(np.unique(applied)) > 1

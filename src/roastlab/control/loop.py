@@ -6,7 +6,8 @@ Every ``sample_s`` seconds from CHARGE to the reference's DROP:
 1. the probe reading: the simulated roaster's Ta (eq. 17) ``delay_s`` ago plus white noise;
 2. the controller returns the decided input; the actuator clips it to its level limits and
    to its rate limit from the input it holds (a request it has to clip is a constraint
-   violation) and holds it over the interval (zero-order hold);
+   violation), rounds it to the machine's steps where the map declares them (P0-P9 on the
+   Bullet) and holds it over the interval (zero-order hold);
 3. the roaster -- the same model file on the same plant with the scenario's changes (batch
    mass, moisture, drum temperature at CHARGE, coefficients, gas supply) -- advances through the
    compiled integrator (:func:`roastlab.sim.simulate.advance`, the one right-hand side).
@@ -300,6 +301,8 @@ def run_closed_loop(model, reference: Batch, controller, scenario: Scenario | st
         lo, hi = max(lim.low, u_prev - cap), min(lim.high, u_prev + cap)
         applied = min(max(u, lo), hi)
         violations += abs(applied - u) > tol
+        if lim.actuator is not None and lim.actuator.stepped:  # the machine's knob has steps
+            applied = float(np.clip(lim.actuator.quantise(applied), lim.low, lim.high))
         u_app[k] = applied
         u_prev = applied
         est = getattr(controller, "estimate", None)
