@@ -45,3 +45,21 @@ def test_crossing_times():
     slope = np.polyfit(t[1:], y[1:], 1)[0]  # degC/s over 60..180 s
     assert crossing_or_projected_s(t, y, 210.0) == pytest.approx(180.0 + 20.0 / slope, rel=1e-9)
     assert crossing_or_projected_s(t, np.array([200.0, 150.0, 120.0, 100.0]), 250.0) is None
+
+
+def test_implausible_states_only_where_the_heat_must_come_through_the_drum():
+    """Metal colder than the beans is flagged when the inlet air is colder than the beans (room air
+    into an electric drum), not when hot inlet gas can heat the beans (the paper's gas roaster)."""
+    from types import SimpleNamespace
+
+    from roastlab.metrics.profile import implausible_states
+
+    t = np.arange(0.0, 601.0, 5.0)
+    ta = 100.0 + 0.15 * np.abs(t - 60.0)
+    beans = 60.0 + 0.2 * t
+    cold_metal = beans - 30.0
+    room = SimpleNamespace(time_s=t, Ta_C=ta, Tb_C=beans, Tm_C=cold_metal, Tgi_C=np.full(t.size, 22.0))
+    gas = SimpleNamespace(time_s=t, Ta_C=ta, Tb_C=beans, Tm_C=cold_metal, Tgi_C=np.full(t.size, 450.0))
+    hot_metal = SimpleNamespace(time_s=t, Ta_C=ta, Tb_C=beans, Tm_C=beans + 40.0, Tgi_C=np.full(t.size, 22.0))
+    assert "colder than the beans" in implausible_states(room)[0]
+    assert implausible_states(gas) == [] and implausible_states(hot_metal) == []

@@ -200,22 +200,31 @@ def display_temp_delta(delta_C: float, units: str = "C") -> float:
 
 
 #: Share of the roast after the turning point during which the drum metal may run colder than
-#: the beans before a fit is called physically implausible [-]. In a drum roaster the drum
-#: heats the beans: metal below the beans for most of the roast means the fit found another
-#: path for the heat than the machine has.
+#: the beans before a fit is called physically implausible [-] (on a machine whose inlet air is
+#: colder than the beans, see :func:`implausible_states`).
 METAL_BELOW_BEANS_SHARE = 0.5
 
 
 def implausible_states(result) -> list[str]:
-    """What a simulation's states say that a drum roaster cannot do (empty when nothing):
-    the drum metal colder than the beans for more than :data:`METAL_BELOW_BEANS_SHARE` of the
-    roast after the turning point. ``result`` has ``time_s``, ``Ta_C``, ``Tb_C``, ``Tm_C``."""
+    """What a simulation's states say that the machine cannot do (empty when nothing).
+
+    On a machine whose logged inlet air is colder than the beans (room air drawn into an
+    electric or induction drum: ``Tgi_C`` below ``Tb_C`` for most of the roast), the heat reaches
+    the beans through the drum, so the drum metal must be hotter than the beans; metal colder
+    than the beans for more than :data:`METAL_BELOW_BEANS_SHARE` of the roast after the turning
+    point means the fit found another path for the heat than the machine has. (In the paper's
+    gas roaster the hot inlet gas heats the beans directly and a heavy drum may lag behind
+    them: no warning there.) ``result`` has ``time_s``, ``Ta_C``, ``Tb_C``, ``Tm_C``, ``Tgi_C``.
+    """
     t = np.asarray(result.time_s, dtype=float)
     tp_s, _ = turning_point(t, result.Ta_C)
     after = t >= (tp_s or 0.0)
     if after.sum() < 2:
         return []
-    below = np.asarray(result.Tm_C)[after] < np.asarray(result.Tb_C)[after]
+    tb = np.asarray(result.Tb_C)[after]
+    if not np.mean(np.asarray(result.Tgi_C)[after] < tb) > METAL_BELOW_BEANS_SHARE:
+        return []  # the inlet gas can heat the beans: metal below them is possible
+    below = np.asarray(result.Tm_C)[after] < tb
     if below.mean() > METAL_BELOW_BEANS_SHARE:
         tm, tb = np.asarray(result.Tm_C)[after], np.asarray(result.Tb_C)[after]
         return [
