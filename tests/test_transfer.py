@@ -132,7 +132,7 @@ def test_cli_program_file_reproduces_with_simulate_and_alog_loads(cli, tmp_path)
     "extra, needle",
     [
         (["--tgi-min", "500", "--tgi-max", "400"], "inverted"),
-        (["--tgi-rate", "0"], "rate limit must be > 0"),
+        (["--tgi-rate", "0"], "plausible range"),
         (["--interval-s", "200"], "shorter than two"),
         (["--gg", "0.4", "--gg-min", "0.1", "--gg-max", "1"], "one or the other"),
         (["--gg-min", "0.1"], "both Gg limits"),
@@ -190,3 +190,29 @@ def test_heater_program_on_a_heated_drum_reproduces_and_simulates_back(cli, tmp_
     model.save(tmp_path / "m.json")
     (tmp_path / "prog.csv").write_text(r.program_csv_text())
     assert_simulates_back(cli, tmp_path / "m.json", tmp_path / "prog.csv", r.program.Ta_pred_C)
+
+
+@pytest.mark.parametrize("rate", [2.0, 5.0, 11.0, 17.0, 20.0, 23.0, 77.0])
+def test_any_plausible_rate_limit_solves(rate):
+    """The start program's increments can exceed an odd rate bound by a rounding error; the
+    optimiser projects its start into the bounds instead of refusing it (issue 27)."""
+    model, ref = random_reference(np.random.default_rng(4), "120kg")
+    r = transfer(model, ref, "120kg", "120kg", limits=ProgramLimits(150.0, 550.0, rate), batch_kg=100.0)
+    steps = np.abs(np.diff(r.program.Tgi_C))
+    assert np.all(steps <= rate / 60.0 * 5.0 * (1 + 1e-9) + 1e-9)
+
+
+@pytest.mark.parametrize(
+    "option, value, words",
+    [("--tgi-max", "1e300", "--tgi-max"), ("--tgi-rate", "0", "--tgi-rate"), ("--tgi-min", "-400", "--tgi-min")],
+)
+def test_transfer_limits_are_checked_against_the_plausible_table(cli, tmp_path, option, value, words):
+    model, ref = random_reference(np.random.default_rng(5), "120kg")
+    model.save(tmp_path / "m.json")
+    write_batch_csv(tmp_path / "ref.csv", ref)
+    code, _, err = cli(
+        "transfer", "--model", tmp_path / "m.json", "--reference", tmp_path / "ref.csv", "--out", tmp_path / "p.csv",
+        option, value,
+    )  # fmt: skip
+    assert code == 2 and words in err and "plausible range" in err and err.count("\n") == 1, err
+    assert not (tmp_path / "p.csv").exists()

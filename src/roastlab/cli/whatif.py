@@ -39,7 +39,9 @@ def cmd_whatif(args) -> int:
     setting_changes += [parse_set(text, units) for text in args.set or []]
     changes = initial_changes(args)
     if args.tgi is not None:
-        changes["Tgi_offset_C"] = args.tgi
+        from ..model.limits import check_value
+
+        changes["Tgi_offset_C"] = check_value("Tgi_offset_C", args.tgi, "--tgi")
     if args.batch_kg is not None:
         from ..model.limits import check_value
 

@@ -31,6 +31,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ..errors import InputError
+from ..model.limits import check_value
 from ..metrics.profile import ror_operator
 from ..model.actuators import MIN_HOLD_S, TGI_LIMITS, Actuator
 from ..model.layout import S_TA, S_TM
@@ -84,10 +85,19 @@ class ProgramLimits:
     def __post_init__(self) -> None:
         if self.decide not in DECISIONS:
             raise InputError(f"cannot decide {self.decide!r} (allowed: {', '.join(DECISIONS)})", "limits")
+        if self.decide == "Tgi":  # levels and rate within the quantity table's plausible ranges
+            self.low = check_value("Tgi_C", self.low, "--tgi-min")
+            self.high = check_value("Tgi_C", self.high, "--tgi-max")
+            self.rate_per_min = check_value("rate_per_min", self.rate_per_min, "--tgi-rate")
+        else:
+            self.low = check_value("heater", self.low, "--heater-min")
+            self.high = check_value("heater", self.high, "--heater-max")
+            self.rate_per_min = check_value("rate_per_min", self.rate_per_min, "--heater-rate")
+        for name in ("Gg_min_kg_s", "Gg_max_kg_s"):
+            if getattr(self, name) is not None:
+                setattr(self, name, check_value("Gg_kg_s", getattr(self, name), "--gg-" + name[3:6]))
         if not self.low < self.high:
             raise InputError(f"{self.decide} limits inverted or empty: min {self.low:g} >= max {self.high:g}", "limits")
-        if not self.rate_per_min > 0:
-            raise InputError(f"{self.decide} rate limit must be > 0 per min, got {self.rate_per_min:g}", "limits")
         if (self.Gg_min_kg_s is None) != (self.Gg_max_kg_s is None):
             raise InputError("give both Gg limits (min and max) or neither", "limits")
         if self.Gg_min_kg_s is not None and not 0 < self.Gg_min_kg_s < self.Gg_max_kg_s:
@@ -263,8 +273,10 @@ def optimise_program(
         z0.append(float(np.clip(x0[S_TM], *tm0_bounds)))
         lb.append(tm0_bounds[0])
         ub.append(tm0_bounds[1])
-    z0 = np.array(z0)
     lb, ub = np.array(lb), np.array(ub)
+    # the start, projected into its bounds: the walked start's increments can exceed the rate
+    # bound by a rounding error (1e-14), which the solver refuses
+    z0 = np.clip(np.array(z0), lb, ub)
     counter = {"sims": 0}
 
     def unpack(z):
