@@ -31,10 +31,10 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ..errors import InputError
-from ..model.limits import check_value
 from ..metrics.profile import ror_operator
 from ..model.actuators import MIN_HOLD_S, TGI_LIMITS, Actuator
 from ..model.layout import S_TA, S_TM
+from ..model.limits import check_value
 from ..sim.kernels import H_MAX_S, simulate_one
 from ..sim.sensitivity import ta_input_jacobian
 
