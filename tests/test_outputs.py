@@ -270,3 +270,28 @@ def test_a_failing_figure_leaves_no_earlier_output(cli, tmp_path, monkeypatch, a
     code, _, err = cli(*argv.format(d=tmp_path).split())
     assert code == 2 and "disk full" in err and err.count("\n") == 1, err
     assert set(tmp_path.rglob("*")) == before, "an output or a temporary file was left behind"
+
+
+def test_an_output_that_is_a_link_is_refused_and_the_link_kept(cli, tmp_path):
+    """`--out /dev/stdout > prog.csv` would replace the /dev/stdout link itself: any link is refused."""
+    target = tmp_path / "real.csv"
+    target.write_text("keep\n")
+    link = tmp_path / "link.csv"
+    link.symlink_to(target)
+    src = tmp_path / "in.csv"
+    src.write_text(HEADER + GOOD_ROWS)
+    code, _, err = cli("import", src, "--out", link)
+    assert code == 2 and "symbolic link" in err and err.count("\n") == 1, err
+    assert link.is_symlink() and target.read_text() == "keep\n"
+
+
+def test_a_sidecar_of_an_input_is_refused(tmp_path):
+    """A database's write-ahead log (``S.duckdb.wal``) or temporary file beside an input is the input's."""
+    from roastlab.errors import InputError
+    from roastlab.io.files import Outputs
+
+    store = tmp_path / "S.duckdb"
+    store.write_bytes(b"x")
+    with pytest.raises(InputError, match="sidecar"):
+        Outputs([store]).check(tmp_path / "S.duckdb.wal")
+    Outputs([store]).check(tmp_path / "S.json")  # another name beside it is fine

@@ -198,20 +198,26 @@ class Outputs:
         return out
 
     def check(self, path: str | Path) -> Path:
-        """Refuse an output that is an input, a folder or a special file, or sits in a missing folder."""
+        """Refuse an output that is an input or a sidecar of one (a database's ``.wal``, its
+        temporary files: ``<input>.<anything>`` beside it), a symbolic link (the final rename
+        would replace the link itself, e.g. ``/dev/stdout``), a folder or a special file, or
+        that sits in a missing folder."""
         out = Path(path)
         if str(out) == "" or out.name in ("", ".", ".."):
             raise InputError("not a file name", out)
         for src in self.inputs + [Path(p) for p in inputs_read()]:
             if src.exists() and _same_file(src, out):
                 raise InputError(f"is an input of this run ({src}); refusing to overwrite an input", out)
+            if src.is_file() and out.name.startswith(src.name + ".") and _same_file(src.parent, out.parent):
+                raise InputError(f"is a sidecar file of an input of this run ({src}); refusing to write it", out)
+        if out.is_symlink():
+            raise InputError(
+                f"is a symbolic link (to {os.readlink(out)}); refusing to replace a link: give the file's own path", out
+            )
         if out.is_dir():
             raise InputError("is a directory; give a file name", out)
-        if out.exists() or out.is_symlink():
-            try:
-                mode = os.stat(out).st_mode
-            except OSError:
-                mode = stat.S_IFREG  # a dangling symlink: replaced by the rename
+        if out.exists():
+            mode = os.stat(out).st_mode
             if not stat.S_ISREG(mode):
                 raise InputError("exists and is not a regular file (a pipe or device); refusing to replace it", out)
         folder = out.parent if str(out.parent) else Path(".")
