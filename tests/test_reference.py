@@ -99,3 +99,19 @@ def test_model_check_value():
     assert abs(r.Ta_C[-1] - 210.72) < 0.01
     assert abs(r.X_kg_kg[-1] - 0.0217) < 5e-5
     assert abs(r.Tgo_C[-1] - 216.5) < 0.05
+
+
+@pytest.mark.parametrize("hbm", [1.0, 3.0])
+def test_a_stiff_but_plausible_coefficient_integrates_like_the_reference(hbm):
+    """hbm >= 1 kW/(m2 K) is inside the plausibility table; its first trial step overshoots into
+    a non-finite state, which the step control must shrink, not report (issue 27). The reference
+    is SciPy at 1e-10 on the same right-hand side."""
+    t = np.arange(0.0, 301.0, 10.0)
+    Gg, Tgi = np.full(t.size, 0.4), np.linspace(480.0, 420.0, t.size)
+    x0 = InitialState(Tb0_C=25.0, Tm0_C=180.0, X0=0.11, Ta0_C=25.0)
+    theta = (0.01, hbm, 0.5793)
+    fast = simulate("120kg", t, Gg, Tgi, theta=theta, initial=x0)
+    ref, _ = reference_simulate("120kg", theta, t, Gg, Tgi, x0.vector())
+    assert np.all(np.isfinite(fast.states))
+    for j in (0, 1, 4):
+        assert np.max(np.abs(fast.states[:, j] - ref[:, j])) < TOL_C

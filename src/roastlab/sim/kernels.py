@@ -149,12 +149,18 @@ def integrate_into(t, Gg, Tgi, Q, F, n, x0, p, zoh, h_max, out, h0=H0_S, with_tg
             # RMS over the paper's five states (H adds its error only when a heater moves it), so
             # runs without the actuator extension take exactly the steps they always took
             err = math.sqrt(err / 5.0)
-            if not (err == err) or h < 1e-9 * dt:
-                # non-finite state or step collapse: report NaN rather than loop or lie
+            if h < 1e-9 * dt or (not (err == err) and h < 1e-6):
+                # step collapse, or a trial that stays non-finite down to a microsecond step:
+                # report NaN rather than loop or lie
                 for j in range(k + 1, n):
                     for i in range(N_OUT):
                         out[j, i] = np.nan
                 return h
+            if not (err == err):
+                # a non-finite trial (a stiff start overshooting into exp overflow): a smaller
+                # step, as for a large error, instead of giving up
+                h = h * 0.2
+                continue
             if err <= 1.0:
                 s = dt if last else s + h
                 for i in range(NS):
