@@ -244,6 +244,12 @@ def test_killed_fit_resumes_without_refitting_or_losing_batches(fleet, tmp_path)
     assert fit_fleet(db).fitted == 0
 
 
+def test_a_report_on_a_missing_store_leaves_no_folder_behind(cli, tmp_path):
+    code, _, err = cli("fleet", "report", "--db", tmp_path / "none.duckdb", "--plot", tmp_path / "NEW" / "SUB")
+    assert code == 2 and "no such fleet store" in err and err.count("\n") == 1, err
+    assert not (tmp_path / "NEW").exists()
+
+
 def test_cli_report_writes_json_and_figures(cli, fleet, tmp_path):
     _, db, _ = fleet
     code, out, err = cli("fleet", "report", "--db", db, "--json", tmp_path / "r.json", "--plot", tmp_path / "figs")

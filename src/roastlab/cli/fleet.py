@@ -76,9 +76,9 @@ def cmd_fleet_report(args) -> int:
     outputs = Outputs([args.db])
     if args.json:
         outputs.check(args.json)
-    if args.plot:
-        outputs.folder(args.plot)
-    report = fleet_report(args.db)
+    if args.plot and Path(args.plot).exists():
+        outputs.folder(args.plot, create=False)  # an existing non-folder is refused before any work
+    report = fleet_report(args.db)  # a missing or foreign store fails here, before any folder is made
     print(report.table())
     with outputs as out:
         if args.json:

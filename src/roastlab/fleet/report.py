@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from urllib.parse import quote
 
 import numpy as np
 
@@ -139,7 +140,8 @@ class FleetReport(Result):
         return "\n".join(lines)
 
     def plot_machines(self, folder, outputs=None) -> list[Path]:
-        """One figure per machine (``<machine>.png``): each coefficient over time, alarms marked.
+        """One figure per machine (``<machine>.png``, the name %-escaped so that different names
+        never share a file): each coefficient over time, alarms marked.
 
         Written into ``outputs`` (an :class:`~roastlab.io.files.Outputs`) if given, else all
         together or none.
@@ -151,7 +153,8 @@ class FleetReport(Result):
             folder_ = out.folder(folder)
             written = []
             for m in self.machines:
-                safe = "".join(c if c.isalnum() or c in "-_." else "_" for c in m.name)
+                # escaped, not collapsed: machines "a/b" and "a_b" get different files
+                safe = quote(m.name, safe="-_")
                 path = folder_ / f"{safe}.png"
                 plot_fleet_history(m, path, outputs=out)
                 written.append(path)
