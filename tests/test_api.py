@@ -157,3 +157,36 @@ def test_placeholder_flow_without_a_spec_is_refused():
     b = Batch("b", t, np.ones_like(t), np.full_like(t, 450.0), np.linspace(30, 150, len(t)))
     with pytest.raises(roastlab.InputError, match="placeholder"):
         roastlab.fit([b], "120kg")
+
+
+def _api_misuse_cases():
+    import roastlab
+    from roastlab.io.batch import read_batch_csv
+    from roastlab.model.rhs import pack_params
+    from roastlab.workflows.model import FittedModel, load_model
+
+    b = read_batch_csv(Path(roastlab.__file__).parent / "datasets" / "paper-synthetic" / "dataset-I" / "batch1.csv")
+    m = FittedModel.paper("120kg")
+    return {
+        "load_model(None)": lambda: load_model(None),
+        "fit of a missing path": lambda: roastlab.fit(["x"], "120kg"),
+        "fit of a number": lambda: roastlab.fit([3], "120kg"),
+        "fit with a negative seed": lambda: roastlab.fit([b], "120kg", seed=-1),
+        "predict with an array initial state": lambda: m.predict(b, Tm0_C=np.array([1.0, 2.0])),
+        "predict with NaN hgm": lambda: m.predict(b, hgm=float("nan")),
+        "theta of two values": lambda: roastlab.simulate("120kg", b.time_s, b.Gg_kg_s, b.Tgi_C, theta=(0.01, 0.02)),
+        "pack_params of a name": lambda: pack_params("120kg", (0.01, 0.0254, 0.5793), 0.1),
+        "pack_params with NaN X0": lambda: pack_params(m.plant, (0.01, 0.0254, 0.5793), float("nan")),
+        "complex inlet temperatures": lambda: roastlab.simulate("120kg", b.time_s, b.Gg_kg_s, b.Tgi_C + 0j),
+    }
+
+
+@pytest.mark.parametrize("case", sorted(_api_misuse_cases()))
+def test_api_misuse_raises_the_projects_own_errors(case):
+    """The API's promise (issue 27): ordinary misuse is a RoastlabError with a clear message,
+    never a TypeError/ValueError/AttributeError from inside, nor a silent NaN."""
+    from roastlab.errors import RoastlabError
+
+    with pytest.raises(RoastlabError) as exc:
+        _api_misuse_cases()[case]()
+    assert len(str(exc.value)) > 10

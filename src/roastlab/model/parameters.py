@@ -70,9 +70,17 @@ def as_theta(value) -> Theta:
     if isinstance(value, Theta):
         return value
     if isinstance(value, dict):
+        missing = [k for k in THETA_NAMES if k not in value]
+        if missing:
+            raise ParameterError(f"theta needs {', '.join(THETA_NAMES)}; missing {', '.join(missing)}")
         return Theta(*(value[k] for k in THETA_NAMES))
-    hgm, hbm, Pbm = value
-    return Theta(float(hgm), float(hbm), float(Pbm))
+    try:
+        values = [float(v) for v in value]
+    except (TypeError, ValueError):
+        raise ParameterError(f"theta must be three numbers (hgm, hbm, Pbm), got {str(value)[:60]!r}") from None
+    if len(values) != len(THETA_NAMES):
+        raise ParameterError(f"theta must be three numbers (hgm, hbm, Pbm), got {len(values)}")
+    return Theta(*values)
 
 
 #: Initial-state names and their index in the state vector (:data:`roastlab.model.layout.STATE0`).

@@ -320,7 +320,7 @@ def pack_params(plant, theta, X0: float = 0.1, moisture: str = "schwartzberg") -
 
     Parameters
     ----------
-    plant : roastlab.plant.Plant
+    plant : roastlab.plant.Plant (:func:`roastlab.model.plant.as_plant` for a preset name)
     theta : sequence (hgm [kW/(m2 K)], hbm [kW/(m2 K)], Pbm [-]) or mapping with those keys
     X0 : float
         Initial moisture [kg/kg dry]; fixes the dry batch mass Mbd = Mb / (1 + X0).
@@ -330,6 +330,14 @@ def pack_params(plant, theta, X0: float = 0.1, moisture: str = "schwartzberg") -
     from .quantities import table
 
     th = as_theta(theta)
+    from .limits import check_value
+
+    if not hasattr(plant, "process") or not hasattr(plant, "Mbd_kg"):
+        raise ParameterError(
+            f"plant must be a Plant, got {type(plant).__name__} {str(plant)[:40]!r}: "
+            "roastlab.model.plant.as_plant('120kg') or roastlab.load_plant('PLANT.toml')"
+        )
+    X0 = check_value("X0", X0, "pack_params")
     if moisture not in MOISTURE_LAWS:
         raise ParameterError(f"unknown moisture law {moisture!r} (allowed: {', '.join(MOISTURE_LAWS)})")
     pc = plant.process

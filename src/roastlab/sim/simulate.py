@@ -295,6 +295,8 @@ def simulate(
 
 def _input_array(name: str, values) -> np.ndarray:
     """A private float64 copy of an input, every value finite and plausible (LIMITS)."""
+    if np.iscomplexobj(values):
+        raise ParameterError(f"{name} must be real numbers, got complex values")
     try:
         a = np.array(values, dtype=np.float64).reshape(-1) if np.ndim(values) <= 1 else None
     except (TypeError, ValueError):

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, ParameterError
 from ..evaluate.validate import ValidationResult
 from ..fit.identify import NO_SECOND_READING, IdentificationResult, build_free_parameters, identify
 from ..io.batch import Batch
@@ -26,7 +26,7 @@ from ..model.parameters import REGISTRY, STATE0, THETA_NAMES, THETA_START
 from ..report.result import Result
 from ..sim.population import pack_batches
 from ..sim.simulate import InitialState
-from .model import PAPER_INITIAL, PLACEHOLDER_GG_KG_S, FittedModel, provenance
+from .model import PAPER_INITIAL, PLACEHOLDER_GG_KG_S, FittedModel, load_log, provenance
 
 
 @dataclasses.dataclass
@@ -102,6 +102,13 @@ def _spec_parts(spec, fix, bounds, estimate_tm0):
     return spec.free, dict(spec.fixed), dict(spec.initial), spec.source, dict(spec.weights)
 
 
+def _as_batch(item, column_map) -> Batch:
+    """A log path read into a Batch (with ``column_map`` where given); anything else refused."""
+    if not isinstance(item, (str, Path)):
+        raise ParameterError(f"batches must be Batch objects or log paths, got {type(item).__name__} {item!r}")
+    return load_log(item, column_map)
+
+
 def fit(
     batches: list[Batch],
     plant,
@@ -124,7 +131,8 @@ def fit(
 
     Parameters
     ----------
-    batches : list of Batch (from :func:`roastlab.load_log` or :func:`roastlab.read_dataset`)
+    batches : list of Batch (from :func:`roastlab.load_log` or :func:`roastlab.read_dataset`) or of
+        log paths (read with ``column_map``, or as batch CSVs without one)
     plant : Plant, preset name or PLANT.toml path
     spec : FitSpec or FIT.toml path: free parameters with bounds, fixed values, initial states
     fix, bounds, estimate_tm0 : without a spec: hold values (``{"hgm": 0.01}``), change bounds
@@ -137,9 +145,21 @@ def fit(
     weights : {output: weight}: ``Ta`` (the bean probe, default 1) and ``Tb2`` (a second bean
         reading compared with Tb, default 0); overrides the spec's ``[weights]``
     """
-    batches = list(batches)
+    if isinstance(batches, (str, Path, Batch)):
+        batches = [batches]
+    try:
+        batches = list(batches)
+    except TypeError:
+        raise ParameterError(
+            f"batches must be a list of Batch objects or log paths, got {type(batches).__name__}"
+        ) from None
     if not batches:
         raise InputError("no batches to fit")
+    batches = [b if isinstance(b, Batch) else _as_batch(b, column_map) for b in batches]
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ParameterError(f"seed must be a non-negative integer, got {seed!r}")
+    if isinstance(starts, bool) or not isinstance(starts, (int, np.integer)) or starts < 1:
+        raise ParameterError(f"starts must be a positive integer, got {starts!r}")
     for b in batches:
         if b.Ta_C is None:
             raise InputError("no measured Ta_C column: needed to identify", b.source or b.name)

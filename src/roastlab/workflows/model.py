@@ -32,6 +32,7 @@ from ..io.files import Outputs, input_digest
 from ..io.importers.mapping import ColumnMap, map_from_mapping
 from ..io.modelfile import model_document_text, read_model_document
 from ..io.plants import load_plant
+from ..model.limits import check_value
 from ..model.parameters import REGISTRY, STATE0, THETA_NAMES, THETA_PAPER, THETA_UNITS, Theta
 from ..model.plant import Plant
 from ..model.quantities import default
@@ -214,11 +215,12 @@ class FittedModel:
             ready.append(b)
         for name in STATE0:
             if name in changes:
+                value = check_value(name, changes[name], name)  # one number in its plausible range
                 for b in ready:
-                    b.initial[name] = float(changes[name])
+                    b.initial[name] = value
         for name in REGISTRY:
             if name in changes and name not in STATE0:
-                params[name] = float(changes[name])
+                params[name] = check_value(name, changes[name], name)
         theta = Theta(*(params.pop(k) for k in THETA_NAMES))
         fields = {k: base[k] for k in PAPER_INITIAL}
         if "Ta0_C" in base:
@@ -413,6 +415,8 @@ class FittedModel:
 
 def load_model(path) -> FittedModel:
     """Read the model file at ``path`` (or a THETA.json of roastlab 0.1)."""
+    if not isinstance(path, (str, Path)) or not str(path):
+        raise ParameterError(f"load_model needs a model file's path, got {path!r}")
     doc = read_model_document(path)
     doc["_source"] = str(path)
     return FittedModel(doc)
