@@ -5,7 +5,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: test test-fast reproduce bench lint clean distclean wheel-check real-roaster
+.PHONY: test test-fast reproduce bench lint clean distclean wheel-check real-roaster app-screens
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -48,3 +48,7 @@ wheel-check:
 # The measured figures of docs/real-roaster.md, from the real logs in ../shared/data/real.
 real-roaster: $(STAMP)
 	$(PY) docs/real_roaster.py
+
+# The page's screenshots for docs/app.md and its measured speed (needs Debian's chromium).
+app-screens: $(STAMP)
+	$(PY) docs/app_screens.py

@@ -27,6 +27,7 @@ LAYERS = [
     "workflows",
     "fleet",
     "control",
+    "app",  # the roaster's page (a web layer over the library)
     "cli",
     "apps",  # the deprecated location of the command line (a shim onto cli)
 ]

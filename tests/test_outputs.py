@@ -23,9 +23,12 @@ from test_bad_input import GOOD_ALOG, GOOD_ROWS, HEADER, PLANT
 OUTPUTS = {"--out", "--json", "--plot", "--predictions", "--save", "--alog", "--db"}
 #: Options that name a file or folder the command reads.
 INPUTS = {"--model", "--theta", "--plant", "--inputs", "--map", "--spec", "--data", "batches", "log", "plant"}
-INPUTS |= {"--from", "--to", "--reference", "--scenario", "--scenarios", "--manifest"}
+INPUTS |= {"--from", "--to", "--reference", "--scenario", "--scenarios", "--manifest", "--data-dir"}
 #: Options that take no path: numbers, names, choices and flags.
 VALUES = {
+    "--host",
+    "--port",
+    "--no-browser",
     "--tgi-offset",
     "--heat-flows",
     "--x0",
@@ -199,6 +202,8 @@ RUNS = {
     ("fleet", "fit"): ("fleet fit --db {d}/f.duckdb --spec {d}/spec.toml", ["spec.toml"]),
     ("fleet", "report"): ("fleet report --db {d}/f.duckdb --json {d}/r.json --plot {d}/figs", []),
     ("fleet", "synthetic"): ("fleet synthetic --out {d}/syn --batches 5", []),
+    # a server: no output option, so no case is generated (its writes are tested in test_app.py)
+    ("app",): ("app --data-dir {d} --no-browser", []),
 }
 
 PARSER = build_parser()

@@ -1,7 +1,7 @@
 """The ``roastlab`` command line: a thin layer that parses, calls the library, formats.
 
 One module per command or command group (:mod:`.simulate`, :mod:`.fit`, :mod:`.data`,
-:mod:`.whatif`, :mod:`.transfer`, :mod:`.control`, :mod:`.fleet`, :mod:`.bench`), each with its
+:mod:`.whatif`, :mod:`.transfer`, :mod:`.control`, :mod:`.fleet`, :mod:`.bench`, :mod:`.app`), each with its
 ``add_parsers(sub)`` and ``cmd_*`` functions; what they share is in :mod:`.common`.
 
 Every :class:`~roastlab.errors.RoastlabError` becomes one line on stderr and exit code 2.
@@ -16,7 +16,7 @@ import argparse
 import sys
 
 from ..errors import RoastlabError
-from . import bench, control, data, fit, fleet, simulate, transfer, whatif
+from . import app, bench, control, data, fit, fleet, simulate, transfer, whatif
 from .common import Parser
 
 
@@ -43,7 +43,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
     sub.required = True
 
-    for module in (simulate, fit, data, whatif, transfer, control, fleet, bench):
+    for module in (simulate, fit, data, whatif, transfer, control, fleet, bench, app):
         module.add_parsers(sub)
     return parser
 

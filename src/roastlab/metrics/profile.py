@@ -30,6 +30,8 @@ short, :func:`crossing_or_projected_s` extends it at the RoR of its last two min
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from scipy import sparse
 
@@ -58,6 +60,20 @@ def mmss(seconds: float | None) -> str:
 
 
 def ror_operator(time_s, span_s: float = ROR_SPAN_S) -> tuple[sparse.csr_matrix, np.ndarray]:
+    """(D, valid) of :func:`_ror_operator`, remembered per time grid (a what-if, a page update
+    or an optimiser asks for the same grid again and again)."""
+    t = np.ascontiguousarray(time_s, dtype=float)
+    return _ror_operator_cached(t.tobytes(), float(span_s))
+
+
+@functools.lru_cache(maxsize=64)
+def _ror_operator_cached(t_bytes: bytes, span_s: float):
+    D, valid = _ror_operator(np.frombuffer(t_bytes, dtype=float), span_s)
+    valid.setflags(write=False)
+    return D, valid
+
+
+def _ror_operator(time_s, span_s: float = ROR_SPAN_S) -> tuple[sparse.csr_matrix, np.ndarray]:
     """(D, valid): the rate of rise as a linear map, ``RoR = D @ temp_C`` [degC/min] where ``valid``.
 
     Row i holds the least-squares slope weights 60 (t_k - mean t) / sum (t - mean t)^2 over the

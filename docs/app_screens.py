@@ -1,0 +1,125 @@
+"""Screenshots of the roaster's page for docs/app.md, and its measured speed (make app-screens).
+
+Starts ``roastlab app``'s server on a temporary data folder (the SYNTHETIC paper batch and model,
+and where ../shared/data/real exists, a Bullet log with a model fitted on the 490 g logs), drives
+Debian's chromium with Playwright, saves docs/app-*.png and prints:
+
+* page ready: from starting the server to the curves drawn (numba's disk cache warm);
+* what-if: from an input change to the new curve drawn in the browser, median of 20 changes,
+  and the server's own share;
+* transfer: on the page against the library call for the same case.
+"""
+
+from __future__ import annotations
+
+import shutil
+import statistics
+import sys
+import tempfile
+import threading
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+DOCS = ROOT / "docs"
+REAL = ROOT.parent / "shared" / "data" / "real" / "bullet"
+ARGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
+        "--disable-component-update", "--disable-sync"]  # fmt: skip
+
+
+def data_folder(d: Path) -> tuple[str, str]:
+    """Fill ``d``; return the (log, model) the screenshots open."""
+    import roastlab
+    from roastlab.io.importers import load_map
+    from roastlab.workflows.model import FittedModel, load_log
+
+    shutil.copy(ROOT / "src/roastlab/datasets/paper-synthetic/dataset-I/batch1.csv", d / "batch1.csv")
+    FittedModel.paper("120kg").save(d / "paper-model.json")
+    if not REAL.is_dir():
+        return "batch1.csv", "paper-model.json"
+    ex = ROOT / "examples" / "bullet"
+    cmap = load_map(ex / "map.toml")
+    logs = sorted(p for p in REAL.glob("*.json") if p.name.endswith(("_490g.json", "_500g.json")))
+    fit = roastlab.fit([load_log(p, cmap) for p in logs[0::2]], ex / "plant.toml", ex / "fit.toml", column_map=cmap)
+    fit.model.save(d / "bullet-model.json")
+    shutil.copy(REAL / "bullet_2020-10-01_2053_500g.json", d / "bullet_2020-10-01_2053_500g.json")
+    return "bullet_2020-10-01_2053_500g.json", "bullet-model.json"
+
+
+def main() -> int:
+    import uvicorn
+    from playwright.sync_api import sync_playwright
+
+    from roastlab.app.server import create_app
+
+    chromium = shutil.which("chromium")
+    if chromium is None:
+        print("no chromium: apt-get install chromium", file=sys.stderr)
+        return 2
+    d = Path(tempfile.mkdtemp(prefix="roastlab-app-"))
+    log, model = data_folder(d)
+    with sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=chromium, args=ARGS)
+        page = browser.new_page(viewport={"width": 1400, "height": 1050})
+        t_start = time.perf_counter()
+        srv = uvicorn.Server(uvicorn.Config(create_app(d), host="127.0.0.1", port=8799, log_level="warning"))
+        threading.Thread(target=srv.run, daemon=True).start()
+        while not srv.started:
+            time.sleep(0.01)
+        page.goto("http://127.0.0.1:8799/")
+        page.wait_for_function("document.getElementById('log').options.length > 0")
+        page.select_option("#log", log)
+        page.select_option("#model", model)
+        page.click("#open")
+        page.wait_for_function("document.body.dataset.opened !== undefined")
+        ready_s = time.perf_counter() - t_start
+        page.screenshot(path=str(DOCS / "app-open.png"), full_page=True)
+
+        # what-if latency: input change -> curve drawn, 20 changes
+        kg = float(page.input_value("#batch_kg") or 1.0)
+        lat, server = [], []
+        for k in range(20):
+            n = page.evaluate("Number(document.body.dataset.updates || 0)")
+            page.fill("#batch_kg", f"{kg * (1.0 + 0.01 * (k + 1)):.4f}")
+            page.dispatch_event("#batch_kg", "input")
+            page.wait_for_function(f"Number(document.body.dataset.updates || 0) > {n}")
+            page.wait_for_function("document.body.dataset.latency !== undefined")
+            lat.append(float(page.evaluate("document.body.dataset.latency")))
+            page.evaluate("delete document.body.dataset.latency")
+            server.append(float(page.inner_text("#timing").split()[1]))
+        page.fill("#batch_kg", f"{kg * 1.2:.4f}")
+        page.dispatch_event("#batch_kg", "input")
+        page.fill("#heater", "+1@4:00")
+        page.dispatch_event("#heater", "change")
+        time.sleep(0.5)
+        page.screenshot(path=str(DOCS / "app-whatif.png"), full_page=True)
+
+        page.fill("#tr_batch_kg", f"{kg * 1.6:.3f}")
+        t0 = time.perf_counter()
+        page.click("#run-transfer")
+        page.wait_for_function("document.body.dataset.transfer === 'done'", timeout=120_000)
+        page_transfer_s = time.perf_counter() - t0
+        page.locator("#transfer-summary").scroll_into_view_if_needed()
+        page.screenshot(path=str(DOCS / "app-transfer.png"), full_page=True)
+        browser.close()
+    srv.should_exit = True
+
+    from roastlab.workflows.model import load_log, load_model
+    from roastlab.workflows.transfer import transfer
+
+    m = load_model(d / model)
+    b = load_log(d / log, m.column_map) if m.column_map else load_log(d / log)
+    t0 = time.perf_counter()
+    transfer(m, b, batch_kg=kg * 1.6)
+    lib_s = time.perf_counter() - t0
+    print(f"page ready {ready_s:.2f} s after the server started (warm numba cache)")
+    print(f"what-if: input change to curve drawn, median of 20: {statistics.median(lat):.1f} ms "
+          f"(server {statistics.median(server):.2f} ms)")  # fmt: skip
+    print(f"transfer: {page_transfer_s:.2f} s on the page, {lib_s:.2f} s as a library call")
+    print("wrote docs/app-open.png, docs/app-whatif.png, docs/app-transfer.png")
+    shutil.rmtree(d, ignore_errors=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,352 @@
+"""The roaster's page (``roastlab app``): a local, single-user web page over the library.
+
+Starlette serves one page of our own (``page.html``, ``page.js``) and Plotly's own bundled
+``plotly.min.js`` from the installed ``plotly`` wheel (no CDN, nothing copied into this
+repository); the page talks JSON to a handful of endpoints, each a thin call into the library:
+
+* ``GET  /api/files``     the logs, models and plants under the data folder
+* ``POST /api/open``      a log and a model -> measured and predicted curves, milestones
+* ``POST /api/whatif``    changes -> the changed prediction and the milestone table
+  (:func:`roastlab.workflows.whatif.whatif`, the same call as ``roastlab whatif``)
+* ``POST /api/transfer``  a batch size or plant -> the runnable program, its curve, and the
+  program CSV and Artisan background written to ``<data>/downloads/<session>/``
+  (:func:`roastlab.workflows.transfer.transfer`, as ``roastlab transfer``)
+* ``POST /api/upload``    a log file into ``<data>/uploads/`` (size-limited, read as data)
+* ``GET  /downloads/...`` what a transfer wrote
+
+Safety: the server binds 127.0.0.1 unless told otherwise; every path a request names is
+resolved (symlinks included) and must lie inside the data folder; uploads are size-limited
+and go through the same readers and input guard as the command line; nothing is written
+outside ``<data>/uploads`` and ``<data>/downloads``. Each browser tab sends its own session id,
+so two tabs do not share or overwrite state. A bad file or an infeasible request is a JSON
+``{"error": ...}`` the page shows; the server keeps running.
+"""
+
+from __future__ import annotations
+
+import re
+import threading
+import time
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError, RoastlabError
+from ..io.files import Outputs
+from ..metrics.profile import rate_of_rise_C_per_min
+
+#: Largest upload [bytes]: a 30-minute log sampled every second is ~2 MB.
+MAX_UPLOAD_BYTES = 16 * 1024 * 1024
+#: Suffixes the page lists as logs.
+LOG_SUFFIXES = (".alog", ".json", ".csv")
+#: Sessions kept at most (the oldest is dropped).
+MAX_SESSIONS = 32
+_SESSION = re.compile(r"^[A-Za-z0-9-]{8,64}$")
+
+
+@dataclass
+class Session:
+    """One browser tab's state: the log, the model and the last answers."""
+
+    batch: object = None
+    model: object = None
+    log: str = ""
+    model_path: str = ""
+    as_run: object = None
+    sid: str = ""
+    used: float = field(default_factory=time.monotonic)
+
+
+class Sessions:
+    """Per-tab state, keyed by the id the page sends in ``X-Session`` (a thread-safe dict)."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._items: dict[str, Session] = {}
+
+    def get(self, sid: str | None) -> Session:
+        if not sid or not _SESSION.match(sid):
+            raise InputError("missing or malformed session id (X-Session header)", "request")
+        with self._lock:
+            s = self._items.get(sid)
+            if s is None:
+                if len(self._items) >= MAX_SESSIONS:
+                    oldest = min(self._items, key=lambda k: self._items[k].used)
+                    del self._items[oldest]
+                s = self._items[sid] = Session(sid=sid)
+            s.used = time.monotonic()
+            return s
+
+
+def inside(data_dir: Path, rel: str) -> Path:
+    """The file ``rel`` names inside ``data_dir``, refused when it leaves the folder (``..``, an
+    absolute path, a symlink pointing out) or does not exist."""
+    if not isinstance(rel, str) or not rel or rel.startswith(("/", "\\")) or "\x00" in rel:
+        raise InputError("give a path inside the data folder", str(rel)[:80])
+    root = data_dir.resolve()
+    path = (root / rel).resolve()
+    if path != root and root not in path.parents:
+        raise InputError("outside the data folder: refused", rel)
+    if not path.is_file():
+        raise InputError("no such file in the data folder", rel)
+    return path
+
+
+def list_files(data_dir: Path, limit: int = 2000) -> dict:
+    """Logs, models and plants under ``data_dir`` (relative paths; links leaving it skipped)."""
+    root = data_dir.resolve()
+    logs, models, plants = [], [], []
+    for path in sorted(root.rglob("*")):
+        if len(logs) + len(models) + len(plants) >= limit:
+            break
+        if not path.is_file() or any(p.startswith(".") for p in path.relative_to(root).parts):
+            continue
+        real = path.resolve()
+        if real != root and root not in real.parents:
+            continue
+        rel = path.relative_to(root).as_posix()
+        if rel.startswith("downloads/"):
+            continue
+        suffix = path.suffix.lower()
+        if suffix == ".toml":
+            head = path.read_bytes()[:4096]
+            if b"Dch_m" in head or b"Mb_kg" in head:
+                plants.append(rel)
+        elif suffix == ".json" and b"roastlab-model" in path.read_bytes()[:4096]:
+            models.append(rel)
+        elif suffix in LOG_SUFFIXES:
+            logs.append(rel)
+    return {"logs": logs, "models": models, "plants": plants}
+
+
+def _series(values) -> list | None:
+    """A series as JSON numbers (3 decimals), missing values as null."""
+    if values is None:
+        return None
+    a = np.round(np.asarray(values, dtype=float), 3)
+    return [None if v != v or v in (np.inf, -np.inf) else v for v in a.tolist()]
+
+
+def curves(batch, result) -> dict:
+    """The page's view of one prediction: times, BT and beans, the drum, the settings and the
+    rate of rise [degC/min] (the one RoR of :mod:`roastlab.metrics.profile`); with ``batch``
+    the measured BT (and a second bean reading) too."""
+    t = result.time_s
+    out = {
+        "time_s": _series(t),
+        "BT_model": _series(result.Ta_C),
+        "beans_model": _series(result.Tb_C),
+        "drum_model": _series(result.Tm_C),
+        "RoR_model": _series(rate_of_rise_C_per_min(t, result.Ta_C)),
+        "heater": _series(result.heater),
+        "fan": _series(result.fan),
+    }
+    if batch is not None and batch.Ta_C is not None:
+        out["BT_measured"] = _series(batch.Ta_C)
+        out["RoR_measured"] = _series(rate_of_rise_C_per_min(batch.time_s, batch.Ta_C))
+    if batch is not None and batch.Tb2_C is not None:
+        out["beans_measured"] = _series(batch.Tb2_C)
+    return out
+
+
+def _changes(body: dict, session: Session):
+    """The what-if's changes from the page's fields (the CLI's parsers, the same units)."""
+    from ..model.limits import check_value
+    from ..workflows.whatif import parse_setting_change
+
+    setting_changes, changes = [], {}
+    cmap = session.model.column_map
+    units = {k: (getattr(cmap, k) or {}).get("unit", "") for k in ("heater", "fan")} if cmap else {}
+    for name in ("heater", "fan"):
+        text = str(body.get(name) or "").strip()
+        if text and text not in ("+0", "0", "-0"):
+            setting_changes.append(parse_setting_change(name, text, units.get(name, "")))
+    for key, name in (("Tm0_C", "Tm0_C"), ("Tb0_C", "Tb0_C"), ("X0", "X0"), ("batch_kg", "batch_kg")):
+        if body.get(key) not in (None, ""):
+            changes[name] = check_value(name, body[key], key)
+    if body.get("tgi") not in (None, "", 0, "0"):
+        changes["Tgi_offset_C"] = check_value("Tgi_offset_C", body["tgi"], "tgi")
+    return setting_changes, changes
+
+
+def create_app(data_dir: str | Path):
+    """The Starlette application serving the page over ``data_dir``."""
+    from starlette.applications import Starlette
+    from starlette.requests import Request
+    from starlette.responses import FileResponse, HTMLResponse, JSONResponse, Response
+    from starlette.routing import Route
+
+    data = Path(data_dir)
+    if not data.is_dir():
+        raise InputError("not a folder", data)
+    sessions = Sessions()
+    assets = resources.files("roastlab.app")
+
+    def error(exc: Exception, status: int = 400) -> JSONResponse:
+        return JSONResponse({"error": str(exc)}, status_code=status)
+
+    def handler(fn):
+        async def wrapped(request: Request):
+            try:
+                body = await request.json() if request.method == "POST" else {}
+                if not isinstance(body, dict):
+                    raise InputError("expected a JSON object", "request")
+                session = sessions.get(request.headers.get("x-session"))
+                return JSONResponse(fn(session, body))
+            except RoastlabError as exc:
+                return error(exc)
+            except ValueError as exc:  # malformed JSON
+                return error(InputError(f"bad request ({exc})", "request"))
+            except Exception as exc:  # noqa: BLE001 - the page shows it; the server keeps running
+                return error(RoastlabError(f"internal error: {type(exc).__name__}: {exc}"), 500)
+
+        return wrapped
+
+    async def page(request: Request):
+        return HTMLResponse((assets / "page.html").read_text(encoding="utf-8"))
+
+    async def page_js(request: Request):
+        return Response((assets / "page.js").read_text(encoding="utf-8"), media_type="text/javascript")
+
+    async def plotly_js(request: Request):
+        import plotly
+
+        path = Path(plotly.__file__).parent / "package_data" / "plotly.min.js"
+        return FileResponse(path, media_type="text/javascript")
+
+    def files(session: Session, body: dict) -> dict:
+        return list_files(data)
+
+    def open_log(session: Session, body: dict) -> dict:
+        from ..workflows.model import load_log, load_model
+        from ..workflows.whatif import whatif
+
+        model = load_model(inside(data, body.get("model", "")))
+        log_path = inside(data, body.get("log", ""))
+        batch = load_log(log_path, model.column_map) if model.column_map else load_log(log_path)
+        w = whatif(model, batch)
+        session.batch, session.model, session.log = batch, model, body["log"]
+        session.model_path, session.as_run = body["model"], w.as_run
+        return {
+            "log": batch.name,
+            "batch_kg": batch.Mb_kg,
+            "events": batch.events,
+            "notes": list(batch.notes),
+            "curves": curves(batch, w.as_run),
+            "table": w.to_json_dict(),
+            "settings": {k: (getattr(model.column_map, k) or {}).get("unit") for k in ("heater", "fan")}
+            if model.column_map
+            else {},
+        }
+
+    def need(session: Session):
+        if session.batch is None:
+            raise InputError("open a log and a model first", "page")
+
+    def whatif_(session: Session, body: dict) -> dict:
+        from ..workflows.whatif import whatif
+
+        need(session)
+        t0 = time.perf_counter()
+        setting_changes, changes = _changes(body, session)
+        w = whatif(session.model, session.batch, setting_changes, **changes)
+        return {
+            "curves": curves(None, w.changed),
+            "table": w.to_json_dict(),
+            "server_ms": round((time.perf_counter() - t0) * 1e3, 2),
+        }
+
+    def transfer_(session: Session, body: dict) -> dict:
+        from ..workflows.transfer import transfer
+
+        need(session)
+        kg = body.get("batch_kg")
+        tm0_free = (60.0, 350.0) if body.get("tm0_free") else None
+        r = transfer(
+            session.model,
+            session.batch,
+            body.get("plant_to") or None,
+            body.get("plant_to") or None,
+            batch_kg=None if kg in (None, "") else float(kg),
+            tm0_free=tm0_free,
+        )
+        folder = data / "downloads" / session.sid
+        stem = re.sub(r"[^A-Za-z0-9_.-]", "_", f"{session.batch.name}-{r.batch_kg:g}kg")
+        with Outputs([data / session.log]) as out:
+            out.folder(folder)
+            out.write_text(folder / f"{stem}-program.csv", r.program_csv_text())
+            out.write_text(folder / f"{stem}-background.alog", r.alog_text())
+        rel = folder.relative_to(data).as_posix()
+        pr = r.program
+        return {
+            "summary": r.summary(),
+            "metrics": r.to_json_dict(),
+            "time_s": _series(pr.time_s),
+            "target": _series(r.target_C),
+            "predicted": _series(pr.Ta_pred_C),
+            "program": _series(pr.Tgi_C if r.limits.decide == "Tgi" else pr.heater),
+            "decide": r.limits.decide,
+            "unit": r.limits.unit,
+            "downloads": [f"/{rel}/{stem}-program.csv", f"/{rel}/{stem}-background.alog"],
+        }
+
+    async def upload(request: Request):
+        from ..workflows.model import load_log
+
+        try:
+            sessions.get(request.headers.get("x-session"))
+            name = Path(request.query_params.get("name", "")).name
+            if not name or Path(name).suffix.lower() not in LOG_SUFFIXES:
+                raise InputError(f"upload a log ({', '.join(LOG_SUFFIXES)})", name or "upload")
+            size = int(request.headers.get("content-length") or 0)
+            if size > MAX_UPLOAD_BYTES:
+                raise InputError(f"{size / 1e6:.1f} MB is over the {MAX_UPLOAD_BYTES // 2**20} MB upload limit", name)
+            chunks, total = [], 0
+            async for chunk in request.stream():
+                total += len(chunk)
+                if total > MAX_UPLOAD_BYTES:
+                    raise InputError(f"over the {MAX_UPLOAD_BYTES // 2**20} MB upload limit", name)
+                chunks.append(chunk)
+            folder = data / "uploads"
+            target = folder / name
+            with Outputs() as out:
+                out.folder(folder)
+                out.write_bytes(target, b"".join(chunks))
+            model_rel = request.query_params.get("model")
+            try:  # read it as the model would, so a bad file is refused now, not later
+                if model_rel:
+                    from ..workflows.model import load_model
+
+                    m = load_model(inside(data, model_rel))
+                    load_log(target, m.column_map) if m.column_map else load_log(target)
+                else:
+                    load_log(target)
+            except RoastlabError:
+                target.unlink(missing_ok=True)
+                raise
+            return JSONResponse({"path": target.relative_to(data).as_posix()})
+        except RoastlabError as exc:
+            return error(exc)
+
+    async def download(request: Request):
+        rel = request.path_params["path"]
+        try:
+            path = inside(data, "downloads/" + rel)
+        except RoastlabError as exc:
+            return error(exc, 404)
+        return FileResponse(path, filename=path.name)
+
+    routes = [
+        Route("/", page),
+        Route("/assets/page.js", page_js),
+        Route("/assets/plotly.min.js", plotly_js),
+        Route("/api/files", handler(files), methods=["GET"]),
+        Route("/api/open", handler(open_log), methods=["POST"]),
+        Route("/api/whatif", handler(whatif_), methods=["POST"]),
+        Route("/api/transfer", handler(transfer_), methods=["POST"]),
+        Route("/api/upload", upload, methods=["POST"]),
+        Route("/downloads/{path:path}", download),
+    ]
+    return Starlette(routes=routes)

@@ -1,0 +1,231 @@
+"""The roaster's page (roastlab app): its server through Starlette's test client, and the page
+itself in a real browser (Playwright driving Debian's chromium; skipped with a message without it).
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import socket
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+pytest.importorskip("starlette", reason="the page needs the app extra: pip install 'roastlab[app]'")
+
+from conftest import REAL_DATA  # noqa: E402
+from roastlab.app.server import create_app  # noqa: E402
+from roastlab.workflows.model import FittedModel  # noqa: E402
+
+SYNTHETIC = Path(__file__).resolve().parents[1] / "src" / "roastlab" / "datasets" / "paper-synthetic"
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+#: Debian chromium's flags for a closed network (no background connections, no sandbox as root).
+CHROMIUM_ARGS = [
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+]
+
+
+@pytest.fixture(scope="module")
+def data_dir(tmp_path_factory):
+    """A data folder: the SYNTHETIC paper batch with the paper's model, and where the shared real
+    logs exist, a Bullet log with a model fitted on two other 490 g logs."""
+    d = tmp_path_factory.mktemp("appdata")
+    shutil.copy(SYNTHETIC / "dataset-I" / "batch1.csv", d / "batch1.csv")
+    FittedModel.paper("120kg").save(d / "paper-model.json")
+    bullet = REAL_DATA / "bullet"
+    if bullet.is_dir():
+        import roastlab
+        from roastlab.io.importers import load_map
+        from roastlab.workflows.model import load_log
+
+        ex = Path(__file__).resolve().parents[1] / "examples" / "bullet"
+        cmap = load_map(ex / "map.toml")
+        logs = sorted(bullet.glob("*_490g.json"))
+        fit = roastlab.fit([load_log(p, cmap) for p in logs[:2]], ex / "plant.toml", ex / "fit.toml", column_map=cmap)
+        fit.model.save(d / "bullet-model.json")
+        (d / "logs").mkdir()
+        shutil.copy(bullet / "bullet_2020-10-01_2053_500g.json", d / "logs" / "bullet-500g.json")  # a temp copy
+    return d
+
+
+@pytest.fixture
+def client(data_dir):
+    from starlette.testclient import TestClient
+
+    return TestClient(create_app(data_dir))
+
+
+H = {"X-Session": "test-session-a"}
+
+
+def test_open_whatif_and_table_through_the_api(client):
+    files = client.get("/api/files", headers=H).json()
+    assert "batch1.csv" in files["logs"] and "paper-model.json" in files["models"]
+    r = client.post("/api/open", json={"log": "batch1.csv", "model": "paper-model.json"}, headers=H).json()
+    assert "error" not in r, r
+    assert len(r["curves"]["BT_model"]) == len(r["curves"]["time_s"]) == len(r["curves"]["BT_measured"])
+    w = client.post("/api/whatif", json={"tgi": 20}, headers=H).json()
+    assert "error" not in w, w
+    rows = {(x["reading"], x["key"]): x for x in w["table"]["rows"]}
+    assert rows["beans", "DROP_C"]["changed"] > rows["beans", "DROP_C"]["as_run"]  # hotter inlet, hotter beans
+    assert w["server_ms"] < 1000
+
+
+def test_tabs_do_not_share_state(client):
+    client.post("/api/open", json={"log": "batch1.csv", "model": "paper-model.json"}, headers=H)
+    other = client.post("/api/whatif", json={"tgi": 10}, headers={"X-Session": "test-session-b"}).json()
+    assert "open a log" in other["error"]
+
+
+@pytest.mark.parametrize(
+    "body",
+    [
+        {"log": "../../etc/passwd", "model": "paper-model.json"},
+        {"log": "/etc/passwd", "model": "paper-model.json"},
+        {"log": "batch1.csv", "model": "../paper-model.json"},
+    ],
+)
+def test_paths_outside_the_data_folder_are_refused(client, body):
+    r = client.post("/api/open", json=body, headers=H)
+    assert r.status_code == 400 and "data folder" in r.json()["error"]
+
+
+def test_a_symlink_out_of_the_data_folder_is_refused(client, data_dir, tmp_path):
+    outside = tmp_path / "secret.csv"
+    outside.write_text("x\n")
+    link = data_dir / "escape.csv"
+    if not link.exists():
+        link.symlink_to(outside)
+    r = client.post("/api/open", json={"log": "escape.csv", "model": "paper-model.json"}, headers=H)
+    assert r.status_code == 400 and "outside the data folder" in r.json()["error"]
+    assert "escape.csv" not in client.get("/api/files", headers=H).json()["logs"]
+    assert client.get("/downloads/../paper-model.json").status_code == 404
+
+
+def test_a_bad_upload_is_a_message_and_is_not_kept(client, data_dir):
+    r = client.post("/api/upload?name=bad.alog&model=paper-model.json", content=b"not a roast", headers=H)
+    assert r.status_code == 400 and "bad.alog" in r.json()["error"]
+    assert not (data_dir / "uploads" / "bad.alog").exists()
+    r = client.post("/api/upload?name=run.exe", content=b"x", headers=H)
+    assert r.status_code == 400 and "upload a log" in r.json()["error"]
+    assert client.get("/api/files", headers=H).status_code == 200  # still answering
+
+
+# ------------------------------------------------------------------------------- in a browser
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.fixture(scope="module")
+def server(data_dir):
+    import uvicorn
+
+    port = _free_port()
+    srv = uvicorn.Server(uvicorn.Config(create_app(data_dir), host="127.0.0.1", port=port, log_level="warning"))
+    thread = threading.Thread(target=srv.run, daemon=True)
+    thread.start()
+    deadline = time.monotonic() + 20
+    while not srv.started and time.monotonic() < deadline:
+        time.sleep(0.05)
+    yield f"http://127.0.0.1:{port}"
+    srv.should_exit = True
+    thread.join(timeout=10)
+
+
+@pytest.fixture(scope="module")
+def browser():
+    if CHROMIUM is None:
+        pytest.skip("no chromium: install Debian's with 'apt-get install chromium' to run the browser tests")
+    sync_api = pytest.importorskip("playwright.sync_api")
+    with sync_api.sync_playwright() as p:
+        b = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+        yield b
+        b.close()
+
+
+@pytest.fixture
+def page(browser, server, tmp_path):
+    context = browser.new_context(accept_downloads=True, viewport={"width": 1400, "height": 1000})
+    pg = context.new_page()
+    pg.goto(server + "/")
+    yield pg
+    context.close()
+
+
+def _open(page, log, model):
+    page.wait_for_function("document.getElementById('log').options.length > 0")
+    page.select_option("#log", log)
+    page.select_option("#model", model)
+    page.click("#open")
+    page.wait_for_function("document.body.dataset.opened !== undefined && document.getElementById('plot').data")
+
+
+def _traces(page) -> dict:
+    return page.evaluate("Object.fromEntries(document.getElementById('plot').data.map(t => [t.name, t.y]))")
+
+
+@pytest.mark.slow
+def test_the_page_draws_a_real_log_and_follows_a_what_if(page, data_dir, tmp_path):
+    if not (data_dir / "bullet-model.json").exists():
+        pytest.skip("../shared/data/real is absent")
+    _open(page, "logs/bullet-500g.json", "bullet-model.json")
+    traces = _traces(page)
+    assert {"BT measured", "BT model, as run", "heater", "fan"} <= set(traces)
+    assert len(traces["BT measured"]) > 50
+    before = page.inner_text("tr[data-key='beans-DROP_C'] td.changed")
+    updates = page.evaluate("Number(document.body.dataset.updates || 0)")
+    page.fill("#batch_kg", "0.6")
+    page.dispatch_event("#batch_kg", "input")
+    page.wait_for_function(f"Number(document.body.dataset.updates || 0) > {updates}")
+    after = page.inner_text("tr[data-key='beans-DROP_C'] td.changed")
+    assert float(after) < float(before) - 5.0  # a heavier batch: cooler beans at DROP, in the table
+    changed = _traces(page)["BT model, changed"]
+    assert not np.allclose(np.array(changed, dtype=float), np.array(traces["BT model, as run"], dtype=float))
+    page.screenshot(path=str(tmp_path / "whatif.png"), full_page=True)
+    assert (tmp_path / "whatif.png").stat().st_size > 20_000
+
+
+@pytest.mark.slow
+def test_the_page_runs_a_transfer_and_its_downloads_load(page, tmp_path):
+    from roastlab.io.importers.artisan import read_alog
+
+    _open(page, "batch1.csv", "paper-model.json")
+    page.fill("#tr_batch_kg", "100")
+    page.click("#run-transfer")
+    page.wait_for_function("document.body.dataset.transfer === 'done'", timeout=60_000)
+    assert "RMSE" in page.inner_text("#transfer-summary")
+    links = page.locator("#downloads a")
+    assert links.count() == 2
+    saved = []
+    for i in range(2):
+        with page.expect_download() as info:
+            links.nth(i).click()
+        path = tmp_path / info.value.suggested_filename
+        info.value.save_as(path)
+        saved.append(path)
+    program = pd.read_csv(saved[0], comment="#")
+    assert {"time_s", "Tgi_C", "Ta_pred_C"} <= set(program.columns) and len(program) > 50
+    log = read_alog(saved[1])
+    assert len(log.time_s) == len(program)
+
+
+@pytest.mark.slow
+def test_a_bad_upload_shows_a_message_and_the_page_keeps_working(page, tmp_path):
+    _open(page, "batch1.csv", "paper-model.json")
+    bad = tmp_path / "broken.alog"
+    bad.write_text("{'timex': [1, 2], 'temp2': 'oops'}")
+    page.set_input_files("#upload", str(bad))
+    page.wait_for_function("document.getElementById('message').textContent.includes('broken.alog')")
+    assert json.loads(page.evaluate("fetch('/api/files', {headers: {'X-Session': 'probe-12345'}}).then(r => r.text())"))
