@@ -23,9 +23,12 @@ from test_bad_input import GOOD_ALOG, GOOD_ROWS, HEADER, PLANT
 OUTPUTS = {"--out", "--json", "--plot", "--predictions", "--save", "--alog", "--db"}
 #: Options that name a file or folder the command reads.
 INPUTS = {"--model", "--theta", "--plant", "--inputs", "--map", "--spec", "--data", "batches", "log", "plant"}
-INPUTS |= {"--from", "--to", "--reference", "--scenario", "--scenarios", "--manifest", "--data-dir"}
+INPUTS |= {"--from", "--to", "--reference", "--scenario", "--scenarios", "--manifest", "--data-dir", "logs", "dir"}
 #: Options that take no path: numbers, names, choices and flags.
 VALUES = {
+    "--batch-capacity-kg",
+    "--drum-diameter-m",
+    "--drum-length-m",
     "--host",
     "--port",
     "--no-browser",
@@ -204,6 +207,9 @@ RUNS = {
     ("fleet", "synthetic"): ("fleet synthetic --out {d}/syn --batches 5", []),
     # a server: no output option, so no case is generated (its writes are tested in test_app.py)
     ("app",): ("app --data-dir {d} --no-browser", []),
+    ("init",): ("init {d}/log.alog --out {d}/cfg --batch-kg 0.2", ["log.alog"]),
+    # writes into the folder init made (no output option): tested in test_roaster_setup.py
+    ("fit-roaster",): ("fit-roaster {d}/cfg {d}/log.alog", []),
 }
 
 PARSER = build_parser()

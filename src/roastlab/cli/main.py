@@ -16,7 +16,7 @@ import argparse
 import sys
 
 from ..errors import RoastlabError
-from . import app, bench, control, data, fit, fleet, simulate, transfer, whatif
+from . import app, bench, control, data, fit, fleet, roaster, simulate, transfer, whatif
 from .common import Parser
 
 
@@ -43,7 +43,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
     sub.required = True
 
-    for module in (simulate, fit, data, whatif, transfer, control, fleet, bench, app):
+    for module in (simulate, fit, roaster, data, whatif, transfer, control, fleet, bench, app):
         module.add_parsers(sub)
     return parser
 

@@ -88,9 +88,9 @@ def _events(ax, events: dict | None, color="0.55") -> None:
 
 def time_axis(ax, label: str = "time after CHARGE [m:ss]") -> None:
     """The roaster's time axis: data in minutes, ticks written m:ss."""
-    from matplotlib.ticker import FuncFormatter, MultipleLocator
+    from matplotlib.ticker import FuncFormatter, MaxNLocator
 
-    ax.xaxis.set_major_locator(MultipleLocator(1.0))
+    ax.xaxis.set_major_locator(MaxNLocator(nbins=8, steps=[1, 2, 5, 10], integer=True))  # whole minutes
     ax.xaxis.set_major_formatter(FuncFormatter(lambda x, _: mmss(60.0 * x)))
     ax.set_xlabel(label)
 

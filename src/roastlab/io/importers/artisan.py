@@ -72,6 +72,7 @@ class ArtisanLog:
     weight_out_kg: float | None = None
     title: str = ""
     fields: dict = field(default_factory=dict)  # scalar fields of the log (e.g. RoasTime's drum charge temperature)
+    machine: str = ""  # the roaster as the log names it (Artisan's roastertype; "Aillio Bullet" for RoasTime)
 
 
 # Tokens of a Python literal that JSON spells differently. Strings come first so that words,
@@ -303,6 +304,7 @@ def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: boo
         weight_in,
         weight_out,
         str(data.get("title", "")),
+        machine=str(data.get("roastertype", "") or "")[:100],
     )
 
 

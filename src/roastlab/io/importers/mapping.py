@@ -331,7 +331,8 @@ def to_celsius(values: np.ndarray, unit: str) -> np.ndarray:
     return values
 
 
-def _detect_format(path: Path, fmt: str) -> str:
+def detect_format(path: Path, fmt: str = "auto") -> str:
+    """The log format of ``path``: ``fmt`` unless "auto", else by suffix and content."""
     if fmt != "auto":
         return fmt
     suffix = path.suffix.lower()
@@ -398,7 +399,7 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
     default_notes = []
     if cmap is None:
         cmap = ColumnMap(source="default map")
-        if path.exists() and _detect_format(path, "auto") in ("alog", "artisan-csv"):
+        if path.exists() and detect_format(path, "auto") in ("alog", "artisan-csv"):
             # Artisan's own channel names: BT the bean probe, ET the environment (taken as the inlet)
             cmap = ColumnMap(
                 source="default Artisan map",
@@ -412,7 +413,7 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
             )
     if not path.exists():
         raise InputError("file not found", path)
-    fmt = _detect_format(path, cmap.format)
+    fmt = detect_format(path, cmap.format)
     gg = cmap.Gg
     Mb = None
     initial: dict = {}

@@ -167,6 +167,7 @@ def read_roastime(path: str | Path, keep_after_drop: bool = False) -> ArtisanLog
         weight_in_kg=weight / 1000.0 if weight else None,
         weight_out_kg=roasted / 1000.0 if roasted else None,
         title=str(data.get("roastName", ""))[:200],
+        machine="Aillio Bullet",
     )
     log.fields = {k: v for k in FIELDS if (v := _number(data, k, path, -100, 1000, required=False)) is not None}
     return log

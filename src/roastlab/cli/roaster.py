@@ -1,0 +1,85 @@
+"""``roastlab init`` and ``roastlab fit-roaster``: your own roaster from its logs, no hand-written files."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from .common import float_arg, progress
+
+
+def cmd_init(args) -> int:
+    from ..workflows.roaster import init_roaster
+
+    r = init_roaster(
+        args.logs,
+        args.out,
+        batch_kg=args.batch_kg,
+        capacity_kg=args.batch_capacity_kg,
+        diameter_m=args.drum_diameter_m,
+        length_m=args.drum_length_m,
+    )
+    s = r["survey"]
+    print(f"{len(s.logs)} log(s), format {s.format}, roaster {s.machine or '(not named)'}")
+    print(
+        f"  bean probe BT; heater: {s.heater or 'none'} ({s.heater_unit or '-'}); fan: {s.fan or 'none'} ({s.fan_unit or '-'})"
+    )
+    print(f"  second bean reading: {s.second_bean or 'none'}; ET: {'yes' if s.has_et else 'no'}")
+    masses = sorted({round(i.batch_kg * 1000) for i in s.logs})
+    print(f"  green batches: {', '.join(f'{g} g' for g in masses)}")
+    for note in r["notes"]:
+        print(f"  plant: {note}")
+    print(f"wrote {args.out}/map.toml, plant.toml, fit.toml; next: roastlab fit-roaster {args.out} LOG...")
+    return 0
+
+
+def cmd_fit_roaster(args) -> int:
+    from ..workflows.roaster import fit_roaster
+
+    r = fit_roaster(args.dir, args.logs, progress=progress("fit-roaster"), seed=args.seed)
+    f, h, b = r["fit"], r["held_out"], r["baseline_held_out"]
+    print(f"fit set:  FIT {f['FIT']:.1f} %, MAE {f['MAE']:.2f} °C")
+    print(
+        f"held out: FIT {h['FIT']:.1f} %, MAE {h['MAE']:.2f} °C (first-order baseline: {b['FIT']:.1f} %, {b['MAE']:.2f} °C)"
+    )
+    for w in r["warnings"]:
+        print(f"warning: {w}", file=sys.stderr)
+    print(f"wrote {r['model']}, {r['report']}")
+    return 0
+
+
+def add_parsers(sub) -> None:
+    """Register this module's command(s) on the ``roastlab`` subparsers ``sub``."""
+    p = sub.add_parser(
+        "init",
+        help="read a roaster's logs and write its column map, plant and fit spec",
+        description="Inspect LOG... (Artisan .alog/.csv or RoasTime .json of one roaster) and write DIR/map.toml "
+        "(which channel is BT, the heater, the fan, a second bean reading, ET), DIR/plant.toml (the drum, from its "
+        "dimensions, a catalogue entry or the batch capacity, each estimate stated) and DIR/fit.toml (what these "
+        "logs can determine), each commented with what was detected and what was guessed. Logs are never modified. "
+        "Then 'roastlab fit-roaster DIR LOG...' fits the model (MODEL.json) and writes a report.",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog="example:\n  roastlab init roasts/*.alog --out myroaster\n  roastlab fit-roaster myroaster roasts/*.alog",
+    )
+    p.add_argument("logs", nargs="+", metavar="LOG", help="roast logs of one roaster")
+    p.add_argument("--out", required=True, metavar="DIR", help="folder for map.toml, plant.toml, fit.toml")
+    p.add_argument("--batch-kg", type=float_arg("--batch-kg"), help="green batch [kg] for logs that record none")
+    p.add_argument("--batch-capacity-kg", type=float_arg("--batch-capacity-kg"), help="the roaster's rated batch [kg]")
+    p.add_argument("--drum-diameter-m", type=float_arg("--drum-diameter-m"), help="inner drum diameter [m]")
+    p.add_argument("--drum-length-m", type=float_arg("--drum-length-m"), help="inner drum length [m]")
+    p.set_defaults(func=cmd_init)
+
+    p = sub.add_parser(
+        "fit-roaster",
+        help="fit, hold out, compare with a baseline and report, from 'roastlab init's files",
+        description="With DIR from 'roastlab init': sort LOG... by name and split them alternately (1st, 3rd, ... fit; "
+        "2nd, 4th, ... held out), identify the model, validate it on the held-out logs, fit the first-order "
+        "baseline on the same inputs, and write DIR/model.json (MODEL.json for every other command), "
+        "DIR/report.md and DIR/heldout.png.",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog="example:\n  roastlab fit-roaster myroaster roasts/*.alog",
+    )
+    p.add_argument("dir", metavar="DIR", help="the folder 'roastlab init' wrote")
+    p.add_argument("logs", nargs="+", metavar="LOG", help="the roaster's logs")
+    p.add_argument("--seed", type=int, default=0, help="seed of the global search (default 0)")
+    p.set_defaults(func=cmd_fit_roaster)

@@ -1,0 +1,461 @@
+"""Your own roaster in two commands: ``roastlab init`` reads the logs and writes the column map,
+the plant and the fit spec; ``roastlab fit-roaster`` fits, validates on held-out logs, compares
+with the first-order baseline and writes the model and a report.
+
+What :func:`survey` detects in the logs (and says in the files' comments):
+
+* the format (Artisan ``.alog``/CSV, RoasTime JSON) and the bean probe (BT);
+* which channels are the heater/burner and the fan/air, by name in Artisan's languages (an
+  event type or an extra device), with their unit by value range (whole steps up to 20: a
+  level; else percent);
+* a second bean reading (RoasTime's infrared ``drumTemperature``);
+* ET, and so the drum temperature at CHARGE;
+* each log's green batch (Artisan ``weight``, RoasTime ``weightGreen``, a file name's "230g").
+
+The plant (:func:`estimate_plant`) comes from the drum's dimensions when given, else from the
+batch capacity (given, from :data:`CATALOGUE` by the log's machine name, or twice the largest
+logged batch) by the same rules the shipped examples' hand estimates follow: a drum that holds
+the capacity at a 20 % fill, length 1.25 diameters, vanes D/8 high at 0.6 D pitch, metal 3 kg
+per kg of capacity. The fit spec (:func:`fit_spec_text`) frees what these logs can determine:
+the paper's three coefficients and the probe constant always; the gas flow when none is
+logged; the heater's gains and lag when a heater is logged (into the drum metal, and into the
+air unless the machine heats the drum itself); the fan's share of the flow when a fan is
+logged; a shell loss when the inlet is room air; the probe's immersion and the second reading's
+weight when the log has a second bean reading. Bounds come from the quantity table.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from ..io.importers.artisan import read_alog, read_artisan_csv
+from ..io.importers.mapping import detect_format
+from ..io.importers.roastime import read_roastime
+from ..model.constants import GREEN_BULK_DENSITY_KG_M3
+
+#: Names of a heater/burner and a fan/air channel in Artisan's languages (lower case, substrings).
+HEATER_NAMES = ("burner", "heater", "power", "heat", "gas", "brûleur", "bruleur", "brenner", "quemador",
+                "queimador", "bruciatore", "potencia", "leistung", "puissance", "火力", "火")  # fmt: skip
+FAN_NAMES = ("air", "fan", "airflow", "ventilateur", "lüfter", "luefter", "luft", "ventilador", "aria", "風", "风")
+#: Published capacities of common roasters, by a word of Artisan's ``roastertype`` (lower case).
+#: Each: (green batch capacity [kg], how the heat enters, source).
+CATALOGUE = {
+    "aillio": (1.0, "drum", "Aillio Bullet R1: 1 kg maximum batch, induction-heated drum (aillio.com product page)"),
+    "hottop": (0.25, "both", "Hottop KN-8828B-2K+: 250 g maximum batch, electric element (hottopusa.com)"),
+    "behmor": (0.454, "both", "Behmor 1600+: 1 lb maximum batch, quartz elements (behmor.com)"),
+    "kaffelogic": (0.12, "air", "Kaffelogic Nano 7: 120 g maximum batch, hot-air (kaffelogic.com)"),
+}
+#: Fill fraction at which a drum holds its rated batch [-] (the examples' estimates: 20-25 %).
+RATED_FILL = 0.20
+#: Drum length over diameter [-], vane height and pitch over diameter, metal per kg of capacity
+#: [kg/kg]: the rules of the shipped examples' estimates (Skywalker 0.16 x 0.20 m, 1.5 kg for
+#: 0.5 kg; Bullet 0.20 x 0.25 m, 3 kg for 1 kg).
+LENGTH_OVER_DIAMETER = 1.25
+VANE_HEIGHT_OVER_D = 1 / 8
+VANE_PITCH_OVER_D = 0.6
+METAL_KG_PER_KG = 3.0
+#: Lower bound of the heat-transfer coefficients a small roaster's fit may reach [kW/(m2 K)]: an
+#: order below the quantity table's fit bounds (made for the paper's industrial drums), inside
+#: its plausible range (the Bullet's gas-metal coefficient ends near it).
+SMALL_COEFF_FLOOR = 0.001
+_GRAMS = re.compile(r"(?<![0-9])(\d{2,5})\s?g(?![a-z])", re.I)
+
+
+@dataclass
+class LogInfo:
+    """What one log holds (see the module docstring)."""
+
+    path: Path
+    format: str
+    machine: str
+    channels: list[str]
+    batch_kg: float | None
+    batch_from: str
+    heater: str | None = None
+    heater_unit: str | None = None
+    fan: str | None = None
+    fan_unit: str | None = None
+    second_bean: str | None = None
+    has_et: bool = False
+    heater_max: float = 0.0
+    fan_max: float = 0.0
+
+
+@dataclass
+class Survey:
+    """The logs' common layout, the machine and the batches (:func:`survey`)."""
+
+    logs: list[LogInfo]
+    format: str
+    machine: str
+    heater: str | None
+    heater_unit: str | None
+    fan: str | None
+    fan_unit: str | None
+    second_bean: str | None
+    has_et: bool
+    heater_max: float = 0.0
+    fan_max: float = 0.0
+    notes: list[str] = field(default_factory=list)
+
+
+def _unit_of(values: np.ndarray) -> str:
+    v = values[np.isfinite(values)]
+    if v.size and np.all(np.abs(v - np.round(v)) < 1e-9) and v.max() <= 20:
+        return "level"
+    return "percent"
+
+
+def _find(names, candidates) -> str | None:
+    for name in names:
+        low = name.lower()
+        if any(c in low for c in candidates):
+            return name
+    return None
+
+
+def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
+    """One log's layout (format, channels, heater/fan, second bean reading, batch)."""
+    path = Path(path)
+    fmt = detect_format(path, "auto")
+    if fmt == "alog":
+        log = read_alog(path)
+    elif fmt == "artisan-csv":
+        log = read_artisan_csv(path)
+    elif fmt == "roastime":
+        log = read_roastime(path)
+    else:
+        raise InputError("not a roast log roastlab can set up from (Artisan .alog/.csv, RoasTime .json)", path)
+    names = list(log.channels)
+    if "BT" not in log.channels or not np.isfinite(log.channels["BT"]).any():
+        raise InputError("no bean temperature (BT) in this log: roastlab needs the bean probe", path)
+    others = [n for n in names if n not in ("BT", "ET", "beanTemperature", "drumTemperature", "exitTemperature")]
+    heater = "heater" if fmt == "roastime" and "heater" in names else _find(others, HEATER_NAMES)
+    fan = "fan" if fmt == "roastime" and "fan" in names else _find([n for n in others if n != heater], FAN_NAMES)
+    if batch_kg is not None:
+        mass, source = batch_kg, "--batch-kg"
+    elif log.weight_in_kg:
+        mass, source = log.weight_in_kg, "the log's green weight"
+    elif m := _GRAMS.search(path.stem):
+        mass, source = int(m.group(1)) / 1000.0, f"the file name's '{m.group(0)}'"
+    else:
+        mass, source = None, ""
+    return LogInfo(
+        path,
+        fmt,
+        log.machine,
+        names,
+        mass,
+        source,
+        heater,
+        _unit_of(log.channels[heater]) if heater else None,
+        fan,
+        _unit_of(log.channels[fan]) if fan else None,
+        "drumTemperature" if fmt == "roastime" and "drumTemperature" in names else None,
+        "ET" in names and np.isfinite(log.channels["ET"]).any(),
+        float(np.nanmax(log.channels[heater])) if heater else 0.0,
+        float(np.nanmax(log.channels[fan])) if fan else 0.0,
+    )
+
+
+def survey(paths, batch_kg: float | None = None) -> Survey:
+    """Inspect every log; refuse logs that disagree (formats, channels, machines) or have no
+    batch mass, each with one message saying what to pass."""
+    paths = [Path(p) for p in paths]
+    if not paths:
+        raise InputError("give the roast logs of one roaster", "init")
+    infos = [inspect_log(p, batch_kg) for p in paths]
+    first = infos[0]
+    for key, what in (("format", "formats"), ("heater", "heater channels"), ("fan", "fan channels")):
+        kinds = {getattr(i, key) for i in infos}
+        if len(kinds) > 1:
+            odd = next(i for i in infos if getattr(i, key) != getattr(first, key))
+            raise InputError(
+                f"the logs disagree on {what} ({', '.join(sorted(map(str, kinds)))}): {first.path.name} vs "
+                f"{odd.path.name}. Set up one roaster (one layout) at a time",
+                odd.path,
+            )
+    machines = {i.machine for i in infos if i.machine}
+    if len(machines) > 1:
+        raise InputError(f"the logs name different roasters ({', '.join(sorted(machines))}): one at a time", "init")
+    missing = [i.path.name for i in infos if i.batch_kg is None]
+    if missing:
+        raise InputError(
+            f"no green weight in {len(missing)} log(s) ({', '.join(missing[:3])}{' ...' if len(missing) > 3 else ''}) "
+            "and none in the file name: pass --batch-kg",
+            "init",
+        )
+    units = {i.heater_unit for i in infos if i.heater} | set()
+    heater_unit = "percent" if "percent" in units else (units.pop() if units else None)
+    fan_units = {i.fan_unit for i in infos if i.fan}
+    fan_unit = "percent" if "percent" in fan_units else (fan_units.pop() if fan_units else None)
+    return Survey(
+        infos,
+        first.format,
+        machines.pop() if machines else "",
+        first.heater,
+        heater_unit,
+        first.fan,
+        fan_unit,
+        first.second_bean,
+        all(i.has_et for i in infos),
+        max(i.heater_max for i in infos),
+        max(i.fan_max for i in infos),
+    )
+
+
+def catalogue_entry(machine: str):
+    low = machine.lower()
+    return next((v for k, v in CATALOGUE.items() if k in low), None)
+
+
+def estimate_plant(s: Survey, capacity_kg=None, diameter_m=None, length_m=None) -> tuple[dict, list[str]]:
+    """The plant's geometry and the comment lines that say where each number comes from."""
+    masses = [i.batch_kg for i in s.logs]
+    entry = catalogue_entry(s.machine) if s.machine else None
+    notes = []
+    if capacity_kg is not None:
+        cap, why = capacity_kg, "--batch-capacity-kg"
+    elif entry is not None:
+        cap, why = entry[0], f"the catalogue: {entry[2]}"
+    else:
+        cap, why = 2.0 * max(masses), "ESTIMATED as twice the largest logged batch (pass --batch-capacity-kg)"
+    notes.append(f"batch capacity {cap:g} kg: {why}")
+    if diameter_m is None:
+        volume = cap / (GREEN_BULK_DENSITY_KG_M3 * RATED_FILL)
+        diameter_m = (4.0 * volume / (math.pi * LENGTH_OVER_DIAMETER)) ** (1.0 / 3.0)
+        notes.append(
+            f"drum diameter ESTIMATED: a drum that holds {cap:g} kg at a {RATED_FILL:.0%} fill "
+            f"({volume * 1000:.1f} L, length {LENGTH_OVER_DIAMETER:g} diameters); pass --drum-diameter-m"
+        )
+    if length_m is None:
+        length_m = LENGTH_OVER_DIAMETER * diameter_m
+        notes.append(f"drum length ESTIMATED as {LENGTH_OVER_DIAMETER:g} diameters; pass --drum-length-m")
+    notes.append(
+        f"vanes ESTIMATED {VANE_HEIGHT_OVER_D:.3g} D high at {VANE_PITCH_OVER_D:g} D pitch; metal "
+        f"{METAL_KG_PER_KG:g} kg per kg of capacity (drum, vanes and front plate in thermal contact)"
+    )
+    plant = {
+        "name": re.sub(r"[^a-z0-9-]+", "-", (s.machine or "my-roaster").lower()).strip("-") or "my-roaster",
+        "Mb_kg": round(float(np.median(masses)), 4),
+        "Dch_m": round(diameter_m, 4),
+        "Lch_m": round(length_m, 4),
+        "Hflap_m": round(VANE_HEIGHT_OVER_D * diameter_m, 4),
+        "Sflap_m": round(VANE_PITCH_OVER_D * diameter_m, 4),
+        "Mm_kg": round(METAL_KG_PER_KG * cap, 3),
+    }
+    return plant, notes
+
+
+def _setting_span(unit: str, top: float) -> float:
+    """The range of a logged setting: 0..100 for percent, 0..the highest logged level."""
+    return 100.0 if unit == "percent" else max(top, 1.0)
+
+
+def map_text(s: Survey) -> str:
+    """The column map, commented with what was detected."""
+    lines = [
+        "# Written by roastlab init from "
+        + ", ".join(i.path.name for i in s.logs[:3])
+        + (" ..." if len(s.logs) > 3 else ""),
+        f"# format: {s.format}; roaster: {s.machine or '(not named in the logs)'}",
+        f'format = "{s.format}"',
+        "resample_s = 5.0      # fits fast and loses nothing at roasting time scales",
+        "",
+        "[Ta]",
+        'column = "BT"         # the bean probe',
+        "",
+    ]
+    room_air = bool(s.heater)
+    if room_air:
+        lines += ["[Tgi]", "constant_C = 22.0     # room air drawn into the drum: the heat comes from the heater", ""]
+    elif s.has_et:
+        lines += ["[Tgi]", 'column = "ET"         # no heater logged: ET taken as the inlet gas', ""]
+    else:
+        raise InputError("the logs have neither a heater setting nor ET: nothing drives the model", s.logs[0].path)
+    lines += ["[Gg]", "identify = true       # the gas flow is not logged: a constant the fit identifies", ""]
+    for name, col, unit, top in (
+        ("heater", s.heater, s.heater_unit, s.heater_max),
+        ("fan", s.fan, s.fan_unit, s.fan_max),
+    ):
+        if col:
+            step = "step = 1" if unit == "level" else "step = 5              # Artisan's slider in 5 % steps"
+            lines += [
+                f"[{name}]",
+                f'column = "{col}"      # detected by name',
+                f'unit = "{unit}"       # by the logged values ({"whole steps" if unit == "level" else "percent"})',
+            ]
+            if unit == "level":
+                lines += ["min = 0", f"max = {top:g}                # the highest setting the logs use"]
+            lines += [step, ""]
+    if s.second_bean:
+        lines += ["[Tb2]", f'column = "{s.second_bean}"   # a second bean reading (infrared)', "start_s = 10.0", ""]
+    initial = []
+    if s.format == "roastime":
+        initial.append('Tm0_C = "drumChargeTemperature"   # the drum just before the beans drop')
+    elif s.has_et:
+        initial.append('Tm0_C = "ET"          # ET at CHARGE as the drum temperature')
+    if initial:
+        lines += ["[initial]", *initial, ""]
+    return "\n".join(lines)
+
+
+def fit_spec_text(s: Survey, capacity_kg: float) -> str:
+    """The fit spec, freeing what the logs can determine (module docstring), bounds from the table."""
+
+    def line(name, lo, hi, start, why):
+        return f"{name} = [{lo:g}, {hi:g}, {start:g}]".ljust(40) + f"# {why}"
+
+    rows = [
+        "# Written by roastlab init: what these logs can determine (see roastlab.workflows.roaster).",
+        "[free]",
+        line("hgm", SMALL_COEFF_FLOOR, 1.0, 0.02, "gas-metal coefficient [kW/(m2 K)]"),
+        line("hbm", SMALL_COEFF_FLOOR, 1.0, 0.02, "metal-bean coefficient [kW/(m2 K)]"),
+        line("Pbm", 0.05, 0.95, 0.5, "bean area touching metal [-]"),
+        line("Gg_kg_s", 0.0005, 0.05, 0.005, "gas flow [kg/s] (not logged)"),
+        line("Kt", 0.002, 0.2, 0.02, "bean-probe inverse time constant [1/s]"),
+    ]
+    entry = catalogue_entry(s.machine) if s.machine else None
+    path = entry[1] if entry else "both"
+    if s.heater:
+        span = _setting_span(s.heater_unit, s.heater_max)
+        qe_hi = round(10.0 * capacity_kg / span, 4)  # ~10 kW per kg of capacity at full setting, generous
+        if path in ("drum", "both"):
+            rows.append(
+                line(
+                    "Qe_gain_kW", 0.0, qe_hi, qe_hi / 10, f"heater -> heat into the drum metal [kW per {s.heater_unit}]"
+                )
+            )
+        if path in ("air", "both"):
+            rows.append(
+                line(
+                    "Tgi_gain_C",
+                    0.0,
+                    round(1000.0 / span, 4),
+                    round(200.0 / span, 4),
+                    f"heater -> the air it heats [degC per {s.heater_unit}]",
+                )
+            )
+        rows.append(line("tau_heater_s", 1.0, 300.0, 30.0, "lag of the heater's effect [s]"))
+        rows.append(line("U_shell_kW_m2K", 0.0, 0.1, 0.01, "drum shell heat loss to the room [kW/(m2 K)]"))
+    if s.fan and s.fan_unit == "level":
+        rows.append(line("Gg_fan_kg_s", 0.0, 0.01, 0.001, "air flow per fan step [kg/s]"))
+    if s.second_bean:
+        rows.append(line("h_probe_m", 0.0, 0.2, 0.04, "bed depth that covers the bean probe [m]"))
+    rows += ["", "[initial]", "Tb0_C = 22.0                          # green beans at room temperature",
+             "X0 = 0.11                             # typical green-coffee moisture [kg/kg dry]"]  # fmt: skip
+    if s.second_bean:
+        rows += [
+            "",
+            "[weights]",
+            "Ta = 1.0",
+            "Tb2 = 1.0                             # the second bean reading vs the model's Tb",
+        ]
+    return "\n".join(rows) + "\n"
+
+
+def plant_text(plant: dict, notes: list[str]) -> str:
+    lines = ["# Written by roastlab init. " + "; ".join(notes[:1])] + [f"# {n}" for n in notes[1:]]
+    lines.append(f'name = "{plant["name"]}"')
+    for k in ("Mb_kg", "Dch_m", "Lch_m", "Hflap_m", "Sflap_m", "Mm_kg"):
+        lines.append(f"{k} = {plant[k]:g}")
+    return "\n".join(lines) + "\n"
+
+
+def init_roaster(paths, out_dir, *, batch_kg=None, capacity_kg=None, diameter_m=None, length_m=None) -> dict:
+    """Survey the logs and write ``out_dir``/map.toml, plant.toml, fit.toml; returns a summary."""
+    from ..io.files import Outputs
+
+    s = survey(paths, batch_kg)
+    plant, notes = estimate_plant(s, capacity_kg, diameter_m, length_m)
+    cap = capacity_kg or (
+        catalogue_entry(s.machine)[0]
+        if s.machine and catalogue_entry(s.machine)
+        else 2.0 * max(i.batch_kg for i in s.logs)
+    )
+    out = Path(out_dir)
+    with Outputs(list(paths)) as o:
+        o.folder(out)
+        o.write_text(out / "map.toml", map_text(s) + "\n")
+        o.write_text(out / "plant.toml", plant_text(plant, notes))
+        o.write_text(out / "fit.toml", fit_spec_text(s, cap))
+    return {"survey": s, "plant": plant, "notes": notes}
+
+
+def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0) -> dict:
+    """Fit, validate and report a roaster set up by :func:`init_roaster`.
+
+    The logs, sorted by name (both shipped roasters' names start with the date), are split
+    alternately: the 1st, 3rd, ... fit, the 2nd, 4th, ... are held out. Writes
+    ``config_dir``/model.json, report.md and heldout.png (measured vs predicted BT of the
+    held-out logs); returns the figures of the report.
+    """
+    from ..evaluate.metrics import average_metrics
+    from ..fit.baseline import describe, fit_first_order, validate_first_order
+    from ..io.files import Outputs
+    from ..io.importers.mapping import load_map
+    from ..io.modelfile import model_document_text
+    from .fitting import fit
+    from .model import load_log
+
+    d = Path(config_dir)
+    for name in ("map.toml", "plant.toml", "fit.toml"):
+        if not (d / name).is_file():
+            raise InputError(f"no {name} here: run 'roastlab init LOG... --out {d}' first", d)
+    paths = sorted(Path(p) for p in paths)
+    if len(paths) < 2:
+        raise InputError("give at least two logs: one to fit, one to hold out", "fit-roaster")
+    cmap = load_map(d / "map.toml")
+    batches = [load_log(p, cmap) for p in paths]
+    fit_b, val_b = batches[0::2], batches[1::2]
+    result = fit(fit_b, d / "plant.toml", d / "fit.toml", column_map=cmap, progress=progress, seed=seed)
+    model = result.model
+    v_fit, v_val = model.validate(fit_b), model.validate(val_b)
+    base = fit_first_order(fit_b)
+    _, b_fit = validate_first_order(fit_b, base)
+    _, b_val = validate_first_order(val_b, base)
+    bf, bv = average_metrics(b_fit), average_metrics(b_val)
+    lines = [
+        f"# {model.plant.name if model.plant else 'roaster'}: fitted by roastlab fit-roaster",
+        "",
+        f"{len(batches)} logs sorted by name, split alternately: {len(fit_b)} fit, {len(val_b)} held out "
+        f"(the fit never saw them). Fit in {result.identification.wall_s:.1f} s.",
+        "",
+        "| set | logs | model FIT % | model MAE °C | baseline FIT % | baseline MAE °C |",
+        "|---|---|---|---|---|---|",
+        f"| fit | {len(fit_b)} | {v_fit.average['FIT']:.1f} | {v_fit.average['MAE']:.2f} | {bf['FIT']:.1f} | {bf['MAE']:.2f} |",
+        f"| held out | {len(val_b)} | {v_val.average['FIT']:.1f} | {v_val.average['MAE']:.2f} | {bv['FIT']:.1f} | {bv['MAE']:.2f} |",
+        "",
+        f"Baseline: the first-order lag fed the same inputs ({describe(base)}).",
+        "",
+        "| parameter | value | std. error | unit |",
+        "|---|---|---|---|",
+    ]
+    for name, value, se, unit, how in model.table():
+        lines.append(f"| {name} | {value or how} | {se or ('on a bound' if how == 'fitted' else '-')} | {unit} |")
+    lines += ["", "What the fit says in plain words:", ""]
+    lines += [f"- {w}" for w in result.warnings] or ["- no warnings"]
+    lines += ["", "Held-out logs, measured and predicted BT:", "", "![held out](heldout.png)", ""]
+    lines += ["| held-out log | FIT % | MAE °C |", "|---|---|---|"]
+    lines += [f"| {n} | {r['FIT']:.1f} | {r['MAE']:.2f} |" for n, r in zip(v_val.names, v_val.rows)]
+    from ..report.figures import figure_bytes
+
+    fig = v_val.plot()
+    with Outputs(paths) as out:
+        out.write_text(d / "model.json", model_document_text(model.to_document()))
+        out.write_text(d / "report.md", "\n".join(lines) + "\n")
+        out.write_bytes(d / "heldout.png", figure_bytes(fig, d / "heldout.png"))
+    return {
+        "fit": {"FIT": v_fit.average["FIT"], "MAE": v_fit.average["MAE"]},
+        "held_out": {"FIT": v_val.average["FIT"], "MAE": v_val.average["MAE"]},
+        "baseline_held_out": {"FIT": bv["FIT"], "MAE": bv["MAE"]},
+        "warnings": result.warnings,
+        "model": d / "model.json",
+        "report": d / "report.md",
+    }
