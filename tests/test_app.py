@@ -229,3 +229,29 @@ def test_a_bad_upload_shows_a_message_and_the_page_keeps_working(page, tmp_path)
     page.set_input_files("#upload", str(bad))
     page.wait_for_function("document.getElementById('message').textContent.includes('broken.alog')")
     assert json.loads(page.evaluate("fetch('/api/files', {headers: {'X-Session': 'probe-12345'}}).then(r => r.text())"))
+
+
+@pytest.mark.slow
+def test_a_model_is_fitted_on_the_page_in_the_background(client, data_dir):
+    """roastlab init + fit-roaster behind the page: progress to poll, the report, a model listed."""
+    sky = REAL_DATA / "skywalker"
+    if not sky.is_dir():
+        pytest.skip("../shared/data/real is absent")
+    (data_dir / "sky").mkdir(exist_ok=True)
+    logs = []
+    for p in sorted(sky.glob("*.alog"))[:4]:
+        shutil.copy(p, data_dir / "sky" / p.name)  # a temporary copy in the test's data folder
+        logs.append(f"sky/{p.name}")
+    r = client.post("/api/fit", json={"logs": logs, "name": "sky"}, headers=H).json()
+    assert r.get("started"), r
+    deadline = time.monotonic() + 180
+    while True:
+        st = client.get("/api/fit-status", headers=H).json()
+        if not st.get("running") or time.monotonic() > deadline:
+            break
+        time.sleep(0.2)
+    assert "error" not in st, st
+    assert "held out" in st["report"] and st["held_out"]["FIT"] > 0
+    assert st["model"] in client.get("/api/files", headers=H).json()["models"]
+    one = client.post("/api/fit", json={"logs": logs[:1]}, headers=H)
+    assert one.status_code == 400 and "at least two logs" in one.json()["error"]

@@ -172,7 +172,33 @@ async function refreshFiles(selectLog) {
     if (pick) $(id).value = pick;
   };
   fill("log", f.logs, selectLog);
-  fill("model", f.models);
+  fill("model", f.models, pickModel);
+  fill("fit_logs", f.logs);
+}
+let pickModel = null;
+
+async function runFit() {
+  const logs = Array.from($("fit_logs").selectedOptions).map((o) => o.value);
+  say("");
+  try {
+    await api("/api/fit", { logs, name: $("fit_name").value });
+    const poll = async () => {
+      const st = await api("/api/fit-status");
+      $("fit_progress").max = st.total || 1;
+      $("fit_progress").value = st.done || 0;
+      $("fit_text").textContent = st.text || "";
+      if (st.running) { setTimeout(poll, 300); return; }
+      if (st.error) { say(st.error); return; }
+      $("fit-report").textContent = st.report;
+      $("fit_text").textContent = `held out: FIT ${st.held_out.FIT.toFixed(1)} %, MAE ${st.held_out.MAE.toFixed(2)} °C`;
+      pickModel = st.model;
+      await refreshFiles($("log").value);
+      document.body.dataset.fitted = st.model;
+    };
+    poll();
+  } catch (e) {
+    say(e.message);
+  }
 }
 
 async function upload(ev) {
@@ -226,6 +252,7 @@ window.addEventListener("DOMContentLoaded", async () => {
   $("units").addEventListener("change", () => { draw(); drawTable(); });
   $("reset").addEventListener("click", openLog);
   $("run-transfer").addEventListener("click", runTransfer);
+  $("run-fit").addEventListener("click", runFit);
   link("Tm0_C", "Tm0_C_range");
   link("batch_kg", "batch_kg_range");
   for (const id of ["X0", "heater", "fan", "tgi"]) $(id).addEventListener("change", whatif);

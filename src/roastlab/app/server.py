@@ -12,12 +12,14 @@ repository); the page talks JSON to a handful of endpoints, each a thin call int
   program CSV and Artisan background written to ``<data>/downloads/<session>/``
   (:func:`roastlab.workflows.transfer.transfer`, as ``roastlab transfer``)
 * ``POST /api/upload``    a log file into ``<data>/uploads/`` (size-limited, read as data)
+* ``POST /api/fit``       fit a model on chosen logs in the background (``roastlab init`` +
+  ``fit-roaster`` into ``<data>/roasters/<name>/``); ``GET /api/fit-status`` its progress and report
 * ``GET  /downloads/...`` what a transfer wrote
 
 Safety: the server binds 127.0.0.1 unless told otherwise; every path a request names is
 resolved (symlinks included) and must lie inside the data folder; uploads are size-limited
 and go through the same readers and input guard as the command line; nothing is written
-outside ``<data>/uploads`` and ``<data>/downloads``. Each browser tab sends its own session id,
+outside ``<data>/uploads``, ``<data>/downloads`` and ``<data>/roasters``. Each browser tab sends its own session id,
 so two tabs do not share or overwrite state. A bad file or an infeasible request is a JSON
 ``{"error": ...}`` the page shows; the server keeps running.
 """
@@ -55,6 +57,7 @@ class Session:
     log: str = ""
     model_path: str = ""
     as_run: object = None
+    fit: dict = field(default_factory=dict)  # the background fit's progress and answer
     sid: str = ""
     used: float = field(default_factory=time.monotonic)
 
@@ -292,6 +295,43 @@ def create_app(data_dir: str | Path):
             "downloads": [f"/{rel}/{stem}-program.csv", f"/{rel}/{stem}-background.alog"],
         }
 
+    def fit_start(session: Session, body: dict) -> dict:
+        from ..workflows.roaster import fit_roaster, init_roaster
+
+        logs = body.get("logs") or []
+        if not isinstance(logs, list) or len(logs) < 2:
+            raise InputError("choose at least two logs of one roaster to fit (one to fit, one to hold out)", "fit")
+        paths = [inside(data, rel) for rel in logs]
+        name = re.sub(r"[^A-Za-z0-9_-]+", "-", str(body.get("name") or "my-roaster"))[:40].strip("-") or "my-roaster"
+        folder = data / "roasters" / name
+        if session.fit.get("running"):
+            raise InputError("a fit is already running in this tab", "fit")
+        session.fit = {"running": True, "done": 0, "total": 1, "text": "reading the logs", "name": name}
+
+        def progress(done, total, text=""):
+            session.fit.update(done=done, total=total, text=text)
+
+        def work():
+            try:
+                init_roaster(paths, folder, batch_kg=body.get("batch_kg") or None)
+                r = fit_roaster(folder, paths, progress=progress)
+                session.fit.update(
+                    running=False,
+                    model=(folder / "model.json").relative_to(data).as_posix(),
+                    report=(folder / "report.md").read_text(encoding="utf-8"),
+                    held_out=r["held_out"],
+                )
+            except RoastlabError as exc:
+                session.fit.update(running=False, error=str(exc))
+            except Exception as exc:  # noqa: BLE001 - reported on the page
+                session.fit.update(running=False, error=f"internal error: {type(exc).__name__}: {exc}")
+
+        threading.Thread(target=work, daemon=True).start()
+        return {"started": True, "folder": folder.relative_to(data).as_posix()}
+
+    def fit_status(session: Session, body: dict) -> dict:
+        return {k: v for k, v in session.fit.items()}
+
     async def upload(request: Request):
         from ..workflows.model import load_log
 
@@ -347,6 +387,8 @@ def create_app(data_dir: str | Path):
         Route("/api/whatif", handler(whatif_), methods=["POST"]),
         Route("/api/transfer", handler(transfer_), methods=["POST"]),
         Route("/api/upload", upload, methods=["POST"]),
+        Route("/api/fit", handler(fit_start), methods=["POST"]),
+        Route("/api/fit-status", handler(fit_status), methods=["GET"]),
         Route("/downloads/{path:path}", download),
     ]
     return Starlette(routes=routes)
