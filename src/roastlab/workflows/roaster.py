@@ -215,18 +215,24 @@ def catalogue_entry(machine: str):
     return next((v for k, v in CATALOGUE.items() if k in low), None)
 
 
+def batch_capacity(s: Survey, capacity_kg=None) -> tuple[float, str]:
+    """The roaster's rated green batch [kg] and where it comes from: given, the catalogue entry of
+    the logs' machine, or ESTIMATED as twice the largest logged batch."""
+    entry = catalogue_entry(s.machine) if s.machine else None
+    if capacity_kg is not None:
+        return capacity_kg, "--batch-capacity-kg"
+    if entry is not None:
+        return entry[0], f"the catalogue: {entry[2]}"
+    return 2.0 * max(
+        i.batch_kg for i in s.logs
+    ), "ESTIMATED as twice the largest logged batch (pass --batch-capacity-kg)"
+
+
 def estimate_plant(s: Survey, capacity_kg=None, diameter_m=None, length_m=None) -> tuple[dict, list[str]]:
     """The plant's geometry and the comment lines that say where each number comes from."""
     masses = [i.batch_kg for i in s.logs]
-    entry = catalogue_entry(s.machine) if s.machine else None
-    notes = []
-    if capacity_kg is not None:
-        cap, why = capacity_kg, "--batch-capacity-kg"
-    elif entry is not None:
-        cap, why = entry[0], f"the catalogue: {entry[2]}"
-    else:
-        cap, why = 2.0 * max(masses), "ESTIMATED as twice the largest logged batch (pass --batch-capacity-kg)"
-    notes.append(f"batch capacity {cap:g} kg: {why}")
+    cap, why = batch_capacity(s, capacity_kg)
+    notes = [f"batch capacity {cap:g} kg: {why}"]
     if diameter_m is None:
         volume = cap / (GREEN_BULK_DENSITY_KG_M3 * RATED_FILL)
         diameter_m = (4.0 * volume / (math.pi * LENGTH_OVER_DIAMETER)) ** (1.0 / 3.0)
@@ -374,11 +380,7 @@ def init_roaster(paths, out_dir, *, batch_kg=None, capacity_kg=None, diameter_m=
 
     s = survey(paths, batch_kg)
     plant, notes = estimate_plant(s, capacity_kg, diameter_m, length_m)
-    cap = capacity_kg or (
-        catalogue_entry(s.machine)[0]
-        if s.machine and catalogue_entry(s.machine)
-        else 2.0 * max(i.batch_kg for i in s.logs)
-    )
+    cap, _ = batch_capacity(s, capacity_kg)
     out = Path(out_dir)
     with Outputs(list(paths)) as o:
         o.folder(out)
