@@ -332,3 +332,10 @@ def test_fleet_spec_refuses_output_weights(tmp_path):
         fleet_spec(spec)
     spec.write_text("[free]\nhbm = [0.002, 0.1, 0.01]\n[weights]\nTa = 1.0\n")
     assert fleet_spec(spec).names == ("hbm",)
+
+
+@pytest.mark.parametrize("address", ["localhost", "http://localhost:8786", "tcp://host"])
+def test_a_scheduler_address_without_protocol_or_port_is_one_line(cli, fleet, address):
+    _, db, _ = fleet
+    code, _, err = cli("fleet", "fit", "--db", db, "--scheduler", address)
+    assert code == 2 and "tcp://host:8786" in err and err.count("\n") == 1, err

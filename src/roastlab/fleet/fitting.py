@@ -279,9 +279,13 @@ def _client(workers: int | None, scheduler: str | None):
     except ImportError:
         raise InputError("--workers/--scheduler need Dask: pip install 'roastlab[fleet]'") from None
     if scheduler:
+        import re
+
+        if not re.fullmatch(r"(tcp|tls)://[A-Za-z0-9_.\-\[\]:]+:\d{1,5}", str(scheduler)):
+            raise InputError("expected a Dask scheduler address with its port, e.g. tcp://host:8786", scheduler)
         try:
             return Client(scheduler, timeout="10s"), None
-        except (OSError, TimeoutError) as exc:
+        except (OSError, TimeoutError, ValueError) as exc:
             raise InputError(f"cannot reach the Dask scheduler ({exc})", scheduler) from None
     import logging
 
