@@ -184,6 +184,21 @@ def test_parquet(tmp_path):
     assert b.n == 3 and b.Ta_C[-1] == 70.0
 
 
+def test_a_parquet_with_a_duplicated_column_is_one_line(cli, tmp_path):
+    pa = pytest.importorskip("pyarrow")
+    pq = pytest.importorskip("pyarrow.parquet")
+    cols = [
+        pa.array([0.0, 30.0, 60.0]),
+        pa.array([0.4] * 3),
+        pa.array([450.0] * 3),
+        pa.array([30.0] * 3),
+        pa.array([31.0] * 3),
+    ]
+    pq.write_table(pa.table(cols, names=["time_s", "Gg_kg_s", "Tgi_C", "Ta_C", "Ta_C"]), tmp_path / "d.parquet")
+    code, _, err = cli("import", tmp_path / "d.parquet", "--out", tmp_path / "o.csv")
+    assert code == 2 and "more than once" in err and err.count("\n") == 1, err
+
+
 def test_import_cli_then_simulate(cli, real_data, tmp_path):
     m = write_map(tmp_path, SKY_MAP)
     out = tmp_path / "batch.csv"

@@ -364,7 +364,11 @@ def _read_parquet(path: Path, columns: list[str]) -> dict[str, np.ndarray]:
         n_rows = pfile.metadata.num_rows
         if n_rows > MAX_PARQUET_ROWS:
             raise InputError(f"declares {n_rows} rows, over the limit of {MAX_PARQUET_ROWS}", path)
-        names = set(pfile.schema_arrow.names)
+        all_names = list(pfile.schema_arrow.names)
+        twice = sorted({c for c in all_names if all_names.count(c) > 1 and c in columns})
+        if twice:
+            raise InputError(f"column(s) {', '.join(twice)} appear more than once: which one is meant?", path)
+        names = set(all_names)
         frame = pfile.read(columns=[c for c in columns if c in names]).to_pandas()
         frame = frame.reindex(columns=[*frame.columns, *(c for c in names if c not in frame.columns)])
     except InputError:
