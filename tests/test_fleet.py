@@ -134,6 +134,10 @@ def test_manifest_without_its_columns_and_a_non_store_db_are_one_line_errors(cli
     assert code == 2 and "not a DuckDB file" in err and log.read_text().startswith("time_s")
     code, _, err = cli("fleet", "report", "--db", tmp_path / "nothing.duckdb")
     assert code == 2 and "no such fleet store" in err
+    huge = tmp_path / "huge.csv"  # a field over the csv module's 128 KiB limit
+    huge.write_text("path,machine,plant,started_at\n" + "x" * 200_000 + ",a,120kg,2024-01-01T00:00:00\n")
+    code, _, err = cli("fleet", "ingest", "--db", tmp_path / "g.duckdb", "--manifest", huge)
+    assert code == 2 and "unreadable CSV" in err and err.count("\n") == 1, err
 
 
 def test_drift_is_flagged_within_15_batches_and_only_where_injected(fleet):

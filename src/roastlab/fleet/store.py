@@ -160,7 +160,10 @@ def read_manifest(path: str | Path) -> tuple[list[tuple[int, dict]], list[str]]:
     """Rows of a manifest CSV as (line number, {column: text}); a missing column is an InputError."""
     text = read_input_text(path, "manifest")
     reader = csv.DictReader(io.StringIO(text))
-    header = [h.strip() for h in (reader.fieldnames or [])]
+    try:
+        header = [h.strip() for h in (reader.fieldnames or [])]
+    except csv.Error as exc:
+        raise InputError(f"not a readable CSV header ({exc})", path, "line 1") from None
     missing = [c for c in MANIFEST_COLUMNS if c not in header]
     if missing:
         raise InputError(
@@ -170,8 +173,11 @@ def read_manifest(path: str | Path) -> tuple[list[tuple[int, dict]], list[str]]:
         )
     reader.fieldnames = header
     rows = []
-    for rec in reader:
-        rows.append((reader.line_num, {k: (v or "").strip() for k, v in rec.items() if k is not None}))
+    try:
+        for rec in reader:
+            rows.append((reader.line_num, {k: (v or "").strip() for k, v in rec.items() if k is not None}))
+    except csv.Error as exc:  # e.g. a field over the csv module's 128 KiB limit
+        raise InputError(f"unreadable CSV ({exc})", path, f"line {reader.line_num}") from None
     return rows, header
 
 
