@@ -147,13 +147,15 @@ async function openLog() {
     state.open = r;
     state.changed = null;
     state.table = r.table;
-    r.Tm0_C = null; r.X0 = null;
+    $("Tm0_C").value = r.Tm0_C ?? "";
+    $("Tm0_C_range").value = r.Tm0_C ?? 200;
+    $("X0").value = r.X0 ?? "";
     $("batch_kg").value = r.batch_kg ?? "";
     $("batch_kg_range").min = (r.batch_kg || 1) * 0.5;
     $("batch_kg_range").max = (r.batch_kg || 1) * 1.6;
     $("batch_kg_range").value = r.batch_kg || 1;
     $("tr_batch_kg").value = r.batch_kg ?? "";
-    for (const id of ["Tm0_C", "X0", "heater", "fan"]) $(id).value = "";
+    for (const id of ["heater", "fan"]) $(id).value = "";
     $("tgi").value = 0;
     $("notes").textContent = (r.notes || []).join("\n");
     draw();

@@ -235,6 +235,8 @@ def create_app(data_dir: str | Path):
         return {
             "log": batch.name,
             "batch_kg": batch.Mb_kg,
+            "Tm0_C": round(float(w.as_run.Tm_C[0]), 1),  # the drum at CHARGE the model starts from
+            "X0": round(float(w.as_run.X_kg_kg[0]), 4),
             "events": batch.events,
             "notes": list(batch.notes),
             "curves": curves(batch, w.as_run),

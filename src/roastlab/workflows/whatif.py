@@ -222,7 +222,7 @@ class WhatIf(Result):
             a, c, m = r["as_run"], r["changed"], r["measured"]
             if a is None or c is None or m is None or r["key"].startswith("TP"):
                 continue
-            if abs(c - a) < abs(a - m):
+            if 1e-6 < abs(c - a) < abs(a - m):  # a change there is, smaller than the model's own error
                 unit = {"time": "s", "temp": "°C", "pct": "points"}[r["kind"]]
                 out.append(
                     f"{r['reading']} {r['what']}: the change ({c - a:+.1f} {unit}) is within the model's own error "
