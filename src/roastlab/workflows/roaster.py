@@ -42,6 +42,11 @@ from ..model.constants import GREEN_BULK_DENSITY_KG_M3
 #: Names of a heater/burner and a fan/air channel in Artisan's languages (lower case, substrings).
 HEATER_NAMES = ("burner", "heater", "power", "heat", "gas", "brûleur", "bruleur", "brenner", "quemador",
                 "queimador", "bruciatore", "potencia", "leistung", "puissance", "火力", "火")  # fmt: skip
+#: Logged controls the model does not use, named so the map can say so.
+OTHER_NAMES = {
+    "damper": ("damper", "klappe", "registre", "valve"),
+    "drum speed": ("drum", "trommel", "tambour", "tambor"),
+}
 FAN_NAMES = ("air", "fan", "airflow", "ventilateur", "lüfter", "luefter", "luft", "ventilador", "aria", "風", "风")
 #: Published capacities of common roasters, by a word of Artisan's ``roastertype`` (lower case).
 #: Each: (green batch capacity [kg], how the heat enters, source).
@@ -85,6 +90,8 @@ class LogInfo:
     has_et: bool = False
     heater_max: float = 0.0
     fan_max: float = 0.0
+    started_epoch_s: float | None = None
+    unused: dict = field(default_factory=dict)  # other logged controls: {"damper": channel, ...}
 
 
 @dataclass
@@ -102,6 +109,7 @@ class Survey:
     has_et: bool
     heater_max: float = 0.0
     fan_max: float = 0.0
+    unused: dict = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
 
 
@@ -161,6 +169,12 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
         "ET" in names and np.isfinite(log.channels["ET"]).any(),
         float(np.nanmax(log.channels[heater])) if heater else 0.0,
         float(np.nanmax(log.channels[fan])) if fan else 0.0,
+        log.started_epoch_s,
+        {
+            what: ch
+            for what, names_ in OTHER_NAMES.items()
+            if (ch := _find([n for n in others if n not in (heater, fan)], names_))
+        },
     )
 
 
@@ -207,6 +221,7 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
         all(i.has_et for i in infos),
         max(i.heater_max for i in infos),
         max(i.fan_max for i in infos),
+        {k: v for i in infos for k, v in i.unused.items()},
     )
 
 
@@ -300,6 +315,8 @@ def map_text(s: Survey) -> str:
             if unit == "level":
                 lines += ["min = 0", f"max = {top:g}                # the highest setting the logs use"]
             lines += [step, ""]
+    for what, ch in s.unused.items():
+        lines.insert(2, f"# logged but not used by the model: {what} ({ch!r})")
     if s.second_bean:
         lines += ["[Tb2]", f'column = "{s.second_bean}"   # a second bean reading (infrared)', "start_s = 10.0", ""]
     initial = []
@@ -393,8 +410,9 @@ def init_roaster(paths, out_dir, *, batch_kg=None, capacity_kg=None, diameter_m=
 def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0) -> dict:
     """Fit, validate and report a roaster set up by :func:`init_roaster`.
 
-    The logs, sorted by name (both shipped roasters' names start with the date), are split
-    alternately: the 1st, 3rd, ... fit, the 2nd, 4th, ... are held out. Writes
+    The logs, sorted by when they were roasted (Artisan ``roastepoch``, RoasTime ``dateTime``;
+    by name when a log has no date), are split alternately: the 1st, 3rd, ... fit, the 2nd,
+    4th, ... are held out. Writes
     ``config_dir``/model.json, report.md and heldout.png (measured vs predicted BT of the
     held-out logs); returns the figures of the report.
     """
@@ -410,9 +428,15 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0) -> dict:
     for name in ("map.toml", "plant.toml", "fit.toml"):
         if not (d / name).is_file():
             raise InputError(f"no {name} here: run 'roastlab init LOG... --out {d}' first", d)
-    paths = sorted(Path(p) for p in paths)
+    paths = [Path(p) for p in paths]
     if len(paths) < 2:
         raise InputError("give at least two logs: one to fit, one to hold out", "fit-roaster")
+    infos = [inspect_log(p, 1.0) for p in paths]
+    if all(i.started_epoch_s for i in infos):  # by when they were roasted, else by name
+        order, by = sorted(range(len(paths)), key=lambda k: infos[k].started_epoch_s), "date"
+    else:
+        order, by = sorted(range(len(paths)), key=lambda k: paths[k].name), "name"
+    paths = [paths[k] for k in order]
     cmap = load_map(d / "map.toml")
     batches = [load_log(p, cmap) for p in paths]
     fit_b, val_b = batches[0::2], batches[1::2]
@@ -426,7 +450,7 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0) -> dict:
     lines = [
         f"# {model.plant.name if model.plant else 'roaster'}: fitted by roastlab fit-roaster",
         "",
-        f"{len(batches)} logs sorted by name, split alternately: {len(fit_b)} fit, {len(val_b)} held out "
+        f"{len(batches)} logs sorted by {by}, split alternately: {len(fit_b)} fit, {len(val_b)} held out "
         f"(the fit never saw them). Fit in {result.identification.wall_s:.1f} s.",
         "",
         "| set | logs | model FIT % | model MAE °C | baseline FIT % | baseline MAE °C |",

@@ -73,6 +73,7 @@ class ArtisanLog:
     title: str = ""
     fields: dict = field(default_factory=dict)  # scalar fields of the log (e.g. RoasTime's drum charge temperature)
     machine: str = ""  # the roaster as the log names it (Artisan's roastertype; "Aillio Bullet" for RoasTime)
+    started_epoch_s: float | None = None  # when the roast started (Artisan roastepoch, RoasTime dateTime)
 
 
 # Tokens of a Python literal that JSON spells differently. Strings come first so that words,
@@ -305,7 +306,16 @@ def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: boo
         weight_out,
         str(data.get("title", "")),
         machine=str(data.get("roastertype", "") or "")[:100],
+        started_epoch_s=epoch_or_none(data.get("roastepoch")),
     )
+
+
+def epoch_or_none(value) -> float | None:
+    """A plausible Unix time [s] (1990-2100), else None: a log's start, for ordering logs."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return None
+    v = float(value)
+    return v if 6.3e8 < v < 4.1e9 else None
 
 
 def _mmss(text: str) -> float:

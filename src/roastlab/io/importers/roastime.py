@@ -31,7 +31,7 @@ import numpy as np
 from ...errors import InputError
 from ..files import read_input_text
 from ..modelfile import parse_json_document
-from .artisan import ArtisanLog, number_list
+from .artisan import ArtisanLog, epoch_or_none, number_list
 
 #: RoasTime's control types in ``actions.actionTimeList`` and the channel each becomes.
 CONTROL_TYPES = {0: "heater", 1: "fan", 2: "drum"}
@@ -168,6 +168,9 @@ def read_roastime(path: str | Path, keep_after_drop: bool = False) -> ArtisanLog
         weight_out_kg=roasted / 1000.0 if roasted else None,
         title=str(data.get("roastName", ""))[:200],
         machine="Aillio Bullet",
+        started_epoch_s=epoch_or_none(
+            data.get("dateTime") / 1000.0 if isinstance(data.get("dateTime"), (int, float)) else None
+        ),
     )
     log.fields = {k: v for k in FIELDS if (v := _number(data, k, path, -100, 1000, required=False)) is not None}
     return log
