@@ -161,7 +161,7 @@ def _changes(body: dict, session: Session):
 
     setting_changes, changes = [], {}
     cmap = session.model.column_map
-    units = {k: (getattr(cmap, k) or {}).get("unit", "") for k in ("heater", "fan")} if cmap else {}
+    units = cmap.setting_units() if cmap else {}
     for name in ("heater", "fan"):
         text = str(body.get(name) or "").strip()
         if text and text not in ("+0", "0", "-0"):
@@ -241,9 +241,7 @@ def create_app(data_dir: str | Path):
             "notes": list(batch.notes),
             "curves": curves(batch, w.as_run),
             "table": w.to_json_dict(),
-            "settings": {k: (getattr(model.column_map, k) or {}).get("unit") for k in ("heater", "fan")}
-            if model.column_map
-            else {},
+            "settings": model.column_map.setting_units() if model.column_map else {},
         }
 
     def need(session: Session):

@@ -30,7 +30,7 @@ def cmd_whatif(args) -> int:
         check_figure_path(args.plot)
     model = load_model(args.model)
     cmap = load_map(args.map) if args.map else model.column_map
-    units = {k: (getattr(cmap, k) or {}).get("unit", "") for k in ("heater", "fan")} if cmap is not None else {}
+    units = cmap.setting_units() if cmap is not None else {}
     setting_changes = [
         parse_setting_change(name, getattr(args, name), units.get(name, ""))
         for name in ("heater", "fan")

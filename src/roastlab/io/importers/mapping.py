@@ -138,6 +138,10 @@ class ColumnMap:
         spec = getattr(self, name)
         return None if spec is None else Actuator.from_spec(name, spec)
 
+    def setting_units(self) -> dict[str, str]:
+        """The unit of each logged setting this map reads ({"heater": "level", ...})."""
+        return {k: getattr(self, k)["unit"] for k in ("heater", "fan") if getattr(self, k)}
+
     @property
     def inlet_is_constant(self) -> bool:
         """True if the inlet gas is a constant (room air drawn into an induction or electric drum)."""
