@@ -32,15 +32,43 @@ PLANTS = {
 }
 
 
-def make_rhs(plant: str, theta, X0: float, moisture: str = "schwartzberg", act=None):
+def bed_segment(Mb, Dch, Lch, rho=680.0):
+    """(angle t [rad], depth h [m], wetted wall area [m2]) of a bed at rest: the circular segment
+    holding Mb / rho of beans, found by bisection on its area R^2/2 (t - sin t)."""
+    R = Dch / 2
+    area = Mb / rho / Lch
+    lo, hi = 0.0, 2 * math.pi
+    for _ in range(200):
+        mid = (lo + hi) / 2
+        lo, hi = (mid, hi) if R * R / 2 * (mid - math.sin(mid)) < area else (lo, mid)
+    t = (lo + hi) / 2
+    return t, R * (1 - math.cos(t / 2)), R * t * Lch + 2 * R * R / 2 * (t - math.sin(t))
+
+
+def make_rhs(plant: str, theta, X0: float, moisture: str = "schwartzberg", act=None, bed=None):
     """The slow reference right-hand side. ``act`` holds the actuator extension's values
-    (Qe_gain, Qe_offset, Tgi_gain, tau, Gg_fan, U_shell, T_room); None = the paper's model."""
+    (Qe_gain, Qe_offset, Tgi_gain, tau, Gg_fan, U_shell, T_room); None = the paper's model.
+    ``bed`` the bed laws and the probe's depth: {"contact": "paper"|"wall", "probe": "rest"|"tumbling",
+    "probe_gas": "outlet"|"mean", "h_probe": m}; None = the paper's."""
     g = PLANTS[plant]
     c = PROCESS
     hgm, hbm, Pbm = theta
     Agm = math.pi * g["Dch"] * (g["Lch"] + g["Hflap"] * g["Lch"] / g["Sflap"] + g["Dch"] / 2)
     Ab = g["Mb"] / c["mb"] * math.pi * c["Db"] ** 2
-    Agb, Abm = Ab * (1 - Pbm), Ab * Pbm
+    bed = {"contact": "paper", "probe": "rest", "probe_gas": "outlet", "h_probe": 0.0, **(bed or {})}
+    _, h_bed, A_wall = bed_segment(g["Mb"], g["Dch"], g["Lch"])
+    if bed["contact"] == "wall":  # beans touch the wetted wall; the rest of their surface meets the gas
+        Abm = Pbm * A_wall
+        Agb = Ab - Abm
+    else:
+        Agb, Abm = Ab * (1 - Pbm), Ab * Pbm
+    hp = bed["h_probe"]
+    if hp == 0:
+        cover = 1.0
+    elif bed["probe"] == "tumbling":
+        cover = 1 - math.exp(-h_bed / hp)
+    else:
+        cover = min(1.0, h_bed / hp)
     Mbd = g["Mb"] / (1 + X0)
     k1, xexp = (c["k1"], 2) if moisture == "schwartzberg" else (4.32e-9, 0)
 
@@ -69,7 +97,10 @@ def make_rhs(plant: str, theta, X0: float, moisture: str = "schwartzberg", act=N
         # shell loss to the room from the outer drum surface (mantle and two end discs)
         Qloss = a.get("U_shell", 0.0) * math.pi * g["Dch"] * (g["Lch"] + g["Dch"] / 2) * (Tm - a.get("T_room", 22.0))
         dTm = (Qgm - Qbm + Qe - Qloss) / (g["Mm"] * c["cm"])
-        return [dTb, dTm, dX, Qr, c["Kt"] * (Tb - Ta), dH], Tgi - drop
+        # the uncovered probe sees the outlet gas, or the mean of the exponential profile along the path
+        Tg = Tgi - drop if bed["probe_gas"] == "outlet" else Tstar + (Tgi - Tstar) * (1 - math.exp(-ntu)) / ntu
+        dTa = c["Kt"] * (cover * (Tb - Ta) + (1 - cover) * (Tg - Ta))
+        return [dTb, dTm, dX, Qr, dTa, dH], Tgi - drop
 
     return f
 
@@ -88,9 +119,10 @@ def reference_simulate(
     heater=None,
     fan=None,
     act=None,
+    bed=None,
 ):
     """Return (states (n, 6), Tgo (n,)) at the sample times (x0 of 5 states gets H = heater[0])."""
-    f = make_rhs(plant, theta, x0[2], moisture, act)
+    f = make_rhs(plant, theta, x0[2], moisture, act, bed)
     n = len(t)
     heater = np.zeros(n) if heater is None else np.asarray(heater, dtype=float)
     fan = np.zeros(n) if fan is None else np.asarray(fan, dtype=float)

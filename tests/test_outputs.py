@@ -51,6 +51,7 @@ VALUES = {
     "--hbm",
     "--pbm",
     "--hold",
+    "--bed",
     "--moisture",
     "--heater",
     "--fan",

@@ -113,6 +113,23 @@ def add_model_options(p: argparse.ArgumentParser, with_model: bool = True) -> No
     p.add_argument(
         "--hold", choices=("linear", "zoh"), help="input hold between samples (default: the model's, else linear)"
     )
+    p.add_argument(
+        "--bed",
+        type=bed_arg,
+        metavar="LAWS",
+        help="bed laws, e.g. 'contact=wall,probe=tumbling' or 'paper' (roastlab.model.bed; "
+        "default: the model's or the fit spec's, else the paper's)",
+    )
+
+
+def bed_arg(text: str):
+    """argparse type of --bed: the laws, or the parse error as argparse's one line."""
+    from ..model.bed import BedLaws
+
+    try:
+        return BedLaws.parse(text)
+    except RoastlabError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
 
 
 def add_initial_options(p: argparse.ArgumentParser) -> None:
@@ -172,6 +189,9 @@ def model_from_args(args, plant_spec):
         if getattr(args, key, None):
             model.doc[key] = getattr(args, key)
             setattr(model, key, getattr(args, key))
+    if getattr(args, "bed", None) is not None:
+        model.doc["bed"] = args.bed.as_dict()
+        model.bed = args.bed
     return model
 
 

@@ -63,6 +63,7 @@ def cmd_identify(args) -> int:
         column_map=load_map(args.map) if args.map else None,
         progress=progress("identify"),
         weights=weights_arg(args.weight),
+        bed=args.bed,
     )
     from ..io.modelfile import model_document_text
 

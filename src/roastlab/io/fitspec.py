@@ -16,6 +16,10 @@ A fit spec is a TOML file::
     Tb0_C = 22.0
     X0 = 0.11
 
+    [bed]                       # optional: the bed laws (roastlab.model.bed; default the paper's)
+    contact = "wall"
+    probe = "tumbling"
+
     [weights]                   # optional: outputs fitted together (default Ta = 1 alone)
     Ta = 1.0                    # the bean probe, model Ta (eq. 16)
     Tb2 = 0.25                  # a second bean reading (map [Tb2]), model Tb (eq. 15a)
@@ -31,6 +35,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import InputError, ParameterError
+from ..model.bed import PAPER_BED, BedLaws
 from ..model.limits import check_value
 from ..model.parameters import (
     DEFAULT_WEIGHTS,
@@ -54,6 +59,7 @@ class FitSpec:
     initial: dict[str, float] = field(default_factory=dict)
     source: str = ""
     weights: dict[str, float] = field(default_factory=dict)
+    bed: BedLaws = PAPER_BED
 
 
 def _checked(name: str, value: float, path, where) -> float:
@@ -68,9 +74,15 @@ def load_fit_spec(path: str | Path) -> FitSpec:
     """Read and check the fit spec at ``path`` (see the module docstring for the format)."""
     path = Path(path)
     data = read_toml(path)
-    unknown = sorted(set(data) - {"free", "fixed", "initial", "weights", "description", "notes"})
+    unknown = sorted(set(data) - {"free", "fixed", "initial", "weights", "bed", "description", "notes"})
     if unknown:
-        raise InputError(f"unknown table(s) {', '.join(unknown)} (allowed: free, fixed, initial, weights)", path)
+        raise InputError(f"unknown table(s) {', '.join(unknown)} (allowed: free, fixed, initial, weights, bed)", path)
+    if not isinstance(data.get("bed", {}), dict):
+        raise InputError("[bed] must be a table of option = law", path, "bed")
+    try:
+        bed = BedLaws.parse(data.get("bed") or None)
+    except ParameterError as exc:
+        raise InputError(exc.problem, path, "bed") from None
     free = []
     for name, spec in (data.get("free") or {}).items():
         where = f"free.{name}"
@@ -130,4 +142,4 @@ def load_fit_spec(path: str | Path) -> FitSpec:
         weights[name] = w
     if weights and not any(w > 0 for w in {**DEFAULT_WEIGHTS, **weights}.values()):
         raise InputError("every output weight is 0: nothing to fit", path, "weights")
-    return FitSpec(free, fixed, initial, str(path), weights)
+    return FitSpec(free, fixed, initial, str(path), weights, bed)

@@ -29,6 +29,7 @@ import math
 from pathlib import Path
 
 from ..errors import InputError, ParameterError
+from ..model.bed import BedLaws
 from ..model.limits import check_value
 from ..model.parameters import REGISTRY, STATE0, THETA_NAMES, Theta
 from ..model.plant import GEOMETRY_KEYS, Plant, plant_from_mapping
@@ -185,6 +186,11 @@ def check_document(doc: dict, path) -> dict:
     for key, allowed in (("moisture", ("schwartzberg", "printed")), ("hold", ("linear", "zoh"))):
         if doc.get(key, allowed[0]) not in allowed:
             raise InputError(f"must be one of {', '.join(allowed)}", path, key)
+    if doc.get("bed") is not None:
+        try:
+            doc["bed"] = BedLaws.parse(doc["bed"]).as_dict()
+        except ParameterError as exc:
+            raise InputError(exc.problem, path, "bed") from None
     plant = doc.get("plant")
     if isinstance(plant, dict):
         data = {k: v for k, v in plant.items() if k in GEOMETRY_KEYS or k in ("name", "process")}

@@ -72,6 +72,11 @@ PARAM_NAMES = (
     # probe immersion (extension; h_probe 0 = the paper's fully immersed probe)
     "h_bed",  # depth of the bean bed at rest [m] (plant- and batch-derived)
     "h_probe",  # bed depth that covers the bean probe fully [m]
+    # bed laws (roastlab.model.bed; 0 = the paper's law of each option)
+    "A_wall",  # drum wall the bed at rest wets [m2] (plant- and batch-derived)
+    "contact_law",  # 0: Abm = Pbm Ab (section 3.1); 1: Abm = Pbm A_wall, Agb = Ab - Abm
+    "probe_law",  # 0: covered share min(1, h_bed/h_probe) (bed at rest); 1: 1 - exp(-h_bed/h_probe) (tumbling)
+    "probe_gas_law",  # 0: the uncovered probe sees Tgo (eq. 15e); 1: the gas's mean along its path
 )
 P = {name: i for i, name in enumerate(PARAM_NAMES)}
 N_PARAMS = len(PARAM_NAMES)
@@ -82,3 +87,4 @@ I_K1, I_K2, I_KT, I_LAM, I_XEXP, I_GGS = (P[k] for k in ("k1", "k2", "Kt", "lam"
 I_QEG, I_QEO, I_TGIG, I_TAUH, I_GGF = (P[k] for k in ("Qe_gain", "Qe_offset", "Tgi_gain", "tau_heater", "Gg_fan"))
 I_USH, I_ASH, I_TROOM = (P[k] for k in ("U_shell", "Ashell", "T_room"))
 I_HBED, I_HPROBE = P["h_bed"], P["h_probe"]
+I_AWALL, I_CONTACT, I_PROBELAW, I_PROBEGAS = (P[k] for k in ("A_wall", "contact_law", "probe_law", "probe_gas_law"))

@@ -145,14 +145,39 @@ class Plant:
         >>> round(p.bed_depth_m / p.Dch_m, 3)   # 120 kg in a 1.1 m x 1.5 m drum (fill ~ 12 %)
         0.167
         """
+        if self.fill_fraction >= 1.0:
+            return self.Dch_m
+        return self.Dch_m / 2.0 * (1.0 - math.cos(self.bed_angle_rad / 2.0))
+
+    @property
+    def bed_angle_rad(self) -> float:
+        """Central angle t [rad] of the circular segment the bed at rest fills in the drum's
+        cross-section: (t - sin t) / (2 pi) = fill fraction (the segment's area over the disc's);
+        2 pi when overfilled. Not in the paper; the bed geometry of :mod:`roastlab.model.bed`."""
         from scipy.optimize import brentq
 
         fill = self.fill_fraction
         if fill >= 1.0:
-            return self.Dch_m
+            return 2.0 * math.pi
         # (t - sin t) / (2 pi) rises monotonically from 0 to 1 on [0, 2 pi]: one root
-        t = brentq(lambda a: (a - math.sin(a)) / (2.0 * math.pi) - fill, 0.0, 2.0 * math.pi, xtol=1e-14, rtol=1e-15)
-        return self.Dch_m / 2.0 * (1.0 - math.cos(t / 2.0))
+        return brentq(lambda a: (a - math.sin(a)) / (2.0 * math.pi) - fill, 0.0, 2.0 * math.pi, xtol=1e-14, rtol=1e-15)
+
+    @property
+    def wall_contact_area_m2(self) -> float:
+        """Drum metal the bed at rest wets [m^2]: the segment's arc (D/2) t along the drum length
+        plus the segment on each end disc, (D/2) t L + 2 (D^2/8)(t - sin t).
+
+        Not in the paper (its metal-bean area is Pbm Ab, proportional to the mass); the
+        ``contact = "wall"`` law of :mod:`roastlab.model.bed`. It grows more slowly than the
+        mass (as the fill to the power ~2/3 for a shallow bed) and is the whole drum when full.
+
+        >>> p = Plant("half", 1.0, 1.0, 1.0, 0.1, 0.1, 10.0)   # a 1 m drum
+        >>> q = Plant("half", p.capacity_kg / 2, 1.0, 1.0, 0.1, 0.1, 10.0)   # filled half way
+        >>> round(q.bed_angle_rad / math.pi, 6), round(q.wall_contact_area_m2 / (math.pi / 2 + math.pi / 4), 6)
+        (1.0, 1.0)
+        """
+        t = self.bed_angle_rad
+        return self.Dch_m / 2.0 * t * self.Lch_m + 2.0 * self.Dch_m**2 / 8.0 * (t - math.sin(t))
 
     @property
     def Ab_m2(self) -> float:
@@ -192,6 +217,7 @@ class Plant:
             ("Agm", self.Agm_m2, "m2", "gas-metal area, eq. 7"),
             ("Ashell", self.Ashell_m2, "m2", "outer drum surface (shell-loss extension)"),
             ("h_bed", self.bed_depth_m, "m", "bean-bed depth at rest (probe-immersion extension)"),
+            ("A_wall", self.wall_contact_area_m2, "m2", "drum wall the bed at rest wets (bed law contact=wall)"),
             ("Ab", self.Ab_m2, "m2", "total bean area"),
             ("Agb", self.Agb_m2(Pbm), "m2", f"gas-bean area at Pbm={Pbm:g}"),
             ("Abm", self.Abm_m2(Pbm), "m2", f"metal-bean area at Pbm={Pbm:g}"),

@@ -45,6 +45,8 @@ from .layout import (  # noqa: E402, F401
     I_AB,
     I_AGM,
     I_ASH,
+    I_AWALL,
+    I_CONTACT,
     I_CM,
     I_CW,
     I_DB,
@@ -63,6 +65,8 @@ from .layout import (  # noqa: E402, F401
     I_MBD,
     I_MM,
     I_PBM,
+    I_PROBEGAS,
+    I_PROBELAW,
     I_QEG,
     I_QEO,
     I_TAUH,
@@ -132,6 +136,21 @@ def bean_areas_m2(Ab_m2, Pbm):
 
 
 @register_jitable
+def bed_areas_m2(p):
+    """(Agb, Abm) [m^2] under the model's contact law (:mod:`roastlab.model.bed`).
+
+    ``contact_law`` 0 (the paper, section 3.1): :func:`bean_areas_m2`, both shares of Ab.
+    1 (``"wall"``): Abm = Pbm A_wall, the share Pbm of the drum wall the bed wets
+    (:attr:`roastlab.model.plant.Plant.wall_contact_area_m2`), and Agb = Ab - Abm, every other
+    bean surface (never below 1 % of Ab).
+    """
+    if p[I_CONTACT] == 0.0:
+        return bean_areas_m2(p[I_AB], p[I_PBM])
+    Abm = p[I_PBM] * p[I_AWALL]
+    return fmax(p[I_AB] - Abm, 0.01 * p[I_AB]), Abm
+
+
+@register_jitable
 def conductance_ratio_F(hgm, Agm_m2, he, Agb_m2):
     """F = hgm Agm / (he Agb) [-], gas-metal over gas-bean conductance (eq. 6)."""
     return hgm * Agm_m2 / (he * Agb_m2)
@@ -175,27 +194,60 @@ def shell_loss_kW(Tm, p):
 
 @register_jitable
 def probe_coverage(p):
-    """Share c of the bean probe the bean bed covers [-]: min(1, h_bed / h_probe).
+    """Share c of the bean probe the bean bed covers [-] (eq. 17 extended; :mod:`roastlab.model.bed`).
 
-    An extension of eq. 17 (the paper's probe is always immersed: c = 1, also when h_probe is
-    0, the default). ``h_bed`` [m] is the depth of the bed at rest, computed from the drum
-    geometry and the batch mass (:attr:`roastlab.model.plant.Plant.bed_depth_m`); ``h_probe``
-    [m] is the bed depth at which the probe is covered, a property of where the probe sits,
-    identified from the logs. Coverage then grows linearly with the bed depth.
+    The paper's probe is always immersed: c = 1, also whenever h_probe is 0 (the default).
+    ``h_bed`` [m] is the depth of the bed at rest, computed from the drum geometry and the
+    batch mass (:attr:`roastlab.model.plant.Plant.bed_depth_m`); ``h_probe`` [m], a property of
+    where the probe sits, is identified from the logs. ``probe_law`` 0 (a bed at rest):
+    c = min(1, h_bed / h_probe), coverage linear in the depth up to the covering depth h_probe;
+    1 (a tumbling bed): c = 1 - exp(-h_bed / h_probe), the Boolean-coverage law of beans laid
+    over the probe at random, h_probe the e-folding depth.
     """
     h_probe = p[I_HPROBE]
-    return where(h_probe > p[I_HBED], p[I_HBED] / fmax(h_probe, 1e-12), 1.0)
+    if p[I_PROBELAW] == 0.0:
+        return where(h_probe > p[I_HBED], p[I_HBED] / fmax(h_probe, 1e-12), 1.0)
+    return where(h_probe > 0.0, 1.0 - exp(-p[I_HBED] / fmax(h_probe, 1e-12)), 1.0)
 
 
 @register_jitable
-def probe_rate_C_s(Tb, Ta, Tgo, p):
+def probe_rate_C_s(Tb, Ta, Tg, p):
     """dTa/dt [degC/s]: eq. 17, Kt (Tb - Ta), with the probe-immersion extension
-    Kt [c (Tb - Ta) + (1 - c) (Tgo - Ta)]: the covered share c of the probe (:func:`probe_coverage`)
-    follows the beans, the rest the gas in the drum, taken at the outlet temperature Tgo
-    (eq. 15e, the well-mixed gas). With c = 1 it is eq. 17 exactly.
+    Kt [c (Tb - Ta) + (1 - c) (Tg - Ta)]: the covered share c of the probe (:func:`probe_coverage`)
+    follows the beans, the rest the gas in the drum at ``Tg`` (:func:`probe_gas_C`). With c = 1
+    it is eq. 17 exactly.
     """
     c = probe_coverage(p)
-    return p[I_KT] * (c * (Tb - Ta) + (1.0 - c) * (Tgo - Ta))
+    return p[I_KT] * (c * (Tb - Ta) + (1.0 - c) * (Tg - Ta))
+
+
+@register_jitable
+def exchanger(Tb, Tm, X, Gg, Tgi, p):
+    """The gas path of eq. 15e: ``(T_star [degC], NTU [-], F [-], Agb, Abm [m^2], he [kW/(m^2 K)], cg [kJ/(kg K)])``.
+
+    T* = (Tb + F Tm)/(1 + F) is the mean sink temperature (eq. 5/15e), NTU = he Agb (1 + F)/(Gg cg)
+    (eq. 15e), F eq. 6, the areas from :func:`bed_areas_m2`, he eq. 3, cg eq. 2.
+    """
+    Agb, Abm = bed_areas_m2(p)  # section 3.1 (or the bed's contact law)
+    he = bean_heat_transfer_coefficient_kW_m2K(X)  # eq. 3
+    cg = gas_heat_capacity_kJ_kgK(Tgi)  # eq. 2
+    F = conductance_ratio_F(p[I_HGM], p[I_AGM], he, Agb)  # eq. 6
+    T_star = (Tb + F * Tm) / (1.0 + F)  # eq. 5/15e: mean sink temperature
+    NTU = he * Agb * (1.0 + F) / (Gg * cg)  # eq. 15e
+    return T_star, NTU, F, Agb, Abm, he, cg
+
+
+@register_jitable
+def probe_gas_C(Tb, Tm, X, Gg, Tgi, Tgo, p):
+    """The gas temperature the uncovered probe sees [degC] (``probe_gas_law``, :mod:`roastlab.model.bed`).
+
+    0: the outlet temperature Tgo (eq. 15e, the well-mixed gas). 1: the mean of the gas along its
+    path, T* + (Tgi - Tgo)/NTU (the exchanger's exponential profile Tgi -> T* averaged over the path).
+    """
+    if p[I_PROBEGAS] == 0.0:
+        return Tgo
+    T_star, NTU, _, _, _, _, _ = exchanger(Tb, Tm, X, Gg, Tgi, p)
+    return T_star + (Tgi - Tgo) / NTU
 
 
 @register_jitable
@@ -206,12 +258,7 @@ def heat_flows(Tb, Tm, X, Gg, Tgi, p):
     Returns ``(Tgo [degC], Qgb, Qgm, Qbm [kW])``:
     Tgi - Tgo from eq. 15e, Qgb eq. 9, Qgm eq. 10, Qbm eq. 11.
     """
-    Agb, Abm = bean_areas_m2(p[I_AB], p[I_PBM])  # section 3.1
-    he = bean_heat_transfer_coefficient_kW_m2K(X)  # eq. 3
-    cg = gas_heat_capacity_kJ_kgK(Tgi)  # eq. 2
-    F = conductance_ratio_F(p[I_HGM], p[I_AGM], he, Agb)  # eq. 6
-    T_star = (Tb + F * Tm) / (1.0 + F)  # eq. 5/15e: mean sink temperature
-    NTU = he * Agb * (1.0 + F) / (Gg * cg)  # eq. 15e
+    T_star, NTU, F, Agb, Abm, he, cg = exchanger(Tb, Tm, X, Gg, Tgi, p)  # eq. 15e's gas path
     drop = (Tgi - T_star) * (1.0 - exp(-NTU))  # eq. 15e: Tgi - Tgo
     Qgb = Gg * cg * drop  # eq. 9
     Qgm = F * (he * Agb * (Tb - Tm) + Qgb) / (1.0 + F)  # eq. 10
@@ -250,7 +297,7 @@ def derivatives(Tb, Tm, X, He, Ta, H, Gg, Tgi, heater, fan, p):
     cs = 1.099 + 0.007 * Tb  # partial heat capacity of bean solids, section 3.2
     dTb = (Qgb - Qgm + Qbm + Mbd * (Qr + p[I_LAM] * dX)) / (Mbd * (cs + p[I_CW] * X))  # eq. 15a
     dTm = (Qgm - Qbm + heater_power_kW(H, p) - shell_loss_kW(Tm, p)) / (p[I_MM] * p[I_CM])  # eq. 15b, eq. 12's Qe
-    dTa = probe_rate_C_s(Tb, Ta, Tgo, p)  # eq. 17 (probe immersion: extension)
+    dTa = probe_rate_C_s(Tb, Ta, probe_gas_C(Tb, Tm, X, g, T, Tgo, p), p)  # eq. 17 (probe immersion: extension)
     dH = (heater - H) / p[I_TAUH]  # actuator lag (extension)
     return dTb, dTm, dX, Qr, dTa, dH
 
@@ -315,7 +362,7 @@ def rebind(**operations) -> types.SimpleNamespace:
     return types.SimpleNamespace(**functions)
 
 
-def pack_params(plant, theta, X0: float = 0.1, moisture: str = "schwartzberg") -> np.ndarray:
+def pack_params(plant, theta, X0: float = 0.1, moisture: str = "schwartzberg", bed=None) -> np.ndarray:
     """Build the parameter vector ``p`` for a plant, theta and initial moisture.
 
     Parameters
@@ -325,7 +372,11 @@ def pack_params(plant, theta, X0: float = 0.1, moisture: str = "schwartzberg") -
     X0 : float
         Initial moisture [kg/kg dry]; fixes the dry batch mass Mbd = Mb / (1 + X0).
     moisture : {"schwartzberg", "printed"}
+    bed : :class:`roastlab.model.bed.BedLaws`, its text (``"contact=wall,probe=tumbling"``) or None
+        (the paper's bed)
     """
+    from .bed import BedLaws
+
     from .parameters import as_theta
     from .quantities import table
 
@@ -364,6 +415,8 @@ def pack_params(plant, theta, X0: float = 0.1, moisture: str = "schwartzberg") -
         "Gg_scale": 1.0,  # the flow input as given
         "Ashell": plant.Ashell_m2,
         "h_bed": plant.bed_depth_m,
+        "A_wall": plant.wall_contact_area_m2,
+        **BedLaws.parse(bed).codes(),
     }
     # the extensions' defaults (each the paper's model) from the one quantity table
     values.update({q.slot: q.default for q in table() if q.kind == "extension"})

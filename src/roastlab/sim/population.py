@@ -77,12 +77,13 @@ class PackedBatches:
 
 
 def pack_batches(
-    batches, plants, theta, initial=None, moisture="schwartzberg", hold="linear", h_max_s=H_MAX_S
+    batches, plants, theta, initial=None, moisture="schwartzberg", hold="linear", h_max_s=H_MAX_S, bed=None
 ) -> PackedBatches:
     """Pack :class:`roastlab.io.batch.Batch` objects with their plants (one per batch or one for all).
 
     ``initial`` is an :class:`InitialState` for all batches; each batch's ``initial`` dict
     (e.g. ``{"Tm0_C": 105}``) overrides it, and Ta(0) defaults to the batch's first measured Ta.
+    ``bed``: the bed laws (:mod:`roastlab.model.bed`; None = the paper's).
     """
     from ..io.plants import load_plant
 
@@ -127,7 +128,7 @@ def pack_batches(
         X0[i] = state.vector(None if b.Ta_C is None else float(b.Ta_C[0]), float(QQ[i, 0]))
         if getattr(b, "Mb_kg", None):  # the batch's own green weight (e.g. from an Artisan log)
             plant = dataclasses.replace(plant, Mb_kg=float(b.Mb_kg))
-        p = pack_params(plant, theta, state.X0, moisture)
+        p = pack_params(plant, theta, state.X0, moisture, bed)
         if PB is None:
             PB = np.zeros((nb, len(p)))
         PB[i] = p

@@ -234,6 +234,7 @@ def simulate(
     heater=None,
     fan=None,
     values: dict | None = None,
+    bed=None,
 ) -> SimulationResult:
     """Simulate one batch.
 
@@ -250,6 +251,7 @@ def simulate(
     heater, fan : arrays of logged settings (the actuator extension; None = not used)
     values : {registry name: value} for the other parameter-vector entries (e.g. the
         actuator gains ``Qe_gain_kW``, a process constant ``Kt``)
+    bed : bed laws (:class:`roastlab.model.bed.BedLaws` or its text; None = the paper's)
 
     Examples
     --------
@@ -282,7 +284,7 @@ def simulate(
     check_value_h = check_value("dt_s", h_max_s, "h_max_s")
     x0 = initial.vector(None if Ta_meas is None else float(Ta_meas[0]), 0.0 if q is None else float(q[0]))
     _check_initial(x0)
-    p = pack_params(plant, theta, initial.X0, moisture)
+    p = pack_params(plant, theta, initial.X0, moisture, bed)
     if values:
         from ..model.parameters import set_values
 
@@ -368,13 +370,14 @@ class Simulator:
         hold: str = "zoh",
         h_max_s: float = H_MAX_S,
         u0=None,
+        bed=None,
     ):
         from ..io.plants import load_plant
         from ..model.parameters import THETA_PAPER
 
         self.plant = load_plant(plant)
         self.initial = initial or InitialState()
-        self.params = pack_params(self.plant, THETA_PAPER if theta is None else theta, self.initial.X0, moisture)
+        self.params = pack_params(self.plant, THETA_PAPER if theta is None else theta, self.initial.X0, moisture, bed)
         self.zoh = check_hold(hold)
         self.h_max_s = float(h_max_s)
         self.x = self.initial.vector()  # heater lag starts settled at 0

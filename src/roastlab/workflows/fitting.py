@@ -22,6 +22,7 @@ from ..io.fitspec import FitSpec, load_fit_spec
 from ..io.importers.mapping import ColumnMap
 from ..io.plants import load_plant
 from ..metrics.profile import implausible_states
+from ..model.bed import PAPER_BED, BedLaws
 from ..model.parameters import REGISTRY, STATE0, THETA_NAMES, THETA_START
 from ..report.result import Result
 from ..sim.population import pack_batches
@@ -95,11 +96,11 @@ class FitResult(Result):
 def _spec_parts(spec, fix, bounds, estimate_tm0):
     if spec is None:
         free, fixed = build_free_parameters(fix, bounds, estimate_tm0=estimate_tm0)
-        return free, fixed, {}, None, {}
+        return free, fixed, {}, None, {}, None
     spec = spec if isinstance(spec, FitSpec) else load_fit_spec(spec)
     if fix or bounds or estimate_tm0:
         raise InputError("a fit spec sets free and fixed parameters itself; drop fix/bounds/estimate_tm0", spec.source)
-    return spec.free, dict(spec.fixed), dict(spec.initial), spec.source, dict(spec.weights)
+    return spec.free, dict(spec.fixed), dict(spec.initial), spec.source, dict(spec.weights), spec.bed
 
 
 def _as_batch(item, column_map) -> Batch:
@@ -126,6 +127,7 @@ def fit(
     column_map: ColumnMap | None = None,
     progress=None,
     weights: dict | None = None,
+    bed=None,
 ) -> FitResult:
     """Identify a model on batches with measured Ta and return a :class:`FitResult`.
 
@@ -144,6 +146,8 @@ def fit(
     progress : callable ``progress(done, total, text)`` or None
     weights : {output: weight}: ``Ta`` (the bean probe, default 1) and ``Tb2`` (a second bean
         reading compared with Tb, default 0); overrides the spec's ``[weights]``
+    bed : bed laws (:class:`roastlab.model.bed.BedLaws`, its text or mapping); overrides the spec's
+        ``[bed]``; default the paper's bed
     """
     if isinstance(batches, (str, Path, Batch)):
         batches = [batches]
@@ -165,7 +169,8 @@ def fit(
             raise InputError("no measured Ta_C column: needed to identify", b.source or b.name)
     plant_file = str(plant) if isinstance(plant, (str, Path)) and str(plant).lower().endswith(".toml") else None
     plant = load_plant(plant)
-    free, fixed, spec_initial, spec_source, spec_weights = _spec_parts(spec, fix, bounds, estimate_tm0)
+    free, fixed, spec_initial, spec_source, spec_weights, spec_bed = _spec_parts(spec, fix, bounds, estimate_tm0)
+    laws = BedLaws.parse(bed if bed is not None else spec_bed)
     given = dict(weights or {})
     weights = {**spec_weights, **given}
     if weights.get("Tb2", 0) > 0 and all(b.Tb2_C is None or not np.isfinite(b.Tb2_C).any() for b in batches):
@@ -178,9 +183,11 @@ def fit(
             batches[0].source or batches[0].name,
         )
     init = {**PAPER_INITIAL, **(initial or {}), **spec_initial}
-    packed = pack_batches(batches, plant, THETA_START, InitialState(**init), moisture, hold)
+    packed = pack_batches(batches, plant, THETA_START, InitialState(**init), moisture, hold, bed=laws)
     ident = identify(packed, free, fixed, method=method, seed=seed, n_starts=starts, progress=progress, weights=weights)
     doc = _document(ident, free, fixed, init, plant, moisture, hold, column_map)
+    if laws != PAPER_BED:
+        doc["bed"] = laws.as_dict()
     model = FittedModel(doc)
     validation = model.validate(batches)
     # a fit whose states a drum roaster cannot have is reported, not hidden (metrics.profile)

@@ -32,6 +32,7 @@ from ..io.files import Outputs, input_digest
 from ..io.importers.mapping import ColumnMap, map_from_mapping
 from ..io.modelfile import model_document_text, read_model_document
 from ..io.plants import load_plant
+from ..model.bed import BedLaws
 from ..model.limits import check_value
 from ..model.parameters import REGISTRY, STATE0, THETA_NAMES, THETA_PAPER, THETA_UNITS, Theta
 from ..model.plant import Plant
@@ -110,6 +111,8 @@ class FittedModel:
         self.initial: dict = doc.get("initial") or {}
         self.moisture: str = doc.get("moisture", "schwartzberg")
         self.hold: str = doc.get("hold", "linear")
+        #: the bed laws (:mod:`roastlab.model.bed`; the paper's unless the model file says otherwise)
+        self.bed: BedLaws = BedLaws.parse(doc.get("bed"))
         m = doc.get("map")
         self.column_map: ColumnMap | None = None if m is None else map_from_mapping(copy.deepcopy(m), "model file map")
         self.source: str | None = doc.get("_source")
@@ -225,7 +228,7 @@ class FittedModel:
         fields = {k: base[k] for k in PAPER_INITIAL}
         if "Ta0_C" in base:
             fields["Ta0_C"] = base["Ta0_C"]
-        packed = pack_batches(ready, target, theta, InitialState(**fields), self.moisture, self.hold)
+        packed = pack_batches(ready, target, theta, InitialState(**fields), self.moisture, self.hold, bed=self.bed)
         names = list(params)
         values = np.array([[[params[k] for k in names]] * len(ready)]) if names else np.zeros((1, len(ready), 0))
         return Applied(ready, packed, names, values, target, notes)

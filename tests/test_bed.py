@@ -1,0 +1,182 @@
+"""The bed laws (roastlab.model.bed): geometry by hand, limits where they are the paper's, files and options."""
+
+import dataclasses
+import json
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from reference_model import bed_segment
+from roastlab import InitialState, simulate
+from roastlab.errors import InputError, ParameterError
+from roastlab.model import rhs
+from roastlab.model.bed import PAPER_BED, VARIANTS, BedLaws
+from roastlab.model.constants import GREEN_BULK_DENSITY_KG_M3
+from roastlab.model.layout import P
+from roastlab.model.plant import as_plant
+
+
+def test_wall_contact_area_by_hand():
+    """A half-full drum wets half the mantle and half of each end disc; a full one all of it;
+    any fill agrees with the reference's own bisection; the area grows more slowly than the mass."""
+    plant = as_plant("120kg")
+    R, L = plant.Dch_m / 2, plant.Lch_m
+    full = GREEN_BULK_DENSITY_KG_M3 * math.pi * R**2 * L
+    half = dataclasses.replace(plant, Mb_kg=full / 2)
+    assert half.wall_contact_area_m2 == pytest.approx(math.pi * R * L + math.pi * R**2, rel=1e-12)
+    whole = dataclasses.replace(plant, Mb_kg=full)
+    assert whole.wall_contact_area_m2 == pytest.approx(2 * math.pi * R * L + 2 * math.pi * R**2, rel=1e-9)
+    per_kg = []
+    for share in (0.02, 0.1, 0.25, 0.6):
+        p = dataclasses.replace(plant, Mb_kg=share * full)
+        t, h, area = bed_segment(p.Mb_kg, p.Dch_m, p.Lch_m)
+        assert p.bed_angle_rad == pytest.approx(t, rel=1e-9)
+        assert p.bed_depth_m == pytest.approx(h, rel=1e-9)
+        assert p.wall_contact_area_m2 == pytest.approx(area, rel=1e-9)
+        per_kg.append(p.wall_contact_area_m2 / p.Mb_kg)
+    assert all(a > b for a, b in zip(per_kg, per_kg[1:]))  # a deeper bed wets less wall per kilogram
+
+
+def test_paper_bed_packs_the_paper_and_codes_each_law():
+    plant = as_plant("120kg")
+    theta = (0.01, 0.0254, 0.5793)
+    paper = rhs.pack_params(plant, theta)
+    assert np.array_equal(paper, rhs.pack_params(plant, theta, bed="paper"))
+    assert [paper[P[k]] for k in ("contact_law", "probe_law", "probe_gas_law")] == [0.0, 0.0, 0.0]
+    both = rhs.pack_params(plant, theta, bed="contact=wall,probe=tumbling,probe_gas=mean")
+    assert [both[P[k]] for k in ("contact_law", "probe_law", "probe_gas_law")] == [1.0, 1.0, 1.0]
+    assert both[P["A_wall"]] == pytest.approx(plant.wall_contact_area_m2)
+    Agb, Abm = rhs.bed_areas_m2(both)
+    assert Abm == pytest.approx(0.5793 * plant.wall_contact_area_m2)
+    assert Agb == pytest.approx(plant.Ab_m2 - Abm)
+    assert rhs.bed_areas_m2(paper) == rhs.bean_areas_m2(plant.Ab_m2, 0.5793)
+
+
+def _run(plant, bed=None, **values):
+    t = np.arange(0.0, 40001.0, 50.0)
+    n = len(t)
+    return simulate(
+        plant,
+        t,
+        np.full(n, 6.0),
+        np.full(n, 25.0),
+        theta=(0.005, 0.05, 0.6),
+        initial=InitialState(Tb0_C=25.0, Tm0_C=25.0, X0=0.0, He0_kJ_kg=232.0, Ta0_C=25.0),
+        heater=np.full(n, 400.0),
+        values={"Qe_gain_kW": 0.5, "tau_heater_s": 20.0, **values},
+        bed=bed,
+    )
+
+
+def test_tumbling_probe_reads_its_covered_mix_and_is_eq17_without_a_depth():
+    """Steady state: Ta = c Tb + (1 - c) Tgo with c = 1 - exp(-h_bed/h_probe); with h_probe 0 the
+    tumbling law is eq. 17 bit for bit, like the law at rest."""
+    plant = as_plant("120kg")
+    h = plant.bed_depth_m
+    r = _run(plant, "probe=tumbling", h_probe_m=h)
+    c = 1.0 - math.exp(-1.0)
+    assert r.Tb_C[-1] - r.Tgo_C[-1] > 50
+    assert r.Ta_C[-1] == pytest.approx(c * r.Tb_C[-1] + (1 - c) * r.Tgo_C[-1], abs=1e-3)
+    assert np.array_equal(_run(plant, "probe=tumbling").states, _run(plant).states)
+
+
+def test_mean_gas_is_the_mean_of_the_exchanger_profile():
+    """The probe's gas under probe_gas=mean is the path average of Tgi -> T* as exp(-NTU s)
+    (numerical quadrature here), between the outlet and the inlet temperature."""
+    from scipy.integrate import quad
+
+    plant = as_plant("120kg")
+    p = rhs.pack_params(plant, (0.02, 0.05, 0.6), bed="probe_gas=mean")
+    Tb, Tm, X, Gg, Tgi = 150.0, 220.0, 0.05, 30.0, 400.0
+    Tgo = rhs.heat_flows(Tb, Tm, X, Gg, Tgi, p)[0]
+    T_star, NTU = rhs.exchanger(Tb, Tm, X, Gg, Tgi, p)[:2]
+    by_quad = quad(lambda s: T_star + (Tgi - T_star) * math.exp(-NTU * s), 0.0, 1.0)[0]
+    mean = rhs.probe_gas_C(Tb, Tm, X, Gg, Tgi, Tgo, p)
+    assert mean == pytest.approx(by_quad, rel=1e-12)
+    assert Tgo < mean < Tgi
+    outlet = rhs.pack_params(plant, (0.02, 0.05, 0.6))
+    assert rhs.probe_gas_C(Tb, Tm, X, Gg, Tgi, Tgo, outlet) == Tgo
+
+
+def test_wall_contact_makes_the_batch_response_flatter():
+    """Per kilogram, the wall law gives a small batch more metal contact than the paper's law does
+    relative to a large one: the ratio of Abm per kg small/large is > 1 under the wall law, 1 under the paper's."""
+    plant = as_plant("120kg")
+    small, large = dataclasses.replace(plant, Mb_kg=40.0), dataclasses.replace(plant, Mb_kg=160.0)
+
+    def abm_per_kg(pl, bed):
+        return rhs.bed_areas_m2(rhs.pack_params(pl, (0.01, 0.03, 0.5), bed=bed))[1] / pl.Mb_kg
+
+    assert abm_per_kg(small, None) == pytest.approx(abm_per_kg(large, None))
+    assert abm_per_kg(small, "contact=wall") / abm_per_kg(large, "contact=wall") > 1.5
+
+
+@pytest.mark.parametrize(
+    "text, problem",
+    [("probe=wobbly", "unknown probe law"), ("colour=green", "unknown bed option"), ("probe", "not option=law")],
+)
+def test_bad_laws_are_one_clear_error(text, problem):
+    with pytest.raises(ParameterError, match=problem):
+        BedLaws.parse(text)
+
+
+def test_variants_and_names():
+    assert VARIANTS["paper"] is PAPER_BED
+    assert BedLaws.parse({"probe": "tumbling"}).name == "probe=tumbling"
+    for name, laws in VARIANTS.items():
+        assert BedLaws.parse(name) == laws
+
+
+def test_fit_spec_and_model_file_carry_the_laws(tmp_path):
+    from roastlab.io.fitspec import load_fit_spec
+    from roastlab.io.modelfile import read_model_document
+
+    spec = tmp_path / "fit.toml"
+    spec.write_text('[free]\nhbm = [0.01, 0.3, 0.05]\n[bed]\nprobe = "tumbling"\n')
+    assert load_fit_spec(spec).bed == BedLaws(probe="tumbling")
+    spec.write_text('[free]\nhbm = [0.01, 0.3, 0.05]\n[bed]\nprobe = "sideways"\n')
+    with pytest.raises(InputError, match="fit.toml.*bed.*unknown probe law"):
+        load_fit_spec(spec)
+    doc = {
+        "format": "roastlab-model/1",
+        "plant": "120kg",
+        "parameters": {k: {"value": v} for k, v in (("hgm", 0.01), ("hbm", 0.0254), ("Pbm", 0.5793))},
+        "bed": {"contact": "sideways"},
+    }
+    path = tmp_path / "m.json"
+    path.write_text(json.dumps(doc))
+    with pytest.raises(InputError, match="m.json.*bed.*unknown contact law"):
+        read_model_document(path)
+
+
+def test_a_fitted_model_keeps_its_laws(tmp_path):
+    """fit(bed=...) writes the laws into the model file; the loaded model predicts with them."""
+    import roastlab
+    from roastlab.workflows.datasets import make_batch
+
+    rng = np.random.default_rng(3)  # synthetic batches of the 120 kg plant (workflows.datasets)
+    batches = [make_batch(rng, "120kg", i, False)[0] for i in range(2)]
+    result = roastlab.fit(batches, "120kg", fix={"hgm": 0.01}, bed="contact=wall", starts=1)
+    path = result.model.save(tmp_path / "m.json")
+    assert json.loads(path.read_text())["bed"]["contact"] == "wall"
+    loaded = roastlab.load_model(path)
+    assert loaded.bed == BedLaws(contact="wall")
+    a, b = result.model.predict(batches[0]), loaded.predict(batches[0])
+    assert np.array_equal(a.Ta_C, b.Ta_C)
+    paper = result.model.with_values()
+    paper.bed = PAPER_BED
+    assert np.max(np.abs(paper.predict(batches[0]).Ta_C - a.Ta_C)) > 0.1  # the law is in force
+
+
+def test_cli_bad_bed_is_exit_2(tmp_path):
+    out = subprocess.run(
+        [sys.executable, "-m", "roastlab", "identify", "--plant", "120kg", "--bed", "probe=wobbly", "x.csv"],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+    )
+    assert out.returncode == 2
+    assert "unknown probe law" in out.stderr and "Traceback" not in out.stderr
