@@ -46,8 +46,8 @@ from .layout import (  # noqa: E402, F401
     I_AGM,
     I_ASH,
     I_AWALL,
-    I_CONTACT,
     I_CM,
+    I_CONTACT,
     I_CW,
     I_DB,
     I_GGF,
@@ -376,7 +376,6 @@ def pack_params(plant, theta, X0: float = 0.1, moisture: str = "schwartzberg", b
         (the paper's bed)
     """
     from .bed import BedLaws
-
     from .parameters import as_theta
     from .quantities import table
 
