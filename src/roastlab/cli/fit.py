@@ -23,6 +23,9 @@ from .common import (
 )
 
 
+FIT_HELP_COMPARE = "logs with their green weight (raw logs with --map, or batch CSVs)"
+
+
 def cmd_identify(args) -> int:
     from ..io.files import Outputs
 
@@ -145,6 +148,39 @@ def cmd_validate(args) -> int:
     return 0
 
 
+def cmd_compare_models(args) -> int:
+    from ..io.files import Outputs
+    from ..io.importers import load_map
+    from ..workflows.compare import compare_models
+
+    outputs = Outputs(fit_inputs(args))
+    for path in (args.json, args.plot):
+        outputs.check(path)
+    batches, plant_spec = load_batches(args)
+    if plant_spec is None:
+        raise InputError("--plant is required unless a dataset folder names its plant", "command line")
+    if args.group_step_kg is not None and not args.group_step_kg > 0:
+        raise InputError(f"--group-step-kg must be a positive mass, got {args.group_step_kg:g}", "command line")
+    result = compare_models(
+        batches,
+        plant_spec,
+        args.spec,
+        args.variant or None,
+        column_map=load_map(args.map) if args.map else None,
+        step_kg=args.group_step_kg,
+        seed=args.seed,
+        starts=args.starts,
+        progress=progress("compare-models"),
+    )
+    print(result.summary())
+    with outputs as out:
+        if args.json:
+            out.write_text(args.json, json_text(result.to_dict()))
+        if args.plot:
+            result.plot(args.plot, outputs=out)
+    return 0
+
+
 def _safe_stem(name: str, taken: set) -> str:
     """A file stem from a batch name: no path separators or control characters, unique."""
     stem = "".join(c if (c.isalnum() or c in "-_.") else "_" for c in name)[:80].strip(".") or "batch"
@@ -229,6 +265,45 @@ def add_parsers(sub) -> None:
     )
     add_model_options(p, with_model=False)
     p.set_defaults(func=cmd_identify)
+
+    from ..model.bed import VARIANTS
+    from ..workflows.compare import GROUP_STEP_SHARE
+    from .common import bed_arg
+
+    p = sub.add_parser(
+        "compare-models",
+        help="fit model variants (bed laws) on the same logs; AIC, BIC and leave-one-size-out FIT",
+        description="Fit each model variant on all the logs (summed SSR, AIC, BIC, free parameters, parameters on "
+        "a bound, fit-set FIT) and cross-validate it by batch size: the logs are grouped by green weight, and for "
+        "each group the variant is fitted on the other groups and predicts that one with nothing refitted. The "
+        "variant to prefer is the one with the highest leave-one-size-out FIT, not the best fit. Each fit is a "
+        "full identification, so this takes (variants x (groups + 1)) fits: minutes on real logs.",
+        epilog="example: roastlab compare-models --plant examples/bullet/plant.toml --map examples/bullet/map.toml "
+        "--spec examples/bullet/fit.toml logs/*.json --json compare.json --plot compare.png",
+    )
+    p.add_argument("batches", nargs="+", metavar="BATCH", help=FIT_HELP_COMPARE)
+    p.add_argument("--plant", help="plant preset or PLANT.toml (default: the dataset's)")
+    p.add_argument("--map", metavar="MAP.toml", help="the BATCH arguments are raw logs read with this column map")
+    p.add_argument("--spec", metavar="FIT.toml", help="fit spec: free parameters, bounds, initial states, weights")
+    p.add_argument(
+        "--variant",
+        action="append",
+        type=bed_arg,
+        metavar="LAWS",
+        help="a variant's bed laws, e.g. 'paper' or 'contact=wall,probe=tumbling' (repeatable; default: "
+        + "; ".join(VARIANTS)
+        + ")",
+    )
+    p.add_argument(
+        "--group-step-kg",
+        type=float_arg("--group-step-kg"),
+        help=f"green weights are grouped by rounding to this step [kg] (default {GROUP_STEP_SHARE:g} x the median)",
+    )
+    p.add_argument("--seed", type=seed_arg, default=0, help="random seed of every fit (default 0)")
+    p.add_argument("--starts", type=count_arg("--starts", 1, 100), default=6, help="local polishes per fit (default 6)")
+    p.add_argument("--json", metavar="COMPARE.json", help="write every variant's figures as JSON")
+    p.add_argument("--plot", metavar="FIG.png", help="bar chart of each held-out size's FIT per variant")
+    p.set_defaults(func=cmd_compare_models, baseline=None)
 
     p = sub.add_parser(
         "validate",

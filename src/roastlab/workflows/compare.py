@@ -1,0 +1,293 @@
+"""Model selection by evidence: fit several model variants on the same logs and cross-validate them
+by batch size (issue 25; ``roastlab compare-models``).
+
+For each variant (a set of bed laws, :mod:`roastlab.model.bed`) :func:`compare_models` reports
+
+* on the fit set (every log): the summed weighted SSR, the number of residuals n and of free
+  parameters k, AIC and BIC (the one rule of :mod:`roastlab.fit.uncertainty`), the parameters a
+  bound holds, and the mean probe FIT;
+* **leave-one-size-out** cross-validation: the logs are grouped by green weight (each weight
+  rounded to a step, default a tenth of the median batch); for each group, the variant is fitted
+  on every other group and predicts that one with nothing refitted. The figure of merit is the
+  mean over groups of the group's mean probe FIT (each batch size counts once), with each
+  group's figure beside it.
+
+The variant to prefer is the one that predicts the sizes it never saw best (the highest
+cross-validated FIT), not the one that fits best: more freedom always fits the fit set better.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import InputError
+from ..model.bed import PAPER_BED, VARIANTS, BedLaws
+from ..report.result import Result
+
+#: Default group step as a share of the median green weight (a tenth: 490 and 500 g together).
+GROUP_STEP_SHARE = 0.1
+
+
+def size_groups(batches, step_kg: float | None = None) -> tuple[list[str], float]:
+    """A size-group label per batch and the step used: batches whose green weights round to the same
+    multiple of ``step_kg`` (default :data:`GROUP_STEP_SHARE` of the median weight) form a group,
+    labelled by their weights ("0.49-0.5 kg")."""
+    masses = []
+    for b in batches:
+        m = getattr(b, "Mb_kg", None)
+        if not m or not math.isfinite(m):
+            raise InputError(
+                "no green weight: a leave-one-size-out comparison groups logs by their batch mass", b.source or b.name
+            )
+        masses.append(float(m))
+    if step_kg is None:
+        step_kg = float(np.median(masses)) * GROUP_STEP_SHARE
+    if not (step_kg > 0 and math.isfinite(step_kg)):
+        raise InputError(f"group step must be a positive mass in kg, got {step_kg!r}", "command line")
+    keys = [round(m / step_kg) for m in masses]
+    labels = {}
+    for key in set(keys):
+        members = [m for m, k in zip(masses, keys) if k == key]
+        lo, hi = min(members), max(members)
+        labels[key] = f"{lo:.3g} kg" if lo == hi else f"{lo:.3g}-{hi:.3g} kg"
+    return [labels[k] for k in keys], step_kg
+
+
+@dataclass
+class VariantScore:
+    """One variant's figures (see the module docstring)."""
+
+    name: str
+    laws: BedLaws
+    ssr: float
+    n_residuals: int
+    k_free: int
+    aic: float
+    bic: float
+    on_bound: list[str]
+    fit_FIT: float
+    cv_FIT: float
+    cv_by_group: dict[str, float]
+    cv_by_batch: dict[str, float] = field(default_factory=dict)
+    warnings: list[str] = field(default_factory=list)
+
+
+@dataclass
+class ModelComparison(Result):
+    """What :func:`compare_models` returns: one :class:`VariantScore` per variant, best first by
+    cross-validated FIT."""
+
+    scores: list[VariantScore]
+    groups: dict[str, list[str]]
+    step_kg: float
+
+    @property
+    def best(self) -> VariantScore:
+        """The variant with the highest leave-one-size-out FIT."""
+        return max(self.scores, key=lambda s: s.cv_FIT)
+
+    def to_frame(self):
+        import pandas as pd
+
+        rows = []
+        for s in self.scores:
+            rows.append(
+                {
+                    "variant": s.name,
+                    "k": s.k_free,
+                    "SSR": s.ssr,
+                    "AIC": s.aic,
+                    "BIC": s.bic,
+                    "on bound": len(s.on_bound),
+                    "fit FIT %": s.fit_FIT,
+                    "LOSO FIT %": s.cv_FIT,
+                    **{f"{g} %": v for g, v in s.cv_by_group.items()},
+                }
+            )
+        return pd.DataFrame(rows).set_index("variant")
+
+    def summary(self) -> str:
+        groups = list(self.groups)
+        head = (
+            f"{len(self.scores)} variant(s) on {sum(len(v) for v in self.groups.values())} log(s) in "
+            f"{len(groups)} size group(s) (step {self.step_kg:.3g} kg); probe FIT %"
+        )
+        cols = ["variant", "k", "SSR °C²", "AIC", "BIC", "on bound", "fit FIT", "LOSO FIT", *groups]
+        table = [cols]
+        for s in self.scores:
+            table.append(
+                [
+                    s.name,
+                    str(s.k_free),
+                    f"{s.ssr:.4g}",
+                    f"{s.aic:.1f}",
+                    f"{s.bic:.1f}",
+                    str(len(s.on_bound)),
+                    f"{s.fit_FIT:.1f}",
+                    f"{s.cv_FIT:.1f}",
+                    *(f"{s.cv_by_group[g]:.1f}" for g in groups),
+                ]
+            )
+        widths = [max(len(r[i]) for r in table) for i in range(len(cols))]
+        lines = [head, ""]
+        for r in table:
+            lines.append("  ".join(c.ljust(w) if i == 0 else c.rjust(w) for i, (c, w) in enumerate(zip(r, widths))))
+        best = self.best
+        by_aic = min(self.scores, key=lambda s: s.aic)
+        lines += ["", f"best by leave-one-size-out FIT: {best.name} ({best.cv_FIT:.1f} %)"]
+        if by_aic is not best:
+            lines.append(
+                f"lowest AIC: {by_aic.name} (fits the logs best, predicts unseen sizes worse: prefer {best.name})"
+            )
+        for s in self.scores:
+            if s.on_bound:
+                lines.append(f"{s.name}: on a bound: {', '.join(s.on_bound)}")
+        return "\n".join(lines)
+
+    def to_json_dict(self) -> dict:
+        return {
+            "step_kg": self.step_kg,
+            "groups": self.groups,
+            "best": self.best.name,
+            "variants": [
+                {
+                    "name": s.name,
+                    "bed": s.laws.as_dict(),
+                    "SSR": s.ssr,
+                    "n_residuals": s.n_residuals,
+                    "k_free": s.k_free,
+                    "AIC": s.aic,
+                    "BIC": s.bic,
+                    "on_bound": s.on_bound,
+                    "fit_FIT": s.fit_FIT,
+                    "loso_FIT": s.cv_FIT,
+                    "loso_FIT_by_group": s.cv_by_group,
+                    "loso_FIT_by_batch": s.cv_by_batch,
+                    "warnings": s.warnings,
+                }
+                for s in self.scores
+            ],
+        }
+
+    def _draw(self, ax) -> None:
+        groups = list(self.groups)
+        x = np.arange(len(groups))
+        width = 0.8 / max(len(self.scores), 1)
+        for i, s in enumerate(self.scores):
+            ax.bar(x + (i - (len(self.scores) - 1) / 2) * width, [s.cv_by_group[g] for g in groups], width,
+                   label=f"{s.name} (mean {s.cv_FIT:.1f} %)")  # fmt: skip
+        ax.set_xticks(x, groups)
+        ax.set_xlabel("held-out batch size (fitted on every other size)")
+        ax.set_ylabel("probe FIT [%]")
+        ax.set_ylim(max(min(0.0, ax.get_ylim()[0]), -50.0), 100.0)
+        ax.axhline(0.0, color="0.5", lw=0.6)
+        ax.legend(fontsize=8, loc="lower left")
+        ax.grid(axis="y", alpha=0.3)
+
+    def _figure(self, path, outputs, title=None):
+        import matplotlib.pyplot as plt
+
+        from ..report.figures import save_figure
+
+        fig, ax = plt.subplots(figsize=(9, 4.5))
+        self._draw(ax)
+        ax.set_title(title or "Leave-one-size-out: each batch size predicted by a model fitted on the others")
+        fig.tight_layout()
+        save_figure(fig, path, outputs)
+        return fig
+
+
+def _fit(batches, plant, spec, laws, column_map, seed, starts):
+    from .fitting import fit
+
+    return fit(batches, plant, spec, column_map=column_map, seed=seed, starts=starts, bed=laws)
+
+
+def compare_models(
+    batches,
+    plant,
+    spec=None,
+    variants=None,
+    *,
+    column_map=None,
+    step_kg: float | None = None,
+    seed: int = 0,
+    starts: int = 6,
+    progress=None,
+) -> ModelComparison:
+    """Fit each variant on ``batches`` and cross-validate it leaving one batch size out.
+
+    Parameters
+    ----------
+    batches : list of Batch (each with its green weight ``Mb_kg``)
+    plant, spec, column_map, seed, starts : as :func:`roastlab.workflows.fitting.fit`
+    variants : {name: BedLaws or its text} or a list of law texts; default
+        :data:`roastlab.model.bed.VARIANTS`
+    step_kg : the group step (default :data:`GROUP_STEP_SHARE` of the median green weight)
+    progress : callable ``progress(done, total, text)``
+    """
+    if variants is None:
+        variants = VARIANTS
+    if not isinstance(variants, dict):
+        parsed = [BedLaws.parse(v) for v in variants]
+        variants = {b.name: b for b in parsed}
+    variants = {name: BedLaws.parse(v) for name, v in variants.items()}
+    if not variants:
+        raise InputError("no model variants to compare", "command line")
+    batches = list(batches)
+    labels, step = size_groups(batches, step_kg)
+    order = sorted(set(labels), key=lambda g: float(g.split()[0].split("-")[0]))
+    if len(order) < 2:
+        raise InputError(
+            f"every log is in one size group ({order[0]}): leave-one-size-out needs at least two batch sizes",
+            batches[0].source or batches[0].name,
+        )
+    groups = {g: [b.name for b, lab in zip(batches, labels) if lab == g] for g in order}
+    total, done = len(variants) * (1 + len(order)), 0
+    scores = []
+    for name, laws in variants.items():
+        if progress:
+            progress(done, total, f"{name}: all logs")
+        full = _fit(batches, plant, spec, laws, column_map, seed, starts)
+        done += 1
+        ident = full.identification
+        u = ident.uncertainty
+        on_bound = [n for n, b in zip(u.names, u.on_bound) if b] if u is not None else []
+        by_group, by_batch = {}, {}
+        for g in order:
+            if progress:
+                progress(done, total, f"{name}: without {g}")
+            train = [b for b, lab in zip(batches, labels) if lab != g]
+            test = [b for b, lab in zip(batches, labels) if lab == g]
+            model = _fit(train, plant, spec, laws, column_map, seed, starts).model
+            v = model.validate(test)
+            by_group[g] = float(v.average["FIT"])
+            by_batch.update({n: float(r["FIT"]) for n, r in zip(v.names, v.rows)})
+            done += 1
+        scores.append(
+            VariantScore(
+                name=name,
+                laws=laws,
+                ssr=float(ident.SSR),
+                n_residuals=int(ident.n_residuals),
+                k_free=int(u.k_free) if u is not None else len(ident.values),
+                aic=float(ident.aic),
+                bic=float(ident.bic),
+                on_bound=on_bound,
+                fit_FIT=float(full.validation.average["FIT"]),
+                cv_FIT=float(np.mean(list(by_group.values()))),
+                cv_by_group=by_group,
+                cv_by_batch=by_batch,
+                warnings=list(ident.warnings),
+            )
+        )
+    if progress:
+        progress(total, total, "done")
+    scores.sort(key=lambda s: -s.cv_FIT)
+    return ModelComparison(scores, groups, step)
+
+
+__all__ = ["ModelComparison", "VariantScore", "compare_models", "size_groups", "PAPER_BED"]
