@@ -22,7 +22,6 @@ from .common import (
     weights_arg,
 )
 
-
 FIT_HELP_COMPARE = "logs with their green weight (raw logs with --map, or batch CSVs)"
 
 
