@@ -22,6 +22,20 @@ from .common import (
     weights_arg,
 )
 
+
+def level_arg(text: str) -> float:
+    """argparse type of --band: a level in (0, 1)."""
+    import argparse
+
+    try:
+        v = float(text)
+    except ValueError:
+        v = float("nan")
+    if not 0.0 < v < 1.0:
+        raise argparse.ArgumentTypeError(f"a band level is a number in (0, 1), e.g. 0.9, got {text!r}")
+    return v
+
+
 FIT_HELP_COMPARE = "logs with their green weight (raw logs with --map, or batch CSVs)"
 
 
@@ -129,9 +143,12 @@ def cmd_validate(args) -> int:
             f"validation on plant {result.plant}, theta = hgm {th.hgm:.4f}, hbm {th.hbm:.4f}, Pbm {th.Pbm:.4f}"
         )
     )
+    doc = result.to_json_dict()
+    if args.band is not None:
+        doc["band"] = _band_table(model, batches, args.band, plant_spec, changes)
     with outputs as out:
         if args.json:
-            out.write_text(args.json, json_text(result.to_json_dict()))
+            out.write_text(args.json, json_text(doc))
         if args.plot:
             plot_fit(result, args.plot, title=f"measured vs predicted BT, plant {result.plant}", outputs=out)
         if args.predictions:
@@ -178,6 +195,28 @@ def cmd_compare_models(args) -> int:
         if args.plot:
             result.plot(args.plot, outputs=out)
     return 0
+
+
+def _band_table(model, batches, level, plant_spec, changes) -> dict:
+    """Print and return how often each batch's measured probe lies inside the model's band."""
+    from ..evaluate.bands import band_coverage
+
+    if changes or plant_spec not in (None, model.plant):
+        raise InputError(
+            "--band scores the model as fitted: drop --plant/--tgi-offset/--tb0/--tm0/--x0", "command line"
+        )
+    if not (model.doc.get("fit") or {}).get("spread"):
+        print("note: the model file has no roast-to-roast spread (fitted on one log, or by an older roastlab): "
+              "the band is the parameters' alone")  # fmt: skip
+    rows = band_coverage(model, batches, level)
+    print(f"\n{level:.0%} prediction band (parameters and roast-to-roast spread, roastlab.evaluate.bands):")
+    print(f"{'batch':<36} {'kg':>6} {'inside':>7} {'median width':>13}")
+    for r in rows:
+        kg = "" if not r["Mb_kg"] else f"{r['Mb_kg']:.3g}"
+        print(f"{r['name'][:36]:<36} {kg:>6} {r['inside']:>7.0%} {r['median_width_C']:>10.1f} °C")
+    inside = sum(r["inside"] * r["n"] for r in rows) / max(sum(r["n"] for r in rows), 1)
+    print(f"{'all samples':<36} {'':>6} {inside:>7.0%}   (a calibrated band holds about {level:.0%})")
+    return {"level": level, "inside_all": inside, "batches": rows}
 
 
 def _safe_stem(name: str, taken: set) -> str:
@@ -265,6 +304,7 @@ def add_parsers(sub) -> None:
     add_model_options(p, with_model=False)
     p.set_defaults(func=cmd_identify)
 
+    from ..evaluate.bands import BAND_LEVEL
     from ..model.bed import VARIANTS
     from ..workflows.compare import GROUP_STEP_SHARE
     from .common import bed_arg
@@ -323,6 +363,15 @@ def add_parsers(sub) -> None:
     )
     p.add_argument(
         "--tgi-offset", type=float_arg("--tgi-offset"), help="what-if: add this to the inlet gas / ET [degC]"
+    )
+    p.add_argument(
+        "--band",
+        type=level_arg,
+        nargs="?",
+        const=BAND_LEVEL,
+        metavar="LEVEL",
+        help=f"also score the model's prediction band of this level (default {BAND_LEVEL:g}): the share of each "
+        "batch's measured probe samples inside it and its median width",
     )
     add_model_options(p)
     p.set_defaults(func=cmd_validate)

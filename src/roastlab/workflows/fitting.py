@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError, ParameterError
+from ..evaluate.bands import roast_spread
 from ..evaluate.validate import ValidationResult
 from ..fit.identify import NO_SECOND_READING, IdentificationResult, build_free_parameters, identify
 from ..io.batch import Batch
@@ -196,6 +197,8 @@ def fit(
         summary = odd[0] if len(odd) == 1 else f"{odd[0]} (and {len(odd) - 1} more batch(es) alike)"
         ident.warnings.append(summary)
         doc["fit"]["warnings"] = ident.warnings
+    # the roast-to-roast part of the prediction bands (evaluate.bands): the fit set's probe error by time
+    doc["fit"]["spread"] = roast_spread(validation.time_s, validation.measured, validation.predicted)
     doc["metrics"] = {
         "batches": [{"name": n, **r} for n, r in zip(validation.names, validation.rows)],
         "average": validation.average,

@@ -1,0 +1,185 @@
+"""Prediction bands: how far a measured probe curve may lie from the model's, and how often it does.
+
+A band of level L (default :data:`BAND_LEVEL`) around a prediction combines two independent
+sources of error, each a standard deviation at every instant t:
+
+* **the parameters**: the fitted values are drawn from their normal approximation N(z*, C)
+  (covariance C = the fit's correlation times its standard errors, :mod:`roastlab.fit.uncertainty`;
+  parameters a bound holds stay at their value), clipped into their bounds, and every draw is
+  simulated by the compiled population simulation; sigma_p(t) is the spread of the draws;
+* **roast to roast**: what no parameter explains (the roaster's state on the day, the beans).
+  At fitting, the root mean square over the fit-set logs of the model's probe error at each time
+  since CHARGE, sigma_r(t), is stored in the model file (``fit.spread``, on a
+  :data:`SPREAD_GRID_S` grid; held at its last value past the longest log).
+
+The band is prediction +- sqrt((z sigma_p)^2 + (z_n sigma_r)^2), z the standard normal quantile
+of (1 + L)/2 and z_n = t_{(1+L)/2, n-1} sqrt(1 + 1/n) the prediction-interval factor of a new
+roast when sigma_r was estimated from n logs (Student's t). :func:`band_coverage` says how often measured samples fall inside it (calibration:
+about L of them should) and how wide it is.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ParameterError
+
+#: The default level of a prediction band (a 90 % band).
+BAND_LEVEL = 0.9
+#: Time grid of the stored roast-to-roast spread [s].
+SPREAD_GRID_S = 30.0
+#: Parameter draws per band (the compiled population simulation runs them together).
+BAND_SAMPLES = 200
+
+
+def roast_spread(time_s, measured, predicted) -> dict | None:
+    """``{"time_s": grid, "rms_C": ...}``: RMS over logs of measured - predicted probe at each grid
+    time (each log interpolated onto the grid; a time counts the logs that reach it). None for
+    fewer than two logs: one roast says nothing about the spread between roasts."""
+    if len(time_s) < 2:
+        return None
+    end = max(float(t[-1]) for t in time_s)
+    grid = np.arange(0.0, end + SPREAD_GRID_S, SPREAD_GRID_S)
+    sq, count = np.zeros(grid.size), np.zeros(grid.size)
+    for t, m, p in zip(time_s, measured, predicted):
+        e = np.asarray(m, float) - np.asarray(p, float)
+        ok = np.isfinite(e)
+        if ok.sum() < 2:
+            continue
+        inside = grid <= t[ok][-1]
+        sq[inside] += np.interp(grid[inside], t[ok], e[ok]) ** 2
+        count[inside] += 1
+    keep = count >= 2
+    if not keep.any():
+        return None
+    rms = np.sqrt(sq[keep] / count[keep])
+    return {"time_s": grid[keep].tolist(), "rms_C": [round(float(v), 4) for v in rms], "logs": int(len(time_s))}
+
+
+def _z(level: float) -> float:
+    from scipy.stats import norm
+
+    if not (isinstance(level, (int, float)) and 0.0 < level < 1.0):
+        raise ParameterError(f"band level must be in (0, 1), e.g. 0.9, got {level!r}")
+    return float(norm.ppf(0.5 + level / 2.0))
+
+
+def _new_roast_quantile(level: float, n_logs: int) -> float:
+    """Half-width factor of a band for a new roast from the spread of ``n_logs`` fitted ones: the
+    prediction interval of a new draw from a normal population whose variance is estimated from n
+    draws, t_{(1+L)/2, n-1} sqrt(1 + 1/n) (Student's t; it tends to the normal quantile as n grows)."""
+    from scipy.stats import t
+
+    n = max(int(n_logs), 2)
+    return float(t.ppf(0.5 + level / 2.0, n - 1) * np.sqrt(1.0 + 1.0 / n))
+
+
+def parameter_draws(model, samples: int, seed: int) -> tuple[list[str], np.ndarray]:
+    """(names, (samples, k) values) of the model's fitted scalar parameters drawn from N(z*, C),
+    clipped into their bounds; parameters without a standard error stay at their value."""
+    corr = (model.doc.get("fit") or {}).get("correlation") or {}
+    names = [n for n in corr.get("names", []) if n in model.parameters or n in model.initial]
+    entries = {**model.parameters, **model.initial}
+    vals, ses, keep = [], [], []
+    for n in names:
+        e = entries[n]
+        se = e.get("stderr")
+        if e.get("value") is None or not isinstance(se, (int, float)) or not np.isfinite(se) or se <= 0:
+            continue
+        keep.append(n)
+        vals.append(float(e["value"]))
+        ses.append(float(se))
+    if not keep:
+        return [], np.zeros((samples, 0))
+    index = [corr["names"].index(n) for n in keep]
+    R = np.array([[corr["matrix"][i][j] if corr["matrix"][i][j] is not None else 0.0 for j in index] for i in index])
+    np.fill_diagonal(R, 1.0)
+    se = np.array(ses)
+    C = R * np.outer(se, se)
+    w, V = np.linalg.eigh(0.5 * (C + C.T))
+    L = V * np.sqrt(np.clip(w, 0.0, None))  # C = L L' (a covariance that is only semi-definite still samples)
+    rng = np.random.default_rng(seed)
+    draws = np.asarray(vals) + rng.standard_normal((samples, len(keep))) @ L.T
+    for j, n in enumerate(keep):
+        b = entries[n].get("bounds")
+        if b:
+            draws[:, j] = np.clip(draws[:, j], b[0], b[1])
+    return keep, draws
+
+
+@dataclass
+class Band:
+    """One batch's band: prediction and bounds of the probe reading [degC] at its sample times [s]."""
+
+    name: str
+    time_s: np.ndarray
+    predicted_C: np.ndarray
+    lower_C: np.ndarray
+    upper_C: np.ndarray
+    sigma_parameters_C: np.ndarray
+    sigma_roasts_C: np.ndarray
+    level: float
+
+    @property
+    def width_C(self) -> np.ndarray:
+        return self.upper_C - self.lower_C
+
+
+def prediction_bands(
+    model, batches, level: float = BAND_LEVEL, samples: int = BAND_SAMPLES, seed: int = 0, plant=None, **changes
+) -> list[Band]:
+    """The level-``level`` band of the probe prediction for each batch (module docstring)."""
+    from ..sim.population import predict_outputs
+
+    z = _z(level)
+    applied = model.apply(list(batches), plant, **changes)
+    center = model.simulate(applied)
+    names, draws = parameter_draws(model, samples, seed)
+    sigma_p = None
+    if names:
+        base_names = list(applied.names)
+        values = np.repeat(applied.values, samples, axis=0)  # (samples, nb, k0)
+        extra = [n for n in names if n not in base_names]
+        if extra:
+            values = np.concatenate([values, np.zeros(values.shape[:2] + (len(extra),))], axis=2)
+        all_names = base_names + extra
+        for j, n in enumerate(names):
+            values[:, :, all_names.index(n)] = draws[:, j : j + 1]
+        ta, _ = predict_outputs(applied.packed, all_names, values, with_tb=False)
+        with warnings.catch_warnings():  # padding past a batch's end is NaN in every draw
+            warnings.simplefilter("ignore", RuntimeWarning)
+            sigma_p = np.nanstd(ta, axis=0)  # (nb, nmax)
+    spread = (model.doc.get("fit") or {}).get("spread")
+    z_roasts = _new_roast_quantile(level, spread["logs"]) if spread else 0.0
+    out = []
+    for i, r in enumerate(center):
+        t = r.time_s
+        sp = np.zeros(t.size) if sigma_p is None else np.nan_to_num(sigma_p[i, : t.size])
+        sr = np.interp(t, spread["time_s"], spread["rms_C"]) if spread else np.zeros(t.size)
+        half = np.sqrt((z * sp) ** 2 + (z_roasts * sr) ** 2)
+        out.append(Band(r.name, t, r.Ta_C, r.Ta_C - half, r.Ta_C + half, sp, sr, level))
+    return out
+
+
+def band_coverage(model, batches, level: float = BAND_LEVEL, samples: int = BAND_SAMPLES, seed: int = 0) -> list[dict]:
+    """Per batch: ``{"name", "n", "inside" (share of measured probe samples inside the band),
+    "median_width_C", "Mb_kg"}``."""
+    rows = []
+    batches = list(batches)
+    for b, band in zip(batches, prediction_bands(model, batches, level, samples, seed)):
+        m = np.asarray(b.Ta_C, float)[: band.time_s.size]
+        ok = np.isfinite(m)
+        inside = (m[ok] >= band.lower_C[ok]) & (m[ok] <= band.upper_C[ok])
+        rows.append(
+            {
+                "name": b.name,
+                "Mb_kg": b.Mb_kg,
+                "n": int(ok.sum()),
+                "inside": float(inside.mean()) if ok.any() else float("nan"),
+                "median_width_C": float(np.median(band.width_C)),
+            }
+        )
+    return rows

@@ -1,0 +1,77 @@
+"""Prediction bands (roastlab.evaluate.bands) on SYNTHETIC logs (tests/test_compare.py's seeded
+generator: 120 kg plant batches with 0.5 degC probe noise and roast-to-roast input changes)."""
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import roastlab
+from roastlab.errors import ParameterError
+from roastlab.evaluate.bands import _new_roast_quantile, band_coverage, parameter_draws, prediction_bands, roast_spread
+from test_compare import synthetic_sizes
+
+
+@pytest.fixture(scope="module")
+def fitted():
+    batches = [b for b in synthetic_sizes(seed=8) + synthetic_sizes(seed=9) if b.Mb_kg == 120.0]
+    result = roastlab.fit(batches[:3], "120kg", bed="contact=wall", starts=2)
+    return result.model, batches
+
+
+def test_spread_is_stored_and_is_the_rms_by_time():
+    t = np.arange(0.0, 301.0, 10.0)
+    s = roast_spread([t, t, t[:11]], [t + 1, t - 1, t[:11] + 3], [t, t, t[:11]])
+    assert s["time_s"][0] == 0.0 and s["logs"] == 3
+    assert s["rms_C"][0] == pytest.approx(
+        np.sqrt((1 + 1 + 9) / 3), abs=1e-4
+    )  # stored to 4 decimals  # three logs reach t = 0
+    assert s["rms_C"][-1] == pytest.approx(1.0)  # past 100 s only two logs, errors +-1
+    assert roast_spread([t], [t], [t]) is None  # one log says nothing about the spread between roasts
+
+
+def test_band_holds_about_its_level_on_a_held_out_log(fitted):
+    model, batches = fitted
+    assert model.doc["fit"]["spread"]["logs"] == 3
+    rows = band_coverage(model, batches[3:], level=0.9)
+    inside = np.mean([r["inside"] for r in rows])
+    assert 0.8 <= inside <= 1.0, rows
+    assert all(0.5 < r["median_width_C"] < 10.0 for r in rows)
+    narrow = band_coverage(model, batches[3:], level=0.5)
+    assert np.mean([r["inside"] for r in narrow]) < inside  # a lower level is a narrower band
+    band = prediction_bands(model, batches[3:4])[0]
+    assert np.all(band.lower_C <= band.predicted_C) and np.all(band.predicted_C <= band.upper_C)
+    assert band.sigma_parameters_C.max() > 0  # the fitted parameters' covariance propagates
+
+
+def test_parameter_draws_follow_the_covariance(fitted):
+    model, _ = fitted
+    names, draws = parameter_draws(model, 4000, seed=1)
+    assert names and draws.shape == (4000, len(names))
+    for j, n in enumerate(names):
+        se = model.parameters[n]["stderr"]
+        assert np.std(draws[:, j]) == pytest.approx(se, rel=0.1)
+    again = parameter_draws(model, 4000, seed=1)[1]
+    assert np.array_equal(draws, again)  # the same seed, the same band
+
+
+def test_levels_and_quantile():
+    assert _new_roast_quantile(0.9, 1000) == pytest.approx(1.645, abs=0.01)
+    assert _new_roast_quantile(0.9, 3) > 2.5  # three logs: wide
+    with pytest.raises(ParameterError, match="band level"):
+        prediction_bands(None, [], level=1.5)
+
+
+def test_validate_band_cli(fitted, tmp_path):
+    from roastlab.io.batch import write_batch_csv
+
+    model, batches = fitted
+    model.save(tmp_path / "m.json")
+    write_batch_csv(tmp_path / "b.csv", batches[3])
+    cmd = [sys.executable, "-m", "roastlab", "validate", "--model", "m.json", "b.csv", "--band", "--json", "v.json"]
+    out = subprocess.run(cmd, capture_output=True, text=True, cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    assert "90% prediction band" in out.stdout and "median width" in out.stdout
+    bad = subprocess.run(cmd[:-3] + ["--band", "2"], capture_output=True, text=True, cwd=tmp_path)
+    assert bad.returncode == 2 and "band level" in bad.stderr
