@@ -52,6 +52,9 @@ VALUES = {
     "--pbm",
     "--hold",
     "--bed",
+    "--variant",
+    "--group-step-kg",
+    "--band",
     "--moisture",
     "--heater",
     "--fan",
@@ -168,6 +171,10 @@ RUNS = {
     ("plant",): ("plant {d}/plant.toml", ["plant.toml"]),
     ("identify",): (
         "identify --plant {d}/plant.toml --spec {d}/spec.toml {d}/ds --out {d}/m.json",
+        ["plant.toml", "spec.toml", "ds/dataset.toml", "ds/b1.csv", "ds/b2.csv"],
+    ),
+    ("compare-models",): (
+        "compare-models --plant {d}/plant.toml --spec {d}/spec.toml {d}/ds --json {d}/c.json --plot {d}/c.png",
         ["plant.toml", "spec.toml", "ds/dataset.toml", "ds/b1.csv", "ds/b2.csv"],
     ),
     ("validate",): (

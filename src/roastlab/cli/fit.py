@@ -171,8 +171,12 @@ def cmd_compare_models(args) -> int:
 
     outputs = Outputs(fit_inputs(args))
     for path in (args.json, args.plot):
-        outputs.check(path)
+        if path:
+            outputs.check(path)
     batches, plant_spec = load_batches(args)
+    for path in (args.json, args.plot):  # again, now that the files a dataset folder names were read
+        if path:
+            outputs.check(path)
     if plant_spec is None:
         raise InputError("--plant is required unless a dataset folder names its plant", "command line")
     if args.group_step_kg is not None and not args.group_step_kg > 0:
