@@ -46,8 +46,13 @@ wheel-check:
 	cd /tmp/roastlab-wheel && venv/bin/roastlab reproduce --out X && test -s X/model.json && test -s X/fig2_profiles.png
 
 # The measured figures of docs/real-roaster.md, from the real logs in ../shared/data/real.
+# Then every bed-law variant cross-validated by batch size on the Bullet (36 fits, ~8 min).
+BULLET = ../shared/data/real/bullet
 real-roaster: $(STAMP)
 	$(PY) docs/real_roaster.py
+	$(VENV)/bin/roastlab compare-models --plant examples/bullet/plant.toml --map examples/bullet/map.toml \
+	  --spec examples/bullet/fit.toml $$(ls $(BULLET)/*_*g.json) \
+	  --json docs/real-roaster-compare.json --plot docs/real-roaster-compare.png
 
 # The page's screenshots for docs/app.md and its measured speed (needs Debian's chromium).
 app-screens: $(STAMP)
