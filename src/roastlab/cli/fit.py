@@ -320,7 +320,8 @@ def add_parsers(sub) -> None:
         "a bound, fit-set FIT) and cross-validate it by batch size: the logs are grouped by green weight, and for "
         "each group the variant is fitted on the other groups and predicts that one with nothing refitted. The "
         "variant to prefer is the one with the highest leave-one-size-out FIT, not the best fit. Each fit is a "
-        "full identification, so this takes (variants x (groups + 1)) fits: minutes on real logs.",
+        "full identification, so this takes (variants x (groups + 1)) fits: minutes on real logs. It writes no "
+        "model file: fit the chosen variant with 'roastlab identify --bed LAWS ... --out MODEL.json'.",
         epilog="example: roastlab compare-models --plant examples/bullet/plant.toml --map examples/bullet/map.toml "
         "--spec examples/bullet/fit.toml logs/*.json --json compare.json --plot compare.png",
     )
