@@ -184,7 +184,7 @@ class ModelComparison(Result):
         ax.set_ylabel("probe FIT [%]")
         ax.set_ylim(max(min(0.0, ax.get_ylim()[0]), -50.0), 100.0)
         ax.axhline(0.0, color="0.5", lw=0.6)
-        ax.legend(fontsize=8, loc="lower left")
+        ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, frameon=False)
         ax.grid(axis="y", alpha=0.3)
 
     def _figure(self, path, outputs, title=None):
@@ -192,7 +192,7 @@ class ModelComparison(Result):
 
         from ..report.figures import save_figure
 
-        fig, ax = plt.subplots(figsize=(9, 4.5))
+        fig, ax = plt.subplots(figsize=(9, 5.2))
         self._draw(ax)
         ax.set_title(title or "Leave-one-size-out: each batch size predicted by a model fitted on the others")
         fig.tight_layout()
