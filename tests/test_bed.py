@@ -94,11 +94,11 @@ def test_mean_gas_is_the_mean_of_the_exchanger_profile():
     Tgo = rhs.heat_flows(Tb, Tm, X, Gg, Tgi, p)[0]
     T_star, NTU = rhs.exchanger(Tb, Tm, X, Gg, Tgi, p)[:2]
     by_quad = quad(lambda s: T_star + (Tgi - T_star) * math.exp(-NTU * s), 0.0, 1.0)[0]
-    mean = rhs.probe_gas_C(Tb, Tm, X, Gg, Tgi, Tgo, p)
+    mean = rhs.probe_gas_C(Tgi, Tgo, T_star, NTU, p)
     assert mean == pytest.approx(by_quad, rel=1e-12)
     assert Tgo < mean < Tgi
     outlet = rhs.pack_params(plant, (0.02, 0.05, 0.6))
-    assert rhs.probe_gas_C(Tb, Tm, X, Gg, Tgi, Tgo, outlet) == Tgo
+    assert rhs.probe_gas_C(Tgi, Tgo, T_star, NTU, outlet) == Tgo
 
 
 def test_wall_contact_makes_the_batch_response_flatter():

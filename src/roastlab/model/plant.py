@@ -149,11 +149,12 @@ class Plant:
             return self.Dch_m
         return self.Dch_m / 2.0 * (1.0 - math.cos(self.bed_angle_rad / 2.0))
 
-    @property
+    @functools.cached_property
     def bed_angle_rad(self) -> float:
         """Central angle t [rad] of the circular segment the bed at rest fills in the drum's
         cross-section: (t - sin t) / (2 pi) = fill fraction (the segment's area over the disc's);
-        2 pi when overfilled. Not in the paper; the bed geometry of :mod:`roastlab.model.bed`."""
+        2 pi when overfilled. Not in the paper; the bed geometry of :mod:`roastlab.model.bed`.
+        Solved once per plant (the bed depth and the wetted wall both read it at packing)."""
         from scipy.optimize import brentq
 
         fill = self.fill_fraction

@@ -238,16 +238,29 @@ def exchanger(Tb, Tm, X, Gg, Tgi, p):
 
 
 @register_jitable
-def probe_gas_C(Tb, Tm, X, Gg, Tgi, Tgo, p):
+def probe_gas_C(Tgi, Tgo, T_star, NTU, p):
     """The gas temperature the uncovered probe sees [degC] (``probe_gas_law``, :mod:`roastlab.model.bed`).
 
     0: the outlet temperature Tgo (eq. 15e, the well-mixed gas). 1: the mean of the gas along its
-    path, T* + (Tgi - Tgo)/NTU (the exchanger's exponential profile Tgi -> T* averaged over the path).
+    path, T* + (Tgi - Tgo)/NTU (the exchanger's exponential profile Tgi -> T* averaged over the path;
+    ``T_star`` and ``NTU`` from :func:`exchanger`).
     """
     if p[I_PROBEGAS] == 0.0:
         return Tgo
-    T_star, NTU, _, _, _, _, _ = exchanger(Tb, Tm, X, Gg, Tgi, p)
     return T_star + (Tgi - Tgo) / NTU
+
+
+@register_jitable
+def gas_heat_flows(Tb, Tm, Gg, Tgi, path, p):
+    """Outlet gas temperature and heat flows ``(Tgo [degC], Qgb, Qgm, Qbm [kW])`` from the gas
+    path ``path`` = :func:`exchanger` of the same instant: Tgi - Tgo from eq. 15e, Qgb eq. 9,
+    Qgm eq. 10, Qbm eq. 11."""
+    T_star, NTU, F, Agb, Abm, he, cg = path
+    drop = (Tgi - T_star) * (1.0 - exp(-NTU))  # eq. 15e: Tgi - Tgo
+    Qgb = Gg * cg * drop  # eq. 9
+    Qgm = F * (he * Agb * (Tb - Tm) + Qgb) / (1.0 + F)  # eq. 10
+    Qbm = p[I_HBM] * Abm * (Tm - Tb)  # eq. 11
+    return Tgi - drop, Qgb, Qgm, Qbm
 
 
 @register_jitable
@@ -255,15 +268,9 @@ def heat_flows(Tb, Tm, X, Gg, Tgi, p):
     """Outlet gas temperature and heat flows at one instant, for the gas the chamber sees.
 
     ``Gg`` [kg/s] and ``Tgi`` [degC] are the effective gas inputs (:func:`gas_inputs`).
-    Returns ``(Tgo [degC], Qgb, Qgm, Qbm [kW])``:
-    Tgi - Tgo from eq. 15e, Qgb eq. 9, Qgm eq. 10, Qbm eq. 11.
+    Returns ``(Tgo [degC], Qgb, Qgm, Qbm [kW])`` (:func:`gas_heat_flows` of :func:`exchanger`).
     """
-    T_star, NTU, F, Agb, Abm, he, cg = exchanger(Tb, Tm, X, Gg, Tgi, p)  # eq. 15e's gas path
-    drop = (Tgi - T_star) * (1.0 - exp(-NTU))  # eq. 15e: Tgi - Tgo
-    Qgb = Gg * cg * drop  # eq. 9
-    Qgm = F * (he * Agb * (Tb - Tm) + Qgb) / (1.0 + F)  # eq. 10
-    Qbm = p[I_HBM] * Abm * (Tm - Tb)  # eq. 11
-    return Tgi - drop, Qgb, Qgm, Qbm
+    return gas_heat_flows(Tb, Tm, Gg, Tgi, exchanger(Tb, Tm, X, Gg, Tgi, p), p)
 
 
 @register_jitable
@@ -290,14 +297,15 @@ def derivatives(Tb, Tm, X, He, Ta, H, Gg, Tgi, heater, fan, p):
     :func:`heater_power_kW` turn them into what the chamber sees.
     """
     g, T = gas_inputs(Gg, Tgi, H, fan, p)
-    Tgo, Qgb, Qgm, Qbm = heat_flows(Tb, Tm, X, g, T, p)
+    path = exchanger(Tb, Tm, X, g, T, p)  # eq. 15e's gas path, once per evaluation
+    Tgo, Qgb, Qgm, Qbm = gas_heat_flows(Tb, Tm, g, T, path, p)
     dX = moisture_rate_1_s(Tb, X, p)  # eq. 15c
     Qr = reaction_heat_rate_kW_kg(Tb, He, p)  # eq. 15d
     Mbd = p[I_MBD]
     cs = 1.099 + 0.007 * Tb  # partial heat capacity of bean solids, section 3.2
     dTb = (Qgb - Qgm + Qbm + Mbd * (Qr + p[I_LAM] * dX)) / (Mbd * (cs + p[I_CW] * X))  # eq. 15a
     dTm = (Qgm - Qbm + heater_power_kW(H, p) - shell_loss_kW(Tm, p)) / (p[I_MM] * p[I_CM])  # eq. 15b, eq. 12's Qe
-    dTa = probe_rate_C_s(Tb, Ta, probe_gas_C(Tb, Tm, X, g, T, Tgo, p), p)  # eq. 17 (probe immersion: extension)
+    dTa = probe_rate_C_s(Tb, Ta, probe_gas_C(T, Tgo, path[0], path[1], p), p)  # eq. 17 (probe immersion: extension)
     dH = (heater - H) / p[I_TAUH]  # actuator lag (extension)
     return dTb, dTm, dX, Qr, dTa, dH
 
