@@ -222,7 +222,7 @@ def scaling(model, column_map, paths, nominal_val, lines):
 def variants_and_bands(column_map, paths, lines):
     """Each bed-law variant (roastlab.model.bed) fitted on the same 490-500 g logs: held-out
     nominal FIT, every other size predicted, and the 90 % band's coverage (roastlab.evaluate.bands)."""
-    from roastlab.evaluate.bands import band_coverage
+    from roastlab.evaluate.bands import band_coverage, share_inside
     from roastlab.model.bed import VARIANTS
 
     example = ROOT / "examples" / "bullet"
@@ -241,13 +241,10 @@ def variants_and_bands(column_map, paths, lines):
         v_val, v_oth = model.validate(val_b), model.validate(oth_b)
         cov_val, cov_oth = band_coverage(model, val_b), band_coverage(model, oth_b)
 
-        def inside(rows):
-            return sum(r["inside"] * r["n"] for r in rows) / sum(r["n"] for r in rows)
-
         width = float(np.median([r["median_width_C"] for r in cov_val + cov_oth]))
         lines.append(
             f"| {name} | {v_val.average['FIT']:.1f} / {v_val.average['MAE']:.2f} | {v_oth.average['FIT']:.1f} "
-            f"| {v_oth.output_average('Tb2')['FIT']:.1f} | {inside(cov_val):.0%} | {inside(cov_oth):.0%} | {width:.1f} |"
+            f"| {v_oth.output_average('Tb2')['FIT']:.1f} | {share_inside(cov_val):.0%} | {share_inside(cov_oth):.0%} | {width:.1f} |"
         )
         print(f"variant {name}: held-out {v_val.average['FIT']:.1f} %, others {v_oth.average['FIT']:.1f} %", file=sys.stderr)
     lines.append("")

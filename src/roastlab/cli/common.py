@@ -82,6 +82,18 @@ def json_text(doc) -> str:
     return json.dumps(jsonable(doc), indent=1, allow_nan=False) + "\n"
 
 
+def check_targets(outputs, *targets, plot=None) -> None:
+    """Refuse a run's output targets before any work: each given path (:meth:`Outputs.check`: not
+    an input, a link, a folder ...) and the figure's suffix (``plot``, one Matplotlib can write)."""
+    from ..report.figures import check_figure_path
+
+    for target in (*targets, plot):
+        if target:
+            outputs.check(target)
+    if plot:
+        check_figure_path(plot)
+
+
 def write_json_and_plot(out, args, doc, figure) -> None:
     """Write ``--json`` (``doc``) and ``--plot`` (``figure.plot``) through ``out`` when asked for."""
     if args.json:

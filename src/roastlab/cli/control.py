@@ -9,6 +9,7 @@ from ..errors import InputError
 from .common import (
     MODEL_HELP,
     Parser,
+    check_targets,
     float_arg,
     model_from_args,
     progress,
@@ -37,16 +38,11 @@ def cmd_control(args) -> int:
     from ..control import load_scenario, make_controller, run_closed_loop
     from ..control.loop import find_scenario
     from ..io.files import Outputs
-    from ..report.figures import check_figure_path
 
     if args.what == "compare":
         return cmd_control_compare(args)
     outputs = Outputs([args.reference, args.model, args.map, args.plant, args.scenario])
-    for target in (args.out, args.json, args.plot):
-        if target:
-            outputs.check(target)
-    if args.plot:
-        check_figure_path(args.plot)
+    check_targets(outputs, args.out, args.json, plot=args.plot)
     controller = make_controller(args.controller)
     if args.ror_weight:
         if args.controller != "mpc":
@@ -75,7 +71,6 @@ def cmd_control(args) -> int:
 def cmd_control_compare(args) -> int:
     from ..control import compare, make_controller, standard_scenarios
     from ..io.files import Outputs
-    from ..report.figures import check_figure_path
 
     scenarios = standard_scenarios()
     if args.scenarios:
@@ -86,11 +81,7 @@ def cmd_control_compare(args) -> int:
         if not scenarios:
             raise InputError("no .toml scenario files in this folder", folder)
     outputs = Outputs([args.reference, args.model, args.map, args.plant, *scenarios])
-    for target in (args.json, args.plot):
-        if target:
-            outputs.check(target)
-    if args.plot:
-        check_figure_path(args.plot)
+    check_targets(outputs, args.json, plot=args.plot)
     names = [c.strip() for c in args.controllers.split(",") if c.strip()]
     controllers = [make_controller(c) for c in names]
     if not controllers:

@@ -8,6 +8,7 @@ from ..errors import InputError
 from .common import (
     add_batch_options,
     add_model_options,
+    check_targets,
     count_arg,
     fit_inputs,
     float_arg,
@@ -20,20 +21,21 @@ from .common import (
     say,
     seed_arg,
     weights_arg,
+    write_json_and_plot,
 )
 
 
 def level_arg(text: str) -> float:
-    """argparse type of --band: a level in (0, 1)."""
+    """argparse type of --band: a number (float_arg) that is a band level (evaluate.bands.check_level)."""
     import argparse
 
+    from ..errors import ParameterError
+    from ..evaluate.bands import check_level
+
     try:
-        v = float(text)
-    except ValueError:
-        v = float("nan")
-    if not 0.0 < v < 1.0:
-        raise argparse.ArgumentTypeError(f"a band level is a number in (0, 1), e.g. 0.9, got {text!r}")
-    return v
+        return check_level(float_arg("--band")(text))
+    except ParameterError as exc:
+        raise argparse.ArgumentTypeError(exc.problem) from None
 
 
 FIT_HELP_COMPARE = "logs with their green weight (raw logs with --map, or batch CSVs)"
@@ -118,14 +120,10 @@ def _identify_per_batch(args, batches, plant_spec, fix, bounds, outputs) -> int:
 
 def cmd_validate(args) -> int:
     from ..io.files import Outputs
-    from ..report.figures import check_figure_path, plot_fit
+    from ..report.figures import plot_fit
 
     outputs = Outputs(fit_inputs(args))
-    for target in (args.json, args.plot):
-        if target:
-            outputs.check(target)
-    if args.plot:
-        check_figure_path(args.plot)
+    check_targets(outputs, args.json, plot=args.plot)
     if args.predictions:
         outputs.folder(args.predictions, create=False)
     if args.baseline:
@@ -170,17 +168,11 @@ def cmd_compare_models(args) -> int:
     from ..workflows.compare import compare_models
 
     outputs = Outputs(fit_inputs(args))
-    for path in (args.json, args.plot):
-        if path:
-            outputs.check(path)
+    check_targets(outputs, args.json, plot=args.plot)
     batches, plant_spec = load_batches(args)
-    for path in (args.json, args.plot):  # again, now that the files a dataset folder names were read
-        if path:
-            outputs.check(path)
+    check_targets(outputs, args.json, args.plot)  # again, now that the files a dataset folder names were read
     if plant_spec is None:
         raise InputError("--plant is required unless a dataset folder names its plant", "command line")
-    if args.group_step_kg is not None and not args.group_step_kg > 0:
-        raise InputError(f"--group-step-kg must be a positive mass, got {args.group_step_kg:g}", "command line")
     result = compare_models(
         batches,
         plant_spec,
@@ -194,16 +186,13 @@ def cmd_compare_models(args) -> int:
     )
     print(result.summary())
     with outputs as out:
-        if args.json:
-            out.write_text(args.json, json_text(result.to_dict()))
-        if args.plot:
-            result.plot(args.plot, outputs=out)
+        write_json_and_plot(out, args, result.to_json_dict(), result)
     return 0
 
 
 def _band_table(model, batches, level, plant_spec, changes) -> dict:
     """Print and return how often each batch's measured probe lies inside the model's band."""
-    from ..evaluate.bands import band_coverage
+    from ..evaluate.bands import band_coverage, share_inside
 
     if changes or plant_spec not in (None, model.plant):
         raise InputError(
@@ -218,7 +207,7 @@ def _band_table(model, batches, level, plant_spec, changes) -> dict:
     for r in rows:
         kg = "" if not r["Mb_kg"] else f"{r['Mb_kg']:.3g}"
         print(f"{r['name'][:36]:<36} {kg:>6} {r['inside']:>7.0%} {r['median_width_C']:>10.1f} °C")
-    inside = sum(r["inside"] * r["n"] for r in rows) / max(sum(r["n"] for r in rows), 1)
+    inside = share_inside(rows)
     print(f"{'all samples':<36} {'':>6} {inside:>7.0%}   (a calibrated band holds about {level:.0%})")
     return {"level": level, "inside_all": inside, "batches": rows}
 

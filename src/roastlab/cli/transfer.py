@@ -7,6 +7,7 @@ import argparse
 from ..errors import InputError
 from .common import (
     MODEL_HELP,
+    check_targets,
     float_arg,
     range_arg,
     read_inputs,
@@ -19,16 +20,11 @@ def cmd_transfer(args) -> int:
     from ..fit.program import ProgramLimits
     from ..io.files import Outputs
     from ..model.limits import check_value
-    from ..report.figures import check_figure_path
     from ..workflows.model import load_model
     from ..workflows.transfer import default_limits, transfer
 
     outputs = Outputs([args.reference, args.model, args.map, args.plant_from, args.plant_to])
-    for target in (args.out, args.json, args.plot, args.alog):
-        if target:
-            outputs.check(target)
-    if args.plot:
-        check_figure_path(args.plot)
+    check_targets(outputs, args.out, args.json, args.alog, plot=args.plot)
     if args.gg is not None and (args.gg_min is not None or args.gg_max is not None):
         raise InputError(
             "--gg fixes the flow; --gg-min/--gg-max let the optimiser choose it: give one or the other", "command line"

@@ -7,6 +7,7 @@ import argparse
 from .common import (
     MODEL_HELP,
     add_initial_options,
+    check_targets,
     float_arg,
     initial_changes,
     read_inputs,
@@ -18,16 +19,11 @@ from .common import (
 def cmd_whatif(args) -> int:
     from ..io.files import Outputs
     from ..io.importers.mapping import load_map
-    from ..report.figures import check_figure_path
     from ..workflows.model import load_model
     from ..workflows.whatif import parse_set, parse_setting_change, whatif
 
     outputs = Outputs([args.log, args.model, args.map])
-    for target in (args.json, args.plot):
-        if target:
-            outputs.check(target)
-    if args.plot:
-        check_figure_path(args.plot)
+    check_targets(outputs, args.json, plot=args.plot)
     model = load_model(args.model)
     cmap = load_map(args.map) if args.map else model.column_map
     units = cmap.setting_units() if cmap is not None else {}

@@ -40,7 +40,7 @@ from ..metrics.profile import crossing_or_projected_s, rate_of_rise_C_per_min
 from ..model.layout import S_HE, S_TA, S_TB, S_TM, S_X
 from ..model.parameters import REGISTRY
 from ..model.rhs import N_STATES, P
-from ..report.result import Result, draw_curves
+from ..report.result import Result, aligned, draw_curves
 from ..sim.kernels import H0_S
 from ..sim.simulate import advance
 from .base import LoopSetup
@@ -474,11 +474,7 @@ class Comparison(Result):
             a = r.get("oracle_rmse_C")
             cells.append("-" if a is None else f"{a:.2f}")
             lines.append(cells)
-        widths = [max(len(str(row[i])) for row in lines) for i in range(len(head))]
-        text = [
-            "  ".join(str(c).ljust(w) if i < 2 else str(c).rjust(w) for i, (c, w) in enumerate(zip(row, widths)))
-            for row in lines
-        ]
+        text = aligned(lines, left=2)
         s = self.statistics()
         text.append("")
         text.append("mean RMSE: " + ", ".join(f"{c} {v:.2f} °C" for c, v in s["mean_rmse_C"].items()))

@@ -59,12 +59,17 @@ def roast_spread(time_s, measured, predicted) -> dict | None:
     return {"time_s": grid[keep].tolist(), "rms_C": [round(float(v), 4) for v in rms], "logs": int(len(time_s))}
 
 
+def check_level(level) -> float:
+    """A band level in (0, 1), or :class:`~roastlab.errors.ParameterError`."""
+    if isinstance(level, bool) or not (isinstance(level, (int, float)) and 0.0 < level < 1.0):
+        raise ParameterError(f"band level must be in (0, 1), e.g. 0.9, got {level!r}")
+    return float(level)
+
+
 def _z(level: float) -> float:
     from scipy.stats import norm
 
-    if not (isinstance(level, (int, float)) and 0.0 < level < 1.0):
-        raise ParameterError(f"band level must be in (0, 1), e.g. 0.9, got {level!r}")
-    return float(norm.ppf(0.5 + level / 2.0))
+    return float(norm.ppf(0.5 + check_level(level) / 2.0))
 
 
 def _new_roast_quantile(level: float, n_logs: int) -> float:
@@ -162,6 +167,13 @@ def prediction_bands(
         half = np.sqrt((z * sp) ** 2 + (z_roasts * sr) ** 2)
         out.append(Band(r.name, t, r.Ta_C, r.Ta_C - half, r.Ta_C + half, sp, sr, level))
     return out
+
+
+def share_inside(rows: list[dict]) -> float:
+    """The share of all measured samples inside the band over the rows of :func:`band_coverage`
+    (each batch weighted by its samples)."""
+    n = sum(r["n"] for r in rows)
+    return sum(r["inside"] * r["n"] for r in rows if r["n"]) / n if n else float("nan")
 
 
 def band_coverage(model, batches, level: float = BAND_LEVEL, samples: int = BAND_SAMPLES, seed: int = 0) -> list[dict]:

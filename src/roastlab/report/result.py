@@ -73,6 +73,16 @@ class Result:
         return out + frame.head(12).to_html(float_format=lambda v: f"{v:.4g}")
 
 
+def aligned(rows: list[list], left: int = 1) -> list[str]:
+    """Rows of cells as text lines in aligned columns, two spaces apart: the first ``left`` columns
+    left-aligned (names), the others right-aligned (numbers)."""
+    widths = [max(len(str(row[i])) for row in rows) for i in range(len(rows[0]))]
+    return [
+        "  ".join(str(c).ljust(w) if i < left else str(c).rjust(w) for i, (c, w) in enumerate(zip(row, widths)))
+        for row in rows
+    ]
+
+
 def draw_curves(ax, curves: dict, ylabel: str = "temperature [°C]") -> None:
     """``curves`` {label: (time_s, values)} on ``ax`` against minutes, labelled and with a legend."""
     import numpy as np

@@ -24,8 +24,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
-from ..model.bed import PAPER_BED, VARIANTS, BedLaws
-from ..report.result import Result
+from ..model.bed import VARIANTS, BedLaws
+from ..report.result import Result, aligned
 
 #: Default group step as a share of the median green weight (a tenth: 490 and 500 g together).
 GROUP_STEP_SHARE = 0.1
@@ -131,10 +131,7 @@ class ModelComparison(Result):
                     *(f"{s.cv_by_group[g]:.1f}" for g in groups),
                 ]
             )
-        widths = [max(len(r[i]) for r in table) for i in range(len(cols))]
-        lines = [head, ""]
-        for r in table:
-            lines.append("  ".join(c.ljust(w) if i == 0 else c.rjust(w) for i, (c, w) in enumerate(zip(r, widths))))
+        lines = [head, "", *aligned(table)]
         best = self.best
         by_aic = min(self.scores, key=lambda s: s.aic)
         lines += ["", f"best by leave-one-size-out FIT: {best.name} ({best.cv_FIT:.1f} %)"]
@@ -188,22 +185,12 @@ class ModelComparison(Result):
         ax.grid(axis="y", alpha=0.3)
 
     def _figure(self, path, outputs, title=None):
-        import matplotlib.pyplot as plt
+        from ..report.figures import finish_figure, new_figure
 
-        from ..report.figures import save_figure
-
-        fig, ax = plt.subplots(figsize=(9, 5.2))
-        self._draw(ax)
-        ax.set_title(title or "Leave-one-size-out: each batch size predicted by a model fitted on the others")
-        fig.tight_layout()
-        save_figure(fig, path, outputs)
-        return fig
-
-
-def _fit(batches, plant, spec, laws, column_map, seed, starts):
-    from .fitting import fit
-
-    return fit(batches, plant, spec, column_map=column_map, seed=seed, starts=starts, bed=laws)
+        fig = new_figure(figsize=(9, 5.2))
+        self._draw(fig.add_subplot(1, 1, 1))
+        title = title or "Leave-one-size-out: each batch size predicted by a model fitted on the others"
+        return finish_figure(fig, path, title, outputs)
 
 
 def compare_models(
@@ -229,12 +216,14 @@ def compare_models(
     step_kg : the group step (default :data:`GROUP_STEP_SHARE` of the median green weight)
     progress : callable ``progress(done, total, text)``
     """
+    from .fitting import fit
+
     if variants is None:
         variants = VARIANTS
-    if not isinstance(variants, dict):
-        parsed = [BedLaws.parse(v) for v in variants]
-        variants = {b.name: b for b in parsed}
-    variants = {name: BedLaws.parse(v) for name, v in variants.items()}
+    if isinstance(variants, dict):
+        variants = {name: BedLaws.parse(v) for name, v in variants.items()}
+    else:
+        variants = {laws.name: laws for laws in map(BedLaws.parse, variants)}
     if not variants:
         raise InputError("no model variants to compare", "command line")
     batches = list(batches)
@@ -251,7 +240,7 @@ def compare_models(
     for name, laws in variants.items():
         if progress:
             progress(done, total, f"{name}: all logs")
-        full = _fit(batches, plant, spec, laws, column_map, seed, starts)
+        full = fit(batches, plant, spec, column_map=column_map, seed=seed, starts=starts, bed=laws)
         done += 1
         ident = full.identification
         u = ident.uncertainty
@@ -262,7 +251,7 @@ def compare_models(
                 progress(done, total, f"{name}: without {g}")
             train = [b for b, lab in zip(batches, labels) if lab != g]
             test = [b for b, lab in zip(batches, labels) if lab == g]
-            model = _fit(train, plant, spec, laws, column_map, seed, starts).model
+            model = fit(train, plant, spec, column_map=column_map, seed=seed, starts=starts, bed=laws).model
             v = model.validate(test)
             by_group[g] = float(v.average["FIT"])
             by_batch.update({n: float(r["FIT"]) for n, r in zip(v.names, v.rows)})
@@ -290,4 +279,4 @@ def compare_models(
     return ModelComparison(scores, groups, step)
 
 
-__all__ = ["ModelComparison", "VariantScore", "compare_models", "size_groups", "PAPER_BED"]
+__all__ = ["ModelComparison", "VariantScore", "compare_models", "size_groups"]
