@@ -202,7 +202,6 @@ def model_from_args(args, plant_spec):
             model.doc[key] = getattr(args, key)
             setattr(model, key, getattr(args, key))
     if getattr(args, "bed", None) is not None:
-        model.doc["bed"] = args.bed.as_dict()
         model.bed = args.bed
     return model
 

@@ -111,11 +111,18 @@ class FittedModel:
         self.initial: dict = doc.get("initial") or {}
         self.moisture: str = doc.get("moisture", "schwartzberg")
         self.hold: str = doc.get("hold", "linear")
-        #: the bed laws (:mod:`roastlab.model.bed`; the paper's unless the model file says otherwise)
-        self.bed: BedLaws = BedLaws.parse(doc.get("bed"))
         m = doc.get("map")
         self.column_map: ColumnMap | None = None if m is None else map_from_mapping(copy.deepcopy(m), "model file map")
         self.source: str | None = doc.get("_source")
+
+    @property
+    def bed(self) -> BedLaws:
+        """The bed laws (:mod:`roastlab.model.bed`): the model file's ``bed``, else the paper's."""
+        return BedLaws.parse(self.doc.get("bed"))
+
+    @bed.setter
+    def bed(self, laws) -> None:
+        self.doc["bed"] = BedLaws.parse(laws).as_dict()
 
     # ------------------------------------------------------------------ construction
     @classmethod
