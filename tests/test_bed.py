@@ -10,13 +10,13 @@ import numpy as np
 import pytest
 
 from reference_model import bed_segment
-from roastlab import InitialState, simulate
 from roastlab.errors import InputError, ParameterError
 from roastlab.model import rhs
 from roastlab.model.bed import PAPER_BED, VARIANTS, BedLaws
 from roastlab.model.constants import GREEN_BULK_DENSITY_KG_M3
 from roastlab.model.layout import P
 from roastlab.model.plant import as_plant
+from test_physics import steady_probe_run
 
 
 def test_wall_contact_area_by_hand():
@@ -55,32 +55,16 @@ def test_paper_bed_packs_the_paper_and_codes_each_law():
     assert rhs.bed_areas_m2(paper) == rhs.bean_areas_m2(plant.Ab_m2, 0.5793)
 
 
-def _run(plant, bed=None, **values):
-    t = np.arange(0.0, 40001.0, 50.0)
-    n = len(t)
-    return simulate(
-        plant,
-        t,
-        np.full(n, 6.0),
-        np.full(n, 25.0),
-        theta=(0.005, 0.05, 0.6),
-        initial=InitialState(Tb0_C=25.0, Tm0_C=25.0, X0=0.0, He0_kJ_kg=232.0, Ta0_C=25.0),
-        heater=np.full(n, 400.0),
-        values={"Qe_gain_kW": 0.5, "tau_heater_s": 20.0, **values},
-        bed=bed,
-    )
-
-
 def test_tumbling_probe_reads_its_covered_mix_and_is_eq17_without_a_depth():
     """Steady state: Ta = c Tb + (1 - c) Tgo with c = 1 - exp(-h_bed/h_probe); with h_probe 0 the
     tumbling law is eq. 17 bit for bit, like the law at rest."""
     plant = as_plant("120kg")
     h = plant.bed_depth_m
-    r = _run(plant, "probe=tumbling", h_probe_m=h)
+    r = steady_probe_run(plant, "probe=tumbling", h_probe_m=h)
     c = 1.0 - math.exp(-1.0)
     assert r.Tb_C[-1] - r.Tgo_C[-1] > 50
     assert r.Ta_C[-1] == pytest.approx(c * r.Tb_C[-1] + (1 - c) * r.Tgo_C[-1], abs=1e-3)
-    assert np.array_equal(_run(plant, "probe=tumbling").states, _run(plant).states)
+    assert np.array_equal(steady_probe_run(plant, "probe=tumbling").states, steady_probe_run(plant).states)
 
 
 def test_mean_gas_is_the_mean_of_the_exchanger_profile():

@@ -214,27 +214,33 @@ def test_bed_depth_is_the_circular_segment_of_the_fill(mass_kg):
     assert half.bed_depth_m == pytest.approx(R, rel=1e-9)  # a half-full drum: the bed reaches the axis
 
 
+def steady_probe_run(plant, bed=None, **extra):
+    """Eleven hours of much air through a drum heated by the heater: at the end the states are
+    steady and the gas leaves well below the beans, so the probe's covered share shows."""
+    from roastlab.sim.simulate import InitialState, simulate
+
+    t = np.arange(0.0, 40001.0, 50.0)
+    n = len(t)
+    return simulate(
+        plant,
+        t,
+        np.full(n, 6.0),
+        np.full(n, 25.0),
+        theta=(0.005, 0.05, 0.6),
+        initial=InitialState(Tb0_C=25.0, Tm0_C=25.0, X0=0.0, He0_kJ_kg=232.0, Ta0_C=25.0),
+        heater=np.full(n, 400.0),
+        values={"Qe_gain_kW": 0.5, "tau_heater_s": 20.0, **extra},
+        bed=bed,
+    )
+
+
 def test_probe_immersion_reads_the_covered_mix_at_steady_state():
     """At steady state a probe covered over a share c = h_bed / h_probe reads c Tb + (1 - c) Tgo
     (eq. 17 extended); with h_probe 0 (the paper) or below the bed it reads Tb, bit for bit as eq. 17."""
-    from roastlab.sim.simulate import InitialState, simulate
-
     plant = load_plant("120kg")
-    t = np.arange(0.0, 40001.0, 50.0)
-    n = len(t)
-    base = {"Qe_gain_kW": 0.5, "tau_heater_s": 20.0}
 
-    def run(**extra):  # much air through a drum heated by the heater: the gas leaves well below the beans
-        return simulate(
-            plant,
-            t,
-            np.full(n, 6.0),
-            np.full(n, 25.0),
-            theta=(0.005, 0.05, 0.6),
-            initial=InitialState(Tb0_C=25.0, Tm0_C=25.0, X0=0.0, He0_kJ_kg=232.0, Ta0_C=25.0),
-            heater=np.full(n, 400.0),
-            values={**base, **extra},
-        )
+    def run(**extra):
+        return steady_probe_run(plant, **extra)
 
     half = run(h_probe_m=2 * plant.bed_depth_m)
     assert half.Tb_C[-1] - half.Tgo_C[-1] > 50  # the gas is much cooler than the beans, so c matters
