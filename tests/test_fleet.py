@@ -343,3 +343,95 @@ def test_a_scheduler_address_without_protocol_or_port_is_one_line(cli, fleet, ad
     _, db, _ = fleet
     code, _, err = cli("fleet", "fit", "--db", db, "--scheduler", address)
     assert code == 2 and "tcp://host:8786" in err and err.count("\n") == 1, err
+
+
+def _small_store(fleet, path):
+    """A copy of the module's fitted store (the fixture's own file is never touched)."""
+    import shutil
+
+    _, db, _ = fleet
+    shutil.copyfile(db, path)
+    return path
+
+
+def _digest(path):
+    import hashlib
+
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def test_a_foreign_database_or_another_schema_version_is_refused_untouched(cli, fleet, tmp_path):
+    other = tmp_path / "analytics.duckdb"
+    con = duckdb.connect(str(other))
+    con.execute("CREATE TABLE sales (day DATE, amount DOUBLE)")
+    con.execute("INSERT INTO sales VALUES ('2024-01-01', 3.5)")
+    con.close()
+    before = _digest(other)
+    for args in (("fit",), ("ingest", "--manifest", fleet[0] / "data" / "manifest.csv"), ("report",)):
+        code, _, err = cli("fleet", args[0], "--db", other, *args[1:])
+        assert code == 2 and "not a roastlab fleet store" in err and "sales" in err and err.count("\n") == 1, err
+    assert _digest(other) == before
+    newer = _small_store(fleet, tmp_path / "newer.duckdb")
+    con = duckdb.connect(str(newer))
+    con.execute("UPDATE meta SET value = '7' WHERE key = 'schema_version'")
+    con.close()
+    before = _digest(newer)
+    code, _, err = cli("fleet", "fit", "--db", newer)
+    assert code == 2 and "newer roastlab" in err and err.count("\n") == 1, err
+    assert _digest(newer) == before
+
+
+@pytest.mark.parametrize("damage", ["view", "column", "half", "blocks"])
+def test_a_damaged_store_is_one_line_naming_it(cli, fleet, tmp_path, damage):
+    db = _small_store(fleet, tmp_path / "d.duckdb")
+    if damage in ("view", "column"):
+        con = duckdb.connect(str(db))
+        if damage == "view":
+            con.execute("ALTER TABLE series RENAME TO series_old")
+            con.execute("CREATE VIEW series AS SELECT * FROM series_old")
+        else:
+            con.execute("ALTER TABLE fits DROP COLUMN MAE")
+        con.close()
+    else:
+        raw = bytearray(db.read_bytes())
+        if damage == "half":
+            raw = raw[: len(raw) // 2]
+        else:  # overwrite blocks past the headers with noise
+            rng = np.random.default_rng(0)
+            a = len(raw) // 3
+            raw[a : a + 200_000] = rng.integers(0, 256, min(200_000, len(raw) - a), dtype=np.uint8).tobytes()
+        db.write_bytes(bytes(raw))
+    for what in ("report", "fit"):
+        code, out, err = cli("fleet", what, "--db", db)
+        assert code == 2 and str(db) in err and err.count("\n") == 1 and "Traceback" not in err, (what, err)
+
+
+def test_a_store_locked_by_another_process_says_so_and_can_be_waited_for(cli, fleet, tmp_path):
+    import time
+
+    db = _small_store(fleet, tmp_path / "l.duckdb")
+    holder = subprocess.Popen(
+        [
+            sys.executable,
+            "-c",
+            "import duckdb,sys,time; c=duckdb.connect(sys.argv[1]); print('held', flush=True); "
+            "time.sleep(float(sys.argv[2]))",
+            str(db),
+            "3",
+        ],
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert holder.stdout.readline().strip() == "held"
+        code, _, err = cli("fleet", "report", "--db", db)
+        assert code == 2 and "in use by another process" in err and f"PID {holder.pid}" in err, err
+        assert err.count("\n") == 1 and "--wait" in err
+        t0 = time.monotonic()
+        code, out, err = cli("fleet", "fit", "--db", db, "--wait", "60")
+        assert code == 0, err
+        assert time.monotonic() - t0 >= 1.0  # it waited for the holder rather than failing
+    finally:
+        holder.kill()
+        holder.wait()
+        holder.stdout.close()

@@ -199,6 +199,29 @@ def test_a_parquet_with_a_duplicated_column_is_one_line(cli, tmp_path):
     assert code == 2 and "more than once" in err and err.count("\n") == 1, err
 
 
+def test_parquet_columns_are_checked_from_the_footer(cli, tmp_path, monkeypatch):
+    """Only the columns the map reads are decoded: a junk list column beside them is ignored,
+    a wanted column of lists, strings or integers-with-gaps is judged by its type, and the wanted
+    columns' decoded size is bounded from the footer's page sizes."""
+    pa = pytest.importorskip("pyarrow")
+    pq = pytest.importorskip("pyarrow.parquet")
+    from roastlab.errors import InputError
+    from roastlab.io.importers import mapping
+
+    base = {"time_s": [0.0, 30.0, 60.0], "Gg_kg_s": [0.4] * 3, "Tgi_C": [450, None, 450], "Ta_C": [30.0, 50.0, 70.0]}
+    junk = pa.array([[1.0] * 50] * 3)
+    pq.write_table(pa.table({**base, "junk": junk}), tmp_path / "ok.parquet")
+    b = import_log(tmp_path / "ok.parquet", None)  # an integer column with a gap: that sample is dropped, said
+    assert b.n == 2 and b.Ta_C[-1] == 70.0 and "incomplete" in " ".join(b.notes)
+    pq.write_table(pa.table({**base, "Ta_C": [["a"], ["b"], ["c"]]}), tmp_path / "lists.parquet")
+    code, _, err = cli("import", tmp_path / "lists.parquet", "--out", tmp_path / "o.csv")
+    assert code == 2 and "column Ta_C" in err and "not one number per row" in err and err.count("\n") == 1, err
+    monkeypatch.setattr(mapping, "MAX_PARQUET_DECODED_BYTES", 100)
+    with pytest.raises(InputError, match="would decode to"):
+        import_log(tmp_path / "ok.parquet", None)
+    assert not (tmp_path / "o.csv").exists()
+
+
 def test_import_cli_then_simulate(cli, real_data, tmp_path):
     m = write_map(tmp_path, SKY_MAP)
     out = tmp_path / "batch.csv"

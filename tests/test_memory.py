@@ -109,6 +109,36 @@ def _parquet(path):
     return n
 
 
+def _parquet_bomb(kind):
+    """A small Parquet log whose ``bt`` column decodes to gigabytes: 2 million rows of 100-number
+    lists (1.6 GB) or of 3,000-character strings (6 GB), written as repeated row groups that
+    compress to a few MB. Refused from its footer, before a page is decoded."""
+
+    def build(path):
+        pa = pytest.importorskip("pyarrow")
+        pq = pytest.importorskip("pyarrow.parquet")
+        n, reps = 10_000, 200
+        if kind == "lists":
+            offsets = pa.array(np.arange(0, 100 * n + 1, 100, dtype=np.int32))
+            bt = pa.ListArray.from_arrays(offsets, pa.array(np.full(100 * n, 150.0)))
+        else:
+            bt = pa.array(["x" * 3000] * n)
+        table = pa.table({"t": np.arange(n, dtype=float), "bt": bt, "et": np.full(n, 300.0), "flow": np.full(n, 0.01)})
+        with pq.ParquetWriter(path, table.schema) as writer:
+            for _ in range(reps):
+                writer.write_table(table)
+        return n * reps
+
+    return build
+
+
+_PARQUET_LOADER = (
+    "from roastlab.io.importers.mapping import import_log, map_from_mapping\n"
+    "MAP = {'format': 'parquet', 'time': {'column': 't'}, 'Ta': {'column': 'bt'}, 'Tgi': {'column': 'et'},"
+    " 'Gg': {'column': 'flow'}}\n"
+    "load = lambda p: import_log(p, map_from_mapping(MAP, 'map'))"
+)
+
 CASES = {
     # name: (file name, text builder, loader source run in the child)
     "Aillio RoasTime JSON (series)": (
@@ -121,14 +151,9 @@ CASES = {
         lambda: _roastime_actions(MAX_INPUT_BYTES),
         "from roastlab.io.importers.roastime import read_roastime as load",
     ),
-    "Parquet log at the row limit (import)": (
-        "big.parquet",
-        _parquet,
-        "from roastlab.io.importers.mapping import import_log, map_from_mapping\n"
-        "MAP = {'format': 'parquet', 'time': {'column': 't'}, 'Ta': {'column': 'bt'}, 'Tgi': {'column': 'et'},"
-        " 'Gg': {'column': 'flow'}}\n"
-        "load = lambda p: import_log(p, map_from_mapping(MAP, 'map'))",
-    ),
+    "Parquet log at the row limit (import)": ("big.parquet", _parquet, _PARQUET_LOADER),
+    "Parquet bomb: 2 M rows of lists (refused)": ("bomb-lists.parquet", _parquet_bomb("lists"), _PARQUET_LOADER),
+    "Parquet bomb: 2 M long strings (refused)": ("bomb-strings.parquet", _parquet_bomb("strings"), _PARQUET_LOADER),
     "batch CSV": (
         "big.csv",
         lambda: _rows("time_s,Gg_kg_s,Tgi_C,Ta_C\n", lambda i: f"{i / 20:.2f},0.4,400,30\n", MAX_INPUT_BYTES),
@@ -235,4 +260,6 @@ def test_largest_accepted_input_parses_in_bounded_memory(case, tmp_path):
     result = json.loads(proc.stdout.strip().splitlines()[-1])
     assert "MemoryError" not in result["outcome"], result
     assert result["rss_mb"] <= RSS_BOUND_MB, (case, result)
+    if name.startswith("bomb"):
+        assert result["outcome"].startswith("refused") and "not one number per row" in result["outcome"], result
     print(f"{case}: {size / 1e6:.1f} MB file, peak RSS {result['rss_mb']:.0f} MB, {result['outcome'][:80]}")

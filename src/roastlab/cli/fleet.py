@@ -28,7 +28,7 @@ def cmd_fleet_ingest(args) -> int:
     from ..fleet import ingest
 
     _db_output(args.db, [args.manifest])
-    report = ingest(args.db, args.manifest, progress=progress("ingest"))
+    report = ingest(args.db, args.manifest, progress=progress("ingest"), wait_s=args.wait)
     for line in report.rejected:
         print(f"roastlab fleet ingest: rejected: {line}", file=sys.stderr)
     print(report.summary())
@@ -63,7 +63,13 @@ def cmd_fleet_fit(args) -> int:
     _db_output(args.db, [v.partition("=")[2] if "=" in v and not Path(v).exists() else v for v in args.spec or []])
     spec = _specs(args.spec)
     report = fit_fleet(
-        args.db, spec, workers=args.workers, scheduler=args.scheduler, chunk=args.chunk, progress=progress("fit")
+        args.db,
+        spec,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        chunk=args.chunk,
+        progress=progress("fit"),
+        wait_s=args.wait,
     )
     print(report.summary())
     return 0
@@ -135,6 +141,13 @@ def add_parsers(sub) -> None:
     )
     q.add_argument("--db", required=True, metavar="FLEET.duckdb", help="the store (created if missing)")
     q.add_argument("--manifest", required=True, metavar="MANIFEST.csv", help="CSV: path,machine,plant,started_at[,map]")
+    q.add_argument(
+        "--wait",
+        type=count_arg("--wait", 0, 86_400),
+        default=0,
+        metavar="SECONDS",
+        help="if another process has the store open, wait up to this long for it (default 0: refuse at once)",
+    )
     q.set_defaults(func=cmd_fleet_ingest)
 
     q = fsub.add_parser(
@@ -160,6 +173,13 @@ def add_parsers(sub) -> None:
         type=count_arg("--chunk", 1, 1_000_000),
         default=500,
         help="batches per task and commit (default 500)",
+    )
+    q.add_argument(
+        "--wait",
+        type=count_arg("--wait", 0, 86_400),
+        default=0,
+        metavar="SECONDS",
+        help="if another process has the store open, wait up to this long for it (default 0: refuse at once)",
     )
     q.set_defaults(func=cmd_fleet_fit)
 

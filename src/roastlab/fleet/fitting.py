@@ -31,7 +31,7 @@ from ..errors import InputError
 from ..io.batch import Batch
 from ..io.fitspec import FitSpec, load_fit_spec
 from ..model.parameters import DEFAULT_WEIGHTS, REGISTRY, THETA_NAMES, THETA_PAPER, THETA_START, FreeParameter
-from .store import SERIES_COLUMNS, filled, open_store, plant_of
+from .store import SERIES_COLUMNS, filled, open_store, plant_of, store_errors
 
 #: Batches per task: large enough that shipping and committing are noise against the fitting
 #: (~1-5 ms a batch), small enough that an interruption loses little.
@@ -309,6 +309,7 @@ def fit_fleet(
     chunk: int = CHUNK,
     progress=None,
     on_commit=None,
+    wait_s: float = 0.0,
 ) -> FleetFitReport:
     """Fit every batch of the store at ``db`` that has no fit with its machine's spec yet.
 
@@ -316,79 +317,83 @@ def fit_fleet(
     not named get the default) or None (the default, :data:`DEFAULT_FREE`). ``workers``,
     ``scheduler`` or an existing Dask ``client`` choose where the chunks run (module docstring).
     ``progress(done, total, text)`` follows the batches; ``on_commit(n)`` is called after each
-    committed chunk (the tests interrupt there).
+    committed chunk (the tests interrupt there). A store locked by another process is waited for
+    up to ``wait_s`` seconds.
     """
     from .drift import refresh_models
 
     t0 = time.perf_counter()
-    con = open_store(db)
+    con = open_store(db, wait_s=wait_s)
     report = FleetFitReport()
     default = fleet_spec()
     version = _version()
     owned = None
-    try:
-        machines = con.execute(
-            "SELECT machine_id, name, plant, plant_toml FROM machines ORDER BY machine_id"
-        ).fetchall()
-        specs = {}
-        for mid, name, _plant, _toml in machines:
-            s = spec.get(name, default) if isinstance(spec, dict) else (spec or default)
-            specs[mid] = s
-            report.specs[name] = s.spec_id
-        if isinstance(spec, dict):
-            unknown = sorted(set(spec) - {m[1] for m in machines})
-            if unknown:
-                raise InputError(
-                    f"no machine {', '.join(unknown)} in the store (has: {', '.join(m[1] for m in machines)})"
+    with store_errors(db):
+        try:
+            machines = con.execute(
+                "SELECT machine_id, name, plant, plant_toml FROM machines ORDER BY machine_id"
+            ).fetchall()
+            specs = {}
+            for mid, name, _plant, _toml in machines:
+                s = spec.get(name, default) if isinstance(spec, dict) else (spec or default)
+                specs[mid] = s
+                report.specs[name] = s.spec_id
+            if isinstance(spec, dict):
+                unknown = sorted(set(spec) - {m[1] for m in machines})
+                if unknown:
+                    raise InputError(
+                        f"no machine {', '.join(unknown)} in the store (has: {', '.join(m[1] for m in machines)})"
+                    )
+            for s in {s.spec_id: s for s in specs.values()}.values():
+                con.execute(
+                    "INSERT OR IGNORE INTO fit_specs VALUES (?, ?, ?)",
+                    [s.spec_id, json.dumps(s.document(), sort_keys=True), datetime.datetime.now(datetime.UTC)],
                 )
-        for s in {s.spec_id: s for s in specs.values()}.values():
-            con.execute(
-                "INSERT OR IGNORE INTO fit_specs VALUES (?, ?, ?)",
-                [s.spec_id, json.dumps(s.document(), sort_keys=True), datetime.datetime.now(datetime.UTC)],
-            )
-        work = []  # (machine id, ids of one chunk)
-        total = 0
-        for mid, _name, _plant, _toml in machines:
-            sid = specs[mid].spec_id
-            ids = [
-                r[0]
-                for r in con.execute(
-                    "SELECT batch_id FROM batches b WHERE machine_id = ? AND NOT EXISTS "
-                    "(SELECT 1 FROM fits f WHERE f.batch_id = b.batch_id AND f.spec_id = ?) ORDER BY batch_id",
+            work = []  # (machine id, ids of one chunk)
+            total = 0
+            for mid, _name, _plant, _toml in machines:
+                sid = specs[mid].spec_id
+                ids = [
+                    r[0]
+                    for r in con.execute(
+                        "SELECT batch_id FROM batches b WHERE machine_id = ? AND NOT EXISTS "
+                        "(SELECT 1 FROM fits f WHERE f.batch_id = b.batch_id AND f.spec_id = ?) ORDER BY batch_id",
+                        [mid, sid],
+                    ).fetchall()
+                ]
+                report.already += con.execute(
+                    "SELECT count(*) FROM fits f JOIN batches b USING (batch_id) WHERE b.machine_id = ? AND f.spec_id = ?",
                     [mid, sid],
-                ).fetchall()
-            ]
-            report.already += con.execute(
-                "SELECT count(*) FROM fits f JOIN batches b USING (batch_id) WHERE b.machine_id = ? AND f.spec_id = ?",
-                [mid, sid],
-            ).fetchall()[0][0]
-            total += len(ids)
-            work += [(mid, ids[a : a + chunk]) for a in range(0, len(ids), chunk)]
-        plants = {mid: plant_of(name, plant, toml) for mid, name, plant, toml in machines}
-        if client is None and (workers or scheduler):
-            client, owned = _client(workers, scheduler)
-        report.where = "in-process" if client is None else f"dask ({len(client.scheduler_info()['workers'])} workers)"
+                ).fetchall()[0][0]
+                total += len(ids)
+                work += [(mid, ids[a : a + chunk]) for a in range(0, len(ids), chunk)]
+            plants = {mid: plant_of(name, plant, toml) for mid, name, plant, toml in machines}
+            if client is None and (workers or scheduler):
+                client, owned = _client(workers, scheduler)
+            report.where = (
+                "in-process" if client is None else f"dask ({len(client.scheduler_info()['workers'])} workers)"
+            )
 
-        def done(mid, res):
-            _write(con, specs[mid], res, version)
-            report.fitted += len(res["batch_id"])
-            report.chunks += 1
-            if on_commit is not None:
-                on_commit(report.fitted)
-            if progress is not None:
-                progress(report.fitted, total, "batches fitted")
+            def done(mid, res):
+                _write(con, specs[mid], res, version)
+                report.fitted += len(res["batch_id"])
+                report.chunks += 1
+                if on_commit is not None:
+                    on_commit(report.fitted)
+                if progress is not None:
+                    progress(report.fitted, total, "batches fitted")
 
-        if client is None:
-            for mid, ids in work:
-                done(mid, fit_chunk(ids, _load_chunk(con, ids), plants[mid], specs[mid]))
-        else:
-            _run_on_dask(client, con, work, plants, specs, done)
-        refresh_models(con, {mid: s.spec_id for mid, s in specs.items()})
-    finally:
-        con.close()
-        if owned is not None:
-            client.close()
-            owned.close()
+            if client is None:
+                for mid, ids in work:
+                    done(mid, fit_chunk(ids, _load_chunk(con, ids), plants[mid], specs[mid]))
+            else:
+                _run_on_dask(client, con, work, plants, specs, done)
+            refresh_models(con, {mid: s.spec_id for mid, s in specs.items()})
+        finally:
+            con.close()
+            if owned is not None:
+                client.close()
+                owned.close()
     report.wall_s = time.perf_counter() - t0
     return report
 

@@ -11,7 +11,7 @@ import numpy as np
 from ..errors import InputError
 from ..report.result import Result
 from .drift import CLIP_Z, CUSUM_H, CUSUM_K, OUTLIER_FIT, OUTLIER_RATIO, WARMUP, analyse, machine_history, robust_stats
-from .store import open_store
+from .store import open_store, store_errors
 
 
 @dataclass
@@ -169,23 +169,24 @@ class FleetReport(Result):
 def fleet_report(db) -> FleetReport:
     """Analyse every machine of the store at ``db`` with the spec of its latest fit."""
     con = open_store(db, read_only=True)
-    try:
-        rows = con.execute(
-            "SELECT m.machine_id, m.name, m.plant, "
-            "(SELECT f.spec_id FROM fits f JOIN batches b USING (batch_id) WHERE b.machine_id = m.machine_id "
-            " ORDER BY f.fitted_at DESC LIMIT 1) FROM machines m ORDER BY m.machine_id"
-        ).fetchall()
-        if not any(r[3] for r in rows):
-            raise InputError("no fits in the store yet: run 'roastlab fleet fit' first", db)
-        machines = []
-        for mid, name, plant, sid in rows:
-            if sid is None:
-                continue
-            frame, vals = machine_history(con, mid, sid)
-            params = list(dict.fromkeys(vals["parameter"]))
-            res = analyse(frame, vals, params)
-            err = vals.pivot(index="batch_id", columns="parameter", values="stderr").reindex(frame["batch_id"])
-            machines.append(MachineHistory(name, plant, sid, frame, res["wide"][params], err[params], res))
-    finally:
-        con.close()
+    with store_errors(db):
+        try:
+            rows = con.execute(
+                "SELECT m.machine_id, m.name, m.plant, "
+                "(SELECT f.spec_id FROM fits f JOIN batches b USING (batch_id) WHERE b.machine_id = m.machine_id "
+                " ORDER BY f.fitted_at DESC LIMIT 1) FROM machines m ORDER BY m.machine_id"
+            ).fetchall()
+            if not any(r[3] for r in rows):
+                raise InputError("no fits in the store yet: run 'roastlab fleet fit' first", db)
+            machines = []
+            for mid, name, plant, sid in rows:
+                if sid is None:
+                    continue
+                frame, vals = machine_history(con, mid, sid)
+                params = list(dict.fromkeys(vals["parameter"]))
+                res = analyse(frame, vals, params)
+                err = vals.pivot(index="batch_id", columns="parameter", values="stderr").reindex(frame["batch_id"])
+                machines.append(MachineHistory(name, plant, sid, frame, res["wide"][params], err[params], res))
+        finally:
+            con.close()
     return FleetReport(machines, str(db))

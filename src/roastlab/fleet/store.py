@@ -35,11 +35,14 @@ Every write is one transaction: an ingest that fails part-way leaves the store a
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import datetime
+import functools
 import hashlib
 import io
 import json
+import re
 import time
 import tomllib
 from dataclasses import dataclass, field
@@ -96,33 +99,132 @@ def _duckdb():
     return duckdb
 
 
-def open_store(db: str | Path, read_only: bool = False):
-    """Open (creating if needed) the fleet store at ``db``; returns a DuckDB connection."""
+#: How often a store locked by another process is tried again while waiting [s].
+LOCK_POLL_S = 0.25
+
+
+def _connect(db: Path, read_only: bool, wait_s: float):
+    """A DuckDB connection to ``db``; a lock held by another process is waited for up to
+    ``wait_s`` seconds and then named as such (not as a damaged file)."""
     duckdb = _duckdb()
+    deadline = time.monotonic() + wait_s
+    while True:
+        try:
+            return duckdb.connect(str(db), read_only=read_only)
+        except duckdb.Error as exc:
+            text = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            if "lock" not in text.lower():
+                raise InputError(f"cannot open as a DuckDB fleet store ({text})", db) from None
+            if time.monotonic() < deadline:
+                time.sleep(LOCK_POLL_S)
+                continue
+            pid = re.search(r"PID (\d+)", text)
+            who = f" (PID {pid.group(1)})" if pid else ""
+            waited = f"still after {wait_s:g} s" if wait_s > 0 else "try again when it has finished, or wait for it"
+            raise InputError(
+                f"in use by another process{who}: {waited} (ingest and fit take --wait SECONDS)", db
+            ) from None
+
+
+@functools.cache
+def _schema_columns() -> dict[str, list[str]]:
+    """Each table of :data:`_SCHEMA` and its columns, read from DuckDB itself (one source)."""
+    con = _duckdb().connect(":memory:")
+    try:
+        con.execute(_SCHEMA)
+        rows = con.execute(
+            "SELECT table_name, column_name FROM information_schema.columns ORDER BY table_name, ordinal_position"
+        ).fetchall()
+    finally:
+        con.close()
+    out: dict[str, list[str]] = {}
+    for table, column in rows:
+        out.setdefault(table, []).append(column)
+    return out
+
+
+def _check_store(con, db: Path) -> bool:
+    """Whether the database behind ``con`` (opened read-only) is empty; raise unless it is empty
+    or a roastlab fleet store of :data:`SCHEMA_VERSION` with every table and column in place."""
+    kinds = dict(
+        con.execute(
+            "SELECT table_name, table_type FROM information_schema.tables WHERE table_catalog = current_database()"
+        ).fetchall()
+    )
+    if not kinds:
+        return True
+    if "meta" not in kinds:
+        shown = ", ".join(sorted(kinds)[:6]) + (", ..." if len(kinds) > 6 else "")
+        raise InputError(f"a DuckDB database but not a roastlab fleet store (its tables: {shown}); left untouched", db)
+    rows = con.execute("SELECT value FROM meta WHERE key = 'schema_version'").fetchall()
+    version = rows[0][0] if rows else None
+    if version != str(SCHEMA_VERSION):
+        newer = str(version).isdigit() and int(version) > SCHEMA_VERSION
+        why = "written by a newer roastlab" if newer else f"schema version {version!r}"
+        raise InputError(f"fleet store of {why}; this roastlab reads version {SCHEMA_VERSION}; left untouched", db)
+    for table, columns in _schema_columns().items():
+        if table not in kinds:
+            raise InputError(f"damaged fleet store: no table {table!r}", db)
+        if kinds[table] != "BASE TABLE":
+            raise InputError(f"damaged fleet store: {table!r} is a {kinds[table].lower()}, not a table", db)
+        have = {
+            r[0]
+            for r in con.execute(
+                "SELECT column_name FROM information_schema.columns WHERE table_catalog = current_database() "
+                "AND table_name = ?",
+                [table],
+            ).fetchall()
+        }
+        missing = [c for c in columns if c not in have]
+        if missing:
+            raise InputError(f"damaged fleet store: table {table!r} lacks column(s) {', '.join(missing)}", db)
+    return False
+
+
+@contextlib.contextmanager
+def store_errors(db):
+    """Turn any DuckDB error while working on the store into one line naming it."""
+    duckdb = _duckdb()
+    try:
+        yield
+    except duckdb.Error as exc:
+        text = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise InputError(f"fleet store unreadable or damaged ({text})", db) from None
+
+
+def open_store(db: str | Path, read_only: bool = False, wait_s: float = 0.0):
+    """Open (creating if needed) the fleet store at ``db``; returns a DuckDB connection.
+
+    An existing file is first opened read-only and checked (:func:`_check_store`): a foreign
+    database, another schema version or a damaged store is refused before anything is written.
+    A lock held by another process is waited for up to ``wait_s`` seconds.
+    """
     db = Path(db)
     if read_only and not db.exists():
         raise InputError("no such fleet store (create it with 'roastlab fleet ingest')", db)
     if db.exists() and not db.is_file():
         raise InputError("not a file", db)
-    try:
-        con = duckdb.connect(str(db), read_only=read_only)
-    except duckdb.Error as exc:
-        raise InputError(f"cannot open as a DuckDB fleet store ({str(exc).splitlines()[0]})", db) from None
-    con.execute("SET TimeZone = 'UTC'")
-    # DuckDB's buffer manager takes up to 80 % of RAM by default; a store of years of batches
-    # streams through far less (it spills to a temporary folder beside the file if it must)
-    con.execute(f"SET memory_limit = '{DUCKDB_MEMORY}'")
+    empty = True
+    if db.exists():
+        con = _connect(db, True, wait_s)
+        try:
+            with store_errors(db):
+                empty = _check_store(con, db)
+        finally:
+            if not read_only or empty:
+                con.close()
+        if read_only and empty:
+            raise InputError("an empty database, not a fleet store (create it with 'roastlab fleet ingest')", db)
     if not read_only:
-        con.execute(_SCHEMA)
-        con.execute("INSERT OR IGNORE INTO meta VALUES ('schema_version', ?)", [str(SCHEMA_VERSION)])
-    try:
-        rows = con.execute("SELECT value FROM meta WHERE key = 'schema_version'").fetchall()
-        row = rows[0] if rows else None
-    except duckdb.Error:
-        row = None
-    if row is None or row[0] != str(SCHEMA_VERSION):
-        con.close()
-        raise InputError(f"not a roastlab fleet store of schema version {SCHEMA_VERSION}", db)
+        con = _connect(db, False, wait_s)
+    with store_errors(db):
+        con.execute("SET TimeZone = 'UTC'")
+        # DuckDB's buffer manager takes up to 80 % of RAM by default; a store of years of batches
+        # streams through far less (it spills to a temporary folder beside the file if it must)
+        con.execute(f"SET memory_limit = '{DUCKDB_MEMORY}'")
+        if not read_only and empty:
+            con.execute(_SCHEMA)
+            con.execute("INSERT OR IGNORE INTO meta VALUES ('schema_version', ?)", [str(SCHEMA_VERSION)])
     return con
 
 
@@ -234,14 +336,15 @@ class _Machines:
         return mid
 
 
-def ingest(db: str | Path, manifest: str | Path, progress=None) -> IngestReport:
+def ingest(db: str | Path, manifest: str | Path, progress=None, wait_s: float = 0.0) -> IngestReport:
     """Ingest the logs a manifest lists into the store at ``db`` (one transaction).
 
     The manifest is a CSV with columns ``path,machine,plant,started_at[,map]``: ``path`` and
     ``map`` relative to the manifest's folder, ``plant`` a preset or a PLANT.toml, ``started_at``
     ISO 8601 (UTC if it names no zone). A row that cannot be ingested (missing file, unknown
     plant, bad date, unreadable log) is rejected with one line naming its line number; the
-    others still ingest. A file already in the store (same SHA-256) is skipped.
+    others still ingest. A file already in the store (same SHA-256) is skipped. A store locked by
+    another process is waited for up to ``wait_s`` seconds.
     """
     from ..io.batch import read_batch_csv
     from ..io.importers import import_log, load_map
@@ -251,84 +354,85 @@ def ingest(db: str | Path, manifest: str | Path, progress=None) -> IngestReport:
     rows, _ = read_manifest(manifest)
     base = manifest.parent
     report = IngestReport()
-    con = open_store(db)
-    try:
-        con.execute("BEGIN TRANSACTION")
-        machines = _Machines(con, base)
-        seen = {r[0] for r in con.execute("SELECT sha256 FROM batches").fetchall()}
-        next_batch = 1 + (con.execute("SELECT max(batch_id) FROM batches").fetchall()[0][0] or 0)
-        maps: dict[str, tuple] = {}
-        pending_b: list[tuple] = []
-        pending_s: list[tuple] = []
-        now = datetime.datetime.now(datetime.UTC)
-        for k, (line, row) in enumerate(rows):
-            where = f"line {line}"
-            try:
-                for col in MANIFEST_COLUMNS:
-                    if not row.get(col):
-                        raise ValueError(f"empty {col}")
-                started = _parse_started_at(row["started_at"])
-                machines.check(row["machine"], row["plant"])
-                path = Path(row["path"]) if Path(row["path"]).is_absolute() else base / row["path"]
-                if not path.exists():
-                    raise ValueError(f"file not found: {row['path']}")
-                raw = read_input_bytes(path)
-                sha = hashlib.sha256(raw).hexdigest()
-                if sha in seen:
-                    report.already += 1
-                    continue
-                map_name = row.get("map") or ""
-                if map_name:
-                    if map_name not in maps:
-                        mpath = Path(map_name) if Path(map_name).is_absolute() else base / map_name
-                        mtext = read_input_text(mpath, "map")
-                        maps[map_name] = (load_map(mpath), str(mpath), hashlib.sha256(mtext.encode()).hexdigest())
-                    cmap, map_path, map_sha = maps[map_name]
-                    batch = import_log(path, cmap)
-                elif path.suffix.lower() == ".csv":
-                    batch, map_path, map_sha = read_batch_csv(path), None, None
-                else:
-                    batch, map_path, map_sha = import_log(path, None), None, None
-                mid = machines.resolve(row["machine"], row["plant"])
-            except (InputError, ValueError, OSError) as exc:
-                report.rejected.append(f"{manifest}: {where}: {exc}")
-                continue
-            seen.add(sha)
-            bid = next_batch
-            next_batch += 1
-            pending_b.append(
-                (
-                    bid,
-                    mid,
-                    str(path),
-                    sha,
-                    started,
-                    batch.name,
-                    batch.Mb_kg,
-                    batch.n,
-                    map_path,
-                    map_sha,
-                    json.dumps(batch.initial),
-                    json.dumps(batch.events),
-                    "\n".join(batch.notes) or None,
-                    now,
-                )
-            )
-            pending_s.append((bid, batch))
-            report.added += 1
-            if len(pending_s) >= INGEST_CHUNK:
-                _flush(con, machines, pending_b, pending_s)
-            if progress is not None and (k + 1) % 500 == 0:
-                progress(k + 1, len(rows), "rows read")
-        _flush(con, machines, pending_b, pending_s)
-        con.execute("COMMIT")
-    except BaseException:
+    with store_errors(db):
+        con = open_store(db, wait_s=wait_s)
         try:
-            con.execute("ROLLBACK")
-        finally:
-            con.close()
-        raise
-    con.close()
+            con.execute("BEGIN TRANSACTION")
+            machines = _Machines(con, base)
+            seen = {r[0] for r in con.execute("SELECT sha256 FROM batches").fetchall()}
+            next_batch = 1 + (con.execute("SELECT max(batch_id) FROM batches").fetchall()[0][0] or 0)
+            maps: dict[str, tuple] = {}
+            pending_b: list[tuple] = []
+            pending_s: list[tuple] = []
+            now = datetime.datetime.now(datetime.UTC)
+            for k, (line, row) in enumerate(rows):
+                where = f"line {line}"
+                try:
+                    for col in MANIFEST_COLUMNS:
+                        if not row.get(col):
+                            raise ValueError(f"empty {col}")
+                    started = _parse_started_at(row["started_at"])
+                    machines.check(row["machine"], row["plant"])
+                    path = Path(row["path"]) if Path(row["path"]).is_absolute() else base / row["path"]
+                    if not path.exists():
+                        raise ValueError(f"file not found: {row['path']}")
+                    raw = read_input_bytes(path)
+                    sha = hashlib.sha256(raw).hexdigest()
+                    if sha in seen:
+                        report.already += 1
+                        continue
+                    map_name = row.get("map") or ""
+                    if map_name:
+                        if map_name not in maps:
+                            mpath = Path(map_name) if Path(map_name).is_absolute() else base / map_name
+                            mtext = read_input_text(mpath, "map")
+                            maps[map_name] = (load_map(mpath), str(mpath), hashlib.sha256(mtext.encode()).hexdigest())
+                        cmap, map_path, map_sha = maps[map_name]
+                        batch = import_log(path, cmap)
+                    elif path.suffix.lower() == ".csv":
+                        batch, map_path, map_sha = read_batch_csv(path), None, None
+                    else:
+                        batch, map_path, map_sha = import_log(path, None), None, None
+                    mid = machines.resolve(row["machine"], row["plant"])
+                except (InputError, ValueError, OSError) as exc:
+                    report.rejected.append(f"{manifest}: {where}: {exc}")
+                    continue
+                seen.add(sha)
+                bid = next_batch
+                next_batch += 1
+                pending_b.append(
+                    (
+                        bid,
+                        mid,
+                        str(path),
+                        sha,
+                        started,
+                        batch.name,
+                        batch.Mb_kg,
+                        batch.n,
+                        map_path,
+                        map_sha,
+                        json.dumps(batch.initial),
+                        json.dumps(batch.events),
+                        "\n".join(batch.notes) or None,
+                        now,
+                    )
+                )
+                pending_s.append((bid, batch))
+                report.added += 1
+                if len(pending_s) >= INGEST_CHUNK:
+                    _flush(con, machines, pending_b, pending_s)
+                if progress is not None and (k + 1) % 500 == 0:
+                    progress(k + 1, len(rows), "rows read")
+            _flush(con, machines, pending_b, pending_s)
+            con.execute("COMMIT")
+        except BaseException:
+            try:
+                con.execute("ROLLBACK")
+            finally:
+                con.close()
+            raise
+        con.close()
     report.machines_added = [m[1] for m in machines.new]
     report.wall_s = time.perf_counter() - t0
     if progress is not None:

@@ -357,24 +357,57 @@ def detect_format(path: Path, fmt: str = "auto") -> str:
 #: Most rows a Parquet log may declare; checked from its footer before any column is decoded,
 #: so a small file that would decompress to gigabytes is refused first.
 MAX_PARQUET_ROWS = 2_000_000
+#: Most bytes the columns a map reads may decode to, by the footer's uncompressed page sizes
+#: (2 million rows of eight 8-byte columns, with room for page headers).
+MAX_PARQUET_DECODED_BYTES = 160 * 1024 * 1024
+
+
+def _parquet_plain_number(kind) -> bool:
+    """Whether an Arrow type decodes to one fixed-width number per row (what a log column is)."""
+    import pyarrow.types as pat
+
+    return pat.is_integer(kind) or pat.is_floating(kind) or pat.is_boolean(kind) or pat.is_decimal(kind)
 
 
 def _read_parquet(path: Path, columns: list[str]) -> dict[str, np.ndarray]:
+    """The ``columns`` of a Parquet log as float arrays; refused from the footer alone (before any
+    page is decoded) when it declares too many rows, a wanted column is not a plain number
+    (lists, structs, strings, dictionaries) or the wanted columns would decode too large."""
     raw = read_input_bytes(path)  # the bytes come through the guard, never from the name
     try:
         import pyarrow.parquet as pq
 
         pfile = pq.ParquetFile(io.BytesIO(raw))
-        n_rows = pfile.metadata.num_rows
-        if n_rows > MAX_PARQUET_ROWS:
-            raise InputError(f"declares {n_rows} rows, over the limit of {MAX_PARQUET_ROWS}", path)
-        all_names = list(pfile.schema_arrow.names)
+        meta = pfile.metadata
+        if meta.num_rows > MAX_PARQUET_ROWS:
+            raise InputError(f"declares {meta.num_rows} rows, over the limit of {MAX_PARQUET_ROWS}", path)
+        schema = pfile.schema_arrow
+        all_names = list(schema.names)
         twice = sorted({c for c in all_names if all_names.count(c) > 1 and c in columns})
         if twice:
             raise InputError(f"column(s) {', '.join(twice)} appear more than once: which one is meant?", path)
-        names = set(all_names)
-        frame = pfile.read(columns=[c for c in columns if c in names]).to_pandas()
-        frame = frame.reindex(columns=[*frame.columns, *(c for c in names if c not in frame.columns)])
+        missing = [c for c in columns if c not in all_names]
+        if missing:
+            shown = ", ".join(map(str, all_names[:20])) + (", ..." if len(all_names) > 20 else "")
+            raise InputError(f"missing column {missing[0]!r} (columns: {shown})", path)
+        for c in columns:
+            kind = schema.field(c).type
+            if not _parquet_plain_number(kind):
+                raise InputError(f"holds {str(kind)[:60]} values, not one number per row", path, f"column {c}")
+        wanted = set(columns)
+        decoded = sum(
+            rg.column(j).total_uncompressed_size
+            for rg in (meta.row_group(i) for i in range(meta.num_row_groups))
+            for j in range(rg.num_columns)
+            if rg.column(j).path_in_schema.split(".")[0] in wanted
+        )
+        if decoded > MAX_PARQUET_DECODED_BYTES:
+            raise InputError(
+                f"its columns {', '.join(columns)} would decode to {decoded / 2**20:.0f} MiB, over the limit of "
+                f"{MAX_PARQUET_DECODED_BYTES / 2**20:.0f} MiB",
+                path,
+            )
+        table = pfile.read(columns=list(dict.fromkeys(columns)))
     except InputError:
         raise
     except ImportError:
@@ -383,11 +416,9 @@ def _read_parquet(path: Path, columns: list[str]) -> dict[str, np.ndarray]:
         raise InputError(f"not a readable Parquet file ({type(exc).__name__})", path) from None
     out = {}
     for c in columns:
-        if c not in frame.columns:
-            raise InputError(f"missing column {c!r} (columns: {', '.join(map(str, frame.columns))})", path)
         try:
-            out[c] = frame[c].to_numpy(dtype=float)
-        except (TypeError, ValueError):
+            out[c] = table.column(c).to_numpy(zero_copy_only=False).astype(float)
+        except (TypeError, ValueError, ArithmeticError):
             raise InputError("not numeric", path, f"column {c}") from None
     return out
 
