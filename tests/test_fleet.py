@@ -435,3 +435,26 @@ def test_a_store_locked_by_another_process_says_so_and_can_be_waited_for(cli, fl
         holder.kill()
         holder.wait()
         holder.stdout.close()
+
+
+def test_sigterm_during_a_long_command_cleans_up_like_ctrl_c(tmp_path):
+    """SIGTERM (what a service manager, a CI runner or `kill` sends) leaves nothing behind."""
+    import signal
+    import time
+
+    out = tmp_path / "data"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "roastlab", "fleet", "synthetic", "--out", out, "--batches", "50000"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    deadline = time.monotonic() + 120
+    while not any(p.name.startswith(".data.") for p in tmp_path.iterdir()):  # its staging folder
+        assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
+        time.sleep(0.05)
+    time.sleep(0.5)
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 128 + signal.SIGTERM and "terminated" in err, err
+    assert list(tmp_path.iterdir()) == []

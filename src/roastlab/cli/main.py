@@ -13,7 +13,9 @@ outputs are written together at the end or not at all.
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
+import threading
 
 from ..errors import RoastlabError
 from . import app, bench, control, data, fit, fleet, roaster, simulate, transfer, whatif
@@ -51,22 +53,40 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised where the program is, so that every output and temporary folder is
+    cleaned up exactly as on Ctrl-C (a KeyboardInterrupt) instead of the process just ending."""
+
+
+def _on_sigterm(signum, frame):
+    raise Terminated()
+
+
 def main(argv: list[str] | None = None) -> int:
     from ..io.files import begin_run
 
     parser = build_parser()
     args = parser.parse_args(argv)
     begin_run()
+    previous = None
+    if threading.current_thread() is threading.main_thread():
+        previous = signal.signal(signal.SIGTERM, _on_sigterm)
     try:
         return int(args.func(args) or 0)
     except RoastlabError as exc:
         print(f"roastlab {args.command}: error: {_one_line(str(exc))}", file=sys.stderr)
         return 2
+    except Terminated:
+        print("roastlab: terminated", file=sys.stderr)
+        return 128 + signal.SIGTERM
     except KeyboardInterrupt:
         print("roastlab: interrupted", file=sys.stderr)
         return 130
     except BrokenPipeError:
         return 0
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
 
 
 def _one_line(text: str, limit: int = 300) -> str:
