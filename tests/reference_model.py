@@ -45,13 +45,15 @@ def bed_segment(Mb, Dch, Lch, rho=680.0):
     return t, R * (1 - math.cos(t / 2)), R * t * Lch + 2 * R * R / 2 * (t - math.sin(t))
 
 
-def make_rhs(plant: str, theta, X0: float, moisture: str = "schwartzberg", act=None, bed=None):
+def make_rhs(plant: str, theta, X0: float, moisture: str = "schwartzberg", act=None, bed=None, process=None):
     """The slow reference right-hand side. ``act`` holds the actuator extension's values
     (Qe_gain, Qe_offset, Tgi_gain, tau, Gg_fan, U_shell, T_room); None = the paper's model.
     ``bed`` the bed laws and the probe's depth: {"contact": "paper"|"wall", "probe": "rest"|"tumbling",
-    "probe_gas": "outlet"|"mean", "h_probe": m}; None = the paper's."""
-    g = PLANTS[plant]
-    c = PROCESS
+    "probe_gas": "outlet"|"mean", "h_probe": m}; None = the paper's. ``process`` overrides values
+    of PROCESS (and the plant's metal mass Mm)."""
+    process = dict(process or {})
+    g = {**PLANTS[plant], **({"Mm": process.pop("Mm")} if "Mm" in process else {})}
+    c = {**PROCESS, **process}
     hgm, hbm, Pbm = theta
     Agm = math.pi * g["Dch"] * (g["Lch"] + g["Hflap"] * g["Lch"] / g["Sflap"] + g["Dch"] / 2)
     Ab = g["Mb"] / c["mb"] * math.pi * c["Db"] ** 2
@@ -120,9 +122,12 @@ def reference_simulate(
     fan=None,
     act=None,
     bed=None,
+    process=None,
+    method="DOP853",
 ):
-    """Return (states (n, 6), Tgo (n,)) at the sample times (x0 of 5 states gets H = heater[0])."""
-    f = make_rhs(plant, theta, x0[2], moisture, act, bed)
+    """Return (states (n, 6), Tgo (n,)) at the sample times (x0 of 5 states gets H = heater[0]);
+    ``method`` a SciPy solver (``"Radau"`` for stiff values)."""
+    f = make_rhs(plant, theta, x0[2], moisture, act, bed, process)
     n = len(t)
     heater = np.zeros(n) if heater is None else np.asarray(heater, dtype=float)
     fan = np.zeros(n) if fan is None else np.asarray(fan, dtype=float)
@@ -142,7 +147,7 @@ def reference_simulate(
             w = (s - t0) / (t1 - t0)
             return tuple(v[k] + w * (v[k + 1] - v[k]) for v in series)
 
-        sol = solve_ivp(lambda s, y: f(y, *u(s))[0], (t0, t1), x, method="DOP853", rtol=rtol, atol=atol)
+        sol = solve_ivp(lambda s, y: f(y, *u(s))[0], (t0, t1), x, method=method, rtol=rtol, atol=atol)
         x = sol.y[:, -1]
         out[k + 1] = x
         j = k if hold == "zoh" else k + 1

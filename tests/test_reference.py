@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 
 from reference_model import reference_simulate
 from roastlab import InitialState, simulate
+from roastlab.errors import ParameterError
 from roastlab.model.parameters import THETA_BOUNDS
 
 TOL_C = 0.01
@@ -115,6 +116,62 @@ def test_a_stiff_but_plausible_coefficient_integrates_like_the_reference(hbm):
     assert np.all(np.isfinite(fast.states))
     for j in (0, 1, 4):
         assert np.max(np.abs(fast.states[:, j] - ref[:, j])) < TOL_C
+
+
+#: The quantities a corner case sets (each at its plausible floor, ceiling or default) and
+#: their names in the reference model.
+CORNER_NAMES = {
+    "hgm": None,
+    "hbm": None,
+    "Pbm": None,
+    "A": "A",
+    "cm": "cm",
+    "cw": "cw",
+    "Ha_R": "HaR",
+    "Het": "Het",
+    "k1": "k1",
+    "k2": "k2",
+    "Kt": "Kt",
+    "lam": "lam",
+    "Mm": "Mm",
+}
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_random_corners_of_the_plausibility_table_integrate_or_stop_on_the_step_budget(seed):
+    """Every quantity at its plausible floor, ceiling or default, at random (issue 27): the compiled
+    run either matches SciPy's stiff solver (Radau) on the same right-hand side or stops with a
+    message that says the values are too stiff (step budget or collapse) or blow up, in bounded
+    time; never a wrong finite answer."""
+    import time
+
+    from roastlab.model.quantities import QUANTITIES
+    from roastlab.sim.kernels import MAX_STEPS
+
+    rng = np.random.default_rng(seed)
+    vals = {}
+    for k in CORNER_NAMES:
+        lo, hi = QUANTITIES[k].plausible
+        choices = [lo, hi] + ([QUANTITIES[k].default] if QUANTITIES[k].default is not None else [])
+        vals[k] = float(choices[rng.integers(0, len(choices))])
+    theta = tuple(vals.pop(k) for k in ("hgm", "hbm", "Pbm"))
+    t = np.arange(0.0, 301.0, 10.0)
+    Gg, Tgi = np.full(t.size, 0.4), np.linspace(480.0, 420.0, t.size)
+    x0 = InitialState(Tb0_C=25.0, Tm0_C=180.0, X0=0.11, Ta0_C=25.0)
+    t0 = time.perf_counter()
+    try:
+        fast = simulate("120kg", t, Gg, Tgi, theta=theta, initial=x0, values=vals)
+    except ParameterError as exc:
+        assert "too stiff" in str(exc) and f"{MAX_STEPS:,} steps" in str(exc) or "non-finite" in str(exc), exc
+        assert time.perf_counter() - t0 < 10.0
+        return
+    process = {CORNER_NAMES[k]: v for k, v in vals.items()}
+    ref, _ = reference_simulate(
+        "120kg", theta, t, Gg, Tgi, x0.vector(), process=process, method="Radau", rtol=1e-9, atol=1e-9
+    )
+    for j in (0, 1, 4):
+        scale = 1.0 + np.max(np.abs(ref[:, j]))
+        assert np.max(np.abs(fast.states[:, j] - ref[:, j])) < TOL_C * scale / 100, (j, theta, vals)
 
 
 @pytest.mark.parametrize(

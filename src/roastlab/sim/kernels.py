@@ -35,6 +35,15 @@ H0_S = 5.0
 ATOL = np.array([1e-4, 1e-4, 1e-7, 1e-3, 1e-4, 1e-4])
 RTOL = 1e-6
 NS = N_STATES
+#: Most Dormand-Prince steps (accepted or rejected) one run may take: about half a second of
+#: compiled work, ~1000x what a plausible roast needs. Values that make the model this stiff (a
+#: tiny drum mass with large coefficients, a huge Arrhenius factor) would otherwise run for up
+#: to an hour; the run stops instead and its remaining samples are marked :data:`STIFF_MARK`.
+MAX_STEPS = 1_000_000
+#: What the states of a run hold from where the explicit integrator gave up on stiffness (the
+#: step budget spent, or the step collapsed below 1e-9 of the sample interval); a trial that
+#: stays non-finite down to a microsecond step writes NaN instead, so callers can say which.
+STIFF_MARK = np.inf
 #: Output columns: the six states, then the outlet gas temperature Tgo.
 N_OUT = NS + 1
 I_TGO = NS
@@ -89,6 +98,7 @@ def integrate_into(t, Gg, Tgi, Q, F, n, x0, p, zoh, h_max, out, h0=H0_S, with_tg
     y = np.empty(NS)
     xn = np.empty(NS)
     h = min(h_max, h0)
+    steps = 0
     for k in range(n - 1):
         t0 = t[k]
         dt = t[k + 1] - t0
@@ -112,6 +122,13 @@ def integrate_into(t, Gg, Tgi, Q, F, n, x0, p, zoh, h_max, out, h0=H0_S, with_tg
             # hold is continuous, so the last stage of the previous interval is still valid
             _f(x, g0, T0, q0, f0, p, k1)
         while s < dt:
+            steps += 1
+            if steps > MAX_STEPS or h < 1e-9 * dt:
+                # the step budget spent or the step collapsed: too stiff for an explicit method
+                for j in range(k + 1, n):
+                    for i in range(N_OUT):
+                        out[j, i] = STIFF_MARK
+                return h
             last = False
             h_try = h
             if s + h >= dt * (1.0 - 1e-12):
@@ -149,9 +166,9 @@ def integrate_into(t, Gg, Tgi, Q, F, n, x0, p, zoh, h_max, out, h0=H0_S, with_tg
             # RMS over the paper's five states (H adds its error only when a heater moves it), so
             # runs without the actuator extension take exactly the steps they always took
             err = math.sqrt(err / 5.0)
-            if h < 1e-9 * dt or (not (err == err) and h < 1e-6):
-                # step collapse, or a trial that stays non-finite down to a microsecond step:
-                # report NaN rather than loop or lie
+            if not (err == err) and h < 1e-6:
+                # a trial that stays non-finite down to a microsecond step: report NaN rather
+                # than loop or lie
                 for j in range(k + 1, n):
                     for i in range(N_OUT):
                         out[j, i] = np.nan
@@ -179,6 +196,21 @@ def integrate_into(t, Gg, Tgi, Q, F, n, x0, p, zoh, h_max, out, h0=H0_S, with_tg
             j = k if zoh else k + 1
             out[k + 1, I_TGO] = outlet_gas_C(x, Gg[j], Tgi[j], F[j], p)
     return h
+
+
+def failure(states: np.ndarray, t: np.ndarray) -> str | None:
+    """Why a run's states (rows at times ``t``) stopped being finite, in words; None if they did not."""
+    bad = ~np.isfinite(states)
+    if not bad.any():
+        return None
+    i = int(np.argwhere(bad)[0][0])
+    after = f"t = {t[max(i - 1, 0)]:g} s"
+    if np.all(states[i] == STIFF_MARK):
+        return (
+            f"the model is too stiff to integrate after {after} (over {MAX_STEPS:,} steps, or a step below a "
+            "billionth of the sample interval): these values give it a time constant far below a second"
+        )
+    return f"the simulation went non-finite after {after}"
 
 
 @compiled

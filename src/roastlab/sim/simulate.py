@@ -27,7 +27,7 @@ from ..model.rhs import (
     shell_loss_kW,
 )
 from ..report.result import Result, draw_curves
-from .kernels import H0_S, H_MAX_S, I_TGO, NS, simulate_one, step_kernel
+from .kernels import H0_S, H_MAX_S, I_TGO, NS, failure, simulate_one, step_kernel
 
 
 @dataclass(frozen=True)
@@ -315,12 +315,9 @@ def _check_initial(x0: np.ndarray) -> None:
 
 
 def _check_finite(out: np.ndarray, t: np.ndarray) -> None:
-    bad = ~np.isfinite(out[:, :NS])
-    if bad.any():
-        i = int(np.argwhere(bad)[0][0])
-        raise ParameterError(
-            f"the simulation went non-finite after t = {t[max(i - 1, 0)]:g} s: inputs, initial state or values out of the model's range"
-        )
+    why = failure(out[:, :NS], t)
+    if why is not None:
+        raise ParameterError(f"{why}: inputs, initial state or values out of the model's range")
 
 
 def _u4(Gg_kg_s, Tgi_C, heater=0.0, fan=0.0) -> np.ndarray:

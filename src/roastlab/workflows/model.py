@@ -38,7 +38,7 @@ from ..model.parameters import REGISTRY, STATE0, THETA_NAMES, THETA_PAPER, THETA
 from ..model.plant import Plant
 from ..model.quantities import default
 from ..model.rhs import P
-from ..sim.kernels import I_TGO, NS
+from ..sim.kernels import I_TGO, NS, failure
 from ..sim.population import pack_batches, run_arrays, simulate_population
 from ..sim.simulate import InitialState, SimulationResult
 
@@ -309,14 +309,9 @@ class FittedModel:
             res.name, res.meta = b.name, meta
             res.Ta_measured_C = None if b.Ta_C is None else b.Ta_C.copy()
             res.Tb2_measured_C = None if b.Tb2_C is None else b.Tb2_C.copy()
-            bad = ~np.isfinite(res.states)
-            if bad.any():
-                i0 = int(np.argwhere(bad)[0][0])
-                raise InputError(
-                    f"the model could not be simulated past t = {b.time_s[max(i0 - 1, 0)]:g} s "
-                    "(non-finite state): check the inputs, initial state and values",
-                    b.source or b.name,
-                )
+            why = failure(res.states, b.time_s)
+            if why is not None:
+                raise InputError(f"{why}: check the inputs, initial state and values", b.source or b.name)
             results.append(res)
         return results
 
