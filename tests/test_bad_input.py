@@ -1,8 +1,13 @@
 """Every kind of bad input: one line on stderr naming the file and the problem, exit code 2,
 no traceback, no output file (not even a partial or temporary one)."""
 
+import ast
+import functools
 import json
 import os
+import shutil
+import tempfile
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -488,8 +493,168 @@ ROASTIME = {
         "column or constant_C",
     ),
 }
+SMALL_PLANT = "Mb_kg = 0.2\nDch_m = 0.16\nLch_m = 0.2\nHflap_m = 0.02\nSflap_m = 0.1\nMm_kg = 1.5\n"
+ALOG_MAP = '[Ta]\ncolumn = "BT"\n[Tgi]\ncolumn = "ET"\n[Gg]\nconstant_kg_s = 0.4\n'
+
+
+@functools.cache
+def _model_text() -> str:
+    """A model file fitted once on the small Artisan log (for the commands that need one)."""
+    from roastlab.cli import main
+
+    d = Path(tempfile.mkdtemp(prefix="roastlab-model-"))
+    try:
+        (d / "log.alog").write_text(GOOD_ALOG)
+        (d / "map.toml").write_text(ALOG_MAP)
+        (d / "small.toml").write_text(SMALL_PLANT)
+        (d / "spec.toml").write_text("[free]\nhbm = [0.01, 0.35, 0.02]\n")
+        argv = ["identify", "--plant", d / "small.toml", "--map", d / "map.toml", d / "log.alog"]
+        assert main([*map(str, argv), "--spec", str(d / "spec.toml"), "--out", str(d / "m.json"), "--starts", "1"]) == 0
+        return (d / "m.json").read_text()
+    finally:
+        shutil.rmtree(d)
+
+
+def _newer(d, *argv, log=GOOD_ALOG):
+    """The small log, its map, a small plant and a model in ``d``; argv with {d} filled in."""
+    (d / "log.alog").write_text(log)
+    (d / "map.toml").write_text(ALOG_MAP)
+    (d / "small.toml").write_text(SMALL_PLANT)
+    (d / "model.json").write_text(_model_text())
+    return [a.format(d=d) if isinstance(a, str) else a for a in argv]
+
+
+_NO_BT = repr({k: v for k, v in ast.literal_eval(GOOD_ALOG).items() if k != "temp2"})
+
+#: The commands added since the first rounds: what-if, transfer, control, model comparison,
+#: prediction bands, init and fit-roaster (fleet: tests/test_fleet.py; page uploads: test_app.py).
+NEWER = {
+    "whatif on a log without BT": (
+        lambda d: _newer(
+            d, "whatif", "{d}/log.alog", "--model", "{d}/model.json", "--map", "{d}/map.toml", "--tgi", "10", log=_NO_BT
+        ),
+        "log.alog",
+        "temp2",
+    ),
+    "whatif --set that is not SETTING=VALUE@TIME": (
+        lambda d: _newer(
+            d,
+            "whatif",
+            "{d}/log.alog",
+            "--model",
+            "{d}/model.json",
+            "--map",
+            "{d}/map.toml",
+            "--set",
+            "heater=abc@1:00",
+        ),
+        "--set",
+        "SETTING=VALUE@TIME",
+    ),
+    "whatif changes a setting the log has not": (
+        lambda d: _newer(
+            d, "whatif", "{d}/log.alog", "--model", "{d}/model.json", "--map", "{d}/map.toml", "--heater", "+1@1:00"
+        ),
+        "log.alog",
+        "no heater setting",
+    ),
+    "whatif --tgi beyond the plausible inlet": (
+        lambda d: _newer(
+            d, "whatif", "{d}/log.alog", "--model", "{d}/model.json", "--map", "{d}/map.toml", "--tgi", "5000"
+        ),
+        "--tgi",
+        "plausible",
+    ),
+    "transfer reference going back in time": (
+        lambda d: (
+            _newer(d, "transfer", "--model", "{d}/model.json", "--reference", "{d}/ref.csv", "--out", "{d}/p.csv")
+            if (d / "ref.csv").write_text(HEADER + GOOD_ROWS.replace("60,0.4", "20,0.4"))
+            else None
+        ),
+        "ref.csv",
+        "not strictly increasing",
+    ),
+    "transfer limit of 1e300": (
+        lambda d: (
+            _newer(
+                d,
+                "transfer",
+                "--model",
+                "{d}/model.json",
+                "--reference",
+                "{d}/ref.csv",
+                "--out",
+                "{d}/p.csv",
+                "--tgi-max",
+                "1e300",
+            )
+            if (d / "ref.csv").write_text(HEADER + GOOD_ROWS)
+            else None
+        ),
+        "--tgi-max",
+        "plausible",
+    ),
+    "control scenario with an unknown key": (
+        lambda d: (
+            _newer(
+                d,
+                "control",
+                "--model",
+                "{d}/model.json",
+                "--plant",
+                "{d}/small.toml",
+                "--reference",
+                "{d}/ref.csv",
+                "--scenario",
+                "{d}/sc.toml",
+                "--controller",
+                "pid",
+                "--out",
+                "{d}/t.csv",
+            )
+            if (d / "ref.csv").write_text(HEADER + GOOD_ROWS) and (d / "sc.toml").write_text('name = "q"\nbogus = 3\n')
+            else None
+        ),
+        "sc.toml",
+        "unknown key(s) bogus",
+    ),
+    "compare-models with an unknown law": (
+        lambda d: _newer(
+            d,
+            "compare-models",
+            "--plant",
+            "{d}/small.toml",
+            "--map",
+            "{d}/map.toml",
+            "{d}/log.alog",
+            "--variant",
+            "contact=bogus",
+        ),
+        "--variant",
+        "unknown contact law",
+    ),
+    "validate --band of 1.5": (
+        lambda d: _newer(
+            d, "validate", "--model", "{d}/model.json", "--map", "{d}/map.toml", "{d}/log.alog", "--band", "1.5"
+        ),
+        "--band",
+        "in (0, 1)",
+    ),
+    "init on a log without BT": (
+        lambda d: _newer(d, "init", "{d}/log.alog", "--out", "{d}/cfg", "--batch-kg", "0.2", log=_NO_BT),
+        "log.alog",
+        "temp2",
+    ),
+    "fit-roaster without init": (
+        lambda d: _newer(d, "fit-roaster", "{d}/nocfg", "{d}/log.alog"),
+        "nocfg",
+        "roastlab init",
+    ),
+}
+
 CASES.update(HOSTILE)
 CASES.update(ROASTIME)
+CASES.update(NEWER)
 
 
 @pytest.mark.parametrize("case", sorted(CASES))

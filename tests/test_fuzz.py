@@ -14,6 +14,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from roastlab.errors import RoastlabError
+from roastlab.fleet.store import read_manifest
 from roastlab.io.batch import read_batch_csv, read_dataset
 from roastlab.io.fitspec import load_fit_spec
 from roastlab.io.importers import import_log, load_map
@@ -66,6 +67,8 @@ VALID = {
         }
     ),
     ".fit.toml": "[free]\nhgm = [0.001, 1.0, 0.02]\nTm0_C = { lower = 60, upper = 300, start = 170, per_batch = true }\n[fixed]\nKt = 0.02\n[initial]\nTb0_C = 22\n[weights]\nTa = 1\nTb2 = 0.5\n",
+    ".manifest.csv": "path,machine,plant,started_at,map\nlogs/a.alog,m1,120kg,2024-01-01T08:00:00,map.toml\n"
+    "b.csv,m2,360kg,2024-01-02 09:30+02:00,\n",
     ".scenario.toml": 'name = "s"\n[plant]\nmass_factor = 1.2\nTm0_offset_C = -30\ntheta_factor = { hgm = 0.8 }\n'
     "[sensor]\nnoise_C = 0.5\ndelay_s = 2\nseed = 7\n[actuator]\nTgi_min_C = 150\nTgi_max_C = 550\nsample_s = 5\n",
 }
@@ -288,6 +291,7 @@ def run_loader(kind, data, loader):
             ".fit.toml": ".toml",
             ".scenario.toml": ".toml",
             ".roastime.json": ".json",
+            ".manifest.csv": ".csv",
         }.get(kind, kind)
         path = Path(tmp) / f"fuzz{suffix}"
         if isinstance(data, bytes):
@@ -323,6 +327,7 @@ LOADERS = {
     ".fit.toml": [load_fit_spec],
     ".scenario.toml": [load_scenario],
     ".roastime.json": [read_roastime, lambda p: import_log(p, ROASTIME_MAP)],
+    ".manifest.csv": [read_manifest],
 }
 
 
@@ -418,3 +423,101 @@ def test_fuzz_control_characters_in_names_stay_data(name):
         assert np.array_equal(a.time_s, b.time_s) and np.array_equal(a.Ta_C, b.Ta_C)
         lines = [ln for ln in outs[1].read_text().splitlines() if not ln.startswith("#")]
         assert lines == [ln for ln in outs[0].read_text().splitlines() if not ln.startswith("#")]
+
+
+PARQUET_MAP = map_from_mapping(
+    {
+        "format": "parquet",
+        "time": {"column": "t"},
+        "Ta": {"column": "bt"},
+        "Tgi": {"column": "et"},
+        "Gg": {"column": "flow"},
+    },
+    "fuzz map",
+)
+
+
+@pytest.fixture(scope="module")
+def parquet_bytes():
+    pa = pytest.importorskip("pyarrow")
+    pq = pytest.importorskip("pyarrow.parquet")
+    import io
+
+    buf = io.BytesIO()
+    n = 40
+    table = pa.table(
+        {
+            "t": np.arange(n) * 2.0,
+            "bt": np.linspace(150, 200, n),
+            "et": np.full(n, 300.0),
+            "flow": np.full(n, 0.01),
+            "note": ["x"] * n,
+        }
+    )
+    pq.write_table(table, buf)
+    return buf.getvalue()
+
+
+def test_fuzz_parquet(parquet_bytes):
+    """A Parquet log with bytes flipped, cut or inserted (footer and pages alike): a batch or a
+    RoastlabError, never a crash or a pyarrow exception."""
+
+    @FUZZ
+    @given(
+        st.lists(st.tuples(st.integers(0, len(parquet_bytes) - 1), st.integers(0, 255)), min_size=1, max_size=8),
+        st.one_of(st.none(), st.integers(8, len(parquet_bytes))),
+    )
+    def check(flips, cut):
+        raw = bytearray(parquet_bytes)
+        for i, b in flips:
+            raw[i] = b
+        if cut is not None:
+            raw = raw[:cut] + raw[-8:]  # keep the magic and footer length, lose the middle
+        run_loader(".parquet", bytes(raw), lambda p: import_log(p, PARQUET_MAP))
+
+    check()
+
+
+#: The text options of the newer commands, each with the function that reads it.
+def _option_readers():
+    import argparse
+
+    from roastlab.cli.common import bed_arg, count_arg, float_arg
+    from roastlab.cli.fit import level_arg
+    from roastlab.workflows.whatif import parse_set, parse_setting_change
+
+    return {
+        "whatif --set": parse_set,
+        "whatif --heater": lambda t: parse_setting_change("heater", t, "level"),
+        "--bed / --variant": bed_arg,
+        "validate --band": level_arg,
+        "fleet --wait": count_arg("--wait", 0, 86_400),
+        "transfer --tgi-rate": float_arg("--tgi-rate"),
+    }, argparse.ArgumentTypeError
+
+
+OPTION_TEXT = st.one_of(
+    st.text(max_size=40),
+    st.from_regex(r"(heater|fan|x)?=?[+\-x*]?[0-9.eE+\-]{0,12}(@[0-9:.\-]{0,8})?", fullmatch=True),
+    st.from_regex(
+        r"(contact|probe|probe_gas)=(paper|wall|rest|tumbling|mean|outlet|\w{0,5})(,.{0,12})?", fullmatch=True
+    ),
+)
+
+
+@pytest.mark.parametrize("option", sorted(_option_readers()[0]))
+def test_fuzz_option_text(option):
+    """Any text given to a newer command's option is read or refused with the project's error (or
+    argparse's one line), never a ValueError, an overflow or a traceback."""
+    readers, arg_error = _option_readers()
+    read = readers[option]
+
+    @FUZZ
+    @given(OPTION_TEXT)
+    def check(text):
+        try:
+            read(text)
+        except (RoastlabError, arg_error):
+            pass
+
+    check()

@@ -4,8 +4,9 @@ The parser is walked, so a new subcommand or option cannot slip past: each optio
 classified below as an input, an output or a plain value, and each subcommand needs a
 working invocation in :data:`RUNS`. For each output option and each input file of the run
 the test points the output at the input, and checks exit code 2, one line naming the file,
-and the input byte-for-byte unchanged; then it points the output at a FIFO and at
-``/dev/null`` (existing non-regular files), which must be refused the same way.
+and the input byte-for-byte unchanged; then at a sidecar of the first input (``<input>.wal``,
+as a database's write-ahead log), at a FIFO, at a symbolic link and at ``/dev/null``
+(existing non-regular files), which must be refused the same way.
 """
 
 import argparse
@@ -83,6 +84,7 @@ VALUES = {
     "--workers",
     "--scheduler",
     "--chunk",
+    "--wait",
     "--batches",
     "--help",
     "-h",
@@ -238,7 +240,7 @@ def _digest(p: Path) -> str:
 def _cases():
     for path, (_argv, inputs) in RUNS.items():
         for opt in output_options(LEAVES[path]):
-            for target in [*inputs, "FIFO", "/dev/null"]:
+            for target in [*inputs, *(f"{i}.wal" for i in inputs[:1]), "FIFO", "LINK", "/dev/null"]:
                 yield pytest.param(path, opt, target, id=f"{' '.join(path)} {opt}->{target}")
 
 
@@ -249,6 +251,10 @@ def test_output_pointed_at_an_input_is_refused(cli, tmp_path, model_text, path, 
     if target == "FIFO":
         dest = tmp_path / "fifo"
         os.mkfifo(dest)
+    elif target == "LINK":  # a link to a fresh file: the final rename would replace the link itself
+        dest = tmp_path / "link"
+        (tmp_path / "linked").write_text("keep\n")
+        dest.symlink_to(tmp_path / "linked")
     elif target.startswith("/"):
         dest = Path(target)
     else:
@@ -265,6 +271,8 @@ def test_output_pointed_at_an_input_is_refused(cli, tmp_path, model_text, path, 
     assert set(after) == set(before), f"left behind: {sorted(set(after) - set(before))}"
     if target == "FIFO":
         assert dest.is_fifo()  # not replaced by a regular file
+    if target == "LINK":
+        assert dest.is_symlink() and (tmp_path / "linked").read_text() == "keep\n"
 
 
 @pytest.mark.parametrize(

@@ -180,9 +180,7 @@ class Outputs:
         outputs are discarded.
         """
         out = Path(path)
-        for src in self.inputs + [Path(p) for p in inputs_read()]:
-            if src.exists() and _same_file(src, out):
-                raise InputError(f"is an input of this run ({src}); refusing to write into it", out)
+        self._refuse_inputs(out, "write into it")
         if out.exists() or out.is_symlink():
             if not out.is_dir():
                 raise InputError("exists and is not a folder; give a folder for this output", out)
@@ -197,6 +195,15 @@ class Outputs:
         self._created += missing
         return out
 
+    def _refuse_inputs(self, out: Path, doing: str) -> None:
+        """Refuse ``out`` if it is an input of this run or a sidecar of one (``<input>.<anything>``
+        beside it: a database's write-ahead log, its temporary files)."""
+        for src in self.inputs + [Path(p) for p in inputs_read()]:
+            if src.exists() and _same_file(src, out):
+                raise InputError(f"is an input of this run ({src}); refusing to {doing}", out)
+            if src.is_file() and out.name.startswith(src.name + ".") and _same_file(src.parent, out.parent):
+                raise InputError(f"is a sidecar file of an input of this run ({src}); refusing to write it", out)
+
     def check(self, path: str | Path) -> Path:
         """Refuse an output that is an input or a sidecar of one (a database's ``.wal``, its
         temporary files: ``<input>.<anything>`` beside it), a symbolic link (the final rename
@@ -205,11 +212,7 @@ class Outputs:
         out = Path(path)
         if str(out) == "" or out.name in ("", ".", ".."):
             raise InputError("not a file name", out)
-        for src in self.inputs + [Path(p) for p in inputs_read()]:
-            if src.exists() and _same_file(src, out):
-                raise InputError(f"is an input of this run ({src}); refusing to overwrite an input", out)
-            if src.is_file() and out.name.startswith(src.name + ".") and _same_file(src.parent, out.parent):
-                raise InputError(f"is a sidecar file of an input of this run ({src}); refusing to write it", out)
+        self._refuse_inputs(out, "overwrite an input")
         if out.is_symlink():
             raise InputError(
                 f"is a symbolic link (to {os.readlink(out)}); refusing to replace a link: give the file's own path", out

@@ -288,7 +288,10 @@ def whatif(
     for c in setting_changes:
         series = getattr(changed_batch, c.setting)
         if series is None:
-            raise ParameterError(f"the log has no {c.setting} setting (its map reads none), so it cannot change")
+            raise ParameterError(
+                f"{c}: the log has no {c.setting} setting (its map reads none), so it cannot change",
+                batch.source or batch.name,
+            )
         new = c.apply(batch.time_s, series)
         act = (actuators or {}).get(c.setting)
         if act is None and actuators is None and model.column_map is not None and getattr(model.column_map, c.setting):
