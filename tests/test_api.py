@@ -190,3 +190,54 @@ def test_api_misuse_raises_the_projects_own_errors(case):
     with pytest.raises(RoastlabError) as exc:
         _api_misuse_cases()[case]()
     assert len(str(exc.value)) > 10
+
+
+#: Wrong values of every kind: none, NaN, complex, a wrong shape, a string, a negative number,
+#: a list, a mapping, an all-NaN array and a Boolean.
+WRONG = [None, float("nan"), 1 + 2j, np.array([[1.0, 2.0]]), "abc", -1, [1, 2], {"a": 1}, np.full(3, np.nan), True]
+
+
+def _public_calls():
+    """Each public function and class of ``roastlab`` with good arguments."""
+    import roastlab
+
+    b = roastlab.read_batch_csv(
+        Path(roastlab.__file__).parent / "datasets" / "paper-synthetic" / "dataset-I" / "batch1.csv"
+    )
+    p = roastlab.pack_params(roastlab.load_plant("120kg"), (0.01, 0.0254, 0.5793), 0.1)
+    return {
+        "simulate": ("120kg", b.time_s, b.Gg_kg_s, b.Tgi_C),
+        "pack_params": (roastlab.load_plant("120kg"), (0.01, 0.0254, 0.5793), 0.1),
+        "rhs": (0.0, np.array([30.0, 120, 0.1, 0, 30]), np.array([0.4, 450.0]), p),
+        "load_plant": ("120kg",),
+        "load_model": ("missing.json",),
+        "load_log": ("missing.alog",),
+        "read_batch_csv": ("missing.csv",),
+        "read_dataset": ("missing",),
+        "InitialState": (25.0,),
+        "Theta": (0.01, 0.02, 0.5),
+        "Simulator": ("120kg",),
+        "fit": ([b], "120kg"),
+    }
+
+
+@pytest.mark.parametrize("name", sorted(_public_calls()))
+def test_every_public_function_refuses_wrong_arguments_with_its_own_error(name):
+    """Each argument of each public function, in turn, given each kind of wrong value: the call
+    returns or raises the project's own error, never a TypeError, AttributeError or ValueError
+    from inside (issue 27, the API's promise)."""
+    import roastlab
+    from roastlab.errors import RoastlabError
+
+    good = _public_calls()[name]
+    func = getattr(roastlab, name)
+    for i in range(len(good)):
+        for wrong in WRONG:
+            args = list(good)
+            args[i] = wrong
+            try:
+                func(*args)
+            except RoastlabError as exc:
+                assert len(str(exc)) > 10
+            except Exception as exc:  # noqa: BLE001 - the point of the test
+                pytest.fail(f"{name} argument {i} = {wrong!r}: {type(exc).__name__}: {exc}")

@@ -30,7 +30,8 @@ from .io.batch import Batch, read_batch_csv, read_dataset  # noqa: E402
 from .io.plants import load_plant  # noqa: E402
 from .model.parameters import REGISTRY, THETA_BOUNDS, THETA_PAPER, THETA_START, Theta  # noqa: E402
 from .model.plant import Plant, preset_names  # noqa: E402
-from .model.rhs import INPUT_NAMES, PARAM_NAMES, STATE_NAMES, pack_params, rhs  # noqa: E402
+from .model.rhs import INPUT_NAMES, PARAM_NAMES, STATE_NAMES, pack_params  # noqa: E402
+from .model.rhs import checked_rhs as rhs  # noqa: E402
 from .sim.simulate import InitialState, SimulationResult, Simulator, simulate  # noqa: E402
 from .workflows.fitting import FitResult, fit  # noqa: E402
 from .workflows.model import FittedModel, load_log, load_model  # noqa: E402

@@ -20,7 +20,7 @@ import numpy as np
 
 from ..errors import InputError, ParameterError
 from ..model.limits import check_array, check_value
-from .files import atomic_write_text, read_input_text, read_toml
+from .files import as_path, atomic_write_text, read_input_text, read_toml
 
 REQUIRED_COLUMNS = ("time_s", "Gg_kg_s", "Tgi_C")
 #: Optional columns: the probe reading, the actuator settings (the actuator extension) and a
@@ -138,7 +138,7 @@ def read_table(
     Lines starting with ``#`` are comments. Returns ``{column: array}`` for the required
     columns and those optional ones present.
     """
-    path = Path(path)
+    path = as_path(path, "path")
     text = read_text(path) if text is None else text  # callers that already read it pass it
     # Streamed: the C csv reader walks the text once and each value goes into a compact
     # array of doubles, so memory is a small multiple of the file size whatever its shape.
@@ -227,7 +227,7 @@ def read_batch_csv(path: str | Path, name: str | None = None, require_Ta: bool =
 
     ``name`` names the batch (default: the file stem); ``require_Ta`` refuses a file without Ta_C.
     """
-    path = Path(path)
+    path = as_path(path, "path")
     required = REQUIRED_COLUMNS + (("Ta_C",) if require_Ta else ())
     text = read_text(path)  # once: the table and the '# Mb_kg' metadata come from the same text
     _refuse_raw_log(text, path)
@@ -318,7 +318,7 @@ class Dataset:
 
 def read_dataset(folder: str | Path) -> Dataset:
     """Read a dataset folder: ``dataset.toml`` with ``plant``, ``[[batch]]`` ``file``/``name``."""
-    folder = Path(folder)
+    folder = as_path(folder, "folder")
     meta_path = folder / "dataset.toml"
     if not meta_path.is_file():
         raise InputError("not a dataset folder (no dataset.toml)", folder)

@@ -52,13 +52,22 @@ def begin_run() -> None:
     _RUN["active"] = True
 
 
+def as_path(value, what: str = "path") -> Path:
+    """``value`` as a Path if it is one (a str or os.PathLike); else the project's own error."""
+    if isinstance(value, Path):
+        return value
+    if isinstance(value, (str, os.PathLike)) and not isinstance(value, bool):
+        return Path(value)
+    raise InputError(f"{what} must be a file path (str or Path), got {type(value).__name__} {str(value)[:40]!r}")
+
+
 def read_input_bytes(path: str | Path, limit: int = MAX_INPUT_BYTES) -> bytes:
     """Read a user's input file in bounded memory and time.
 
     Refuses missing files, folders, anything that is not a regular file (pipes, devices,
     sockets) and files over ``limit`` bytes (counted while reading, not taken from stat).
     """
-    path = Path(path)
+    path = as_path(path)
     try:
         fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0))
     except FileNotFoundError:

@@ -345,6 +345,48 @@ def rhs(t, x, u, p):
     return out
 
 
+def _real_vector(name: str, value, sizes: tuple[int, ...]) -> np.ndarray:
+    if np.iscomplexobj(value):
+        raise ParameterError(f"{name} must be real numbers, got complex values")
+    try:
+        a = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name} must be an array of numbers, got {type(value).__name__}") from None
+    if a.ndim != 1 or a.shape[0] not in sizes:
+        raise ParameterError(
+            f"{name} must be a 1-D array of {' or '.join(map(str, sizes))} numbers, got shape {a.shape}"
+        )
+    if not np.all(np.isfinite(a)):
+        raise ParameterError(f"{name} must be finite, got {a.tolist()}")
+    return a
+
+
+def checked_rhs(t, x, u, p) -> np.ndarray:
+    """:func:`rhs` for Python callers (``roastlab.rhs``): the arguments' types, shapes and
+    finiteness are checked first and a wrong one is a ParameterError naming it. The compiled
+    :func:`rhs` itself (callable from numba code) checks nothing.
+
+    Parameters
+    ----------
+    t : float
+        Time [s] (unused: the model is autonomous).
+    x : array of 5 or 6 floats
+        ``[Tb degC, Tm degC, X kg/kg dry, He kJ/kg dry, Ta degC[, H setting units]]``.
+    u : array of 2 or 4 floats
+        ``[Gg kg/s, Tgi degC[, heater, fan]]``.
+    p : array
+        Parameter vector from :func:`pack_params`.
+
+    Returns dx/dt, an array of the same length as ``x``.
+    """
+    if isinstance(t, bool) or not isinstance(t, (int, float, np.integer, np.floating)) or not math.isfinite(t):
+        raise ParameterError(f"t must be a finite number of seconds, got {str(t)[:40]!r}")
+    x = _real_vector("x (the state)", x, (S_H, S_H + 1))
+    u = _real_vector("u (the inputs)", u, (2, U_FAN + 1))
+    p = _real_vector("p (the parameter vector from pack_params)", p, (N_PARAMS,))
+    return rhs(float(t), x, u, p)
+
+
 def rebind(**operations) -> types.SimpleNamespace:
     """This module's equations evaluated with other elementary operations: the one right-hand side
     for other number types, never a copy of it.

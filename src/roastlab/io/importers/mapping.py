@@ -67,7 +67,7 @@ from ...model.actuators import UNIT_DEFAULTS, Actuator
 from ...model.limits import check_value
 from ...model.pitot import gas_flow_pitot_kg_s
 from ..batch import Batch, read_table
-from ..files import finite_number, read_input_bytes, read_toml
+from ..files import as_path, finite_number, read_input_bytes, read_toml
 from .artisan import read_alog, read_artisan_csv
 from .roastime import read_roastime
 
@@ -434,7 +434,7 @@ def _resample(time_s: np.ndarray, columns: dict[str, np.ndarray], step: float, p
 
 def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None) -> Batch:
     """Read any supported log with a column map into a validated canonical :class:`Batch`."""
-    path = Path(path)
+    path = as_path(path, "path")
     default_notes = []
     if cmap is None:
         cmap = ColumnMap(source="default map")
