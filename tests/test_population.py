@@ -69,3 +69,12 @@ def test_fleet_fit_recovers_per_batch_truth():
     fleet = identify_each(pack_batches(batches, "120kg", THETA_START))
     assert np.all(fleet.SSR < 1e-6)
     assert np.all(fleet.FIT > 99.9)
+
+
+def test_the_benchmarks_fresh_process_measurement_runs():
+    """``roastlab bench`` measures peak memory in a child that imports the benchmark's own
+    helpers (it imported a module that had moved, and the whole bench failed at that step)."""
+    from roastlab.cli.bench import load_benchmark
+
+    out = load_benchmark()._peak_memory_child(3)
+    assert out["peak_MB"] > 0 and out["mean_FIT"] > 50
