@@ -20,6 +20,7 @@ def write_map(tmp_path, text, name="map.toml"):
 
 
 SKY_MAP = '[Ta]\ncolumn = "BT"\n[Tgi]\ncolumn = "ET"\n[Gg]\nidentify = true\n'
+ROOM_AIR_MAP = '[Ta]\ncolumn = "BT"\n[Tgi]\nconstant_C = 22.0\n[Gg]\nidentify = true\n'
 
 
 def test_all_shared_logs_import(real_data, tmp_path):
@@ -245,3 +246,43 @@ def test_inputs_never_modified(cli, real_data, tmp_path):
     before = src.read_bytes()
     cli("import", src, "--map", write_map(tmp_path, SKY_MAP), "--out", tmp_path / "o.csv")
     assert src.read_bytes() == before
+
+
+def test_an_artisan_logs_et_is_kept_beside_the_model_and_survives_the_batch_csv(tmp_path):
+    """ET (Artisan's temp1) is read from every Artisan log as ``Batch.ET_C``: drawn beside the
+    model, never an input (the Skywalker map's inlet stays room air), kept by the batch CSV with
+    its gaps (an ET that read nothing, Artisan's -1, is a gap, not a sample dropped)."""
+    from roastlab.io.batch import read_batch_csv, write_batch_csv
+
+    n = 120
+    et = [150.0 + 0.4 * i for i in range(n)]
+    et[40] = -1
+    p = tmp_path / "et.alog"
+    p.write_text(fake_alog(et=et, n=n))
+    raw = read_alog(p)
+    b = import_log(p, load_map(write_map(tmp_path, ROOM_AIR_MAP)))
+    assert b.ET_C is not None and b.ET_C.size == b.n
+    assert np.isnan(b.ET_C).sum() == 1  # the -1 sample only
+    ok = np.isfinite(b.ET_C)
+    assert np.allclose(b.ET_C[ok], raw.channels["ET"][: b.n][ok])
+    assert np.all(b.Tgi_C == 22.0)  # not the inlet: the map's inlet is what it says
+    write_batch_csv(tmp_path / "b.csv", b)
+    back = read_batch_csv(tmp_path / "b.csv")
+    assert np.array_equal(np.isnan(back.ET_C), np.isnan(b.ET_C))
+    assert np.allclose(back.ET_C[ok], b.ET_C[ok], atol=1e-4)
+
+
+def test_a_map_names_et_where_the_log_calls_it_something_else(tmp_path):
+    from roastlab.errors import InputError
+
+    p = tmp_path / "et.alog"
+    extra = {
+        "extratimex": [[1.5 * i for i in range(80)]],
+        "extraname1": ["Exhaust"],
+        "extratemp1": [[200.0 + i for i in range(80)]],
+    }
+    p.write_text(fake_alog(n=80, extra=extra))
+    b = import_log(p, load_map(write_map(tmp_path, ROOM_AIR_MAP + '[ET]\ncolumn = "Exhaust"\n')))
+    assert b.ET_C[0] == pytest.approx(205.0)
+    with pytest.raises(InputError, match="ET: no channel 'Nope'"):
+        import_log(p, load_map(write_map(tmp_path, ROOM_AIR_MAP + '[ET]\ncolumn = "Nope"\n')))

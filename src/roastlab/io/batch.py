@@ -24,10 +24,11 @@ from .files import as_path, atomic_write_text, read_input_text, read_toml
 
 REQUIRED_COLUMNS = ("time_s", "Gg_kg_s", "Tgi_C")
 #: Optional columns: the probe reading, the actuator settings (the actuator extension) and a
-#: second bean reading compared with the model's Tb (e.g. an infrared bean-surface channel).
-OPTIONAL_COLUMNS = ("Ta_C", "heater", "fan", "Tb2_C")
+#: second bean reading compared with the model's Tb (e.g. an infrared bean-surface channel) and
+#: the roaster's ET as logged (shown beside the model's, never an input).
+OPTIONAL_COLUMNS = ("Ta_C", "heater", "fan", "Tb2_C", "ET_C")
 #: Columns whose empty cells mean "not measured here" (read as NaN, written empty).
-SPARSE_COLUMNS = ("Tb2_C",)
+SPARSE_COLUMNS = ("Tb2_C", "ET_C")
 
 
 @dataclass
@@ -49,6 +50,9 @@ class Batch:
         changes; units as the map declares (percent, levels or kW)
     Tb2_C : (n,) array or None, a second bean reading compared with the model's Tb (e.g. an
         infrared bean-surface channel); NaN where not measured
+    ET_C : (n,) array or None, the roaster's ET as logged [degC] (Artisan's ``temp1``; what it
+        measures depends on the machine: the drum, the air in it or the exhaust); shown beside
+        the model's temperatures, never an input; NaN where not measured
     events : {event name: time after CHARGE [s]} from the log (e.g. ``FCs``, ``DROP``)
     """
 
@@ -65,6 +69,7 @@ class Batch:
     fan: np.ndarray | None = None
     Tb2_C: np.ndarray | None = None
     events: dict = field(default_factory=dict)
+    ET_C: np.ndarray | None = None
 
     @property
     def n(self) -> int:
@@ -77,8 +82,10 @@ class Batch:
         for name in ("Ta_C", "heater", "fan"):
             if getattr(self, name) is not None:
                 cols[name] = getattr(self, name)
-        if self.Tb2_C is not None and len(self.Tb2_C) != len(self.time_s):
-            raise InputError(f"column Tb2_C has {len(self.Tb2_C)} values, time has {len(self.time_s)}", src)
+        for name in SPARSE_COLUMNS:
+            arr = getattr(self, name)
+            if arr is not None and len(arr) != len(self.time_s):
+                raise InputError(f"column {name} has {len(arr)} values, time has {len(self.time_s)}", src)
         n = len(self.time_s)
         if n < 2:
             raise InputError(f"needs at least 2 samples, got {n}", src)
@@ -103,9 +110,10 @@ class Batch:
         for name in ("time_s", "Gg_kg_s", "Tgi_C", "Ta_C", "heater", "fan"):
             if name in cols:
                 check_array(name, cols[name], src, None)
-        if self.Tb2_C is not None:
-            seen = self.Tb2_C[np.isfinite(self.Tb2_C)]  # NaN = not measured there
-            check_array("Ta_C", seen, src, "column Tb2_C")
+        for name in SPARSE_COLUMNS:  # temperatures; NaN = not measured there
+            arr = getattr(self, name)
+            if arr is not None:
+                check_array("Ta_C", arr[np.isfinite(arr)], src, f"column {name}")
         check_array("dt_s", dt, src)
         if self.Mb_kg is not None:
             check_value("Mb_kg", self.Mb_kg, src)
@@ -244,6 +252,7 @@ def read_batch_csv(path: str | Path, name: str | None = None, require_Ta: bool =
         heater=cols.get("heater"),
         fan=cols.get("fan"),
         Tb2_C=cols.get("Tb2_C"),
+        ET_C=cols.get("ET_C"),
         initial={k: v for k, v in meta.items() if k in INITIAL_METADATA},
     )
     return batch.validate()

@@ -123,6 +123,8 @@ def plot_simulation(result, path=None, title=None, outputs=None, events=None):
     ax.plot(t_min, result.Ta_C, label="BT predicted (model Ta, probe)", color="tab:orange", lw=2)
     if result.Ta_measured_C is not None:
         ax.plot(t_min, result.Ta_measured_C, "k.", ms=3, label="BT measured (log)")
+    if result.ET_measured_C is not None:
+        ax.plot(t_min, result.ET_measured_C, ".", ms=2, color="tab:purple", label="ET measured (log)")
     ax.plot(t_min, result.Tb_C, label="bean core (model Tb)", color="tab:brown")
     ax.plot(t_min, result.Tm_C, label="drum metal (model Tm)", color="tab:gray")
     _, tgi_seen = result.gas_seen()
@@ -273,6 +275,8 @@ def plot_whatif(w, path=None, outputs=None):
         ax.plot(t_min, b.Ta_C, ".", ms=3, color="0.3", label="BT measured (probe)")
     if b.Tb2_C is not None:
         ax.plot(t_min, b.Tb2_C, ".", ms=2, color="tab:brown", alpha=0.5, label="beans measured (second reading)")
+    if b.ET_C is not None:
+        ax.plot(t_min, b.ET_C, ".", ms=2, color="tab:purple", alpha=0.6, label="ET measured (log)")
     change = "; ".join(w.changes) or "no change"
     ax.plot(t_min, w.as_run.Ta_C, color="tab:blue", lw=1.8, label="BT model, as run")
     ax.plot(t_min, w.changed.Ta_C, color="tab:orange", lw=1.8, label=f"BT model, {change}")

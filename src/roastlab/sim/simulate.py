@@ -80,6 +80,7 @@ class SimulationResult(Result):
     heater, fan : (n,) arrays or None, the logged settings (actuator extension)
     Tb2_measured_C : (n,) array or None, a second measured bean reading compared with Tb
         (NaN where not measured), when the batch had one
+    ET_measured_C : (n,) array or None, the roaster's ET as logged (drawn, never an input)
     """
 
     time_s: np.ndarray
@@ -94,6 +95,7 @@ class SimulationResult(Result):
     heater: np.ndarray | None = None
     fan: np.ndarray | None = None
     Tb2_measured_C: np.ndarray | None = None
+    ET_measured_C: np.ndarray | None = None
 
     @property
     def uses_actuators(self) -> bool:

@@ -309,6 +309,7 @@ class FittedModel:
             res.name, res.meta = b.name, meta
             res.Ta_measured_C = None if b.Ta_C is None else b.Ta_C.copy()
             res.Tb2_measured_C = None if b.Tb2_C is None else b.Tb2_C.copy()
+            res.ET_measured_C = None if b.ET_C is None else b.ET_C.copy()
             why = failure(res.states, b.time_s)
             if why is not None:
                 raise InputError(f"{why}: check the inputs, initial state and values", b.source or b.name)

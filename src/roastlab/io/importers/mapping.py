@@ -41,6 +41,8 @@ A map is a TOML file::
     unit = "percent"
     [Tb2]                      # a second bean reading compared with the model's Tb
     column = "drumTemperature" # e.g. the Bullet's infrared channel
+    [ET]                       # the roaster's ET, drawn beside the model (default: an Artisan
+    column = "ET"              # log's ET channel); never an input
     [initial]                  # initial states from the log: a scalar field or a channel at CHARGE
     Tm0_C = "drumChargeTemperature"
 
@@ -102,6 +104,7 @@ class ColumnMap:
     heater: dict | None = None
     fan: dict | None = None
     Tb2: dict | None = None
+    ET: dict | None = None
     initial: dict = field(default_factory=dict)
     batch_kg: float | None = None
 
@@ -123,6 +126,7 @@ class ColumnMap:
                 "heater": self.heater,
                 "fan": self.fan,
                 "Tb2": self.Tb2,
+                "ET": self.ET,
                 "initial": self.initial or None,
                 "batch_kg": self.batch_kg,
             }
@@ -161,6 +165,7 @@ TABLE_KEYS = {
     "heater": {"column", "unit", "min", "max", "step", "rate_per_min"},
     "fan": {"column", "unit", "min", "max", "step", "rate_per_min"},
     "Tb2": {"column", "unit", "offset_C", "start_s"},
+    "ET": {"column", "unit", "offset_C"},
     "initial": set(INITIAL_FROM_LOG),
     "Gg": {"column", "unit", "density_kg_m3", "constant_kg_s", "identify", "pitot"},
     "pitot": {"dp_column", "T_column", "section_m2", "rho0_kg_m3", "T_unit"},
@@ -211,7 +216,7 @@ def map_from_mapping(data: dict, path: str | Path) -> ColumnMap:
     if not isinstance(data, dict):
         raise InputError("a column map must be a table", path)
     known = {"format", "keep_after_drop", "resample_s", "time", "Ta", "Tgi", "Gg", "name", "description", "notes"}
-    known |= {"heater", "fan", "Tb2", "initial", "batch_kg"}
+    known |= {"heater", "fan", "Tb2", "ET", "initial", "batch_kg"}
     unknown = sorted(set(data) - known)
     if unknown:
         raise InputError(f"unknown key(s) {', '.join(unknown)} (allowed: {', '.join(sorted(known))})", path)
@@ -230,7 +235,7 @@ def map_from_mapping(data: dict, path: str | Path) -> ColumnMap:
             "column": _check_str(t, "column", path, "time", required=False) or "time_s",
             "unit": _check_str(t, "unit", path, "time", required=False, choices=tuple(TIME_UNITS)) or "s",
         }
-    for key in ("Ta", "Tgi", "Tb2"):
+    for key in ("Ta", "Tgi", "Tb2", "ET"):
         if key in data:
             t = _table(data, key, path)
             if key == "Tgi" and "constant_C" in t:
@@ -458,6 +463,7 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
     initial: dict = {}
     events: dict = {}
     settings = {k: spec for k, spec in (("heater", cmap.heater), ("fan", cmap.fan), ("Tb2", cmap.Tb2)) if spec}
+    et_spec = cmap.ET
     if fmt in ("alog", "artisan-csv", "roastime"):
         if fmt == "alog":
             log = read_alog(path, keep_after_drop=cmap.keep_after_drop)
@@ -483,6 +489,11 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
             extra["dp"] = channel({"column": gg["pitot"]["dp_column"]}, "Gg.pitot.dp_column")
             extra["Tp"] = channel({"column": gg["pitot"]["T_column"]}, "Gg.pitot.T_column")
         series = {k: channel(spec, k) + (spec.get("offset_C") or 0.0) for k, spec in settings.items()}
+        if et_spec is None and fmt != "roastime" and "ET" in available:
+            et_spec = {"column": "ET"}  # Artisan's ET (temp1): drawn beside the model, never an input
+        if et_spec is not None:
+            settings["ET"] = et_spec
+            series["ET"] = channel(et_spec, "ET") + (et_spec.get("offset_C") or 0.0)
         Mb = log.weight_in_kg
         drop_known = log.drop_index is not None
         events = dict(log.events)
@@ -501,6 +512,8 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
             needed.append(gg["column"])
         elif "pitot" in gg:
             needed += [gg["pitot"]["dp_column"], gg["pitot"]["T_column"]]
+        if et_spec is not None:
+            settings["ET"] = et_spec
         needed += [spec["column"] for spec in settings.values()]
         needed = list(dict.fromkeys(needed))
         cols = _read_parquet(path, needed) if fmt == "parquet" else read_table(path, tuple(needed))
@@ -520,7 +533,9 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
         series = {}
         for k, spec in settings.items():
             v = cols[spec["column"]]
-            series[k] = to_celsius(v, spec.get("unit", "C")) + (spec.get("offset_C") or 0.0) if k == "Tb2" else v
+            series[k] = (
+                to_celsius(v, spec.get("unit", "C")) + (spec.get("offset_C") or 0.0) if k in ("Tb2", "ET") else v
+            )
         drop_known = True
         if cmap.initial:
             raise InputError("[initial] from the log needs a roast log (alog, artisan-csv, roastime)", cmap.source)
@@ -563,6 +578,8 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
             ok &= np.isfinite(series[k])
     if "Tb2" in series:  # the second reading only counts from start_s (e.g. once the beans are in view)
         series["Tb2"] = np.where(time_s >= settings["Tb2"].get("start_s", 0.0), series["Tb2"], np.nan)
+    if "ET" in series:  # Artisan writes -1 where a channel read nothing
+        series["ET"] = np.where(series["ET"] > -1.0 + 1e-9, series["ET"], np.nan)
     if ok.sum() < 2:
         raise InputError("fewer than 2 complete samples after dropping missing values", path)
     time_s, Ta, Tgi, Gg = time_s[ok], Ta[ok], Tgi[ok], Gg[ok]
@@ -608,6 +625,7 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
         heater=series.get("heater"),
         fan=series.get("fan"),
         Tb2_C=series.get("Tb2"),
+        ET_C=series.get("ET"),
         events=events,
     )
     batch.initial.update(initial)
