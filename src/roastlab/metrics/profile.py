@@ -205,6 +205,27 @@ def milestones(t, y, levels: dict[str, float]) -> dict[str, float | None]:
     }
 
 
+#: A roast's three phases as Artisan shades them, each (name, milestone it starts at, milestone
+#: it ends at): drying from CHARGE to DRY END, Maillard (browning) to first crack, development
+#: from first crack to DROP.
+PHASES = (("drying", "CHARGE", "DRY_s"), ("Maillard", "DRY_s", "FCs_s"), ("development", "FCs_s", "DROP_s"))
+
+
+def phases(ms: dict) -> list[dict]:
+    """The phases (:data:`PHASES`) of one curve from its :func:`milestones`:
+    ``[{"name", "from_s", "to_s"}, ...]``, a phase left out when a milestone it needs is missing.
+
+    >>> [p["name"] for p in phases({"DRY_s": 240.0, "FCs_s": None, "DROP_s": 600.0})]
+    ['drying']
+    """
+    at = {**ms, "CHARGE": 0.0}
+    return [
+        {"name": name, "from_s": float(at[a]), "to_s": float(at[b])}
+        for name, a, b in PHASES
+        if at.get(a) is not None and at.get(b) is not None and at[b] > at[a]
+    ]
+
+
 def display_temp(temp_C: float, units: str = "C") -> float:
     """A temperature [degC] in the display unit ("C" or "F")."""
     return temp_C * 9.0 / 5.0 + 32.0 if units == "F" else temp_C

@@ -276,7 +276,7 @@ def default_limits(model, plant_from=None, plant_to=None) -> ProgramLimits:
     return ProgramLimits.for_model(getattr(model, "column_map", None))
 
 
-def _et_source(cmap) -> str:
+def et_source(cmap) -> str:
     """What ET is on this machine, for the background's ET curve: the inlet gas where the map
     reads ET as the inlet (``[Tgi] column = "ET"``), else the drum (the Skywalker's and the
     Bullet's ET is the drum's temperature, as their maps' [initial] Tm0_C says)."""
@@ -305,6 +305,7 @@ def _grid_batch(ref: Batch, interval_s: float) -> Batch:
         heater=held(ref.heater),
         fan=held(ref.fan),
         Tb2_C=None,
+        ET_C=None,
         initial=dict(ref.initial),
     )
 
@@ -527,7 +528,7 @@ def transfer(
         actuators=grid.heater is not None or grid.fan is not None,
         continuous=continuous,
         events=dict(reference.events),
-        et_source=_et_source(cmap),
+        et_source=et_source(cmap),
         fan_actuator=cmap.actuator("fan") if cmap is not None and cmap.fan else None,
     )
 

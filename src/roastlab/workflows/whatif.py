@@ -52,19 +52,22 @@ READINGS = {"beans": "beans (model Tb; measured: a second bean reading where log
 
 @dataclass
 class SettingChange:
-    """One change of a logged setting from ``from_s`` [s after CHARGE] on: ``shift`` (add
-    ``value``), ``scale`` (multiply) or ``set`` (the setting becomes ``value``); ``unit`` is the
-    setting's unit as the map declares it ("percent", "level", ...)."""
+    """One change of a logged setting from ``from_s`` [s after CHARGE] on (until ``until_s``,
+    default the end of the roast): ``shift`` (add ``value``), ``scale`` (multiply) or ``set``
+    (the setting becomes ``value``); ``unit`` is the setting's unit as the map declares it
+    ("percent", "level", ...). Changes apply in the order given, so a program drawn as steps
+    is a list of ``set`` changes, each from its step's start to its end."""
 
     setting: str
     how: str  # "shift" | "scale" | "set"
     value: float
     from_s: float = 0.0
     unit: str = ""
+    until_s: float = float("inf")
 
     def apply(self, t: np.ndarray, series: np.ndarray) -> np.ndarray:
         out = series.copy()
-        after = t >= self.from_s
+        after = (t >= self.from_s) & (t < self.until_s)
         if self.how == "shift":
             out[after] += self.value
         elif self.how == "scale":
@@ -77,6 +80,8 @@ class SettingChange:
         steps = " step" if abs(self.value) == 1 else " steps"
         unit = {"percent": " %", "level": steps, "": ""}.get(self.unit, f" {self.unit}")
         when = f" from {mmss(self.from_s)}" if self.from_s > 0 else ""
+        if np.isfinite(self.until_s):
+            when = f" from {mmss(self.from_s)} to {mmss(self.until_s)}"
         if self.how == "set":
             unit = {"percent": " %", "level": ""}.get(self.unit, unit)
             return f"{self.setting} = {self.value:g}{unit}{when or ' from CHARGE'}"
