@@ -27,6 +27,15 @@ ARGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--
         "--disable-component-update", "--disable-sync"]  # fmt: skip
 
 
+#: Where the heater's longest step is on the page, in screen pixels, and three levels below it.
+DRAG_SPOT = """() => { const gd = document.getElementById('plot'), sh = gd._fullLayout.shapes;
+  let k = -1, best = -1;
+  sh.forEach((s, i) => { if (s.name && s.name.startsWith('heater:') && s.x1 - s.x0 > best) { best = s.x1 - s.x0; k = i; } });
+  const s = sh[k], xa = gd._fullLayout.xaxis, ya = gd._fullLayout.yaxis3, r = gd.getBoundingClientRect();
+  return { x: r.left + xa._offset + xa.l2p((s.x0 + s.x1) / 2), y: r.top + ya._offset + ya.l2p(s.y0),
+           y_to: r.top + ya._offset + ya.l2p(s.y0 - 3) }; }"""
+
+
 def data_folder(d: Path) -> tuple[str, str]:
     """Fill ``d``; return the (log, model) the screenshots open."""
     import roastlab
@@ -97,6 +106,20 @@ def main() -> int:
         time.sleep(0.5)
         page.screenshot(path=str(DOCS / "app-whatif.png"), full_page=True)
 
+        page.click("#reset")  # back to the log as run, then drag the heater's longest step down
+        page.wait_for_function("document.body.dataset.opened !== undefined")
+        time.sleep(0.3)
+        spot = page.evaluate(DRAG_SPOT)
+        n = page.evaluate("Number(document.body.dataset.updates || 0)")
+        page.mouse.click(spot["x"], spot["y"])
+        page.mouse.move(spot["x"], spot["y"])
+        page.mouse.down()
+        page.mouse.move(spot["x"], spot["y_to"], steps=10)
+        page.mouse.up()
+        page.wait_for_function(f"Number(document.body.dataset.updates || 0) > {n}")
+        time.sleep(0.3)
+        page.screenshot(path=str(DOCS / "app-drag.png"), full_page=True)
+
         page.fill("#tr_batch_kg", f"{kg * 1.6:.3f}")
         t0 = time.perf_counter()
         page.click("#run-transfer")
@@ -115,6 +138,13 @@ def main() -> int:
             fit_s = time.perf_counter() - t0
             page.locator("#fit-report").scroll_into_view_if_needed()
             page.screenshot(path=str(DOCS / "app-fit.png"), full_page=True)
+            fitted = page.evaluate("document.body.dataset.fitted")
+            page.evaluate("delete document.body.dataset.opened")
+            _ = page.select_option("#log", sky[-1]), page.select_option("#model", fitted)
+            page.click("#open")
+            page.wait_for_function("document.body.dataset.opened !== undefined")
+            time.sleep(0.3)
+            page.screenshot(path=str(DOCS / "app-skywalker.png"), full_page=True)
         browser.close()
     srv.should_exit = True
 
@@ -132,7 +162,7 @@ def main() -> int:
     print(f"transfer: {page_transfer_s:.2f} s on the page, {lib_s:.2f} s as a library call")
     if fit_s is not None:
         print(f"fit on the page: 6 Skywalker logs (init + fit-roaster) in {fit_s:.1f} s")
-    print("wrote docs/app-open.png, docs/app-whatif.png, docs/app-transfer.png, docs/app-fit.png")
+    print("wrote docs/app-open.png, docs/app-whatif.png, docs/app-drag.png, docs/app-transfer.png, docs/app-fit.png, docs/app-skywalker.png")
     shutil.rmtree(d, ignore_errors=True)
     return 0
 

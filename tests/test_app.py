@@ -81,6 +81,42 @@ def test_open_whatif_and_table_through_the_api(client):
     assert w["server_ms"] < 1000
 
 
+def test_open_gives_phases_band_fit_figures_and_the_machines_controls(client, data_dir):
+    if not (data_dir / "bullet-model.json").exists():
+        pytest.skip("../shared/data/real is absent")
+    r = client.post("/api/open", json={"log": "logs/bullet-500g.json", "model": "bullet-model.json"}, headers=H).json()
+    assert "error" not in r, r
+    names = [p["name"] for p in r["phases"]]
+    assert names == ["drying", "Maillard", "development"]
+    assert all(a["to_s"] == b["from_s"] for a, b in zip(r["phases"], r["phases"][1:]))
+    assert r["phases"][-1]["to_s"] == pytest.approx(r["curves"]["time_s"][-1])
+    band = r["band"]
+    lower, upper = (np.array(band[k], dtype=float) for k in ("lower", "upper"))
+    bt = np.array(r["curves"]["BT_model"], dtype=float)
+    assert np.all(lower <= bt + 1e-9) and np.all(bt <= upper + 1e-9) and band["median_width_C"] > 0.5
+    assert 0 < r["metrics"]["FIT_pct"] <= 100 and r["metrics"]["MAE_C"] > 0
+    assert r["actuators"]["heater"]["unit"] == "level" and r["actuators"]["heater"]["step"] == 1
+
+
+def test_a_program_step_through_the_api_holds_for_its_span_only(client, data_dir):
+    if not (data_dir / "bullet-model.json").exists():
+        pytest.skip("../shared/data/real is absent")
+    r = client.post("/api/open", json={"log": "logs/bullet-500g.json", "model": "bullet-model.json"}, headers=H).json()
+    t, logged = np.array(r["curves"]["time_s"]), np.array(r["curves"]["heater"])
+    step = {"setting": "heater", "value": 2, "from_s": 120, "until_s": 400}
+    w = client.post("/api/whatif", json={"program": [step]}, headers=H).json()
+    assert "error" not in w, w
+    heater = np.array(w["curves"]["heater"])
+    inside = (t >= 120) & (t < 400)
+    assert np.all(heater[inside] == 2) and np.array_equal(heater[~inside], logged[~inside])
+    rows = {(x["reading"], x["key"]): x for x in w["table"]["rows"]}
+    assert rows["beans", "DROP_C"]["changed"] < rows["beans", "DROP_C"]["as_run"]
+    bad = client.post("/api/whatif", json={"program": [{"setting": "heater", "value": "lots"}]}, headers=H)
+    assert bad.status_code == 400 and "program step 1" in bad.json()["error"]
+    off = client.post("/api/whatif", json={"program": [{**step, "value": 40}]}, headers=H)
+    assert off.status_code == 400 and "range" in off.json()["error"]
+
+
 def test_tabs_do_not_share_state(client):
     client.post("/api/open", json={"log": "batch1.csv", "model": "paper-model.json"}, headers=H)
     other = client.post("/api/whatif", json={"tgi": 10}, headers={"X-Session": "test-session-b"}).json()
@@ -182,7 +218,7 @@ def test_the_page_draws_a_real_log_and_follows_a_what_if(page, data_dir, tmp_pat
         pytest.skip("../shared/data/real is absent")
     _open(page, "logs/bullet-500g.json", "bullet-model.json")
     traces = _traces(page)
-    assert {"BT measured", "BT model, as run", "heater", "fan"} <= set(traces)
+    assert {"BT measured", "BT model, as run", "heater [steps]", "fan [steps]", "90 % band, as run"} <= set(traces)
     assert len(traces["BT measured"]) > 50
     before = page.inner_text("tr[data-key='beans-DROP_C'] td.changed")
     updates = page.evaluate("Number(document.body.dataset.updates || 0)")
@@ -195,6 +231,41 @@ def test_the_page_draws_a_real_log_and_follows_a_what_if(page, data_dir, tmp_pat
     assert not np.allclose(np.array(changed, dtype=float), np.array(traces["BT model, as run"], dtype=float))
     page.screenshot(path=str(tmp_path / "whatif.png"), full_page=True)
     assert (tmp_path / "whatif.png").stat().st_size > 20_000
+
+
+@pytest.mark.slow
+def test_a_program_step_dragged_with_the_mouse_changes_the_prediction(page, data_dir, tmp_path):
+    """Drag the heater's longest step down with the mouse: it snaps to the machine's levels (P
+    steps), the server predicts with it, and the table's changed column follows."""
+    if not (data_dir / "bullet-model.json").exists():
+        pytest.skip("../shared/data/real is absent")
+    _open(page, "logs/bullet-500g.json", "bullet-model.json")
+    before = page.inner_text("tr[data-key='beans-DROP_C'] td.changed")
+    spot = page.evaluate(
+        """() => { const gd = document.getElementById('plot'), sh = gd._fullLayout.shapes;
+        let k = -1, best = -1;
+        sh.forEach((s, i) => { if (s.name && s.name.startsWith('heater:') && s.x1 - s.x0 > best) { best = s.x1 - s.x0; k = i; } });
+        const s = sh[k], xa = gd._fullLayout.xaxis, ya = gd._fullLayout.yaxis3, r = gd.getBoundingClientRect();
+        return { name: s.name, level: s.y0, x: r.left + xa._offset + xa.l2p((s.x0 + s.x1) / 2),
+                 y: r.top + ya._offset + ya.l2p(s.y0), y_to: r.top + ya._offset + ya.l2p(s.y0 - 3) }; }"""
+    )
+    updates = page.evaluate("Number(document.body.dataset.updates || 0)")
+    page.mouse.click(spot["x"], spot["y"])  # activate the step, then drag it three levels down
+    page.mouse.move(spot["x"], spot["y"])
+    page.mouse.down()
+    page.mouse.move(spot["x"], spot["y_to"], steps=10)
+    page.mouse.up()
+    page.wait_for_function(f"Number(document.body.dataset.updates || 0) > {updates}")
+    k = int(spot["name"].split(":")[1])
+    step = page.evaluate(f"state.program.heater[{k}]")
+    assert step["value"] == round(step["value"]) and step["value"] < spot["level"]  # snapped to a P level, lower
+    heater = np.array(_traces(page)["heater [steps]"], dtype=float)
+    t = np.array(page.evaluate("state.open.curves.time_s"), dtype=float)
+    inside = (t >= step["from_s"]) & (t < step["until_s"])
+    assert np.all(heater[inside] == step["value"])
+    after = page.inner_text("tr[data-key='beans-DROP_C'] td.changed")
+    assert float(after) < float(before)  # less heat: cooler beans at DROP
+    page.screenshot(path=str(tmp_path / "drag.png"), full_page=True)
 
 
 @pytest.mark.slow

@@ -4,7 +4,8 @@
 const sid = sessionStorage.getItem("roastlab-session") || crypto.randomUUID();
 sessionStorage.setItem("roastlab-session", sid);
 const $ = (id) => document.getElementById(id);
-const state = { open: null, changed: null, table: null, busy: false, pending: false, lastDrawMs: null, tInput: null };
+const state = { open: null, changed: null, table: null, busy: false, pending: false, lastDrawMs: null, tInput: null,
+                program: {} };  // setting -> [{from_s, until_s, value, logged}]: the steps the roaster can drag
 
 async function api(path, body) {
   const opts = { method: body === undefined ? "GET" : "POST", headers: { "X-Session": sid } };
@@ -35,6 +36,88 @@ function mmssTicks(x) {  // the roaster's time axis: a tick a minute, written m:
   return { tickvals: vals, ticktext: vals.map((m) => `${m}:00`) };
 }
 
+const PHASE_COLORS = { drying: "rgba(255, 214, 102, 0.18)", Maillard: "rgba(214, 140, 69, 0.16)", development: "rgba(140, 80, 40, 0.16)" };
+
+function phaseShapes(phases) {  // Artisan's phase bands: drying, Maillard, development (from the log's marks)
+  const shapes = [], notes = [];
+  for (const p of phases || []) {
+    shapes.push({ type: "rect", xref: "x", yref: "paper", x0: p.from_s / 60, x1: p.to_s / 60, y0: 0.42, y1: 1,
+                  fillcolor: PHASE_COLORS[p.name] || "rgba(0,0,0,0.05)", line: { width: 0 }, layer: "below" });
+    notes.push({ xref: "x", yref: "paper", x: (p.from_s + p.to_s) / 120, y: 0.43, text: `${p.name} ${mmss(p.to_s - p.from_s)}`,
+                 showarrow: false, font: { size: 10, color: "#7a5a3a" } });
+  }
+  return { shapes, notes };
+}
+
+// The program the roaster can drag: each held setting as steps (segments between changes), drawn as
+// thick editable lines on the settings axis; a dragged step is snapped to the machine's levels.
+function stepsOf(t, values) {
+  const out = [];
+  if (!values) return out;
+  let start = 0;
+  for (let i = 1; i <= values.length; i++) {
+    if (i === values.length || values[i] !== values[start]) {
+      const until = i < values.length ? t[i] : t[t.length - 1] + 1;
+      out.push({ from_s: t[start], until_s: until, value: values[start], logged: values[start], logged_from: t[start] });
+      start = i;
+    }
+  }
+  return out.length > 60 ? [] : out;  // a setting logged as a continuous curve is not a program to drag
+}
+
+const STEP_COLORS = { heater: "#d62728", fan: "#2ca02c" };
+function programShapes() {
+  const shapes = [];
+  for (const [name, steps] of Object.entries(state.program)) {
+    steps.forEach((st, k) => shapes.push({ type: "line", xref: "x", yref: "y3", x0: st.from_s / 60, x1: st.until_s / 60,
+      y0: st.value, y1: st.value, editable: true, name: `${name}:${k}`,
+      line: { color: STEP_COLORS[name], width: st.value !== st.logged ? 7 : 5 }, opacity: st.value !== st.logged ? 0.9 : 0.45 }));
+  }
+  return shapes;
+}
+
+function snap(name, v) {
+  const a = (state.open.actuators || {})[name];
+  if (!a) return v;
+  v = Math.min(a.high, Math.max(a.low, v));
+  return a.step ? a.low + Math.round((v - a.low) / a.step) * a.step : Math.round(v * 10) / 10;
+}
+
+function onRelayout(ev) {  // a program step was dragged: its new level (and start, if moved along time)
+  const moved = {};
+  for (const [key, v] of Object.entries(ev || {})) {
+    const m = key.match(/^shapes\[(\d+)\]\.(x0|x1|y0|y1)$/);
+    if (m) (moved[m[1]] = moved[m[1]] || {})[m[2]] = v;
+  }
+  const shapes = ($("plot").layout || {}).shapes || [];
+  let changed = false;
+  for (const [i, m] of Object.entries(moved)) {
+    const sh = shapes[Number(i)];
+    if (!sh || !sh.name || !sh.editable) continue;
+    const [name, k] = sh.name.split(":");
+    const st = state.program[name][Number(k)];
+    const y = m.y0 !== undefined && m.y1 !== undefined ? (m.y0 + m.y1) / 2 : (m.y0 ?? m.y1);
+    if (y !== undefined) st.value = snap(name, y);
+    if (m.x0 !== undefined && m.x1 !== undefined) {  // moved along time: the step starts and ends elsewhere
+      const len = st.until_s - st.from_s;
+      st.from_s = Math.max(0, Math.round(m.x0 * 60 / 5) * 5);
+      st.until_s = st.from_s + len;
+    }
+    changed = true;
+  }
+  if (changed) { state.tInput = performance.now(); whatif(); }
+}
+
+function programBody() {  // the dragged steps as "set" changes (applied in order, as the what-if does)
+  const out = [];
+  for (const [name, steps] of Object.entries(state.program)) {
+    for (const st of steps) {
+      if (st.value !== st.logged || st.from_s !== st.logged_from) out.push({ setting: name, value: st.value, from_s: st.from_s, until_s: st.until_s });
+    }
+  }
+  return out;
+}
+
 function eventShapes(events) {
   const shapes = [], notes = [];
   let i = 0;
@@ -56,16 +139,23 @@ function draw() {
   const traces = [];
   if (c.BT_measured) traces.push({ x, y: T(c.BT_measured), name: "BT measured", mode: "markers", marker: { size: 3, color: "#333" } });
   if (c.beans_measured) traces.push({ x, y: T(c.beans_measured), name: "beans measured (IR)", mode: "markers", marker: { size: 2, color: "#a0785a" } });
+  if (c.ET_measured) traces.push({ x, y: T(c.ET_measured), name: "ET measured", mode: "markers", marker: { size: 2, color: "#9467bd" } });
+  const b = o.band || {};
+  if (b.lower) {  // the as-run band: parameters and roast-to-roast spread (roastlab.evaluate.bands)
+    traces.push({ x, y: T(b.lower), name: "band", line: { width: 0 }, hoverinfo: "skip", showlegend: false });
+    traces.push({ x, y: T(b.upper), name: `${Math.round(b.level * 100)} % band, as run`, fill: "tonexty",
+                  fillcolor: "rgba(31, 119, 180, 0.15)", line: { width: 0 }, hoverinfo: "skip" });
+  }
   traces.push({ x, y: T(c.BT_model), name: "BT model, as run", line: { color: "#1f77b4", width: 2 } });
   traces.push({ x, y: T(ch.BT_model), name: "BT model, changed", line: { color: "#ff7f0e", width: 2 }, uid: "bt-changed" });
   traces.push({ x, y: T(c.beans_model), name: "beans model, as run", line: { color: "#1f77b4", width: 1, dash: "dash" } });
   traces.push({ x, y: T(ch.beans_model), name: "beans model, changed", line: { color: "#ff7f0e", width: 1, dash: "dash" } });
-  traces.push({ x, y: T(ch.drum_model), name: "drum model (ET), changed", line: { color: "#d62728", width: 1 } });
+  traces.push({ x, y: T(ch.ET_model), name: `ET model: ${o.ET_model_is}, changed`, line: { color: "#9467bd", width: 1 } });
   if (c.RoR_measured) traces.push({ x, y: c.RoR_measured.map(dtemp), name: "RoR measured", yaxis: "y2", line: { color: "#555", width: 1 } });
   traces.push({ x, y: ch.RoR_model.map(dtemp), name: "RoR model, changed", yaxis: "y2", line: { color: "#ff7f0e", width: 1 } });
-  if (ch.heater) traces.push({ x, y: ch.heater, name: "heater", yaxis: "y3", line: { shape: "hv", color: "#d62728" } });
-  if (ch.fan) traces.push({ x, y: ch.fan, name: "fan", yaxis: "y3", line: { shape: "hv", color: "#2ca02c" } });
-  const ev = eventShapes(o.events);
+  if (ch.heater) traces.push({ x, y: ch.heater, name: `heater [${unitName("heater")}]`, yaxis: "y3", line: { shape: "hv", color: "#d62728" } });
+  if (ch.fan) traces.push({ x, y: ch.fan, name: `fan [${unitName("fan")}]`, yaxis: "y3", line: { shape: "hv", color: "#2ca02c" } });
+  const ev = eventShapes(o.events), ph = phaseShapes(o.phases);
   const rorAfter = (ch.RoR_model || []).filter((v, i) => v !== null && c.time_s[i] > 90).map(dtemp);
   const rorTop = rorAfter.length ? Math.max(...rorAfter) * 1.2 + 2 : 30;
   const t0 = performance.now();
@@ -73,16 +163,23 @@ function draw() {
     margin: { t: 30, r: 60, l: 60, b: 40 }, legend: { orientation: "h", y: -0.12, font: { size: 10 } },
     xaxis: { title: { text: "time after CHARGE [m:ss]" }, domain: [0, 1], anchor: "y3", ...mmssTicks(x) },
     yaxis: { title: { text: `temperature [${unit()}]` }, domain: [0.42, 1] },
-    yaxis2: { title: { text: `RoR [${unit()}/min]` }, overlaying: "y", side: "right", range: [dtemp(-2), rorTop], showgrid: false },
-    yaxis3: { title: { text: "setting" }, domain: [0, 0.32] },
-    shapes: ev.shapes, annotations: ev.notes, uirevision: "keep",
-  }).then(() => {
+    yaxis2: { title: { text: `RoR [${unit()}/min]` }, overlaying: "y", side: "right", range: [dtemp(-2), rorTop], showgrid: false,
+              tickmode: "auto", nticks: 6, tickformat: ".0f" },
+    yaxis3: { title: { text: "setting (drag a step)" }, domain: [0, 0.32] },
+    shapes: [...ph.shapes, ...ev.shapes, ...programShapes()], annotations: [...ph.notes, ...ev.notes], uirevision: "keep",
+  }, { displaylogo: false }).then(() => {
+    if (!state.hooked) { $("plot").on("plotly_relayout", onRelayout); state.hooked = true; }
     state.lastDrawMs = performance.now() - t0;
     if (state.tInput !== null) {  // from the input change to this curve on screen
       document.body.dataset.latency = String(performance.now() - state.tInput);
       state.tInput = null;
     }
   });
+}
+
+function unitName(name) {
+  const a = (state.open && state.open.actuators || {})[name];
+  return a ? ({ level: "steps", percent: "%" }[a.unit] || a.unit) : "as logged";
 }
 
 function drawTable() {
@@ -105,6 +202,9 @@ function drawTable() {
             `<td>${f(r.as_run)}</td><td class="changed">${f(r.changed)}</td><td>${ch}</td><td>${er}</td></tr>`;
   }
   $("table").innerHTML = html;
+  const m = state.open && state.open.metrics, b = state.open && state.open.band;
+  $("figures").textContent = (m ? `model as run against this log: FIT ${m.FIT_pct.toFixed(1)} %, MAE ${dtemp(m.MAE_C).toFixed(2)} ${unit()}` : "") +
+    (b && b.lower ? `; ${Math.round(b.level * 100)} % band median width ${dtemp(b.median_width_C).toFixed(1)} ${unit()}` : b && b.why ? `; ${b.why}` : "");
   $("warnings").textContent = (t.warnings || []).map((w) => "note: " + w).join("\n");
 }
 
@@ -115,6 +215,8 @@ function changes() {
   if (o && v("Tm0_C") !== "" && Number(v("Tm0_C")) !== o.Tm0_C) body.Tm0_C = Number(v("Tm0_C"));
   if (o && v("batch_kg") !== "" && Number(v("batch_kg")) !== o.batch_kg) body.batch_kg = Number(v("batch_kg"));
   if (v("X0") !== "" && o && Number(v("X0")) !== o.X0) body.X0 = Number(v("X0"));
+  const program = programBody();
+  if (program.length) body.program = program;
   return body;
 }
 
@@ -146,6 +248,11 @@ async function openLog() {
     const r = await api("/api/open", { log: $("log").value, model: $("model").value });
     state.open = r;
     state.changed = null;
+    state.program = {};
+    for (const name of Object.keys(r.actuators || {})) {
+      const steps = stepsOf(r.curves.time_s, r.curves[name]);
+      if (steps.length) state.program[name] = steps;
+    }
     state.table = r.table;
     $("Tm0_C").value = r.Tm0_C ?? "";
     $("Tm0_C_range").value = r.Tm0_C ?? 200;
@@ -220,7 +327,10 @@ async function upload(ev) {
 }
 
 async function runTransfer() {
-  say("running the transfer ...");
+  say("");
+  $("transfer_progress").hidden = false;
+  $("transfer_progress").removeAttribute("value");  // indeterminate: the solve reports no steps
+  $("transfer-summary").textContent = "running the transfer ...";
   try {
     const r = await api("/api/transfer", { batch_kg: $("tr_batch_kg").value, plant_to: $("tr_plant").value.trim(), tm0_free: $("tr_tm0_free").checked });
     $("transfer-summary").textContent = r.summary;
@@ -238,7 +348,10 @@ async function runTransfer() {
     say("");
     document.body.dataset.transfer = "done";
   } catch (e) {
+    $("transfer-summary").textContent = "(the transfer failed: see the message above)";
     say(e.message);
+  } finally {
+    $("transfer_progress").hidden = true;
   }
 }
 

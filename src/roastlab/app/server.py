@@ -57,6 +57,7 @@ class Session:
     log: str = ""
     model_path: str = ""
     as_run: object = None
+    et: str = "Tm"  # what ET is on this machine (workflows.transfer.et_source)
     fit: dict = field(default_factory=dict)  # the background fit's progress and answer
     sid: str = ""
     used: float = field(default_factory=time.monotonic)
@@ -132,16 +133,18 @@ def _series(values) -> list | None:
     return [None if v != v or v in (np.inf, -np.inf) else v for v in a.tolist()]
 
 
-def curves(batch, result) -> dict:
-    """The page's view of one prediction: times, BT and beans, the drum, the settings and the
-    rate of rise [degC/min] (the one RoR of :mod:`roastlab.metrics.profile`); with ``batch``
-    the measured BT (and a second bean reading) too."""
+def curves(batch, result, et: str = "Tm") -> dict:
+    """The page's view of one prediction: times, BT and beans, the model's ET (``et``: "Tm" the
+    drum, "Tgi" the inlet gas the model sees, as :func:`roastlab.workflows.transfer.et_source`
+    reads the machine's map), the settings and the rate of rise [degC/min] (the one RoR of
+    :mod:`roastlab.metrics.profile`); with ``batch`` the measured BT, ET and a second bean
+    reading too."""
     t = result.time_s
     out = {
         "time_s": _series(t),
         "BT_model": _series(result.Ta_C),
         "beans_model": _series(result.Tb_C),
-        "drum_model": _series(result.Tm_C),
+        "ET_model": _series(result.Tm_C if et == "Tm" else result.gas_seen()[1]),
         "RoR_model": _series(rate_of_rise_C_per_min(t, result.Ta_C)),
         "heater": _series(result.heater),
         "fan": _series(result.fan),
@@ -151,6 +154,62 @@ def curves(batch, result) -> dict:
         out["RoR_measured"] = _series(rate_of_rise_C_per_min(batch.time_s, batch.Ta_C))
     if batch is not None and batch.Tb2_C is not None:
         out["beans_measured"] = _series(batch.Tb2_C)
+    if batch is not None and batch.ET_C is not None:
+        out["ET_measured"] = _series(batch.ET_C)
+    return out
+
+
+#: What the model's ET curve is, per :func:`roastlab.workflows.transfer.et_source`.
+ET_NAMES = {"Tm": "drum metal (model Tm)", "Tgi": "inlet gas the model sees (Tgi)"}
+
+
+def band(model, batch) -> dict:
+    """The as-run prediction band of :func:`roastlab.evaluate.bands.prediction_bands` (level
+    :data:`~roastlab.evaluate.bands.BAND_LEVEL`) or, for a model without standard errors or a
+    roast-to-roast spread, ``{"why": ...}``."""
+    from ..evaluate.bands import BAND_LEVEL, prediction_bands
+
+    fit = model.doc.get("fit") or {}
+    if not (fit.get("correlation") or {}).get("names") and not fit.get("spread"):
+        return {"why": "this model file has no parameter covariance or roast-to-roast spread: no band"}
+    b = prediction_bands(model, [batch], BAND_LEVEL)[0]
+    return {
+        "level": BAND_LEVEL,
+        "lower": _series(b.lower_C),
+        "upper": _series(b.upper_C),
+        "median_width_C": round(float(np.median(b.width_C)), 2),
+    }
+
+
+def _fit_figures(batch, result) -> dict | None:
+    """FIT [%] and MAE [degC] of the model as run against the measured BT (the paper's indexes,
+    :func:`roastlab.evaluate.metrics.batch_metrics`)."""
+    from ..evaluate.metrics import batch_metrics
+
+    if batch.Ta_C is None:
+        return None
+    m = batch_metrics(batch.Ta_C, result.Ta_C)
+    return {"FIT_pct": round(m["FIT"], 1), "MAE_C": round(m["MAE"], 2)}
+
+
+def _program_sets(body: dict, units: dict) -> list:
+    """Steps dragged on the page's program plot: ``[{"setting", "value", "from_s", "until_s"}]``
+    -> :class:`~roastlab.workflows.whatif.SettingChange` "set" changes, in the order given."""
+    from ..io.files import finite_number
+    from ..workflows.whatif import SettingChange
+
+    items = body.get("program") or []
+    if not isinstance(items, list) or len(items) > 500:
+        raise InputError("program: expected a list of at most 500 steps", "request")
+    out = []
+    for i, item in enumerate(items):
+        if not isinstance(item, dict) or item.get("setting") not in ("heater", "fan"):
+            raise InputError("program step: expected {setting: heater|fan, value, from_s, until_s}", f"step {i + 1}")
+        where = f"program step {i + 1}"
+        value = finite_number(item.get("value"), "request", where)
+        start = finite_number(item.get("from_s", 0.0), "request", where)
+        end = finite_number(item.get("until_s", 1e9), "request", where)
+        out.append(SettingChange(item["setting"], "set", value, max(start, 0.0), units.get(item["setting"], ""), end))
     return out
 
 
@@ -166,6 +225,7 @@ def _changes(body: dict, session: Session):
         text = str(body.get(name) or "").strip()
         if text and text not in ("+0", "0", "-0"):
             setting_changes.append(parse_setting_change(name, text, units.get(name, "")))
+    setting_changes += _program_sets(body, units)
     for key, name in (("Tm0_C", "Tm0_C"), ("Tb0_C", "Tb0_C"), ("X0", "X0"), ("batch_kg", "batch_kg")):
         if body.get(key) not in (None, ""):
             changes[name] = check_value(name, body[key], key)
@@ -223,7 +283,9 @@ def create_app(data_dir: str | Path):
         return list_files(data)
 
     def open_log(session: Session, body: dict) -> dict:
+        from ..metrics.profile import phases
         from ..workflows.model import load_log, load_model
+        from ..workflows.transfer import et_source
         from ..workflows.whatif import whatif
 
         model = load_model(inside(data, body.get("model", "")))
@@ -232,6 +294,17 @@ def create_app(data_dir: str | Path):
         w = whatif(model, batch)
         session.batch, session.model, session.log = batch, model, body["log"]
         session.model_path, session.as_run = body["model"], w.as_run
+        session.et = et_source(model.column_map)
+        probe = {r["key"]: r for r in w.rows if r["reading"] == "probe"}
+        ms = {k: probe[k]["measured" if batch.Ta_C is not None else "as_run"] for k in ("DRY_s", "FCs_s")}
+        ms["DROP_s"] = float(batch.time_s[-1])
+        cmap = model.column_map
+        actuators = {}
+        for name in ("heater", "fan"):
+            act = cmap.actuator(name) if cmap is not None and getattr(batch, name) is not None else None
+            if act is not None:
+                actuators[name] = {"unit": act.unit, "low": act.low, "high": act.high, "step": act.step,
+                                   "label": act.describe()}  # fmt: skip
         return {
             "log": batch.name,
             "batch_kg": batch.Mb_kg,
@@ -239,9 +312,14 @@ def create_app(data_dir: str | Path):
             "X0": round(float(w.as_run.X_kg_kg[0]), 4),
             "events": batch.events,
             "notes": list(batch.notes),
-            "curves": curves(batch, w.as_run),
+            "curves": curves(batch, w.as_run, session.et),
+            "ET_model_is": ET_NAMES[session.et],
+            "phases": phases(ms),
+            "band": band(model, batch),
+            "metrics": _fit_figures(batch, w.as_run),
             "table": w.to_json_dict(),
             "settings": model.column_map.setting_units() if model.column_map else {},
+            "actuators": actuators,
         }
 
     def need(session: Session):
@@ -256,7 +334,7 @@ def create_app(data_dir: str | Path):
         setting_changes, changes = _changes(body, session)
         w = whatif(session.model, session.batch, setting_changes, **changes)
         return {
-            "curves": curves(None, w.changed),
+            "curves": curves(None, w.changed, session.et),
             "table": w.to_json_dict(),
             "server_ms": round((time.perf_counter() - t0) * 1e3, 2),
         }
