@@ -117,6 +117,27 @@ def test_a_program_step_through_the_api_holds_for_its_span_only(client, data_dir
     assert off.status_code == 400 and "range" in off.json()["error"]
 
 
+def test_transfer_limits_and_charge_state_from_the_page(client, data_dir):
+    if not (data_dir / "bullet-model.json").exists():
+        pytest.skip("../shared/data/real is absent")
+    r = client.post("/api/open", json={"log": "logs/bullet-500g.json", "model": "bullet-model.json"}, headers=H).json()
+    lim = r["transfer_limits"]
+    assert lim["decide"] == "heater" and lim["unit"] == "level" and lim["high"] > 6
+    assert r["ranges"]["Tm0_C"][0] < r["Tm0_C"] < r["ranges"]["Tm0_C"][1]
+    free = client.post("/api/transfer", json={"batch_kg": 0.8}, headers=H).json()
+    held = client.post("/api/transfer", json={"batch_kg": 0.8, "limit_high": 6}, headers=H).json()
+    assert "error" not in held, held
+    assert max(free["program"]) > 6 >= max(held["program"])  # the ceiling the page gave is the program's
+    assert held["metrics"]["rmse_C"] > free["metrics"]["rmse_C"]
+    bad = client.post("/api/transfer", json={"limit_low": 7, "limit_high": 3}, headers=H)
+    assert bad.status_code == 400 and "inverted" in bad.json()["error"]
+    out = client.post("/api/transfer", json={"plant_to": "../plant.toml"}, headers=H)
+    assert out.status_code == 400 and "outside" in out.json()["error"]
+    warm = client.post("/api/whatif", json={"Tb0_C": 50}, headers=H).json()
+    rows = {(x["reading"], x["key"]): x for x in warm["table"]["rows"]}
+    assert rows["beans", "DRY_s"]["changed"] < rows["beans", "DRY_s"]["as_run"]  # warmer beans dry sooner
+
+
 def test_tabs_do_not_share_state(client):
     client.post("/api/open", json={"log": "batch1.csv", "model": "paper-model.json"}, headers=H)
     other = client.post("/api/whatif", json={"tgi": 10}, headers={"X-Session": "test-session-b"}).json()

@@ -255,6 +255,22 @@ def test_bullet_transfer_decides_the_heater_on_its_steps_and_the_background_play
     assert code == 2 and "room air" in err and err.count("\n") == 1
 
 
+def test_a_heater_ceiling_binds_the_runnable_program_too(cli, bullet_model, tmp_path):
+    """--heater-max is the program's ceiling, the runnable steps' as well as the optimiser's (the
+    runnable program once rounded to the map's P9 and printed "P8" under a P6 ceiling); a limit
+    the machine has no setting for is one line, exit 2."""
+    import pandas as pd
+
+    ref = REAL_DATA / "bullet" / "bullet_2020-10-04_2352_490g.json"
+    common = ["transfer", "--model", bullet_model, "--reference", ref, "--batch-kg", "0.8"]
+    code, out, err = cli(*common, "--heater-max", "6", "--out", tmp_path / "p.csv")
+    assert code == 0, err
+    heater = pd.read_csv(tmp_path / "p.csv", comment="#")["heater"].to_numpy()
+    assert heater.max() <= 6 and "P0-P6" in out
+    code, _, err = cli(*common, "--heater-max", "6.5", "--out", tmp_path / "q.csv")
+    assert code == 2 and "not a setting" in err and err.count("\n") == 1
+
+
 def test_skywalker_whatif_set_and_tm0(cli, real_data, tmp_path):
     logs = sorted(real_data.glob("*.alog"))[:3]
     model = tmp_path / "sky.json"

@@ -215,6 +215,7 @@ function changes() {
   if (o && v("Tm0_C") !== "" && Number(v("Tm0_C")) !== o.Tm0_C) body.Tm0_C = Number(v("Tm0_C"));
   if (o && v("batch_kg") !== "" && Number(v("batch_kg")) !== o.batch_kg) body.batch_kg = Number(v("batch_kg"));
   if (v("X0") !== "" && o && Number(v("X0")) !== o.X0) body.X0 = Number(v("X0"));
+  if (v("Tb0_C") !== "" && o && Number(v("Tb0_C")) !== o.Tb0_C) body.Tb0_C = Number(v("Tb0_C"));
   const program = programBody();
   if (program.length) body.program = program;
   return body;
@@ -257,6 +258,14 @@ async function openLog() {
     $("Tm0_C").value = r.Tm0_C ?? "";
     $("Tm0_C_range").value = r.Tm0_C ?? 200;
     $("X0").value = r.X0 ?? "";
+    $("Tb0_C").value = r.Tb0_C ?? "";
+    for (const [k, [lo, hi]] of Object.entries(r.ranges || {})) {
+      for (const id of [k, `${k}_range`]) if ($(id)) { $(id).min = lo; $(id).max = hi; }
+    }
+    const lim = r.transfer_limits;
+    $("tr_limits_label").textContent = `${lim.decide} lowest / highest [${lim.unit}]`;
+    $("tr_low").placeholder = lim.low; $("tr_high").placeholder = lim.high;
+    $("tr_low").value = ""; $("tr_high").value = "";
     $("batch_kg").value = r.batch_kg ?? "";
     $("batch_kg_range").min = (r.batch_kg || 1) * 0.5;
     $("batch_kg_range").max = (r.batch_kg || 1) * 1.6;
@@ -332,7 +341,7 @@ async function runTransfer() {
   $("transfer_progress").removeAttribute("value");  // indeterminate: the solve reports no steps
   $("transfer-summary").textContent = "running the transfer ...";
   try {
-    const r = await api("/api/transfer", { batch_kg: $("tr_batch_kg").value, plant_to: $("tr_plant").value.trim(), tm0_free: $("tr_tm0_free").checked });
+    const r = await api("/api/transfer", { batch_kg: $("tr_batch_kg").value, plant_to: $("tr_plant").value.trim(), tm0_free: $("tr_tm0_free").checked, limit_low: $("tr_low").value, limit_high: $("tr_high").value });
     $("transfer-summary").textContent = r.summary;
     $("downloads").innerHTML = r.downloads.map((u) => `<a href="${u}" download>${u.split("/").pop()}</a>`).join("");
     const x = minutes(r.time_s);
@@ -370,7 +379,7 @@ window.addEventListener("DOMContentLoaded", async () => {
   $("run-fit").addEventListener("click", runFit);
   link("Tm0_C", "Tm0_C_range");
   link("batch_kg", "batch_kg_range");
-  for (const id of ["X0", "heater", "fan", "tgi"]) $(id).addEventListener("change", whatif);
+  for (const id of ["X0", "Tb0_C", "heater", "fan", "tgi"]) $(id).addEventListener("change", whatif);
   try {
     await refreshFiles();
     if ($("log").value && $("model").value) await openLog();

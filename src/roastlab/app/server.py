@@ -234,6 +234,20 @@ def _changes(body: dict, session: Session):
     return setting_changes, changes
 
 
+def _limits(body: dict, model, plant_to):
+    """The transfer's limits: the default for this machine and target
+    (:func:`roastlab.workflows.transfer.default_limits`), with the page's lowest and highest level
+    of the decided input where given (the CLI's --heater-min/--heater-max, --tgi-min/--tgi-max)."""
+    from ..fit.program import ProgramLimits
+    from ..workflows.transfer import default_limits
+
+    d = default_limits(model, None, plant_to)
+    low, high = (None if body.get(k) in (None, "") else body[k] for k in ("limit_low", "limit_high"))
+    if low is None and high is None:
+        return d
+    return ProgramLimits.for_model(model.column_map, d.decide, low, high)
+
+
 def create_app(data_dir: str | Path):
     """The Starlette application serving the page over ``data_dir``."""
     from starlette.applications import Starlette
@@ -284,8 +298,9 @@ def create_app(data_dir: str | Path):
 
     def open_log(session: Session, body: dict) -> dict:
         from ..metrics.profile import phases
+        from ..model.quantities import QUANTITIES
         from ..workflows.model import load_log, load_model
-        from ..workflows.transfer import et_source
+        from ..workflows.transfer import default_limits, et_source
         from ..workflows.whatif import whatif
 
         model = load_model(inside(data, body.get("model", "")))
@@ -295,6 +310,7 @@ def create_app(data_dir: str | Path):
         session.batch, session.model, session.log = batch, model, body["log"]
         session.model_path, session.as_run = body["model"], w.as_run
         session.et = et_source(model.column_map)
+        lim = default_limits(model)
         probe = {r["key"]: r for r in w.rows if r["reading"] == "probe"}
         ms = {k: probe[k]["measured" if batch.Ta_C is not None else "as_run"] for k in ("DRY_s", "FCs_s")}
         ms["DROP_s"] = float(batch.time_s[-1])
@@ -310,6 +326,10 @@ def create_app(data_dir: str | Path):
             "batch_kg": batch.Mb_kg,
             "Tm0_C": round(float(w.as_run.Tm_C[0]), 1),  # the drum at CHARGE the model starts from
             "X0": round(float(w.as_run.X_kg_kg[0]), 4),
+            "Tb0_C": round(float(w.as_run.Tb_C[0]), 1),
+            # the fields' ranges: the span an identification may give each initial state
+            "ranges": {k: QUANTITIES[k].bounds for k in ("Tm0_C", "Tb0_C", "X0")},
+            "transfer_limits": {"decide": lim.decide, "unit": lim.unit, "low": lim.low, "high": lim.high},
             "events": batch.events,
             "notes": list(batch.notes),
             "curves": curves(batch, w.as_run, session.et),
@@ -340,17 +360,23 @@ def create_app(data_dir: str | Path):
         }
 
     def transfer_(session: Session, body: dict) -> dict:
-        from ..workflows.transfer import transfer
+        from ..model.limits import check_value
+        from ..model.plant import preset_names
+        from ..workflows.transfer import TM0_FREE_RANGE_C, transfer
 
         need(session)
         kg = body.get("batch_kg")
-        tm0_free = (60.0, 350.0) if body.get("tm0_free") else None
+        tm0_free = TM0_FREE_RANGE_C if body.get("tm0_free") else None
+        plant_to = body.get("plant_to") or None
+        if plant_to is not None and not any(plant_to == p for p in preset_names()):
+            plant_to = inside(data, plant_to)  # a PLANT.toml in the data folder, never outside it
         r = transfer(
             session.model,
             session.batch,
-            body.get("plant_to") or None,
-            body.get("plant_to") or None,
-            batch_kg=None if kg in (None, "") else float(kg),
+            None,
+            plant_to,
+            limits=_limits(body, session.model, plant_to),
+            batch_kg=None if kg in (None, "") else check_value("batch_kg", kg, "to batch"),
             tm0_free=tm0_free,
         )
         folder = data / "downloads" / session.sid

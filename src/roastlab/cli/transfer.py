@@ -87,6 +87,7 @@ def add_parsers(sub) -> None:
     """Register this module's command(s) on the ``roastlab`` subparsers ``sub``."""
     from ..model.actuators import MIN_HOLD_S, TGI_LIMITS
     from ..model.quantities import default
+    from ..workflows.transfer import TM0_FREE_RANGE_C
 
     p = sub.add_parser(
         "transfer",
@@ -140,7 +141,10 @@ def add_parsers(sub) -> None:
         help="drum temperature at CHARGE on B [degC], or 'free' to let the optimiser choose it (the preheat)",
     )
     p.add_argument(
-        "--tm0-range", default="60:300", metavar="LO:HI", help="range for --tm0 free [degC] (default 60:300)"
+        "--tm0-range",
+        default="{:g}:{:g}".format(*TM0_FREE_RANGE_C),
+        metavar="LO:HI",
+        help="range for --tm0 free [degC] (default {:g}:{:g})".format(*TM0_FREE_RANGE_C),
     )
     p.add_argument(
         "--x0",

@@ -24,6 +24,7 @@ trust-region least squares (``least_squares(method="trf")``), started from a giv
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass, field
 
@@ -98,6 +99,16 @@ class ProgramLimits:
                 setattr(self, name, check_value("Gg_kg_s", getattr(self, name), "--gg-" + name[3:6]))
         if not self.low < self.high:
             raise InputError(f"{self.decide} limits inverted or empty: min {self.low:g} >= max {self.high:g}", "limits")
+        a = self.actuator
+        if a is not None and (self.low, self.high) != (a.low, a.high):
+            # narrower (or wider) limits than the map's: the runnable program's settings obey them
+            # too, so they must be settings the machine has
+            if a.stepped:
+                for v, opt in ((self.low, "--heater-min"), (self.high, "--heater-max")):
+                    k = (v - a.low) / a.step
+                    if abs(k - round(k)) > 1e-9:
+                        raise InputError(f"{a.label(v)} is not a setting of the machine ({a.describe()})", opt)
+            self.actuator = dataclasses.replace(a, low=self.low, high=self.high)
         if (self.Gg_min_kg_s is None) != (self.Gg_max_kg_s is None):
             raise InputError("give both Gg limits (min and max) or neither", "limits")
         if self.Gg_min_kg_s is not None and not 0 < self.Gg_min_kg_s < self.Gg_max_kg_s:

@@ -34,6 +34,7 @@ from ..model.actuators import MIN_HOLD_S
 from ..model.layout import I_QEG, I_TGIG, S_TM
 from ..model.limits import check_value
 from ..model.plant import Plant
+from ..model.quantities import QUANTITIES
 from ..report.result import Result, draw_curves
 
 #: Probe temperatures [degC] whose crossing times define the phases of the retimed baseline:
@@ -262,6 +263,11 @@ class TransferResult(Result):
         draw_curves(ax, {"reference BT": (t, self.target_C), "predicted BT": (t, self.program.Ta_pred_C)}, "BT [°C]")
 
 
+#: Range of the drum temperature at CHARGE when a transfer chooses it (``--tm0 free``) [degC]:
+#: from a barely warm drum to the top of the range an identification may give ``Tm0_C``.
+TM0_FREE_RANGE_C = (60.0, QUANTITIES["Tm0_C"].bounds[1])
+
+
 def default_limits(model, plant_from=None, plant_to=None) -> ProgramLimits:
     """The input a program decides for ``model`` by default: on the model's own machine, the
     control its map has (:meth:`ProgramLimits.for_model`: the heater on a machine whose inlet is
@@ -344,7 +350,8 @@ def transfer(
     model : FittedModel (its carried-over values are applied on ``plant_to``)
     reference : Batch with ``Ta_C`` from CHARGE (t = 0) to DROP, and the inputs it was run with
     plant_from, plant_to : Plant, preset name or PLANT.toml (default: the model's plant)
-    limits : :class:`ProgramLimits` (default: Tgi 150-550 degC, 120 degC/min)
+    limits : :class:`ProgramLimits` (default: :func:`default_limits`, the heater on a room-air
+        machine whose map reads one, else the inlet gas within ``TGI_LIMITS``)
     batch_kg : green batch mass on B [kg] (default: B's nominal batch when B differs from A,
         else the reference's)
     gg_kg_s : fixed gas flow on B [kg/s] (default: A's flow scaled by the batch-mass ratio);
