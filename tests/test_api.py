@@ -241,3 +241,43 @@ def test_every_public_function_refuses_wrong_arguments_with_its_own_error(name):
                 assert len(str(exc)) > 10
             except Exception as exc:  # noqa: BLE001 - the point of the test
                 pytest.fail(f"{name} argument {i} = {wrong!r}: {type(exc).__name__}: {exc}")
+
+
+def test_whatif_band_is_the_changed_curves_and_a_model_without_one_says_why(cli, sky_model, tmp_path):
+    """whatif --band: the band is centred on the changed prediction (the same band the validate
+    command scores, through prediction_bands with the same changes); a model file with neither
+    covariance nor spread refuses it in one line naming the file, exit 2."""
+    from roastlab.evaluate.bands import prediction_bands
+
+    model_path, log = sky_model
+    out_json = tmp_path / "w.json"
+    code, out, err = cli("whatif", log, "--model", model_path, "--tgi", "15", "--band", "--json", out_json)
+    assert code == 0, err
+    doc = json.loads(out_json.read_text())["band"]
+    model = roastlab.load_model(model_path)
+    batch = roastlab.load_log(log, model.column_map)
+    b = prediction_bands(model, [batch], 0.9, Tgi_offset_C=15.0)[0]
+    assert doc["level"] == 0.9 and doc["median_width_C"] == pytest.approx(float(np.median(b.width_C)), abs=0.01)
+    assert doc["DROP_lower_C"] < model.predict(batch, Tgi_offset_C=15.0).Ta_C[-1] < doc["DROP_upper_C"]
+    assert "90 % prediction band of the changed probe BT" in out
+    bare = tmp_path / "bare.json"
+    m = json.loads(model_path.read_text())
+    m["fit"].pop("correlation", None)
+    m["fit"].pop("spread", None)
+    bare.write_text(json.dumps(m))
+    code, _, err = cli("whatif", log, "--model", bare, "--band")
+    errors = [line for line in err.splitlines() if not line.startswith("note: ")]
+    assert code == 2 and len(errors) == 1 and "no band" in errors[0] and str(bare) in errors[0]
+
+
+def test_simulate_band_columns_hold_the_prediction(cli, sky_model, tmp_path):
+    model_path, log = sky_model
+    out = tmp_path / "s.csv"
+    code, text, err = cli("simulate", "--model", model_path, "--inputs", log, "--out", out, "--band", "0.8")
+    assert code == 0, err
+    df = pd.read_csv(out)
+    assert np.all(df["Ta_lower_C"] <= df["Ta_C"] + 1e-6) and np.all(df["Ta_C"] <= df["Ta_upper_C"] + 1e-6)
+    assert (df["Ta_upper_C"] - df["Ta_lower_C"]).median() > 0.5 and "80 % prediction band" in text
+    code, _, err = cli("simulate", "--plant", EXAMPLE / "plant.toml", "--inputs", log, "--map", EXAMPLE / "map.toml",
+                       "--out", tmp_path / "p.csv", "--band")  # fmt: skip
+    assert code == 2 and "carries no band" in err

@@ -111,6 +111,11 @@ def test_a_program_step_through_the_api_holds_for_its_span_only(client, data_dir
     assert np.all(heater[inside] == 2) and np.array_equal(heater[~inside], logged[~inside])
     rows = {(x["reading"], x["key"]): x for x in w["table"]["rows"]}
     assert rows["beans", "DROP_C"]["changed"] < rows["beans", "DROP_C"]["as_run"]
+    banded = client.post("/api/whatif", json={"program": [step], "band": True}, headers=H).json()
+    lower, upper = (np.array(banded["band"][k], dtype=float) for k in ("lower", "upper"))
+    bt = np.array(banded["curves"]["BT_model"], dtype=float)
+    assert np.all(lower <= bt + 1e-9) and np.all(bt <= upper + 1e-9) and banded["band"]["median_width_C"] > 0.5
+    assert w["band"] is None  # asked for only: the live what-if stays fast
     bad = client.post("/api/whatif", json={"program": [{"setting": "heater", "value": "lots"}]}, headers=H)
     assert bad.status_code == 400 and "program step 1" in bad.json()["error"]
     off = client.post("/api/whatif", json={"program": [{**step, "value": 40}]}, headers=H)
@@ -250,6 +255,12 @@ def test_the_page_draws_a_real_log_and_follows_a_what_if(page, data_dir, tmp_pat
     assert float(after) < float(before) - 5.0  # a heavier batch: cooler beans at DROP, in the table
     changed = _traces(page)["BT model, changed"]
     assert not np.allclose(np.array(changed, dtype=float), np.array(traces["BT model, as run"], dtype=float))
+    # once the change stands still, the changed curve gets its own band, around it
+    page.wait_for_function("Number(document.body.dataset.bands || 0) > 0", timeout=10_000)
+    now = _traces(page)
+    upper = np.array(now["90 % band, changed"], dtype=float)
+    assert np.all(upper >= np.array(now["BT model, changed"], dtype=float) - 1e-6)
+    assert "changed:" in page.inner_text("#figures")
     page.screenshot(path=str(tmp_path / "whatif.png"), full_page=True)
     assert (tmp_path / "whatif.png").stat().st_size > 20_000
 

@@ -4,7 +4,7 @@
 const sid = sessionStorage.getItem("roastlab-session") || crypto.randomUUID();
 sessionStorage.setItem("roastlab-session", sid);
 const $ = (id) => document.getElementById(id);
-const state = { open: null, changed: null, table: null, busy: false, pending: false, lastDrawMs: null, tInput: null,
+const state = { open: null, changed: null, changedBand: null, table: null, busy: false, pending: false, lastDrawMs: null, tInput: null,
                 program: {} };  // setting -> [{from_s, until_s, value, logged}]: the steps the roaster can drag
 
 async function api(path, body) {
@@ -146,6 +146,12 @@ function draw() {
     traces.push({ x, y: T(b.upper), name: `${Math.round(b.level * 100)} % band, as run`, fill: "tonexty",
                   fillcolor: "rgba(31, 119, 180, 0.15)", line: { width: 0 }, hoverinfo: "skip" });
   }
+  const cb = state.changed && state.changedBand;
+  if (cb && cb.lower) {  // the changed curve's band, asked for once a change has settled (bandSoon)
+    traces.push({ x, y: T(cb.lower), name: "band changed", line: { width: 0 }, hoverinfo: "skip", showlegend: false });
+    traces.push({ x, y: T(cb.upper), name: `${Math.round(cb.level * 100)} % band, changed`, fill: "tonexty",
+                  fillcolor: "rgba(255, 127, 14, 0.15)", line: { width: 0 }, hoverinfo: "skip" });
+  }
   traces.push({ x, y: T(c.BT_model), name: "BT model, as run", line: { color: "#1f77b4", width: 2 } });
   traces.push({ x, y: T(ch.BT_model), name: "BT model, changed", line: { color: "#ff7f0e", width: 2 }, uid: "bt-changed" });
   traces.push({ x, y: T(c.beans_model), name: "beans model, as run", line: { color: "#1f77b4", width: 1, dash: "dash" } });
@@ -204,7 +210,8 @@ function drawTable() {
   $("table").innerHTML = html;
   const m = state.open && state.open.metrics, b = state.open && state.open.band;
   $("figures").textContent = (m ? `model as run against this log: FIT ${m.FIT_pct.toFixed(1)} %, MAE ${dtemp(m.MAE_C).toFixed(2)} ${unit()}` : "") +
-    (b && b.lower ? `; ${Math.round(b.level * 100)} % band median width ${dtemp(b.median_width_C).toFixed(1)} ${unit()}` : b && b.why ? `; ${b.why}` : "");
+    (b && b.lower ? `; ${Math.round(b.level * 100)} % band median width ${dtemp(b.median_width_C).toFixed(1)} ${unit()}` : b && b.why ? `; ${b.why}` : "") +
+    (state.changed && state.changedBand ? `; changed: ${dtemp(state.changedBand.median_width_C).toFixed(1)} ${unit()}` : "");
   $("warnings").textContent = (t.warnings || []).map((w) => "note: " + w).join("\n");
 }
 
@@ -221,15 +228,40 @@ function changes() {
   return body;
 }
 
+// The changed curve's prediction band costs its 200 parameter draws again (~5-10 ms on the
+// server): asked for once the changes have stood still for BAND_WAIT_MS, not on every drag step.
+const BAND_WAIT_MS = 300;
+let bandTimer = null;
+function bandSoon(body) {
+  clearTimeout(bandTimer);
+  if (!state.open || !state.open.band || !state.open.band.lower) return;  // the model carries no band
+  const key = JSON.stringify(body);
+  bandTimer = setTimeout(async () => {
+    try {
+      const r = await api("/api/whatif", { ...body, band: true });
+      if (JSON.stringify(changes()) !== key) return;  // the roaster moved on meanwhile
+      state.changedBand = r.band;
+      draw();
+      drawTable();
+      document.body.dataset.bands = String(Number(document.body.dataset.bands || 0) + 1);
+    } catch (e) {
+      say(e.message);
+    }
+  }, BAND_WAIT_MS);
+}
+
 async function whatif() {
   if (!state.open) return;
   if (state.busy) { state.pending = true; return; }
   state.busy = true;
   try {
     const t0 = performance.now();
-    const r = await api("/api/whatif", changes());
+    const body = changes();
+    const r = await api("/api/whatif", body);
     state.changed = r.curves;
+    state.changedBand = null;
     state.table = r.table;
+    bandSoon(body);
     draw();
     drawTable();
     say("");

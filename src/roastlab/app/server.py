@@ -167,14 +167,18 @@ def band(model, batch) -> dict:
     """The as-run prediction band of :func:`roastlab.evaluate.bands.prediction_bands` (level
     :data:`~roastlab.evaluate.bands.BAND_LEVEL`) or, for a model without standard errors or a
     roast-to-roast spread, ``{"why": ...}``."""
-    from ..evaluate.bands import BAND_LEVEL, prediction_bands
+    from ..evaluate.bands import BAND_LEVEL, prediction_bands, why_no_band
 
-    fit = model.doc.get("fit") or {}
-    if not (fit.get("correlation") or {}).get("names") and not fit.get("spread"):
-        return {"why": "this model file has no parameter covariance or roast-to-roast spread: no band"}
-    b = prediction_bands(model, [batch], BAND_LEVEL)[0]
+    why = why_no_band(model)
+    if why is not None:
+        return {"why": why}
+    return band_dict(prediction_bands(model, [batch], BAND_LEVEL)[0])
+
+
+def band_dict(b) -> dict:
+    """A :class:`~roastlab.evaluate.bands.Band` as the page draws it."""
     return {
-        "level": BAND_LEVEL,
+        "level": b.level,
         "lower": _series(b.lower_C),
         "upper": _series(b.upper_C),
         "median_width_C": round(float(np.median(b.width_C)), 2),
@@ -347,15 +351,20 @@ def create_app(data_dir: str | Path):
             raise InputError("open a log and a model first", "page")
 
     def whatif_(session: Session, body: dict) -> dict:
+        from ..evaluate.bands import BAND_LEVEL, why_no_band
         from ..workflows.whatif import whatif
 
         need(session)
         t0 = time.perf_counter()
         setting_changes, changes = _changes(body, session)
-        w = whatif(session.model, session.batch, setting_changes, **changes)
+        with_band = bool(body.get("band")) and why_no_band(session.model) is None
+        w = whatif(
+            session.model, session.batch, setting_changes, band_level=BAND_LEVEL if with_band else None, **changes
+        )
         return {
             "curves": curves(None, w.changed, session.et),
             "table": w.to_json_dict(),
+            "band": band_dict(w.band) if w.band is not None else None,
             "server_ms": round((time.perf_counter() - t0) * 1e3, 2),
         }
 

@@ -142,13 +142,16 @@ def cmd_validate(args) -> int:
         )
     )
     doc = result.to_json_dict()
+    bands = None
     if args.band is not None:
-        doc["band"] = _band_table(model, batches, args.band, plant_spec, changes)
+        doc["band"], bands = _band_table(model, batches, args.band, plant_spec, changes)
     with outputs as out:
         if args.json:
             out.write_text(args.json, json_text(doc))
         if args.plot:
-            plot_fit(result, args.plot, title=f"measured vs predicted BT, plant {result.plant}", outputs=out)
+            plot_fit(
+                result, args.plot, title=f"measured vs predicted BT, plant {result.plant}", outputs=out, bands=bands
+            )
         if args.predictions:
             written = set()
             for name, frame in result.frames().items():
@@ -190,9 +193,10 @@ def cmd_compare_models(args) -> int:
     return 0
 
 
-def _band_table(model, batches, level, plant_spec, changes) -> dict:
-    """Print and return how often each batch's measured probe lies inside the model's band."""
-    from ..evaluate.bands import band_coverage, share_inside
+def _band_table(model, batches, level, plant_spec, changes) -> tuple[dict, list]:
+    """Print and return how often each batch's measured probe lies inside the model's band, and
+    the bands (drawn by --plot)."""
+    from ..evaluate.bands import coverage, prediction_bands, share_inside
 
     if changes or plant_spec not in (None, model.plant):
         raise InputError(
@@ -201,7 +205,8 @@ def _band_table(model, batches, level, plant_spec, changes) -> dict:
     if not (model.doc.get("fit") or {}).get("spread"):
         print("note: the model file has no roast-to-roast spread (fitted on one log, or by an older roastlab): "
               "the band is the parameters' alone")  # fmt: skip
-    rows = band_coverage(model, batches, level)
+    bands = prediction_bands(model, batches, level)
+    rows = coverage(batches, bands)
     print(f"\n{level:.0%} prediction band (parameters and roast-to-roast spread, roastlab.evaluate.bands):")
     print(f"{'batch':<36} {'kg':>6} {'inside':>7} {'median width':>13}")
     for r in rows:
@@ -209,7 +214,7 @@ def _band_table(model, batches, level, plant_spec, changes) -> dict:
         print(f"{r['name'][:36]:<36} {kg:>6} {r['inside']:>7.0%} {r['median_width_C']:>10.1f} °C")
     inside = share_inside(rows)
     print(f"{'all samples':<36} {'':>6} {inside:>7.0%}   (a calibrated band holds about {level:.0%})")
-    return {"level": level, "inside_all": inside, "batches": rows}
+    return {"level": level, "inside_all": inside, "batches": rows}, bands
 
 
 def _safe_stem(name: str, taken: set) -> str:

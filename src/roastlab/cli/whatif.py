@@ -45,7 +45,7 @@ def cmd_whatif(args) -> int:
     batch = read_inputs(args.log, args.map, model)
     say(batch.notes)
     actuators = {k: cmap.actuator(k) for k in ("heater", "fan") if cmap is not None and getattr(cmap, k)}
-    result = whatif(model, batch, setting_changes, actuators=actuators, **changes)
+    result = whatif(model, batch, setting_changes, actuators=actuators, band_level=args.band, **changes)
     print(result.table(units=args.units))
     with outputs as out:
         write_json_and_plot(out, args, result.to_json_dict(), result)
@@ -54,6 +54,9 @@ def cmd_whatif(args) -> int:
 
 def add_parsers(sub) -> None:
     """Register this module's command(s) on the ``roastlab`` subparsers ``sub``."""
+    from ..evaluate.bands import BAND_LEVEL
+    from .fit import level_arg
+
     p = sub.add_parser(
         "whatif",
         help="predict a logged roast as run and with changed settings, batch or charge state",
@@ -70,7 +73,8 @@ def add_parsers(sub) -> None:
         "  roastlab whatif roast.alog --model model.json --heater +5 --plot whatif.png\n"
         "  roastlab whatif roast.json --model bullet.json --heater +1@4:00    # one step more from 4:00 on\n"
         "  roastlab whatif roast.json --model bullet.json --set heater=6@2:00 --fan -2\n"
-        "  roastlab whatif roast.json --model bullet.json --batch-kg 0.8 --tm0 260 --units F",
+        "  roastlab whatif roast.json --model bullet.json --batch-kg 0.8 --tm0 260 --units F\n"
+        "  roastlab whatif roast.json --model bullet.json --heater -1@5:00 --band    # with the 90 % band",
     )
     p.add_argument("log", metavar="LOG", help="the roast log (read with the model's map, or --map)")
     p.add_argument("--model", required=True, metavar="MODEL.json", help=MODEL_HELP)
@@ -92,6 +96,16 @@ def add_parsers(sub) -> None:
     p.add_argument("--tgi", type=float_arg("--tgi"), help="add this to the inlet gas temperature [degC]")
     p.add_argument("--batch-kg", type=float_arg("--batch-kg"), help="green batch mass [kg] (default: the log's)")
     add_initial_options(p)
+    p.add_argument(
+        "--band",
+        type=level_arg,
+        nargs="?",
+        const=BAND_LEVEL,
+        metavar="LEVEL",
+        help=f"also the changed probe BT's prediction band of this level (default {BAND_LEVEL:g}), from the model "
+        "file's parameter covariance and roast-to-roast spread: its median width and BT at DROP in the table, "
+        "shaded in --plot, in --json",
+    )
     p.add_argument("--units", choices=("C", "F"), default="C", help="temperatures in the table in C or F (default C)")
     p.add_argument("--json", metavar="WHATIF.json", help="write the table as JSON (temperatures in degC, times in s)")
     p.add_argument("--plot", metavar="FIG.png", help="overlay measured BT and both predictions (.png/.svg/.pdf)")

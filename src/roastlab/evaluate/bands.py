@@ -59,6 +59,15 @@ def roast_spread(time_s, measured, predicted) -> dict | None:
     return {"time_s": grid[keep].tolist(), "rms_C": [round(float(v), 4) for v in rms], "logs": int(len(time_s))}
 
 
+def why_no_band(model) -> str | None:
+    """None when ``model`` can carry a band (its file has the fit's parameter correlation or a
+    roast-to-roast spread); else the reason, in words for the roaster."""
+    fit = model.doc.get("fit") or {}
+    if (fit.get("correlation") or {}).get("names") or fit.get("spread"):
+        return None
+    return "this model file has no parameter covariance or roast-to-roast spread: no band"
+
+
 def check_level(level) -> float:
     """A band level in (0, 1), or :class:`~roastlab.errors.ParameterError`."""
     if isinstance(level, bool) or not (isinstance(level, (int, float)) and 0.0 < level < 1.0):
@@ -179,9 +188,14 @@ def share_inside(rows: list[dict]) -> float:
 def band_coverage(model, batches, level: float = BAND_LEVEL, samples: int = BAND_SAMPLES, seed: int = 0) -> list[dict]:
     """Per batch: ``{"name", "n", "inside" (share of measured probe samples inside the band),
     "median_width_C", "Mb_kg"}``."""
-    rows = []
     batches = list(batches)
-    for b, band in zip(batches, prediction_bands(model, batches, level, samples, seed)):
+    return coverage(batches, prediction_bands(model, batches, level, samples, seed))
+
+
+def coverage(batches, bands: list[Band]) -> list[dict]:
+    """The rows of :func:`band_coverage` for bands already computed (one per batch, in order)."""
+    rows = []
+    for b, band in zip(batches, bands):
         m = np.asarray(b.Ta_C, float)[: band.time_s.size]
         ok = np.isfinite(m)
         inside = (m[ok] >= band.lower_C[ok]) & (m[ok] <= band.upper_C[ok])

@@ -121,6 +121,10 @@ def plot_simulation(result, path=None, title=None, outputs=None, events=None):
     t_min = result.time_s / 60.0
     ax = axes[0]
     ax.plot(t_min, result.Ta_C, label="BT predicted (model Ta, probe)", color="tab:orange", lw=2)
+    if result.band is not None:
+        b = result.band
+        ax.fill_between(t_min, b.lower_C, b.upper_C, color="tab:orange", alpha=0.15, lw=0,
+                        label=f"{b.level * 100:g} % prediction band")  # fmt: skip
     if result.Ta_measured_C is not None:
         ax.plot(t_min, result.Ta_measured_C, "k.", ms=3, label="BT measured (log)")
     if result.ET_measured_C is not None:
@@ -176,8 +180,9 @@ def plot_simulation(result, path=None, title=None, outputs=None, events=None):
     return finish_figure(fig, path, title, outputs)
 
 
-def plot_fit(result, path=None, title=None, max_panels: int = 8, outputs=None):
-    """Measured vs predicted BT per batch of a ValidationResult, each with its residual below."""
+def plot_fit(result, path=None, title=None, max_panels: int = 8, outputs=None, bands=None):
+    """Measured vs predicted BT per batch of a ValidationResult, each with its residual below;
+    ``bands`` (:func:`roastlab.evaluate.bands.prediction_bands`, one per batch) shaded."""
     k = min(len(result.names), max_panels)
     cols = 2 if k > 1 else 1
     rows = (k + cols - 1) // cols
@@ -188,6 +193,11 @@ def plot_fit(result, path=None, title=None, max_panels: int = 8, outputs=None):
         ax = fig.add_subplot(grid[2 * r, c])
         res = fig.add_subplot(grid[2 * r + 1, c], sharex=ax)
         _profile_panel(ax, result, i)
+        if bands is not None:
+            b = bands[i]
+            ax.fill_between(b.time_s / 60.0, b.lower_C, b.upper_C, color="tab:green", alpha=0.15, lw=0,
+                            label=f"{b.level * 100:g} % prediction band")  # fmt: skip
+            ax.legend(fontsize=8)
         t = result.time_s[i] / 60.0
         res.plot(t, result.measured[i] - result.predicted[i], color="tab:purple", lw=1, label="Ta meas − pred")
         second = result.results[i].Tb2_measured_C if i < len(result.results) else None
@@ -280,6 +290,11 @@ def plot_whatif(w, path=None, outputs=None):
     change = "; ".join(w.changes) or "no change"
     ax.plot(t_min, w.as_run.Ta_C, color="tab:blue", lw=1.8, label="BT model, as run")
     ax.plot(t_min, w.changed.Ta_C, color="tab:orange", lw=1.8, label=f"BT model, {change}")
+    if w.band is not None:
+        ax.fill_between(
+            t_min, w.band.lower_C, w.band.upper_C, color="tab:orange", alpha=0.15, lw=0,
+            label=f"{w.band.level * 100:g} % band, changed",
+        )  # fmt: skip
     ax.plot(t_min, w.as_run.Tb_C, color="tab:blue", lw=1.0, ls="--", label="beans model (Tb), as run")
     ax.plot(t_min, w.changed.Tb_C, color="tab:orange", lw=1.0, ls="--", label="beans model (Tb), changed")
     ax.set_ylabel("temperature [°C]")

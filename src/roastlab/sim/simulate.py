@@ -81,6 +81,8 @@ class SimulationResult(Result):
     Tb2_measured_C : (n,) array or None, a second measured bean reading compared with Tb
         (NaN where not measured), when the batch had one
     ET_measured_C : (n,) array or None, the roaster's ET as logged (drawn, never an input)
+    band : :class:`roastlab.evaluate.bands.Band` or None, the probe prediction's band when asked
+        for (``Ta_lower_C``, ``Ta_upper_C`` columns in the CSV, shaded in the figure)
     """
 
     time_s: np.ndarray
@@ -96,6 +98,7 @@ class SimulationResult(Result):
     fan: np.ndarray | None = None
     Tb2_measured_C: np.ndarray | None = None
     ET_measured_C: np.ndarray | None = None
+    band: object | None = None
 
     @property
     def uses_actuators(self) -> bool:
@@ -165,6 +168,8 @@ class SimulationResult(Result):
         for name in PAPER_STATE_NAMES:
             data[name] = self.states[:, S[name]]
         data["Tgo_C"] = self.Tgo_C
+        if self.band is not None:
+            data["Ta_lower_C"], data["Ta_upper_C"] = self.band.lower_C, self.band.upper_C
         if self.uses_actuators:
             q, f = self._settings()
             g, T = self.gas_seen()

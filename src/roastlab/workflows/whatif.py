@@ -176,6 +176,21 @@ class WhatIf(Result):
     changes: list[str]
     rows: list[dict]
     levels: dict = field(default_factory=dict)
+    #: the changed probe BT's prediction band (:class:`roastlab.evaluate.bands.Band`) when asked for
+    band: object | None = None
+
+    def band_line(self, units: str = "C") -> str | None:
+        """The changed probe BT's band in one line: its level, median width and BT at DROP."""
+        b = self.band
+        if b is None:
+            return None
+        u = "°F" if units == "F" else "°C"
+        width = float(np.median(b.width_C)) * (1.8 if units == "F" else 1.0)
+        return (
+            f"{b.level * 100:g} % prediction band of the changed probe BT (parameter covariance and roast-to-roast "
+            f"spread): median width {width:.1f} {u}; BT at DROP {display_temp(b.lower_C[-1], units):.1f} to "
+            f"{display_temp(b.upper_C[-1], units):.1f} {u}"
+        )
 
     def table(self, units: str = "C") -> str:
         """The milestone table as text; ``units`` "C" or "F" for temperatures."""
@@ -206,6 +221,8 @@ class WhatIf(Result):
                 if name in lv.get(r, {})
             )
         )
+        if self.band is not None:
+            lines.append(self.band_line(units))
         if any(r["projected"] for r in self.rows):
             lines.append("* past the logged DROP: where the curve would reach it at the rate of rise of its last 2 min")
         lines += [f"note: {w}" for w in self.warnings()]
@@ -247,6 +264,16 @@ class WhatIf(Result):
             "levels_C": self.levels,
             "rows": self.rows,
             "warnings": self.warnings(),
+            **({"band": self._band_dict()} if self.band is not None else {}),
+        }
+
+    def _band_dict(self) -> dict:
+        b = self.band
+        return {
+            "level": b.level,
+            "median_width_C": round(float(np.median(b.width_C)), 2),
+            "DROP_lower_C": round(float(b.lower_C[-1]), 2),
+            "DROP_upper_C": round(float(b.upper_C[-1]), 2),
         }
 
     def to_frame(self):
@@ -276,6 +303,7 @@ def whatif(
     setting_changes: list[SettingChange] = (),
     *,
     actuators: dict | None = None,
+    band_level: float | None = None,
     **changes,
 ) -> WhatIf:
     """Predict ``batch`` as logged and with the changes; compare the roaster's milestones
@@ -286,8 +314,17 @@ def whatif(
     setting must stay within the machine's range (``actuators``: name -> Actuator, default
     the model's map's :meth:`~roastlab.io.importers.mapping.ColumnMap.actuator`). The probe's
     milestones are judged at the temperatures the log marks (its DRY and FCs); the beans' at
-    the model's bean temperature at those marks as run.
+    the model's bean temperature at those marks as run. ``band_level`` (e.g. 0.9): also the
+    changed probe BT's prediction band (:func:`roastlab.evaluate.bands.prediction_bands`); a
+    model file that cannot carry one is a ParameterError saying why.
     """
+    if band_level is not None:
+        from ..evaluate.bands import check_level, why_no_band
+
+        band_level = check_level(band_level)
+        why = why_no_band(model)
+        if why is not None:
+            raise ParameterError(why, model.source)
     changed_batch = batch
     labels = [str(c) for c in setting_changes]
     for c in setting_changes:
@@ -352,4 +389,9 @@ def whatif(
                     "projected": [k for k, v in projected.items() if v] if key == "FCs_s" else [],
                 }
             )
-    return WhatIf(batch, as_run, changed, labels, rows, levels)
+    band = None
+    if band_level is not None:
+        from ..evaluate.bands import prediction_bands
+
+        band = prediction_bands(model, [changed_batch], band_level, **changes)[0]
+    return WhatIf(batch, as_run, changed, labels, rows, levels, band)
