@@ -58,6 +58,22 @@ def data_folder(d: Path) -> tuple[str, str]:
     return "bullet_2020-10-01_2053_500g.json", "bullet-model.json"
 
 
+def latencies(page, kg: float, n: int = 20) -> tuple[list, list]:
+    """``n`` batch-size changes: from each input change to the new curve drawn [ms] (the page's
+    own mark), and the server's part of it [ms]."""
+    lat, server = [], []
+    for k in range(n):
+        before = page.evaluate("Number(document.body.dataset.updates || 0)")
+        page.fill("#batch_kg", f"{kg * (1.0 + 0.01 * (k + 1)):.4f}")
+        page.dispatch_event("#batch_kg", "input")
+        page.wait_for_function(f"Number(document.body.dataset.updates || 0) > {before}")
+        page.wait_for_function("document.body.dataset.latency !== undefined")
+        lat.append(float(page.evaluate("document.body.dataset.latency")))
+        page.evaluate("delete document.body.dataset.latency")
+        server.append(float(page.inner_text("#timing").split()[1]))
+    return lat, server
+
+
 def main() -> int:
     import uvicorn
     from playwright.sync_api import sync_playwright
@@ -89,16 +105,7 @@ def main() -> int:
 
         # what-if latency: input change -> curve drawn, 20 changes
         kg = float(page.input_value("#batch_kg") or 1.0)
-        lat, server = [], []
-        for k in range(20):
-            n = page.evaluate("Number(document.body.dataset.updates || 0)")
-            page.fill("#batch_kg", f"{kg * (1.0 + 0.01 * (k + 1)):.4f}")
-            page.dispatch_event("#batch_kg", "input")
-            page.wait_for_function(f"Number(document.body.dataset.updates || 0) > {n}")
-            page.wait_for_function("document.body.dataset.latency !== undefined")
-            lat.append(float(page.evaluate("document.body.dataset.latency")))
-            page.evaluate("delete document.body.dataset.latency")
-            server.append(float(page.inner_text("#timing").split()[1]))
+        lat, server = latencies(page, kg)
         page.fill("#batch_kg", f"{kg * 1.2:.4f}")
         page.dispatch_event("#batch_kg", "input")
         page.fill("#heater", "+1@4:00")
@@ -145,6 +152,8 @@ def main() -> int:
             page.wait_for_function("document.body.dataset.opened !== undefined")
             time.sleep(0.3)
             page.screenshot(path=str(DOCS / "app-skywalker.png"), full_page=True)
+            sky_len = page.evaluate("[state.open.curves.time_s.length, state.open.curves.time_s.at(-1)]")
+            sky_lat, sky_server = latencies(page, float(page.input_value("#batch_kg")))
         browser.close()
     srv.should_exit = True
 
@@ -162,6 +171,8 @@ def main() -> int:
     print(f"transfer: {page_transfer_s:.2f} s on the page, {lib_s:.2f} s as a library call")
     if fit_s is not None:
         print(f"fit on the page: 6 Skywalker logs (init + fit-roaster) in {fit_s:.1f} s")
+        print(f"what-if on a Skywalker log ({sky_len[0]} samples, {sky_len[1] / 60:.1f} min), median of 20: "
+              f"{statistics.median(sky_lat):.1f} ms (server {statistics.median(sky_server):.2f} ms)")  # fmt: skip
     print("wrote docs/app-open.png, docs/app-whatif.png, docs/app-drag.png, docs/app-transfer.png, docs/app-fit.png, docs/app-skywalker.png")
     shutil.rmtree(d, ignore_errors=True)
     return 0
