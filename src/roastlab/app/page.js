@@ -384,7 +384,9 @@ async function runTransfer() {
     ], {
       margin: { t: 20, r: 60, l: 60, b: 40 }, legend: { orientation: "h", y: -0.2 },
       xaxis: { title: { text: "time after CHARGE [m:ss]" }, ...mmssTicks(x) }, yaxis: { title: { text: `BT [${unit()}]` } },
-      yaxis2: { title: { text: `${r.decide} [${r.unit}]` }, overlaying: "y", side: "right", showgrid: false },
+      yaxis2: { title: { text: `${r.decide} [${r.unit}]` }, overlaying: "y", side: "right", showgrid: false,
+                range: [r.low - (r.step || (r.high - r.low) / 20), r.high + (r.step || (r.high - r.low) / 20)],
+                ...(r.step ? { dtick: r.step, tickformat: "d" } : {}) },
     });
     say("");
     document.body.dataset.transfer = "done";

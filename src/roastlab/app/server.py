@@ -405,6 +405,10 @@ def create_app(data_dir: str | Path):
             "program": _series(pr.Tgi_C if r.limits.decide == "Tgi" else pr.heater),
             "decide": r.limits.decide,
             "unit": r.limits.unit,
+            # the axis of the program: the limits, in the machine's steps where it has them
+            "low": r.limits.low,
+            "high": r.limits.high,
+            "step": r.limits.actuator.step if r.limits.actuator is not None and r.limits.actuator.stepped else None,
             "downloads": [f"/{rel}/{stem}-program.csv", f"/{rel}/{stem}-background.alog"],
         }
 
