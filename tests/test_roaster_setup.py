@@ -91,3 +91,70 @@ def test_init_and_fit_roaster_reach_the_hand_written_examples_on_the_shared_logs
     report = (tmp_path / "cfg" / "report.md").read_text()
     assert "sorted by date" in report and "held out" in report
     assert (tmp_path / "cfg" / "heldout.png").stat().st_size > 20_000
+
+
+def _synthetic_hottop_logs(folder: Path, n_logs: int = 6, seed: int = 7) -> list[Path]:
+    """SYNTHETIC Artisan logs of a machine no example describes: a Fahrenheit Hottop whose heater
+    and fan are extra-device curves (%), 0.25 kg batches. The layout comes from
+    test_importers.fake_alog; BT and ET are roastlab's own model of the catalogue's Hottop
+    (``roastlab init`` on the layout) with chosen heater/actuator values, plus seeded noise."""
+    import numpy as np
+
+    import roastlab
+    from roastlab.io.importers import load_map
+    from roastlab.workflows.model import FittedModel
+
+    rng = np.random.default_rng(seed)
+    n, dt = 145, 5.0  # 12 minutes, a sample every 5 s
+    t = [dt * i for i in range(n)]
+    layouts = []
+    for _ in range(n_logs):
+        heater = np.full(n, 80.0)
+        for start in sorted(rng.choice(np.arange(12, n - 10), size=3, replace=False)):
+            heater[start:] = np.clip(heater[start] + rng.choice([-15.0, -10.0, 10.0]), 40.0, 100.0)
+        fan = np.where(np.arange(n) < rng.integers(60, 100), 20.0, 40.0)
+        layouts.append((heater, fan))
+    extra = {"roastertype": "Hottop KN-8828B-2K+", "extratimex": [t], "extraname1": ["Heater"], "extraname2": ["Fan"],
+             "extraNoneTempHint1": [True], "extraNoneTempHint2": [True], "weight": [250.0, 210.0, "g"],
+             "timeindex": [0, 0, 0, 0, 0, 0, n - 1, 0]}  # fmt: skip
+    f = lambda c: [float(v) * 9.0 / 5.0 + 32.0 for v in c]  # noqa: E731 - degC -> degF
+    paths = []
+    for k, (heater, fan) in enumerate(layouts):  # first the layout alone, BT a placeholder
+        p = folder / f"hottop_2026-0{1 + k // 3}-1{k % 3}.alog"
+        p.write_text(fake_alog("F", f([200.0] * n), f([220.0] * n), n, {**extra, "timex": t,
+                     "extratemp1": [heater.tolist()], "extratemp2": [fan.tolist()]}))  # fmt: skip
+        paths.append(p)
+    cfg = folder / "truth"
+    from roastlab.cli.main import main
+
+    assert main(["init", *map(str, paths), "--out", str(cfg)]) == 0
+    cmap = load_map(cfg / "map.toml")
+    truth = FittedModel.paper(roastlab.load_plant(cfg / "plant.toml")).with_values(
+        Qe_gain_kW=0.003, Tgi_gain_C=1.5, tau_heater_s=40.0, Gg_kg_s=0.004, Kt=0.03, Tm0_C=210.0
+    )
+    truth.doc["map"] = cmap.to_mapping()
+    truth = FittedModel(truth.doc)
+    for p, (heater, fan) in zip(paths, layouts):
+        sim = truth.predict(roastlab.load_log(p, cmap))
+        bt = sim.Ta_C + rng.normal(0.0, 0.3, n)
+        p.write_text(fake_alog("F", f(bt), f(sim.Tm_C), n, {**extra, "timex": t,
+                     "extratemp1": [heater.tolist()], "extratemp2": [fan.tolist()]}))  # fmt: skip
+    shutil.rmtree(cfg)
+    return paths
+
+
+@pytest.mark.slow
+def test_an_unseen_fahrenheit_hottop_is_fitted_with_no_hand_edits(cli, tmp_path):
+    """init + fit-roaster on SYNTHETIC logs of a machine no example describes (Fahrenheit,
+    heater and fan as extra-device curves): no hand edits, and the held-out FIT beats the
+    first-order baseline fed the same inputs."""
+    logs = _synthetic_hottop_logs(tmp_path)
+    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
+    assert code == 0, err
+    text = (tmp_path / "cfg" / "map.toml").read_text()
+    assert 'column = "Heater"' in text and 'column = "Fan"' in text
+    code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
+    assert code == 0, err
+    held = float(out.split("held out: FIT ")[1].split(" %")[0])
+    base = float(out.split("baseline: ")[1].split(" %")[0])
+    assert held > 80.0 and held > base + 10.0, out
