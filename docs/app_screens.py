@@ -36,6 +36,20 @@ DRAG_SPOT = """() => { const gd = document.getElementById('plot'), sh = gd._full
            y_to: r.top + ya._offset + ya.l2p(s.y0 - 3) }; }"""
 
 
+def long_roast(src: Path, dst: Path) -> None:
+    """The paper's SYNTHETIC batch 1 (15 min, a sample every 30 s) on a 1 s grid, as densely as
+    Artisan logs: the 15-minute roast the what-if latency target names (inputs and BT linearly
+    interpolated; still synthetic, and the file says so)."""
+    import numpy as np
+    import pandas as pd
+
+    df = pd.read_csv(src, comment="#")
+    t = np.arange(0.0, df["time_s"].iloc[-1] + 0.5, 1.0)
+    out = pd.DataFrame({c: np.interp(t, df["time_s"], df[c]) for c in df.columns})
+    head = "## SYNTHETIC DATA: roastlab's paper batch 1 interpolated onto a 1 s grid (docs/app_screens.py)\n"
+    dst.write_text(head + out.to_csv(index=False, float_format="%.4f", lineterminator="\n"))
+
+
 def data_folder(d: Path) -> tuple[str, str]:
     """Fill ``d``; return the (log, model) the screenshots open."""
     import roastlab
@@ -44,6 +58,7 @@ def data_folder(d: Path) -> tuple[str, str]:
 
     shutil.copy(ROOT / "src/roastlab/datasets/paper-synthetic/dataset-I/batch1.csv", d / "batch1.csv")
     FittedModel.paper("120kg").save(d / "paper-model.json")
+    long_roast(d / "batch1.csv", d / "paper-15min-1s.csv")
     if not REAL.is_dir():
         return "batch1.csv", "paper-model.json"
     ex = ROOT / "examples" / "bullet"
@@ -58,20 +73,25 @@ def data_folder(d: Path) -> tuple[str, str]:
     return "bullet_2020-10-01_2053_500g.json", "bullet-model.json"
 
 
-def latencies(page, kg: float, n: int = 20) -> tuple[list, list]:
-    """``n`` batch-size changes: from each input change to the new curve drawn [ms] (the page's
-    own mark), and the server's part of it [ms]."""
+def latencies(page, field: str, values) -> tuple[list, list]:
+    """One change of ``field`` per value: from each input change to the new curve drawn [ms]
+    (the page's own mark), and the server's part of it [ms]."""
     lat, server = [], []
-    for k in range(n):
+    for v in values:
         before = page.evaluate("Number(document.body.dataset.updates || 0)")
-        page.fill("#batch_kg", f"{kg * (1.0 + 0.01 * (k + 1)):.4f}")
-        page.dispatch_event("#batch_kg", "input")
+        page.fill(field, f"{v:.4f}")
+        page.dispatch_event(field, "input" if field == "#batch_kg" else "change")
         page.wait_for_function(f"Number(document.body.dataset.updates || 0) > {before}")
         page.wait_for_function("document.body.dataset.latency !== undefined")
         lat.append(float(page.evaluate("document.body.dataset.latency")))
         page.evaluate("delete document.body.dataset.latency")
         server.append(float(page.inner_text("#timing").split()[1]))
     return lat, server
+
+
+def batch_steps(kg: float, n: int = 20) -> list[float]:
+    """``n`` batch sizes 1 %, 2 %, ... above ``kg``."""
+    return [kg * (1.0 + 0.01 * (k + 1)) for k in range(n)]
 
 
 def main() -> int:
@@ -105,7 +125,7 @@ def main() -> int:
 
         # what-if latency: input change -> curve drawn, 20 changes
         kg = float(page.input_value("#batch_kg") or 1.0)
-        lat, server = latencies(page, kg)
+        lat, server = latencies(page, "#batch_kg", batch_steps(kg))
         page.fill("#batch_kg", f"{kg * 1.2:.4f}")
         page.dispatch_event("#batch_kg", "input")
         page.fill("#heater", "+1@4:00")
@@ -134,7 +154,9 @@ def main() -> int:
         page_transfer_s = time.perf_counter() - t0
         page.locator("#transfer-summary").scroll_into_view_if_needed()
         page.screenshot(path=str(DOCS / "app-transfer.png"), full_page=True)
-        sky = [o for o in page.eval_on_selector_all("#fit_logs option", "os => os.map(o => o.value)") if "skywalker/" in o]
+        sky = [
+            o for o in page.eval_on_selector_all("#fit_logs option", "os => os.map(o => o.value)") if "skywalker/" in o
+        ]
         fit_s = None
         if sky:
             page.select_option("#fit_logs", sky)
@@ -153,7 +175,14 @@ def main() -> int:
             time.sleep(0.3)
             page.screenshot(path=str(DOCS / "app-skywalker.png"), full_page=True)
             sky_len = page.evaluate("[state.open.curves.time_s.length, state.open.curves.time_s.at(-1)]")
-            sky_lat, sky_server = latencies(page, float(page.input_value("#batch_kg")))
+            sky_lat, sky_server = latencies(page, "#batch_kg", batch_steps(float(page.input_value("#batch_kg"))))
+        page.evaluate("delete document.body.dataset.opened")
+        page.select_option("#log", "paper-15min-1s.csv")
+        page.select_option("#model", "paper-model.json")
+        page.click("#open")
+        page.wait_for_function("document.body.dataset.opened !== undefined")
+        long_len = page.evaluate("[state.open.curves.time_s.length, state.open.curves.time_s.at(-1)]")
+        long_lat, long_server = latencies(page, "#tgi", range(1, 21))  # inlet +1 ... +20 degC
         browser.close()
     srv.should_exit = True
 
@@ -173,7 +202,11 @@ def main() -> int:
         print(f"fit on the page: 6 Skywalker logs (init + fit-roaster) in {fit_s:.1f} s")
         print(f"what-if on a Skywalker log ({sky_len[0]} samples, {sky_len[1] / 60:.1f} min), median of 20: "
               f"{statistics.median(sky_lat):.1f} ms (server {statistics.median(sky_server):.2f} ms)")  # fmt: skip
-    print("wrote docs/app-open.png, docs/app-whatif.png, docs/app-drag.png, docs/app-transfer.png, docs/app-fit.png, docs/app-skywalker.png")
+    print(f"what-if on the 15-minute synthetic roast ({long_len[0]} samples, {long_len[1] / 60:.1f} min), median of "
+          f"20: {statistics.median(long_lat):.1f} ms (server {statistics.median(long_server):.2f} ms)")  # fmt: skip
+    print(
+        "wrote docs/app-open.png, docs/app-whatif.png, docs/app-drag.png, docs/app-transfer.png, docs/app-fit.png, docs/app-skywalker.png"
+    )
     shutil.rmtree(d, ignore_errors=True)
     return 0
 

@@ -413,7 +413,8 @@ window.addEventListener("DOMContentLoaded", async () => {
   $("run-fit").addEventListener("click", runFit);
   link("Tm0_C", "Tm0_C_range");
   link("batch_kg", "batch_kg_range");
-  for (const id of ["X0", "Tb0_C", "heater", "fan", "tgi"]) $(id).addEventListener("change", whatif);
+  const changed = () => { if (state.tInput === null) state.tInput = performance.now(); whatif(); };
+  for (const id of ["X0", "Tb0_C", "heater", "fan", "tgi"]) $(id).addEventListener("change", changed);
   try {
     await refreshFiles();
     if ($("log").value && $("model").value) await openLog();
