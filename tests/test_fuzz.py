@@ -482,8 +482,7 @@ def test_fuzz_parquet(parquet_bytes):
 def _option_readers():
     import argparse
 
-    from roastlab.cli.common import bed_arg, count_arg, float_arg
-    from roastlab.cli.fit import level_arg
+    from roastlab.cli.common import bed_arg, count_arg, float_arg, level_arg
     from roastlab.workflows.whatif import parse_set, parse_setting_change
 
     return {

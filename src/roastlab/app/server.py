@@ -181,7 +181,7 @@ def band_dict(b) -> dict:
         "level": b.level,
         "lower": _series(b.lower_C),
         "upper": _series(b.upper_C),
-        "median_width_C": round(float(np.median(b.width_C)), 2),
+        "median_width_C": round(b.median_width_C, 2),
     }
 
 

@@ -108,6 +108,33 @@ def say(notes) -> None:
 
 
 # ----------------------------------------------------------------------------- shared options
+def level_arg(text: str) -> float:
+    """argparse type of --band: a number (float_arg) that is a band level (evaluate.bands.check_level)."""
+    from ..evaluate.bands import check_level
+
+    try:
+        return check_level(float_arg("--band")(text))
+    except ParameterError as exc:
+        raise argparse.ArgumentTypeError(exc.problem) from None
+
+
+def add_band_option(p: argparse.ArgumentParser, what: str, where: str) -> None:
+    """``--band [LEVEL]``: ``what`` of this level (default BAND_LEVEL), from the model file's
+    parameter covariance and roast-to-roast spread (:mod:`roastlab.evaluate.bands`); ``where``
+    says where it shows."""
+    from ..evaluate.bands import BAND_LEVEL
+
+    p.add_argument(
+        "--band",
+        type=level_arg,
+        nargs="?",
+        const=BAND_LEVEL,
+        metavar="LEVEL",
+        help=f"also {what} of this level (default {BAND_LEVEL:g}), from the model file's parameter covariance and "
+        f"roast-to-roast spread: {where}",
+    )
+
+
 def add_model_options(p: argparse.ArgumentParser, with_model: bool = True) -> None:
     if with_model:
         p.add_argument("--model", "--theta", dest="model", metavar="MODEL.json", help=MODEL_HELP)

@@ -6,6 +6,7 @@ from pathlib import Path
 
 from ..errors import InputError
 from .common import (
+    add_band_option,
     add_batch_options,
     add_model_options,
     check_targets,
@@ -23,20 +24,6 @@ from .common import (
     weights_arg,
     write_json_and_plot,
 )
-
-
-def level_arg(text: str) -> float:
-    """argparse type of --band: a number (float_arg) that is a band level (evaluate.bands.check_level)."""
-    import argparse
-
-    from ..errors import ParameterError
-    from ..evaluate.bands import check_level
-
-    try:
-        return check_level(float_arg("--band")(text))
-    except ParameterError as exc:
-        raise argparse.ArgumentTypeError(exc.problem) from None
-
 
 FIT_HELP_COMPARE = "logs with their green weight (raw logs with --map, or batch CSVs)"
 
@@ -302,7 +289,6 @@ def add_parsers(sub) -> None:
     add_model_options(p, with_model=False)
     p.set_defaults(func=cmd_identify)
 
-    from ..evaluate.bands import BAND_LEVEL
     from ..model.bed import VARIANTS
     from ..workflows.compare import GROUP_STEP_SHARE
     from .common import bed_arg
@@ -363,14 +349,7 @@ def add_parsers(sub) -> None:
     p.add_argument(
         "--tgi-offset", type=float_arg("--tgi-offset"), help="what-if: add this to the inlet gas / ET [degC]"
     )
-    p.add_argument(
-        "--band",
-        type=level_arg,
-        nargs="?",
-        const=BAND_LEVEL,
-        metavar="LEVEL",
-        help=f"also score the model's prediction band of this level (default {BAND_LEVEL:g}): the share of each "
-        "batch's measured probe samples inside it and its median width",
-    )
+    add_band_option(p, "score the model's prediction band", "the share of each batch's measured probe samples "
+                    "inside it and its median width")  # fmt: skip
     add_model_options(p)
     p.set_defaults(func=cmd_validate)

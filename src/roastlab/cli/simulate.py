@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from .common import (
+    add_band_option,
     add_model_options,
     float_arg,
     initial_changes,
@@ -30,13 +31,11 @@ def cmd_simulate(args) -> int:
     result = model.predict(batch, plant=args.plant, **changes)
     if args.band is not None:
         from ..errors import ParameterError
-        from ..evaluate.bands import prediction_bands, why_no_band
+        from ..evaluate.bands import prediction_bands, require_band
 
         if args.model is None:
             raise ParameterError("the paper's theta* carries no band: give a fitted --model", "--band")
-        why = why_no_band(model)
-        if why is not None:
-            raise ParameterError(why, args.model)
+        require_band(model, args.model)
         result.band = prediction_bands(model, [batch], args.band, plant=args.plant, **changes)[0]
     say(result.meta.get("notes", []))
     with out_plan as out:
@@ -48,12 +47,10 @@ def cmd_simulate(args) -> int:
             plot_simulation(result, args.plot, f"{batch.name} on {result.meta['plant']} (simulated)", outputs=out)
     last = result.states[-1]
     if result.band is not None:
-        import numpy as np
-
         b = result.band
         print(
             f"{b.level * 100:g} % prediction band of BT (parameter covariance and roast-to-roast spread): median "
-            f"width {float(np.median(b.width_C)):.1f} degC; at the end {b.lower_C[-1]:.1f} to {b.upper_C[-1]:.1f} degC"
+            f"width {b.median_width_C:.1f} degC; at the end {b.lower_C[-1]:.1f} to {b.upper_C[-1]:.1f} degC"
         )
     print(
         f"simulated {batch.name}: {len(result.time_s)} samples, {result.time_s[-1] - result.time_s[0]:.0f} s on plant {result.meta['plant']}; "
@@ -79,9 +76,7 @@ def cmd_plant(args) -> int:
 
 def add_parsers(sub) -> None:
     """Register this module's command(s) on the ``roastlab`` subparsers ``sub``."""
-    from ..evaluate.bands import BAND_LEVEL
     from ..model.quantities import default
-    from .fit import level_arg
 
     p = sub.add_parser(
         "simulate",
@@ -97,15 +92,7 @@ def add_parsers(sub) -> None:
         "--inputs", required=True, metavar="INPUTS.csv", help="input samples (time_s,Gg_kg_s,Tgi_C[,Ta_C]) or a log"
     )
     p.add_argument("--map", metavar="MAP.toml", help="INPUTS is a raw log read with this column map")
-    p.add_argument(
-        "--band",
-        type=level_arg,
-        nargs="?",
-        const=BAND_LEVEL,
-        metavar="LEVEL",
-        help=f"also the probe prediction's band of this level (default {BAND_LEVEL:g}) from the model file's "
-        "parameter covariance and roast-to-roast spread: Ta_lower_C, Ta_upper_C in OUT, shaded in --plot",
-    )
+    add_band_option(p, "the probe prediction's band", "Ta_lower_C, Ta_upper_C in OUT, shaded in --plot")
     p.add_argument(
         "--out", required=True, metavar="OUT.csv", help="where to write the simulated states (.csv or .json)"
     )

@@ -6,6 +6,7 @@ import argparse
 
 from .common import (
     MODEL_HELP,
+    add_band_option,
     add_initial_options,
     check_targets,
     float_arg,
@@ -54,9 +55,6 @@ def cmd_whatif(args) -> int:
 
 def add_parsers(sub) -> None:
     """Register this module's command(s) on the ``roastlab`` subparsers ``sub``."""
-    from ..evaluate.bands import BAND_LEVEL
-    from .fit import level_arg
-
     p = sub.add_parser(
         "whatif",
         help="predict a logged roast as run and with changed settings, batch or charge state",
@@ -96,16 +94,8 @@ def add_parsers(sub) -> None:
     p.add_argument("--tgi", type=float_arg("--tgi"), help="add this to the inlet gas temperature [degC]")
     p.add_argument("--batch-kg", type=float_arg("--batch-kg"), help="green batch mass [kg] (default: the log's)")
     add_initial_options(p)
-    p.add_argument(
-        "--band",
-        type=level_arg,
-        nargs="?",
-        const=BAND_LEVEL,
-        metavar="LEVEL",
-        help=f"also the changed probe BT's prediction band of this level (default {BAND_LEVEL:g}), from the model "
-        "file's parameter covariance and roast-to-roast spread: its median width and BT at DROP in the table, "
-        "shaded in --plot, in --json",
-    )
+    add_band_option(p, "the changed probe BT's prediction band", "its median width and BT at DROP in the table, "
+                    "shaded in --plot, in --json")  # fmt: skip
     p.add_argument("--units", choices=("C", "F"), default="C", help="temperatures in the table in C or F (default C)")
     p.add_argument("--json", metavar="WHATIF.json", help="write the table as JSON (temperatures in degC, times in s)")
     p.add_argument("--plot", metavar="FIG.png", help="overlay measured BT and both predictions (.png/.svg/.pdf)")

@@ -68,6 +68,14 @@ def why_no_band(model) -> str | None:
     return "this model file has no parameter covariance or roast-to-roast spread: no band"
 
 
+def require_band(model, source=None) -> None:
+    """:class:`~roastlab.errors.ParameterError` (naming ``source``, default the model file) when
+    ``model`` cannot carry a band (:func:`why_no_band`)."""
+    why = why_no_band(model)
+    if why is not None:
+        raise ParameterError(why, source or model.source)
+
+
 def check_level(level) -> float:
     """A band level in (0, 1), or :class:`~roastlab.errors.ParameterError`."""
     if isinstance(level, bool) or not (isinstance(level, (int, float)) and 0.0 < level < 1.0):
@@ -141,6 +149,11 @@ class Band:
     def width_C(self) -> np.ndarray:
         return self.upper_C - self.lower_C
 
+    @property
+    def median_width_C(self) -> float:
+        """The band's median width over the roast [degC]: how wide it is, in one number."""
+        return float(np.median(self.width_C))
+
 
 def prediction_bands(
     model, batches, level: float = BAND_LEVEL, samples: int = BAND_SAMPLES, seed: int = 0, plant=None, **changes
@@ -205,7 +218,7 @@ def coverage(batches, bands: list[Band]) -> list[dict]:
                 "Mb_kg": b.Mb_kg,
                 "n": int(ok.sum()),
                 "inside": float(inside.mean()) if ok.any() else float("nan"),
-                "median_width_C": float(np.median(band.width_C)),
+                "median_width_C": band.median_width_C,
             }
         )
     return rows

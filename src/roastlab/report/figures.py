@@ -114,6 +114,12 @@ def ror_limits(ax, time_s, *curves) -> None:
         ax.set_ylim(min(0.0, bottom) - 2.0, max(top, 5.0) * 1.15 + 1.0)
 
 
+def _shade_band(ax, band, color: str, what: str) -> None:
+    """A :class:`~roastlab.evaluate.bands.Band` shaded on ``ax`` (minutes), labelled "90 % ``what``"."""
+    ax.fill_between(band.time_s / 60.0, band.lower_C, band.upper_C, color=color, alpha=0.15, lw=0,
+                    label=f"{band.level * 100:g} % {what}")  # fmt: skip
+
+
 def plot_simulation(result, path=None, title=None, outputs=None, events=None):
     """Four panels: temperatures (BT/ET and the model's states), rate of rise, moisture, heat flows."""
     fig = new_figure(figsize=(8.5, 10), layout="constrained")
@@ -122,9 +128,7 @@ def plot_simulation(result, path=None, title=None, outputs=None, events=None):
     ax = axes[0]
     ax.plot(t_min, result.Ta_C, label="BT predicted (model Ta, probe)", color="tab:orange", lw=2)
     if result.band is not None:
-        b = result.band
-        ax.fill_between(t_min, b.lower_C, b.upper_C, color="tab:orange", alpha=0.15, lw=0,
-                        label=f"{b.level * 100:g} % prediction band")  # fmt: skip
+        _shade_band(ax, result.band, "tab:orange", "prediction band")
     if result.Ta_measured_C is not None:
         ax.plot(t_min, result.Ta_measured_C, "k.", ms=3, label="BT measured (log)")
     if result.ET_measured_C is not None:
@@ -194,9 +198,7 @@ def plot_fit(result, path=None, title=None, max_panels: int = 8, outputs=None, b
         res = fig.add_subplot(grid[2 * r + 1, c], sharex=ax)
         _profile_panel(ax, result, i)
         if bands is not None:
-            b = bands[i]
-            ax.fill_between(b.time_s / 60.0, b.lower_C, b.upper_C, color="tab:green", alpha=0.15, lw=0,
-                            label=f"{b.level * 100:g} % prediction band")  # fmt: skip
+            _shade_band(ax, bands[i], "tab:green", "prediction band")
             ax.legend(fontsize=8)
         t = result.time_s[i] / 60.0
         res.plot(t, result.measured[i] - result.predicted[i], color="tab:purple", lw=1, label="Ta meas − pred")
@@ -291,10 +293,7 @@ def plot_whatif(w, path=None, outputs=None):
     ax.plot(t_min, w.as_run.Ta_C, color="tab:blue", lw=1.8, label="BT model, as run")
     ax.plot(t_min, w.changed.Ta_C, color="tab:orange", lw=1.8, label=f"BT model, {change}")
     if w.band is not None:
-        ax.fill_between(
-            t_min, w.band.lower_C, w.band.upper_C, color="tab:orange", alpha=0.15, lw=0,
-            label=f"{w.band.level * 100:g} % band, changed",
-        )  # fmt: skip
+        _shade_band(ax, w.band, "tab:orange", "band, changed")
     ax.plot(t_min, w.as_run.Tb_C, color="tab:blue", lw=1.0, ls="--", label="beans model (Tb), as run")
     ax.plot(t_min, w.changed.Tb_C, color="tab:orange", lw=1.0, ls="--", label="beans model (Tb), changed")
     ax.set_ylabel("temperature [°C]")

@@ -185,7 +185,7 @@ class WhatIf(Result):
         if b is None:
             return None
         u = "°F" if units == "F" else "°C"
-        width = float(np.median(b.width_C)) * (1.8 if units == "F" else 1.0)
+        width = display_temp_delta(b.median_width_C, units)
         return (
             f"{b.level * 100:g} % prediction band of the changed probe BT (parameter covariance and roast-to-roast "
             f"spread): median width {width:.1f} {u}; BT at DROP {display_temp(b.lower_C[-1], units):.1f} to "
@@ -271,7 +271,7 @@ class WhatIf(Result):
         b = self.band
         return {
             "level": b.level,
-            "median_width_C": round(float(np.median(b.width_C)), 2),
+            "median_width_C": round(b.median_width_C, 2),
             "DROP_lower_C": round(float(b.lower_C[-1]), 2),
             "DROP_upper_C": round(float(b.upper_C[-1]), 2),
         }
@@ -319,12 +319,10 @@ def whatif(
     model file that cannot carry one is a ParameterError saying why.
     """
     if band_level is not None:
-        from ..evaluate.bands import check_level, why_no_band
+        from ..evaluate.bands import check_level, require_band
 
         band_level = check_level(band_level)
-        why = why_no_band(model)
-        if why is not None:
-            raise ParameterError(why, model.source)
+        require_band(model)
     changed_batch = batch
     labels = [str(c) for c in setting_changes]
     for c in setting_changes:
