@@ -15,9 +15,10 @@ extension, the heater setting.
 
 Ta(z) is the compiled model (:func:`roastlab.sim.kernels.integrate_into`, the one right-hand
 side) run with Tgi held linearly (or zero-order) between knots. The Jacobian of Ta in the
-knots comes from :func:`roastlab.sim.sensitivity.ta_input_jacobian` (finite differences that
-restart from the stored state, in parallel); the optional constant gas flow and drum start
-temperature get one forward-difference column each. The solver is SciPy's bounded
+knots, the optional constant gas flow and the drum start temperature comes from one run of
+the forward sensitivities (:func:`roastlab.sim.sensitivity.program_sensitivity`, exact
+derivatives of the integrator's steps); finite differences on the compiled integrator
+(``sensitivities="fd"``, :func:`roastlab.sim.sensitivity.ta_input_jacobian`) are the reference. The solver is SciPy's bounded
 trust-region least squares (``least_squares(method="trf")``), started from a given program
 (for transfer: the reference's own inputs). Deterministic: no random starts.
 """
@@ -37,7 +38,7 @@ from ..model.actuators import MIN_HOLD_S, TGI_LIMITS, Actuator
 from ..model.layout import S_TA, S_TM
 from ..model.limits import check_value
 from ..sim.kernels import H_MAX_S, simulate_one
-from ..sim.sensitivity import ta_input_jacobian
+from ..sim.sensitivity import program_sensitivity, ta_input_jacobian
 
 #: Most knots a program may have (the Jacobian is dense, n x n).
 MAX_KNOTS = 2500
@@ -209,6 +210,7 @@ def optimise_program(
     u_prev: float | None = None,
     Tgi_bias_C: float = 0.0,
     ror_weight: float = 0.0,
+    sensitivities: str = "exact",
 ) -> ProgramResult:
     """The program of one input (Tgi or the heater, ``limits.decide``; optionally also a constant
     Gg and the drum start temperature) whose simulated probe follows ``target_C`` on ``t`` [s].
@@ -237,8 +239,13 @@ def optimise_program(
     ror_weight : weight of the rate-of-rise error [per degC/min] against the level error
         [per degC] (0: track the level only); the RoR is the one of
         :func:`roastlab.metrics.profile.rate_of_rise_C_per_min`, which the control score uses too
+    sensitivities : ``"exact"`` (forward sensitivities integrated with the states,
+        :func:`roastlab.sim.sensitivity.program_sensitivity`) or ``"fd"`` (finite differences on
+        the compiled integrator, the reference)
     """
     t0_clock = time.perf_counter()
+    if sensitivities not in ("exact", "fd"):
+        raise InputError(f"sensitivities must be 'exact' or 'fd', got {sensitivities!r}", "program")
     t = np.ascontiguousarray(t, dtype=np.float64)
     n = t.shape[0]
     if n < 3:
@@ -337,30 +344,37 @@ def optimise_program(
 
     def jacobian(z):
         u, tgi, q, gg, x, out = simulate(z)
-        jt = np.empty((n, n))
-        ta = np.ascontiguousarray(out[:, S_TA])
-        states = np.ascontiguousarray(out[:, :6])
-        delta = 1.0 if which == 0 else 1e-2 * (hi_T - lo_T)
-        ta_input_jacobian(t, gg, tgi, q, F, which, states, ta, p, zoh, H_MAX_S, delta, jt)
-        counter["sims"] += n // 2
         m = z.shape[0]
-        # d Ta_i / d z, unweighted: Tgi_k = sum_{j <= k} z_j, so column j sums the columns k >= j
-        dta = np.empty((n, m))
-        dta[:, :n] = np.cumsum(jt[:, ::-1], axis=1)[:, ::-1]
+        if sensitivities == "exact":  # forward sensitivities: one run gives every column
+            _, dta_u = program_sensitivity(t, gg, tgi, q, F, x, p, zoh, which, extra_names)
+            counter["sims"] += 1
+            dta = np.empty((n, m))
+            # d Ta_i / d z: Tgi_k = sum_{j <= k} z_j, so column j sums the knot columns k >= j
+            dta[:, :n] = np.cumsum(dta_u[:, n - 1 :: -1], axis=1)[:, ::-1]
+            dta[:, n:] = dta_u[:, n:]
+        else:  # the reference: forward differences on the compiled integrator
+            jt = np.empty((n, n))
+            ta = np.ascontiguousarray(out[:, S_TA])
+            states = np.ascontiguousarray(out[:, :6])
+            delta = 1.0 if which == 0 else 1e-2 * (hi_T - lo_T)
+            ta_input_jacobian(t, gg, tgi, q, F, which, states, ta, p, zoh, H_MAX_S, delta, jt)
+            counter["sims"] += n // 2
+            dta = np.empty((n, m))
+            dta[:, :n] = np.cumsum(jt[:, ::-1], axis=1)[:, ::-1]
+            j = n
+            for name in extra_names:
+                h = 1e-3 * max(abs(z[j]), 1e-3) if name == "Gg" else 0.5
+                zp = z.copy()
+                zp[j] += h
+                _, tp, qp, gp, xp = unpack(zp)
+                outp = _run(t, gp, tp, qp, F, xp, p, zoh)
+                counter["sims"] += 1
+                dta[:, j] = (outp[:, S_TA] - out[:, S_TA]) / h
+                j += 1
         J = np.zeros((3 * n - 1 + (ror_rows.shape[0] if ror_weight else 0), m))
         active = ((u > hi_T) | (u < lo_T)).astype(float)
         J[n : 2 * n, :n] = LEVEL_PENALTY * lower * active[:, None]
         J[2 * n : 3 * n - 1, 1:n] = smoothness * np.eye(n - 1)
-        j = n
-        for name in extra_names:
-            h = 1e-3 * max(abs(z[j]), 1e-3) if name == "Gg" else 0.5
-            zp = z.copy()
-            zp[j] += h
-            _, tp, qp, gp, xp = unpack(zp)
-            outp = _run(t, gp, tp, qp, F, xp, p, zoh)
-            counter["sims"] += 1
-            dta[:, j] = (outp[:, S_TA] - out[:, S_TA]) / h
-            j += 1
         J[:n] = w[:, None] * dta
         if ror_weight:  # d(RoR)/dz: the RoR is a linear map of Ta, so its rows map d Ta / d z
             J[3 * n - 1 :] = ror_weight * (ror_rows @ dta)

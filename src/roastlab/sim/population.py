@@ -177,6 +177,54 @@ def predict_outputs(packed: PackedBatches, names: list[str], values: np.ndarray,
     return ta.reshape(m, nb, -1), (tb.reshape(m, nb, -1) if with_tb else None)
 
 
+def output_sensitivities(packed: PackedBatches, names: list[str], values: np.ndarray, directions, with_tb: bool = True):
+    """The probe reading Ta, the bean temperature Tb and their exact derivatives with respect to
+    ``directions``, for one value set over every batch (forward sensitivities,
+    :func:`roastlab.sim.sensitivity.sens_population_kernel`).
+
+    ``values`` (nb, len(names)): each named parameter's value per batch (as one set of
+    :func:`predict_outputs`). ``directions``: one (j, b) per column, the derivative with respect to
+    ``names[j]`` in batch ``b`` only, or in every batch when b < 0. Returns ``(ta, tb, dta, dtb)``
+    of shapes (nb, nmax) and (nb, nmax, m), NaN-padded; tb and dtb are None without ``with_tb``.
+    """
+    from ..model.layout import S_TA, S_TB
+    from .sensitivity import sens_population_kernel
+
+    nb, nmax, m = packed.n_batches, packed.T.shape[1], len(directions)
+    batch_of, X0, PP = run_arrays(packed, names, values[None, :, :])
+    S0 = np.zeros((nb, NS, m))
+    triplets: list[list] = [[] for _ in range(nb)]
+    for col, (j, b) in enumerate(directions):
+        name = names[j]
+        for bb in range(nb) if b < 0 else (b,):
+            if name in PARAM_SLOTS:
+                triplets[bb].append((PARAM_SLOTS[name], col, 1.0))
+            elif name in STATE0:
+                S0[bb, STATE0[name], col] = 1.0
+                if name == "X0":  # Mbd = Mb / (1 + X0)
+                    triplets[bb].append((P["Mbd"], col, -packed.Mb[bb] / (1.0 + X0[bb, STATE0[name]]) ** 2))
+            else:
+                raise KeyError(name)
+    width = max(1, max(len(t) for t in triplets))
+    PQ = np.zeros((nb, width), dtype=np.int64)
+    PC = np.zeros((nb, width), dtype=np.int64)
+    PV = np.zeros((nb, width))  # padding: value 0, no effect
+    for bb, items in enumerate(triplets):
+        for e, (q, c, v) in enumerate(items):
+            PQ[bb, e], PC[bb, e], PV[bb, e] = q, c, v
+    rows = np.array([S_TA, S_TB], dtype=np.int64)
+    out_x = np.full((nb, nmax, NS), np.nan)
+    out_s = np.full((nb, nmax, 2, m), np.nan)
+    sens_population_kernel(
+        *packed.inputs, batch_of, X0, PP, packed.zoh, packed.h_max_s, S0, PQ, PC, PV, rows, out_x, out_s,
+        np.zeros(0, dtype=np.int64), np.zeros(0),
+    )  # fmt: skip
+    ta, dta = out_x[:, :, S_TA], out_s[:, :, 0, :]
+    if not with_tb:
+        return ta, None, dta, None
+    return ta, out_x[:, :, S_TB], dta, out_s[:, :, 1, :]
+
+
 def _population_task(packed, names, values):
     """One Dask task of :func:`simulate_population`: single-threaded (the cluster is the parallelism)."""
     import numba

@@ -1,0 +1,212 @@
+"""The exact Jacobian of the one right-hand side, generated from it by symbolic differentiation.
+
+:func:`roastlab.model.rhs.derivatives` is evaluated once on SymPy symbols (through
+:func:`roastlab.model.rhs.rebind`, the same route that gives the CasADi baseline its symbolic
+model), differentiated with respect to the six states, the four inputs and every continuous
+entry of the parameter vector, reduced to common subexpressions and printed as plain Python that
+numba compiles into the sensitivity integrator (:mod:`roastlab.sim.kernels`). Nothing here is
+written by hand: an edit to ``rhs.py`` changes the generated code with it.
+
+The right-hand side branches in Python on the discrete model options (the bed laws'
+``contact_law``, ``probe_law``, ``probe_gas_law`` and the moisture law's exponent ``x_exp``), so
+the code is generated once per combination of their values (:data:`CODE_VALUES`) and the
+generated function picks the block of the combination in ``p`` at run time.
+
+The generated source is cached beside the compiled kernels (:func:`roastlab.sim.cache.cache_dir`,
+keyed on the hash of the sources it derives from), so SymPy runs once per source version
+(a few seconds) and later processes read the file.
+
+Generated function ``rhs_jacobian(Tb, Tm, X, He, Ta, H, Gg, Tgi, heater, fan, p, f, Jx, Ju, Jp)``
+writes ``f[i]`` = dx_i/dt (as :func:`~roastlab.model.rhs.derivatives`), ``Jx[i, j]`` =
+d f_i / d x_j, ``Ju[i, k]`` = d f_i / d u_k (u = [Gg, Tgi, heater, fan], the logged inputs before
+:func:`~roastlab.model.rhs.gas_inputs`) and ``Jp[i, q]`` = d f_i / d p_q. Entries that are zero
+for every input are not written: pass arrays that start at zero. Where the right-hand side has
+a kink (``fmax``, ``where``), the derivative is that of the branch taken.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import itertools
+import os
+import sys
+import tempfile
+import types
+from pathlib import Path
+
+from ..model import bed as _bed
+from ..model.constants import MOISTURE_LAWS
+from ..model.layout import INPUT_NAMES, N_STATES, PARAM_NAMES, STATE_NAMES, P
+
+#: The parameter-vector entries that select a law (compared with ``==`` in the right-hand side),
+#: and the values each can take: the generated code has one block per combination.
+CODE_VALUES: dict[str, tuple[float, ...]] = {
+    **{f"{k}_law": tuple(float(i) for i in range(len(v))) for k, v in _bed.LAWS.items()},
+    "x_exp": tuple(float(v) for v in MOISTURE_LAWS.values()),
+}
+#: Parameter-vector entries the Jacobian differentiates with respect to (every one but the codes).
+CONTINUOUS = tuple(name for name in PARAM_NAMES if name not in CODE_VALUES)
+FUNCTION_NAME = "rhs_jacobian"
+
+
+def _symbolic_ops():
+    import sympy as sp
+
+    def where(condition, a, b):
+        if isinstance(condition, bool) or condition in (sp.true, sp.false):
+            return a if bool(condition) else b
+        return sp.Piecewise((a, condition), (b, True))
+
+    def fmax(a, b):
+        cond = sp.sympify(a) >= sp.sympify(b)
+        return where(cond, a, b)
+
+    return {"exp": sp.exp, "fmax": fmax, "where": where}
+
+
+def _entries(codes: dict[str, float], xs, us, psym) -> dict:
+    """{(array, i, j): expression} of one combination of the codes, zero entries left out."""
+    import sympy as sp
+
+    from ..model.rhs import rebind
+
+    ns = rebind(**_symbolic_ops())
+    p = [codes[name] if name in codes else psym[name] for name in PARAM_NAMES]
+    out = {}
+    for i, fi in enumerate(ns.derivatives(*xs, *us, p)):
+        fi = sp.sympify(fi)
+        out[("f", i, None)] = fi
+        for j, xj in enumerate(xs):
+            out[("Jx", i, j)] = sp.diff(fi, xj)
+        for k, uk in enumerate(us):
+            out[("Ju", i, k)] = sp.diff(fi, uk)
+        for name in CONTINUOUS:
+            out[("Jp", i, P[name])] = sp.diff(fi, psym[name])
+    return {key: e for key, e in out.items() if e.is_zero is not True}
+
+
+def _merged(xs, us, psym, csym):
+    """{(array, i, j): expression} over every combination of the codes: an entry that differs
+    between combinations is a Piecewise over the codes it depends on (``csym``, compared with
+    ``==`` at run time), so blocks shared between laws are generated and computed once."""
+    import sympy as sp
+
+    names = list(CODE_VALUES)
+    combos = list(itertools.product(*CODE_VALUES.values()))
+    per_combo = {combo: _entries(dict(zip(names, combo)), xs, us, psym) for combo in combos}
+    keys = sorted({k for e in per_combo.values() for k in e}, key=lambda k: (k[0], k[1], -1 if k[2] is None else k[2]))
+    merged = {}
+    for key in keys:
+        expr = {combo: per_combo[combo].get(key, sp.Integer(0)) for combo in combos}
+        # the codes this entry depends on: varying one (the others fixed) changes the expression
+        depends = [
+            c
+            for c, name in enumerate(names)
+            if any(
+                expr[a] != expr[b]
+                for a in combos
+                for b in combos
+                if all(a[d] == b[d] for d in range(len(names)) if d != c) and a[c] != b[c]
+            )
+        ]
+        if not depends:
+            merged[key] = expr[combos[0]]
+            continue
+        pieces = []
+        for values in itertools.product(*(CODE_VALUES[names[c]] for c in depends)):
+            combo = next(cb for cb in combos if all(cb[c] == v for c, v in zip(depends, values)))
+            cond = sp.And(*(sp.Eq(csym[names[c]], v) for c, v in zip(depends, values)))
+            pieces.append((expr[combo], cond))
+        pieces[-1] = (pieces[-1][0], True)
+        merged[key] = sp.Piecewise(*pieces)
+    return merged
+
+
+def generate_source() -> str:
+    """The Python source of ``rhs_jacobian`` (needs SymPy; a few seconds)."""
+    import sympy as sp
+    from sympy.printing.pycode import PythonCodePrinter
+
+    printer = PythonCodePrinter({"fully_qualified_modules": True, "standard": "python3"})
+    xs = sp.symbols(f"x0:{N_STATES}", real=True)
+    us = sp.symbols(f"u0:{len(INPUT_NAMES)}", real=True)
+    psym = {name: sp.Symbol(f"p_{name}", real=True) for name in CONTINUOUS}
+    csym = {name: sp.Symbol(f"p_{name}", real=True) for name in CODE_VALUES}
+    merged = _merged(xs, us, psym, csym)
+    replacements, reduced = sp.cse(list(merged.values()), symbols=sp.numbered_symbols("c"))
+    lines = [
+        '"""GENERATED by roastlab.sim.jacobian from roastlab.model.rhs: do not edit (see that module)."""',
+        "import math",
+        "",
+        "",
+        f"def {FUNCTION_NAME}(x0, x1, x2, x3, x4, x5, u0, u1, u2, u3, p, f, Jx, Ju, Jp):",
+        "    # " + ", ".join(f"x{i} = {n}" for i, n in enumerate(STATE_NAMES)),
+        "    # " + ", ".join(f"u{i} = {n}" for i, n in enumerate(INPUT_NAMES)),
+    ]
+    used = set()
+    for expr in list(reduced) + [e for _, e in replacements]:
+        used |= expr.free_symbols
+    for name, sym in {**psym, **csym}.items():
+        if sym in used:
+            lines.append(f"    {sym.name} = p[{P[name]}]")
+    for sym, expr in replacements:
+        lines.append(f"    {sym.name} = {printer.doprint(expr)}")
+    for (array, i, j), expr in zip(merged, reduced):
+        target = f"{array}[{i}]" if j is None else f"{array}[{i}, {j}]"
+        lines.append(f"    {target} = {printer.doprint(expr)}")
+    return "\n".join(lines) + "\n"
+
+
+def _sources_hash() -> str:
+    from .cache import source_hash
+
+    return hashlib.sha256((source_hash() + FUNCTION_NAME).encode()).hexdigest()[:16]
+
+
+def _write_atomically(path: Path, text: str) -> None:
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".jacobian-", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w") as fh:
+            fh.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def source_path() -> Path | None:
+    """Where this source version's generated module is cached (None when no cache folder)."""
+    from .cache import cache_dir
+
+    folder = cache_dir()
+    return None if folder is None else folder / f"rhs_jacobian_{_sources_hash()}.py"
+
+
+def load():
+    """The generated ``rhs_jacobian`` as a plain Python function (generated and cached on first use)."""
+    path = source_path()
+    if path is not None and path.is_file():
+        text = path.read_text()
+    else:
+        text = generate_source()
+        if path is not None:
+            try:
+                _write_atomically(path, text)
+            except OSError:
+                path = None
+    # a module in sys.modules under a name of its own: numba's disk cache of the kernels that
+    # compile this function in finds its globals by that name in a later process
+    name = f"roastlab_rhs_jacobian_{_sources_hash()}"
+    if name in sys.modules:
+        return getattr(sys.modules[name], FUNCTION_NAME)
+    if path is not None:
+        spec = importlib.util.spec_from_file_location(name, path)
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[name] = module
+        spec.loader.exec_module(module)
+    else:
+        module = types.ModuleType(name)
+        sys.modules[name] = module
+        exec(compile(text, f"<{name}>", "exec"), module.__dict__)  # our own generated code, never user input
+    return getattr(module, FUNCTION_NAME)

@@ -1,0 +1,259 @@
+"""Exact sensitivities (issue 26): the generated Jacobian of the one right-hand side against
+CasADi's and against central differences; the forward sensitivities of the compiled integrator
+against central differences of the integrator itself; their users (identification, program
+optimisation) against the finite-difference reference."""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+
+from roastlab.model.layout import N_INPUTS, N_PARAMS, N_STATES, S_TA, P
+from roastlab.model.plant import as_plant
+from roastlab.model.rhs import derivatives, pack_params
+from roastlab.sim.jacobian import CODE_VALUES, CONTINUOUS, generate_source, load, source_path
+from roastlab.sim.kernels import H_MAX_S, N_OUT, integrate_into
+from roastlab.sim.sensitivity import integrate_sens_into, program_sensitivity
+
+NS = N_STATES
+RHS_JACOBIAN = load()
+
+
+def _params(codes: dict, rng) -> np.ndarray:
+    """The 120 kg plant's parameter vector with every extension switched on at random values and
+    the law codes ``codes``, so each Jacobian entry is exercised."""
+    p = pack_params(as_plant("120kg"), (0.01, 0.0254, 0.5793))
+    p[P["Qe_gain"]] = rng.uniform(1.0, 5.0)
+    p[P["Qe_offset"]] = rng.uniform(0.5, 2.0)
+    p[P["Tgi_gain"]] = rng.uniform(5.0, 20.0)
+    p[P["tau_heater"]] = rng.uniform(10.0, 60.0)
+    p[P["Gg_fan"]] = rng.uniform(0.001, 0.01)
+    p[P["U_shell"]] = rng.uniform(0.001, 0.01)
+    p[P["h_probe"]] = p[P["h_bed"]] * rng.uniform(1.2, 3.0)  # a partly covered probe
+    for name, value in codes.items():
+        p[P[name]] = value
+    return p
+
+
+def _point(rng):
+    x = np.array([rng.uniform(60, 220), rng.uniform(150, 260), rng.uniform(0.02, 0.12), rng.uniform(0, 80),
+                  rng.uniform(50, 210), rng.uniform(1, 8)])  # fmt: skip
+    u = np.array([rng.uniform(0.3, 0.6), rng.uniform(250, 480), rng.uniform(1, 9), rng.uniform(1, 9)])
+    return x, u
+
+
+def _generated(x, u, p):
+    f = np.zeros(NS)
+    Jx, Ju, Jp = np.zeros((NS, NS)), np.zeros((NS, N_INPUTS)), np.zeros((NS, N_PARAMS))
+    RHS_JACOBIAN(*x, *u, p, f, Jx, Ju, Jp)
+    return f, Jx, Ju, Jp
+
+
+COMBOS = [dict(zip(CODE_VALUES, c)) for c in itertools.product(*CODE_VALUES.values())]
+
+
+@pytest.mark.parametrize("codes", COMBOS, ids=lambda c: ",".join(f"{k}={v:g}" for k, v in c.items()))
+def test_generated_jacobian_matches_central_differences(codes):
+    rng = np.random.default_rng(abs(hash(tuple(codes.values()))) % 2**32)
+    p = _params(codes, rng)
+    for _ in range(3):
+        x, u = _point(rng)
+        f, Jx, Ju, Jp = _generated(x, u, p)
+        np.testing.assert_allclose(f, derivatives(*x, *u, p), rtol=1e-12, atol=1e-15)
+
+        def g(xx=x, uu=u, pp=p):
+            return np.array(derivatives(*xx, *uu, pp))
+
+        for j in range(NS):
+            h = 1e-6 * max(1.0, abs(x[j]))
+            e = np.zeros(NS)
+            e[j] = h
+            fd = (g(xx=x + e) - g(xx=x - e)) / (2 * h)
+            np.testing.assert_allclose(Jx[:, j], fd, rtol=1e-5, atol=1e-9 * max(1.0, np.abs(fd).max()))
+        for k in range(N_INPUTS):
+            h = 1e-6 * max(1.0, abs(u[k]))
+            e = np.zeros(N_INPUTS)
+            e[k] = h
+            fd = (g(uu=u + e) - g(uu=u - e)) / (2 * h)
+            np.testing.assert_allclose(Ju[:, k], fd, rtol=1e-5, atol=1e-9 * max(1.0, np.abs(fd).max()))
+        for name in CONTINUOUS:
+            q = P[name]
+            h = 1e-5 * max(abs(p[q]), 1e-6)
+            pp, pm = p.copy(), p.copy()
+            pp[q] += h
+            pm[q] -= h
+            fd = (g(pp=pp) - g(pp=pm)) / (2 * h)
+            scale = max(np.abs(fd).max(), np.abs(Jp[:, q]).max(), 1e-12)
+            # central differences carry roundoff ~1e-16 |f| / h: a loose bound (CasADi checks tightly)
+            assert np.abs(Jp[:, q] - fd).max() <= 1e-4 * scale, (name, Jp[:, q], fd)
+
+
+@pytest.mark.parametrize(
+    "codes", COMBOS[:: max(1, len(COMBOS) // 4)], ids=lambda c: ",".join(f"{v:g}" for v in c.values())
+)
+def test_generated_jacobian_matches_casadi(codes):
+    """The same right-hand side evaluated on CasADi symbols (the control baseline's route) and
+    differentiated by CasADi gives the same state and input Jacobians."""
+    ca = pytest.importorskip("casadi")
+    from roastlab.model.rhs import rebind
+
+    rng = np.random.default_rng(7)
+    p = _params(codes, rng)
+    ns = rebind(exp=ca.exp, fmax=ca.fmax, where=ca.if_else)
+    xs, us = ca.SX.sym("x", NS), ca.SX.sym("u", N_INPUTS)
+    d = ca.vertcat(*ns.derivatives(*[xs[i] for i in range(NS)], *[us[k] for k in range(N_INPUTS)], p))
+    jac = ca.Function("J", [xs, us], [ca.jacobian(d, xs), ca.jacobian(d, us)])
+    for _ in range(3):
+        x, u = _point(rng)
+        _, Jx, Ju, _ = _generated(x, u, p)
+        Jx_ca, Ju_ca = (np.array(a) for a in jac(x, u))
+        np.testing.assert_allclose(Jx, Jx_ca, rtol=1e-10, atol=1e-14)
+        np.testing.assert_allclose(Ju, Ju_ca, rtol=1e-10, atol=1e-14)
+
+
+def test_generated_source_is_the_cached_one():
+    """The cached generated module is what the generator writes for these sources (no stale cache)."""
+    path = source_path()
+    if path is None:
+        pytest.skip("no writable cache folder")
+    assert path.read_text() == generate_source()
+
+
+def _case(zoh, heater=False):
+    t = np.arange(0.0, 901.0, 10.0)
+    n = t.size
+    p = pack_params(as_plant("120kg"), (0.01, 0.0254, 0.5793))
+    Q = np.zeros(n)
+    if heater:
+        p[P["Qe_gain"]], p[P["tau_heater"]] = 3.0, 30.0
+        Q = 5.0 + 2.0 * np.sin(t / 150.0)
+    Gg = np.full(n, 0.45)
+    Tgi = 420.0 + 40.0 * np.sin(t / 200.0)
+    x0 = np.array([25.0, 180.0, 0.1, 0.0, 25.0, Q[0]])
+    return t, Gg, Tgi, Q, np.zeros(n), x0, p, zoh
+
+
+def _ta(t, Gg, Tgi, Q, F, x0, p, zoh):
+    out = np.empty((t.size, N_OUT))
+    integrate_into(t, Gg, Tgi, Q, F, t.size, x0, p, zoh, H_MAX_S, out)
+    return out
+
+
+@pytest.mark.parametrize("zoh", [False, True])
+def test_parameter_sensitivities_match_central_differences(zoh):
+    t, Gg, Tgi, Q, F, x0, p, zoh = _case(zoh)
+    n = t.size
+    names = ["hgm", "hbm", "Pbm", "Kt"]
+    m = len(names) + 1  # and Tm0
+    S0 = np.zeros((NS, m))
+    S0[1, m - 1] = 1.0
+    pq = np.array([P[k] for k in names], dtype=np.int64)
+    pc = np.arange(len(names), dtype=np.int64)
+    none = np.zeros(0, dtype=np.int64)
+    out = np.empty((n, NS))
+    outS = np.empty((n, 1, m))
+    integrate_sens_into(t, Gg, Tgi, Q, F, n, x0, p, zoh, H_MAX_S, S0, none, none, none, none, np.zeros(0), pq, pc,
+                        np.ones(len(names)), np.array([S_TA]), out, outS)  # fmt: skip
+    base = _ta(t, Gg, Tgi, Q, F, x0, p, zoh)
+    np.testing.assert_allclose(out, base[:, :NS], rtol=0, atol=1e-9)  # the same steps, the same states
+    for c, name in enumerate([*names, "Tm0"]):
+        h = 1e-4 * (p[P[name]] if name != "Tm0" else 100.0)
+        runs = []
+        for sign in (1, -1):
+            pp, xx = p.copy(), x0.copy()
+            if name == "Tm0":
+                xx[1] += sign * h
+            else:
+                pp[P[name]] += sign * h
+            runs.append(_ta(t, Gg, Tgi, Q, F, xx, pp, zoh)[:, S_TA])
+        fd = (runs[0] - runs[1]) / (2 * h)
+        assert np.abs(outS[:, 0, c] - fd).max() <= 1e-6 * np.abs(fd).max(), name
+
+
+@pytest.mark.parametrize("zoh,heater", [(False, False), (True, False), (True, True), (False, True)])
+def test_program_sensitivities_match_central_differences(zoh, heater):
+    t, Gg, Tgi, Q, F, x0, p, zoh = _case(zoh, heater)
+    which = 1 if heater else 0
+    states, dta = program_sensitivity(t, Gg, Tgi, Q, F, x0, p, zoh, which, ("Gg", "Tm0"))
+    n = t.size
+    assert dta.shape == (n, n + 2)
+    np.testing.assert_allclose(states, _ta(t, Gg, Tgi, Q, F, x0, p, zoh)[:, :NS], atol=1e-9)
+    for k in (0, 1, 17, n // 2, n - 1):
+        h = 0.5 if which == 0 else 0.05
+        runs = []
+        for sign in (1, -1):
+            T2, Q2, x2 = Tgi.copy(), Q.copy(), x0.copy()
+            if which == 0:
+                T2[k] += sign * h
+            else:
+                Q2[k] += sign * h
+                if k == 0:
+                    x2[5] = Q2[0]  # the lag starts settled at the first setting
+            runs.append(_ta(t, Gg, T2, Q2, F, x2, p, zoh)[:, S_TA])
+        fd = (runs[0] - runs[1]) / (2 * h)
+        assert np.abs(dta[:, k] - fd).max() <= 1e-5 * max(np.abs(fd).max(), 1e-9), k
+        reach = k if zoh or k == 0 else k - 1
+        assert np.all(dta[: reach + 1, k] == 0.0)  # causality: nothing before the knot's interval
+    for c, (which_extra, h) in enumerate((("Gg", 1e-4), ("Tm0", 0.5))):
+        runs = []
+        for sign in (1, -1):
+            g2, x2 = Gg.copy(), x0.copy()
+            if which_extra == "Gg":
+                g2 += sign * h
+            else:
+                x2[1] += sign * h
+            runs.append(_ta(t, g2, Tgi, Q, F, x2, p, zoh)[:, S_TA])
+        fd = (runs[0] - runs[1]) / (2 * h)
+        assert np.abs(dta[:, n + c] - fd).max() <= 1e-5 * np.abs(fd).max(), which_extra
+
+
+def test_identification_jacobian_matches_central_differences():
+    """The identification objective's exact Jacobian (theta, the moisture at charge through the
+    dry mass, and a per-batch drum temperature) against small central differences."""
+    from roastlab.fit.identify import Objective
+    from roastlab.io.batch import read_dataset
+    from roastlab.model.parameters import THETA_START, FreeParameter
+    from roastlab.sim.population import pack_batches
+    from roastlab.workflows.reproduce import default_dataset_root
+
+    ds = read_dataset(default_dataset_root() / "dataset-I")
+    packed = pack_batches(ds.batches[:3], ds.plant, THETA_START)
+    free = [
+        FreeParameter("hgm", 0.001, 0.1, 0.02),
+        FreeParameter("hbm", 0.001, 0.1, 0.03),
+        FreeParameter("Pbm", 0.1, 0.9, 0.5),
+        FreeParameter("X0", 0.05, 0.15, 0.1),
+        FreeParameter("Tm0_C", 100.0, 300.0, 190.0, per_batch=True),
+    ]
+    obj = Objective(packed, free, {})
+    z = obj.start.copy()
+    J = obj.jacobian(z)
+    for k in range(z.size):
+        h = 1e-5 * (obj.upper[k] - obj.lower[k])
+        zp, zm = z.copy(), z.copy()
+        zp[k] += h
+        zm[k] -= h
+        fd = (obj.residuals(zp) - obj.residuals(zm)) / (2 * h)
+        assert np.abs(J[:, k] - fd).max() <= 1e-4 * np.abs(fd).max() + 1e-9, k
+    # the finite-difference reference (its step is 1e-3 of the range) agrees to its truncation error
+    assert np.abs(J - obj.jacobian_fd(z)).max() <= 0.05 * np.abs(J).max()
+
+
+def test_program_optimiser_exact_and_fd_agree():
+    """Profile transfer's optimiser reaches the same program with exact sensitivities as with the
+    finite-difference reference, with fewer simulations."""
+    from roastlab.fit.program import ProgramLimits, optimise_program
+
+    t, Gg, Tgi, Q, F, x0, p, _ = _case(False)
+    target = _ta(t, Gg, Tgi + 15.0 * np.cos(t / 100.0), Q, F, x0, p, False)[:, S_TA]
+    limits = ProgramLimits(low=150.0, high=550.0, rate_per_min=60.0)
+    res = {
+        s: optimise_program(t, target, x0, p, Gg, Tgi, limits, sensitivities=s, max_iterations=60)
+        for s in ("exact", "fd")
+    }
+    for r in res.values():
+        assert np.sqrt(np.mean((r.Ta_pred_C - target) ** 2)) < 0.1
+    assert np.abs(res["exact"].Tgi_C - res["fd"].Tgi_C).max() < 1.0
+    assert res["exact"].simulations < res["fd"].simulations
