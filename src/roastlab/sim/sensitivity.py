@@ -28,6 +28,7 @@ The restart takes fresh adaptive steps, so a column carries the integrator's loc
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -295,17 +296,10 @@ def sens_population_kernel(
         )  # fmt: skip
 
 
-def program_sensitivity(t, Gg, Tgi, Q, F, x0, p, zoh, which, extras=(), h_max=H_MAX_S):
-    """States and the exact d Ta / d z of a run whose decided input is a program on the samples.
-
-    ``which`` 0: z's first n entries are the inlet temperature Tgi at each sample [degC]; 1: the
-    heater setting (whose lag state starts at the first setting, x0[H] = u_0, as the simulator
-    does). ``extras`` name further directions after the knots: ``"Gg"`` (a constant gas flow
-    [kg/s] on every sample) and ``"Tm0"`` (the drum's start temperature [degC]).
-    Returns (states (n, NS), dTa (n, n + len(extras))).
-    """
-    t = np.ascontiguousarray(t, dtype=np.float64)
-    n = t.shape[0]
+@functools.lru_cache(maxsize=64)
+def _program_directions(n: int, which: int, extras: tuple, zoh: bool):
+    """The fixed arrays of :func:`program_sensitivity` for a program's shape (cached: a receding
+    horizon asks for the same shape at every step)."""
     e = len(extras)
     m = n + e
     S0 = np.zeros((NS, m))
@@ -329,14 +323,37 @@ def program_sensitivity(t, Gg, Tgi, Q, F, x0, p, zoh, which, extras=(), h_max=H_
     du_c = np.array([b for _, b, _ in flat], dtype=np.int64)
     du_v = np.array([v for _, _, v in flat], dtype=np.float64)
     ncol = e + np.minimum(np.arange(n, dtype=np.int64) + (1 if zoh else 2), n)
+    for a in (S0, du_ptr, du_j, du_c, du_v, ncol):
+        a.setflags(write=False)
+    return S0, ncol, du_ptr, du_j, du_c, du_v
+
+
+_NO_INT = np.zeros(0, dtype=np.int64)
+_NO_FLOAT = np.zeros(0)
+_ROW_TA = np.array([S_TA], dtype=np.int64)
+
+
+def program_sensitivity(t, Gg, Tgi, Q, F, x0, p, zoh, which, extras=(), h_max=H_MAX_S):
+    """States and the exact d Ta / d z of a run whose decided input is a program on the samples.
+
+    ``which`` 0: z's first n entries are the inlet temperature Tgi at each sample [degC]; 1: the
+    heater setting (whose lag state starts at the first setting, x0[H] = u_0, as the simulator
+    does). ``extras`` name further directions after the knots: ``"Gg"`` (a constant gas flow
+    [kg/s] on every sample) and ``"Tm0"`` (the drum's start temperature [degC]).
+    Returns (states (n, NS), dTa (n, n + len(extras))).
+    """
+    t = np.ascontiguousarray(t, dtype=np.float64)
+    n = t.shape[0]
+    e = len(extras)
+    S0, ncol, du_ptr, du_j, du_c, du_v = _program_directions(n, int(which), tuple(extras), bool(zoh))
     out = np.empty((n, NS))
-    outS = np.empty((n, 1, m))
-    none = np.zeros(0, dtype=np.int64)
+    outS = np.empty((n, 1, n + e))
     integrate_sens_into(
         t, np.ascontiguousarray(Gg, dtype=np.float64), np.ascontiguousarray(Tgi, dtype=np.float64),
         np.ascontiguousarray(Q, dtype=np.float64), np.ascontiguousarray(F, dtype=np.float64), n,
         np.ascontiguousarray(x0, dtype=np.float64), p, zoh, h_max, S0, ncol, du_ptr, du_j, du_c, du_v,
-        none, none, np.zeros(0), np.array([S_TA], dtype=np.int64), out, outS,
+        _NO_INT, _NO_INT, _NO_FLOAT, _ROW_TA, out, outS,
     )  # fmt: skip
-    dta = np.concatenate([outS[:, 0, e:], outS[:, 0, :e]], axis=1)
-    return out, dta
+    if e == 0:
+        return out, outS[:, 0, :]
+    return out, np.concatenate([outS[:, 0, e:], outS[:, 0, :e]], axis=1)
