@@ -78,8 +78,9 @@ TARGETS = {
     "mpc_over_pid_disturbed": ("<=", 0.5),
     "gym_steps_per_s": (">=", 20_000.0),
     "gym_vector_steps_per_s": (">=", 1_000_000.0),
-    "fleet_end_to_end_s": ("<=", 900.0),
-    "fleet_peak_memory_MB": ("<=", 2048.0),
+    "fleet_end_to_end_s": ("<=", 360.0),
+    "fleet_peak_memory_MB": ("<=", 1024.0),
+    "fleet_memory_growth": ("<=", 1.2),
     "fleet_dask_overhead": ("<=", 0.15),
     "fleet_cost_per_batch_ratio": ("<=", 1.25),
     "fleet_worst_detection_delay": ("<=", 15.0),
@@ -286,6 +287,62 @@ def control_bench(quiet: bool = False, horizon_s: float = 300.0, sample_s: float
     return out
 
 
+def sensitivity_bench(quiet: bool = False, repeats: int = 7) -> dict:
+    """Exact forward sensitivities against the finite-difference reference on the same problems
+    (issue 26): the probe's Jacobian in a 181-knot inlet program (15 min, 5-s knots, the 120 kg
+    plant) and the identification objective's Jacobian on dataset-I (theta and a drum
+    temperature per batch). One thread and all cores, medians of ``repeats`` repetitions."""
+    from roastlab.fit.identify import Objective, build_free_parameters
+    from roastlab.io.batch import read_dataset
+    from roastlab.model.parameters import THETA_START
+    from roastlab.model.plant import as_plant
+    from roastlab.model.rhs import pack_params
+    from roastlab.sim.kernels import H_MAX_S, N_OUT, integrate_into
+    from roastlab.sim.population import pack_batches
+    from roastlab.sim.sensitivity import program_sensitivity, ta_input_jacobian
+    from roastlab.workflows.reproduce import default_dataset_root
+
+    _log("sensitivities: exact against finite differences (one thread, all cores) ...", quiet)
+    p = pack_params(as_plant("120kg"), THETA_START)
+    t = np.arange(0.0, 901.0, 5.0)
+    n = t.size
+    Gg, Q, F = np.full(n, 0.4), np.zeros(n), np.zeros(n)
+    Tgi = 400.0 + 50.0 * np.sin(t / 200.0)  # SYNTHETIC program
+    x0 = np.array([25.0, 180.0, 0.1, 0.0, 25.0, 0.0])
+    base = np.empty((n, N_OUT))
+    integrate_into(t, Gg, Tgi, Q, F, n, x0, p, False, H_MAX_S, base)
+    states, ta = np.ascontiguousarray(base[:, :6]), np.ascontiguousarray(base[:, 4])
+    jac = np.empty((n, n))
+
+    def exact():
+        return program_sensitivity(t, Gg, Tgi, Q, F, x0, p, False, 0)
+
+    def fd():
+        ta_input_jacobian(t, Gg, Tgi, Q, F, 0, states, ta, p, False, H_MAX_S, 1.0, jac)
+
+    exact(), fd()  # compile
+    ds = read_dataset(default_dataset_root() / "dataset-I")
+    free, fixed = build_free_parameters(estimate_tm0=True)
+    obj = Objective(pack_batches(ds.batches, ds.plant, THETA_START), free, fixed)
+    z = obj.start.copy()
+    obj.jacobian(z), obj.jacobian_fd(z)
+    out = {"program_knots": n, "identify_columns": int(z.size)}
+    for label, threads in (("1_thread", 1), ("all_cores", None)):
+        with numba_threads(threads):
+            a, b = _times(exact, repeats), _times(fd, repeats)
+            c, d = _times(lambda: obj.jacobian(z), repeats), _times(lambda: obj.jacobian_fd(z), repeats)
+        out[f"program_exact_ms_{label}"] = _spread(a, 1e3)
+        out[f"program_fd_ms_{label}"] = _spread(b, 1e3)
+        out[f"program_speedup_{label}"] = float(np.median(b) / np.median(a))
+        out[f"identify_exact_ms_{label}"] = _spread(c, 1e3)
+        out[f"identify_fd_ms_{label}"] = _spread(d, 1e3)
+        out[f"identify_speedup_{label}"] = float(np.median(d) / np.median(c))
+    _, dta = exact()
+    fd()
+    out["program_max_abs_diff"] = float(np.abs(dta - jac).max())  # forward differences' own error, ~1e-6
+    return out
+
+
 def _times(fn, repeats: int) -> np.ndarray:
     times = []
     for _ in range(repeats):
@@ -387,6 +444,11 @@ def run(quiet: bool = False, baseline_repeats: int = 5, only: str | None = None)
             res["transfer"] = transfer_bench(quiet)
         _load("end", res)
         res["checks"] = check_targets(res)
+        return res
+    if only == "sensitivity":
+        _load("start", res)
+        res["sensitivity"] = sensitivity_bench(quiet)
+        _load("end", res)
         return res
     if only == "control":
         _load("start", res)
@@ -531,6 +593,8 @@ def run(quiet: bool = False, baseline_repeats: int = 5, only: str | None = None)
     _log("profile transfer (one thread) ...", quiet)
     with numba_threads(1):
         res["transfer"] = transfer_bench(quiet)
+    _load("sensitivity", res)
+    res["sensitivity"] = sensitivity_bench(quiet)
     _load("control", res)
     res["control"] = control_bench(quiet)
     _load("end", res)
@@ -582,6 +646,7 @@ def check_targets(res: dict) -> dict:
             {
                 "fleet_end_to_end_s": f["end_to_end_s"],
                 "fleet_peak_memory_MB": f["peak_memory_MB"],
+                "fleet_memory_growth": f["memory_growth"],
                 "fleet_dask_overhead": f["dask_overhead"],
                 "fleet_cost_per_batch_ratio": f["cost_per_batch_ratio"],
                 "fleet_worst_detection_delay": f["worst_detection_delay"],
@@ -662,6 +727,21 @@ def table(res: dict) -> str:
                 f"MPC at most {c['mpc_over_pid_bumpless_disturbed']:.2f}x its RMSE under disturbance",
             )
         )
+    if "sensitivity" in res:
+        sb = res["sensitivity"]
+        for what, name in (
+            ("program", f"{sb['program_knots']}-knot program"),
+            ("identify", f"identification, {sb['identify_columns']} columns"),
+        ):
+            rows.append(
+                (
+                    f"Jacobian of a {name}" if what == "program" else f"Jacobian of {name}",
+                    f"{sb[f'{what}_speedup_1_thread']:.1f}x",
+                    f"exact {sb[f'{what}_exact_ms_1_thread']['median']:.2f} ms vs differences "
+                    f"{sb[f'{what}_fd_ms_1_thread']['median']:.2f} ms, one thread; all cores "
+                    f"{sb[f'{what}_speedup_all_cores']:.1f}x",
+                )
+            )
     if "fleet" in res:
         f = res["fleet"]
         rows.append(
@@ -670,6 +750,14 @@ def table(res: dict) -> str:
                 f"{f['end_to_end_s']:.0f} s",
                 f"ingest {f['ingest_s']:.0f} s + fit {f['fit_s']:.0f} s ({f['fit_ms_per_batch']:.2f} ms/batch, "
                 f"{f['cost_per_batch_ratio']:.2f}x the cost per batch at {f['dask_batches']:,}); peak {f['peak_memory_MB']:.0f} MB",
+            )
+        )
+        rows.append(
+            (
+                f"fleet peak memory, {f['batches']:,} over {f['dask_batches']:,}",
+                f"{f['memory_growth']:.2f}x",
+                f"{f['peak_memory_MB']:.0f} vs {f['peak_memory_MB_small']:.0f} MB (ingest + fit in a fresh process); "
+                f"Dask workers at {f['dask_batches']:,}: {f['dask_worker_peak_MB'] or float('nan'):.0f} MB each at most",
             )
         )
         rows.append(
@@ -718,6 +806,26 @@ print(json.dumps({"ingest_s": t1 - t0, "fit_s": t2 - t1, "added": r.added, "fitt
 """
 
 
+def _peak_rss_MB() -> float:
+    import resource
+
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
+def _fleet_client(workers: int):
+    from roastlab.fleet.fitting import _client
+
+    return _client(workers, None)
+
+
+def _fleet_child(db: Path, manifest: Path) -> dict:
+    """Ingest and fit a manifest end to end in a fresh process; its times and peak RSS."""
+    out = subprocess.run(
+        [sys.executable, "-c", _FLEET_CHILD, str(db), str(manifest)], check=True, capture_output=True, text=True
+    )
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
 def _fleet_detection(db, truth: dict) -> dict:
     """Delays of the injected changes' alarms and alarms where nothing was injected."""
     from roastlab.fleet import fleet_report
@@ -755,19 +863,15 @@ def fleet_bench(quiet: bool, n_batches: int = 100_000, n_dask: int = 10_000) -> 
         truth = make_fleet(tmp / "big", n_batches)
         _log("fleet: ingest + fit end to end (child process) ...", quiet)
         t0 = time.perf_counter()
-        out = subprocess.run(
-            [sys.executable, "-c", _FLEET_CHILD, str(tmp / "big.duckdb"), str(tmp / "big" / "manifest.csv")],
-            check=True,
-            capture_output=True,
-            text=True,
-        )
+        big = _fleet_child(tmp / "big.duckdb", tmp / "big" / "manifest.csv")
         wall = time.perf_counter() - t0
-        big = json.loads(out.stdout.strip().splitlines()[-1])
         detection = _fleet_detection(tmp / "big.duckdb", truth)
         shutil.rmtree(tmp / "big")
 
         _log(f"fleet: Dask (2 workers) vs in-process on {n_dask:,} batches ...", quiet)
         make_fleet(tmp / "small", n_dask, seed=15)
+        # the same end-to-end run at a tenth of the size, for how memory grows with the fleet
+        small = _fleet_child(tmp / "small-peak.duckdb", tmp / "small" / "manifest.csv")
         ingest(tmp / "small.duckdb", tmp / "small" / "manifest.csv")
 
         def clear():
@@ -776,11 +880,20 @@ def fleet_bench(quiet: bool, n_batches: int = 100_000, n_dask: int = 10_000) -> 
             con.close()
 
         walls = {"in-process": [], "dask": []}
+        worker_peaks = []
         for _ in range(2):  # alternate, so drift of the machine's speed hits both alike
             clear()
             walls["in-process"].append(fit_fleet(tmp / "small.duckdb").wall_s)
             clear()
-            walls["dask"].append(fit_fleet(tmp / "small.duckdb", workers=2).wall_s)
+            t_start = time.perf_counter()  # the cluster's start is part of the Dask path's cost
+            client, cluster = _fleet_client(2)
+            try:
+                fit_fleet(tmp / "small.duckdb", client=client)
+                walls["dask"].append(time.perf_counter() - t_start)
+                worker_peaks.append(list(client.run(_peak_rss_MB).values()))
+            finally:
+                client.close()
+                cluster.close()
         t_in, t_dask = min(walls["in-process"]), min(walls["dask"])
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
@@ -792,6 +905,9 @@ def fleet_bench(quiet: bool, n_batches: int = 100_000, n_dask: int = 10_000) -> 
         "fit_s": round(big["fit_s"], 1),
         "end_to_end_s": round(wall, 1),
         "peak_memory_MB": round(big["peak_MB"], 1),
+        "peak_memory_MB_small": round(small["peak_MB"], 1),
+        "memory_growth": round(big["peak_MB"] / small["peak_MB"], 3),
+        "dask_worker_peak_MB": max((max(p) for p in worker_peaks if p), default=None),
         "fit_ms_per_batch": round(1e3 * per_big, 3),
         "cost_per_batch_ratio": round(per_big / per_small, 3),
         "dask_batches": n_dask,

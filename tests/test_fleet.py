@@ -71,15 +71,19 @@ def test_ingest_stores_every_sample_and_reingest_is_a_no_op(fleet):
     assert _counts(db) == before
 
 
-def test_a_failed_ingest_leaves_the_store_as_it_was(fleet, tmp_path, monkeypatch):
+def test_a_failed_ingest_keeps_its_committed_chunks_and_a_rerun_completes_it(fleet, tmp_path, monkeypatch):
+    """Ingest commits chunk by chunk (memory flat in the manifest's length, issue 26): a failure
+    after two chunks keeps exactly those, and running the same manifest again leaves the store as
+    one uninterrupted ingest does."""
     import roastlab.fleet.store as store
 
     d, db, _ = fleet
-    copy = tmp_path / "copy.duckdb"
+    copy, whole = tmp_path / "copy.duckdb", tmp_path / "whole.duckdb"
     copy.write_bytes(db.read_bytes())
+    whole.write_bytes(db.read_bytes())
     before = _counts(copy)
-    # a second machine's worth of new files, and a failure after the first chunk was appended
     make_fleet(tmp_path / "more", 50, seed=99)
+    manifest = tmp_path / "more" / "manifest.csv"
     monkeypatch.setattr(store, "INGEST_CHUNK", 10)
     real_flush = store._flush
     calls = {"n": 0}
@@ -92,9 +96,15 @@ def test_a_failed_ingest_leaves_the_store_as_it_was(fleet, tmp_path, monkeypatch
 
     monkeypatch.setattr(store, "_flush", failing_flush)
     with pytest.raises(RuntimeError):
-        ingest(copy, tmp_path / "more" / "manifest.csv")
-    assert calls["n"] == 3  # two chunks went into the transaction before it failed
-    assert _counts(copy) == before
+        ingest(copy, manifest)
+    assert calls["n"] == 3
+    partial = _counts(copy)
+    assert partial["batches"] == before["batches"] + 20  # the two committed chunks of 10 batches, no more
+    monkeypatch.setattr(store, "_flush", real_flush)
+    rep = ingest(copy, manifest)
+    assert rep.already == 20 and rep.added == 30
+    ingest(whole, manifest)
+    assert _counts(copy) == _counts(whole)
 
 
 def test_bad_manifest_rows_are_reported_one_line_each_and_good_rows_ingest(cli, tmp_path):

@@ -134,7 +134,8 @@ def add_parsers(sub) -> None:
     q = fsub.add_parser(
         "ingest",
         help="read the logs a manifest lists into the store",
-        description="Read every log a manifest lists into the store, in one transaction. A row that cannot be "
+        description="Read every log a manifest lists into the store, committed 2,000 batches at a time (an "
+        "interrupted ingest keeps what it committed; running it again adds the rest). A row that cannot be "
         "ingested (missing file, unknown plant, bad date, unreadable log) is reported on one line with its line "
         "number and the others still ingest (exit code 2 if any row was rejected). A file already in the store "
         "(same SHA-256) is skipped, so ingesting again is a no-op.",

@@ -14,6 +14,7 @@ place only when every one was produced. A failure at any point leaves nothing be
 
 from __future__ import annotations
 
+import collections
 import hashlib
 import math
 import os
@@ -33,7 +34,10 @@ CONFIG_MAX_BYTES = 1024 * 1024
 
 _READ: dict[tuple[int, int], str] = {}  # (device, inode) -> path of every input read in this run
 _RUN = {"active": False}
-_DIGESTS: dict[str, str] = {}  # path as given -> SHA-256 of the bytes read (model-file provenance)
+_DIGESTS: collections.OrderedDict[str, str] = collections.OrderedDict()  # path -> SHA-256 (provenance)
+#: Most input digests kept for model-file provenance (the latest reads): a long-running process
+#: that reads a fleet's logs must not grow with them (a fit reads far fewer).
+MAX_DIGESTS = 16_384
 
 
 def input_digest(path: str | Path) -> str | None:
@@ -93,9 +97,13 @@ def read_input_bytes(path: str | Path, limit: int = MAX_INPUT_BYTES) -> bytes:
             total += len(chunk)
             if total > limit:
                 raise InputError(f"file grew over the {limit // (1024 * 1024)} MB limit while being read", path)
-        _READ[(st.st_dev, st.st_ino)] = str(path)
+        if _RUN["active"]:  # only a command's outputs are checked against its inputs
+            _READ[(st.st_dev, st.st_ino)] = str(path)
         data = b"".join(chunks)
         _DIGESTS[str(path)] = hashlib.sha256(data).hexdigest()
+        _DIGESTS.move_to_end(str(path))
+        if len(_DIGESTS) > MAX_DIGESTS:
+            _DIGESTS.popitem(last=False)
         return data
     except OSError as exc:
         raise InputError(f"cannot read ({exc.strerror})", path) from None
