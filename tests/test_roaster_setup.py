@@ -202,9 +202,10 @@ def _synthetic_gas_drum_logs(folder: Path, n_logs: int = 6, seed: int = 11) -> l
     truth.doc["map"] = cmap.to_mapping()
     truth = FittedModel(truth.doc)
     for p, events in zip(paths, layouts):
-        sim = truth.predict(roastlab.load_log(p, cmap))
-        bt = sim.Ta_C + rng.normal(0.0, 0.3, n)
-        p.write_text(fake_alog("C", bt.tolist(), sim.Tm_C.tolist(), n, {**extra, **events, "timex": t}))
+        sim = truth.predict(roastlab.load_log(p, cmap))  # on the map's resampled grid
+        bt = np.interp(t, sim.time_s, sim.Ta_C) + rng.normal(0.0, 0.3, n)
+        et = np.interp(t, sim.time_s, sim.Tm_C)
+        p.write_text(fake_alog("C", bt.tolist(), et.tolist(), n, {**extra, **events, "timex": t}))
     shutil.rmtree(cfg)
     return paths
 

@@ -64,7 +64,7 @@ MANIFEST_COLUMNS = ("path", "machine", "plant", "started_at")
 SERIES_COLUMNS = ("time_s", "Gg_kg_s", "Tgi_C", "Ta_C", "heater", "fan", "Tb2_C")
 #: DuckDB's memory limit for the store's connection (its buffer pool fills up to it as a store
 #: grows, so it bounds how the process grows with the fleet; a chunk of batches needs far less).
-DUCKDB_MEMORY = "128MB"
+DUCKDB_MEMORY = "64MB"
 #: Batches written to DuckDB per append (bounded memory, whatever the manifest's length).
 INGEST_CHUNK = 2000
 
