@@ -200,6 +200,7 @@ def plot_fit(result, path=None, title=None, max_panels: int = 8, outputs=None, b
         if bands is not None:
             _shade_band(ax, bands[i], "tab:green", "prediction band")
             ax.legend(fontsize=8)
+        _ror_overlay(ax, result.time_s[i], result.measured[i], result.predicted[i])
         t = result.time_s[i] / 60.0
         res.plot(t, result.measured[i] - result.predicted[i], color="tab:purple", lw=1, label="Ta meas − pred")
         second = result.results[i].Tb2_measured_C if i < len(result.results) else None
@@ -217,6 +218,20 @@ def plot_fit(result, path=None, title=None, max_panels: int = 8, outputs=None, b
     if len(result.names) > k:
         title = f"{title or ''} (first {k} of {len(result.names)} batches)".strip()
     return finish_figure(fig, path, title, outputs)
+
+
+def _ror_overlay(ax, time_s, measured, predicted) -> None:
+    """Measured and predicted rate of rise [degC/min] on a right-hand axis of a BT panel, as
+    Artisan draws it (the one RoR definition; the axis clipped past the charge drop)."""
+    ror = ax.twinx()
+    t = np.asarray(time_s, dtype=float)
+    ror.plot(t / 60.0, rate_of_rise_C_per_min(t, predicted), color="tab:blue", lw=1.0, alpha=0.8,
+             label="RoR predicted")  # fmt: skip
+    ror.plot(t / 60.0, rate_of_rise_C_per_min(t, measured), ":", color="tab:blue", lw=1.2, label="RoR measured")
+    ror_limits(ror, t, measured, predicted)
+    ror.set_ylabel("RoR [°C/min]", color="tab:blue", fontsize=8)
+    ror.tick_params(axis="y", labelcolor="tab:blue", labelsize=8)
+    ror.legend(fontsize=7, loc="lower right")
 
 
 def _profile_panel(ax, result, i, label=None):

@@ -467,7 +467,13 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0) -> dict:
         lines.append(f"| {name} | {value or how} | {se or ('on a bound' if how == 'fitted' else '-')} | {unit} |")
     lines += ["", "What the fit says in plain words:", ""]
     lines += [f"- {w}" for w in result.warnings] or ["- no warnings"]
-    lines += ["", "Held-out logs, measured and predicted BT:", "", "![held out](heldout.png)", ""]
+    lines += [
+        "",
+        "Held-out logs, measured and predicted BT, and their rate of rise (right axis):",
+        "",
+        "![held out](heldout.png)",
+        "",
+    ]
     lines += ["| held-out log | FIT % | MAE °C |", "|---|---|---|"]
     lines += [f"| {n} | {r['FIT']:.1f} | {r['MAE']:.2f} |" for n, r in zip(v_val.names, v_val.rows)]
     from ..report.figures import figure_bytes
