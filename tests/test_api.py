@@ -128,7 +128,7 @@ def test_results_display_and_plot_without_pyplot():
     fig = result.plot()
     sim_fig = result.model.predict(ds.batches[0]).plot()
     assert plt.get_fignums() == before  # not registered: Jupyter shows it once
-    assert len(fig.axes) == 4 and len(sim_fig.axes) == 4
+    assert len(fig.axes) == 6 and len(sim_fig.axes) == 4  # per batch: BT with its RoR axis, residual
     frame = result.validation.to_frame()
     assert list(frame.index) == ["batch1", "batch2"] and "FIT" in frame
 

@@ -260,9 +260,14 @@ CASES = {
         "free.warp: unknown parameter",
     ),
     "fit spec weights an unknown output": (
+        lambda d: _spec(d, "[free]\nhgm = [0.001, 1, 0.02]\n[weights]\nBT2 = 1.0\n"),
+        "fit.toml",
+        "weights.BT2: unknown output (allowed: Ta, Tb2, ET)",
+    ),
+    "fit spec weights ET on logs without ET": (
         lambda d: _spec(d, "[free]\nhgm = [0.001, 1, 0.02]\n[weights]\nET = 1.0\n"),
         "fit.toml",
-        "weights.ET: unknown output (allowed: Ta, Tb2)",
+        "the ET output has a weight but no batch has an ET reading",
     ),
     "fit spec with a negative weight": (
         lambda d: _spec(d, "[free]\nhgm = [0.001, 1, 0.02]\n[weights]\nTb2 = -1\n"),

@@ -179,12 +179,12 @@ def test_identification_that_cannot_simulate_is_an_error(monkeypatch, fail_when)
     real = ident.predict_outputs
     calls = {"n": 0}
 
-    def diverging(packed_, names, values, with_tb=True):
+    def diverging(packed_, names, values, with_tb=True, with_tgo=False):
         calls["n"] += 1
-        ta, tb = real(packed_, names, values, with_tb)
+        out = real(packed_, names, values, with_tb, with_tgo)
         if fail_when == "always" or calls["n"] > 1:
-            ta[:] = np.nan
-        return ta, tb
+            out[0][:] = np.nan
+        return out
 
     monkeypatch.setattr(ident, "predict_outputs", diverging)
     needle = "at the starting values" if fail_when == "always" else "every batch can be simulated"
@@ -242,3 +242,29 @@ def test_validation_scores_the_second_output_against_tb():
     assert js["Tb2"]["average"]["n"] == sum(int(np.isfinite(b.Tb2_C).sum()) for b in batches)
     assert js["Ta"]["average"] == v.average
     assert "second output Tb2" in v.table()
+
+
+def test_et_output_fits_the_outlet_gas_and_is_refused_without_an_et_reading():
+    """The ET output compares the logged ET with the model's outlet gas Tgo (eq. 15e): batches
+    whose probe is the model's at hbm 0.02 and whose ET is its Tgo at hbm 0.04 are fitted to each
+    channel by the weights; no ET reading and an ET weight is one clear error."""
+    from roastlab.errors import ParameterError
+    from roastlab.sim.kernels import I_TGO
+    from roastlab.sim.population import simulate_population
+
+    batches = noise_free_batches(9, "120kg", (THETA_START.hgm, 0.02, THETA_START.Pbm), count=3)
+    packed = pack_batches(batches, "120kg", (THETA_START.hgm, 0.04, THETA_START.Pbm), InitialState(Ta0_C=30.0))
+    tgo = simulate_population(packed)[0, :, :, I_TGO]
+    free, fixed = build_free_parameters({"hgm": THETA_START.hgm, "Pbm": THETA_START.Pbm})
+    with pytest.raises(ParameterError, match="no batch has an ET reading"):
+        identify(
+            pack_batches(batches, "120kg", THETA_START, InitialState(Ta0_C=30.0)), free, fixed, weights={"ET": 1.0}
+        )
+    for i, b in enumerate(batches):
+        b.ET_C = tgo[i, : b.n].copy()
+    packed = pack_batches(batches, "120kg", THETA_START, InitialState(Ta0_C=30.0))
+    probe = identify(packed, free, fixed, seed=0, n_starts=2)
+    et = identify(packed, free, fixed, seed=0, n_starts=2, weights={"Ta": 0.0, "ET": 1.0})
+    assert probe.values["hbm"] == pytest.approx(0.02, rel=1e-4)
+    assert et.values["hbm"] == pytest.approx(0.04, rel=1e-4)
+    assert et.outputs["ET"]["n"] == sum(b.n for b in batches) and et.outputs["ET"]["SSR"] < 1e-6

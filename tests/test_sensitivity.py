@@ -257,3 +257,29 @@ def test_program_optimiser_exact_and_fd_agree():
         assert np.sqrt(np.mean((r.Ta_pred_C - target) ** 2)) < 0.1
     assert np.abs(res["exact"].Tgi_C - res["fd"].Tgi_C).max() < 1.0
     assert res["exact"].simulations < res["fd"].simulations
+
+
+def test_outlet_gas_sensitivities_match_central_differences():
+    """ET fitted against the outlet gas Tgo: its exact derivative (the generated outlet Jacobian
+    applied to the state sensitivities) against central differences of the simulated Tgo."""
+    from roastlab.model.parameters import THETA_START
+    from roastlab.sim.population import output_sensitivities, pack_batches, predict_outputs
+
+    t, Gg, Tgi, Q, F, x0, p, _ = _case(True, heater=True)
+    from roastlab.io.batch import Batch
+
+    batch = Batch("synthetic", t, Gg, Tgi, heater=Q)
+    packed = pack_batches([batch], "120kg", THETA_START, hold="zoh")
+    names = ["hgm", "hbm", "Tm0_C"]
+    values = np.array([[0.02, 0.03, 190.0]])
+    res = output_sensitivities(packed, names, values, [(0, -1), (1, -1), (2, -1)], with_tgo=True)
+    g, dg = res["Tgo"]
+    _, _, tgo = predict_outputs(packed, names, values[None], with_tb=False, with_tgo=True)
+    np.testing.assert_allclose(g[0], tgo[0, 0], atol=1e-9)
+    for c, h in enumerate((1e-5, 1e-5, 0.01)):
+        vp, vm = values.copy(), values.copy()
+        vp[0, c] += h
+        vm[0, c] -= h
+        fd = (predict_outputs(packed, names, vp[None], False, True)[2][0, 0]
+              - predict_outputs(packed, names, vm[None], False, True)[2][0, 0]) / (2 * h)  # fmt: skip
+        assert np.abs(dg[0, :, c] - fd).max() <= 1e-4 * np.abs(fd).max(), c

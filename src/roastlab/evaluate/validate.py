@@ -160,4 +160,12 @@ def score(results, plant_name: str) -> ValidationResult:
             "names": [n for n, _, _ in scored],
             "rows": [batch_metrics(y, tb) for _, y, tb in scored],
         }
+    et = [(r.name, r.ET_measured_C, r.Tgo_C) for r in results if getattr(r, "ET_measured_C", None) is not None]
+    scored = [(n, y[ok], g[ok]) for n, y, g in et if (ok := np.isfinite(y)).sum() >= MIN_SECOND_OUTPUT_SAMPLES]
+    if scored:
+        out.outputs["ET"] = {
+            "compared": "model outlet gas Tgo (eq. 15e) with the logged ET",
+            "names": [n for n, _, _ in scored],
+            "rows": [batch_metrics(y, g) for _, y, g in scored],
+        }
     return out

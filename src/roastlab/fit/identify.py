@@ -132,6 +132,13 @@ NO_SECOND_READING = (
 )
 
 
+#: Why a fit weighting ET cannot run on batches that lack it.
+NO_ET_READING = (
+    "the ET output has a weight but no batch has an ET reading: read the logs with a map that keeps ET "
+    "(Artisan's ET channel, or a map's [ET] column), or drop the weight"
+)
+
+
 def check_weights(weights: dict | None) -> dict[str, float]:
     """The output weights with defaults filled in; unknown names or bad values are refused."""
     out = dict(DEFAULT_WEIGHTS)
@@ -178,14 +185,15 @@ class Objective:
         self.start = np.array([free[j].start for j, _ in self.layout])
         self.weights = check_weights(weights)
         valid = packed.mask()
-        self.masks = {
-            "Ta": valid & np.isfinite(packed.TA) & (self.weights["Ta"] > 0),
-            "Tb2": valid & np.isfinite(packed.TB2) & (self.weights["Tb2"] > 0),
-        }
+        measured = {"Ta": packed.TA, "Tb2": packed.TB2, "ET": packed.ET}
+        self.masks = {k: valid & np.isfinite(measured[k]) & (self.weights[k] > 0) for k in OUTPUTS}
         if self.weights["Tb2"] > 0 and not self.masks["Tb2"].any():
             raise ParameterError(NO_SECOND_READING)
+        if self.weights["ET"] > 0 and not self.masks["ET"].any():
+            raise ParameterError(NO_ET_READING)
         self.with_tb = bool(self.masks["Tb2"].any())
-        self.measured = np.concatenate([packed.TA[self.masks["Ta"]], packed.TB2[self.masks["Tb2"]]])
+        self.with_tgo = bool(self.masks["ET"].any())
+        self.measured = np.concatenate([measured[k][self.masks[k]] for k in OUTPUTS])
         counts = {k: int(m.sum()) for k, m in self.masks.items()}
         self.sqrt_w = np.concatenate([np.full(counts[k], np.sqrt(self.weights[k])) for k in OUTPUTS])
         self.output_of_residual = np.repeat(np.arange(len(OUTPUTS)), [counts[k] for k in OUTPUTS])
@@ -198,11 +206,11 @@ class Objective:
 
     def _predicted(self, Z: np.ndarray) -> np.ndarray:
         """(m, n_residuals) model outputs at the measured samples, in the residuals' order."""
-        ta, tb = predict_outputs(self.packed, self.names, self.values_array(Z), with_tb=self.with_tb)
-        parts = [ta[:, self.masks["Ta"]]]
-        if self.with_tb:
-            parts.append(tb[:, self.masks["Tb2"]])
-        return np.concatenate(parts, axis=1)
+        out = predict_outputs(
+            self.packed, self.names, self.values_array(Z), with_tb=self.with_tb, with_tgo=self.with_tgo
+        )
+        model = dict(zip(OUTPUTS, out))  # Ta -> Ta, Tb2 -> the model's Tb, ET -> the outlet gas Tgo
+        return np.concatenate([model[k][:, self.masks[k]] for k in OUTPUTS if self.masks[k].any()], axis=1)
 
     def output_ssr(self, z: np.ndarray) -> dict:
         """Per fitted output: its weight, sample count and unweighted SSR [degC^2] at ``z``."""
@@ -258,10 +266,9 @@ class Objective:
         failed gets a zero row (its residual is the constant :data:`FAILED_RESIDUAL_C`)."""
         self.nfev += 1
         V = self.values_array(z[None, :])[0]
-        _, _, dta, dtb = output_sensitivities(self.packed, self.names, V, self.layout, with_tb=self.with_tb)
-        parts = [dta[self.masks["Ta"]]]
-        if self.with_tb:
-            parts.append(dtb[self.masks["Tb2"]])
+        res = output_sensitivities(self.packed, self.names, V, self.layout, with_tgo=self.with_tgo)
+        model = {"Ta": res["Ta"][1], "Tb2": res["Tb"][1], "ET": res.get("Tgo", (None, None))[1]}
+        parts = [model[k][self.masks[k]] for k in OUTPUTS if self.masks[k].any()]
         J = np.concatenate(parts, axis=0) * self.sqrt_w[:, None]
         return np.where(np.isfinite(J), J, 0.0)
 

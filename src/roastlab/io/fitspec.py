@@ -23,6 +23,7 @@ A fit spec is a TOML file::
     [weights]                   # optional: outputs fitted together (default Ta = 1 alone)
     Ta = 1.0                    # the bean probe, model Ta (eq. 16)
     Tb2 = 0.25                  # a second bean reading (map [Tb2]), model Tb (eq. 15a)
+    ET = 0.1                    # the logged ET (drum air), model outlet gas Tgo (eq. 15e)
 
 Names: the theta coefficients ``hgm, hbm, Pbm``, process constants ``A, cm, cw, Ha_R, Het,
 k1, k2, Kt, lam``, the metal mass ``Mm``, the gas flow ``Gg_kg_s``, and initial states

@@ -148,7 +148,11 @@ class FreeParameter:
 #: Outputs an identification can fit, each with the measured channel it is compared with.
 #: ``Ta``: the model's probe reading Ta (eq. 16) against the log's bean probe; ``Tb2``: the
 #: model's bean temperature Tb (eq. 15a) against a second bean reading of the log (e.g. an
-#: infrared bean-surface sensor, the map's ``[Tb2]``). Weights multiply each output's squared
-#: residuals in the objective; the default fits Ta alone, as the paper does (eq. 19).
-OUTPUTS = ("Ta", "Tb2")
-DEFAULT_WEIGHTS = {"Ta": 1.0, "Tb2": 0.0}
+#: infrared bean-surface sensor, the map's ``[Tb2]``); ``ET``: the model's outlet gas temperature
+#: Tgo (eq. 15e) against the log's ET. Why Tgo: an ET probe sits in the drum's air space, which
+#: eq. 15e treats as well mixed, so the air there is the gas that has passed the beans and the
+#: metal, at Tgo; the inlet temperature is an input, not a prediction, and the metal is not air.
+#: Weights multiply each output's squared residuals in the objective; the default fits Ta alone,
+#: as the paper does (eq. 19).
+OUTPUTS = ("Ta", "Tb2", "ET")
+DEFAULT_WEIGHTS = {"Ta": 1.0, "Tb2": 0.0, "ET": 0.0}

@@ -235,22 +235,27 @@ def simulate_population_kernel(T, GG, TGI, QQ, FF, N, batch_of, X0, PP, zoh, h_m
 
 
 @compiled(parallel=True)
-def ta_population_kernel(T, GG, TGI, QQ, FF, N, batch_of, X0, PP, zoh, h_max, out_ta, out_tb):
+def ta_population_kernel(T, GG, TGI, QQ, FF, N, batch_of, X0, PP, zoh, h_max, out_ta, out_tb, out_tgo):
     """Like :func:`simulate_population_kernel` but keeps only the fitted outputs: the probe
-    reading Ta, and the bean temperature Tb when ``out_tb`` has rows (a second bean reading is
-    fitted); pass an empty (0, 0) ``out_tb`` to keep Ta only."""
+    reading Ta, the bean temperature Tb when ``out_tb`` has rows (a second bean reading is
+    fitted) and the outlet gas Tgo when ``out_tgo`` has rows (ET is fitted); pass empty (0, 0)
+    arrays to keep Ta only."""
     nmax = T.shape[1]
     with_tb = out_tb.shape[0] > 0
+    with_tgo = out_tgo.shape[0] > 0
     for i in prange(batch_of.shape[0]):
         b = batch_of[i]
         scratch = np.empty((nmax, N_OUT))
         n = N[b]
-        integrate_into(T[b], GG[b], TGI[b], QQ[b], FF[b], n, X0[i], PP[i], zoh, h_max, scratch, H0_S, False)
+        integrate_into(T[b], GG[b], TGI[b], QQ[b], FF[b], n, X0[i], PP[i], zoh, h_max, scratch, H0_S, with_tgo)
         for j in range(n):
             out_ta[i, j] = scratch[j, 4]
         if with_tb:
             for j in range(n):
                 out_tb[i, j] = scratch[j, 0]
+        if with_tgo:
+            for j in range(n):
+                out_tgo[i, j] = scratch[j, I_TGO]
 
 
 @compiled

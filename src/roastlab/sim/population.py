@@ -36,6 +36,7 @@ class PackedBatches:
     fan settings (zeros without the actuator extension); N : (nb,) valid lengths;
     TA : (nb, nmax) measured Ta, NaN-padded (NaN everywhere if not measured);
     TB2 : (nb, nmax) a second bean reading compared with Tb, NaN where not measured;
+    ET : (nb, nmax) the roaster's ET as logged, compared with the outlet gas Tgo when fitted;
     x0 : (nb, 6) initial state vectors (X0 is the moisture everywhere else); PB : (nb, n_params) parameter vectors at the start theta;
     Mb : (nb,) green batch mass of each batch's plant [kg] (for Mbd when X0 varies).
     """
@@ -54,13 +55,15 @@ class PackedBatches:
     QQ: np.ndarray | None = None
     FF: np.ndarray | None = None
     TB2: np.ndarray | None = None
+    ET: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         for name in ("QQ", "FF"):
             if getattr(self, name) is None:
                 setattr(self, name, np.zeros_like(self.T))
-        if self.TB2 is None:
-            self.TB2 = np.full_like(self.T, np.nan)
+        for name in ("TB2", "ET"):
+            if getattr(self, name) is None:
+                setattr(self, name, np.full_like(self.T, np.nan))
 
     @property
     def inputs(self) -> tuple:
@@ -105,6 +108,7 @@ def pack_batches(
     QQ = np.zeros((nb, nmax))
     FF = np.zeros((nb, nmax))
     TB2 = np.full((nb, nmax), np.nan)
+    ET = np.full((nb, nmax), np.nan)
     X0 = np.zeros((nb, NS))
     N = np.zeros(nb, dtype=np.int64)
     PB = None
@@ -123,6 +127,8 @@ def pack_batches(
                 arr[i, :n], arr[i, n:] = series, series[-1]
         if b.Tb2_C is not None:
             TB2[i, :n] = b.Tb2_C
+        if getattr(b, "ET_C", None) is not None:
+            ET[i, :n] = b.ET_C
         fields = {**base.__dict__, **b.initial}
         state = InitialState(**fields)
         X0[i] = state.vector(None if b.Ta_C is None else float(b.Ta_C[0]), float(QQ[i, 0]))
@@ -134,7 +140,7 @@ def pack_batches(
         PB[i] = p
         Mb[i] = plant.Mb_kg
     return PackedBatches(
-        T, GG, TGI, N, TA, X0, PB, Mb, [b.name for b in batches], check_hold(hold), float(h_max_s), QQ, FF, TB2
+        T, GG, TGI, N, TA, X0, PB, Mb, [b.name for b in batches], check_hold(hold), float(h_max_s), QQ, FF, TB2, ET
     )
 
 
@@ -166,29 +172,32 @@ def predict_ta(packed: PackedBatches, names: list[str], values: np.ndarray) -> n
     return predict_outputs(packed, names, values, with_tb=False)[0]
 
 
-def predict_outputs(packed: PackedBatches, names: list[str], values: np.ndarray, with_tb: bool = True):
-    """Simulated probe reading Ta and (``with_tb``) bean temperature Tb for every (value set,
-    batch): two arrays of shape (m, nb, nmax), NaN-padded; Tb is None without ``with_tb``."""
+def predict_outputs(packed: PackedBatches, names: list[str], values: np.ndarray, with_tb: bool = True, with_tgo=False):
+    """Simulated probe reading Ta, (``with_tb``) bean temperature Tb and (``with_tgo``) outlet gas
+    Tgo for every (value set, batch): arrays of shape (m, nb, nmax), NaN-padded; Tb and Tgo are
+    None when not asked for. Returns (ta, tb) or, with ``with_tgo``, (ta, tb, tgo)."""
     m, nb = values.shape[0], packed.n_batches
     batch_of, X0, PP = run_arrays(packed, names, values)
     ta = np.full((m * nb, packed.T.shape[1]), np.nan)
     tb = np.full_like(ta, np.nan) if with_tb else np.empty((0, 0))
-    ta_population_kernel(*packed.inputs, batch_of, X0, PP, packed.zoh, packed.h_max_s, ta, tb)
-    return ta.reshape(m, nb, -1), (tb.reshape(m, nb, -1) if with_tb else None)
+    tgo = np.full_like(ta, np.nan) if with_tgo else np.empty((0, 0))
+    ta_population_kernel(*packed.inputs, batch_of, X0, PP, packed.zoh, packed.h_max_s, ta, tb, tgo)
+    out = (ta.reshape(m, nb, -1), (tb.reshape(m, nb, -1) if with_tb else None))
+    return (*out, tgo.reshape(m, nb, -1)) if with_tgo else out
 
 
-def output_sensitivities(packed: PackedBatches, names: list[str], values: np.ndarray, directions, with_tb: bool = True):
-    """The probe reading Ta, the bean temperature Tb and their exact derivatives with respect to
-    ``directions``, for one value set over every batch (forward sensitivities,
+def output_sensitivities(packed: PackedBatches, names: list[str], values: np.ndarray, directions, with_tgo=False):
+    """The fitted outputs and their exact derivatives with respect to ``directions``, for one
+    value set over every batch (forward sensitivities,
     :func:`roastlab.sim.sensitivity.sens_population_kernel`).
 
     ``values`` (nb, len(names)): each named parameter's value per batch (as one set of
     :func:`predict_outputs`). ``directions``: one (j, b) per column, the derivative with respect to
-    ``names[j]`` in batch ``b`` only, or in every batch when b < 0. Returns ``(ta, tb, dta, dtb)``
-    of shapes (nb, nmax) and (nb, nmax, m), NaN-padded; tb and dtb are None without ``with_tb``.
+    ``names[j]`` in batch ``b`` only, or in every batch when b < 0. Returns {"Ta": (value (nb,
+    nmax), derivative (nb, nmax, m)), "Tb": ..., and with ``with_tgo`` "Tgo": ...}, NaN-padded.
     """
     from ..model.layout import S_TA, S_TB
-    from .sensitivity import sens_population_kernel
+    from .sensitivity import outlet_sens_kernel, sens_population_kernel
 
     nb, nmax, m = packed.n_batches, packed.T.shape[1], len(directions)
     batch_of, X0, PP = run_arrays(packed, names, values[None, :, :])
@@ -212,17 +221,26 @@ def output_sensitivities(packed: PackedBatches, names: list[str], values: np.nda
     for bb, items in enumerate(triplets):
         for e, (q, c, v) in enumerate(items):
             PQ[bb, e], PC[bb, e], PV[bb, e] = q, c, v
-    rows = np.array([S_TA, S_TB], dtype=np.int64)
+    # every state's sensitivity when Tgo is asked for (it depends on Tb, Tm, X and H)
+    rows = np.arange(NS, dtype=np.int64) if with_tgo else np.array([S_TA, S_TB], dtype=np.int64)
     out_x = np.full((nb, nmax, NS), np.nan)
-    out_s = np.full((nb, nmax, 2, m), np.nan)
+    out_s = np.full((nb, nmax, rows.size, m), np.nan)
     sens_population_kernel(
         *packed.inputs, batch_of, X0, PP, packed.zoh, packed.h_max_s, S0, PQ, PC, PV, rows, out_x, out_s,
         np.zeros(0, dtype=np.int64), np.zeros(0),
     )  # fmt: skip
-    ta, dta = out_x[:, :, S_TA], out_s[:, :, 0, :]
-    if not with_tb:
-        return ta, None, dta, None
-    return ta, out_x[:, :, S_TB], dta, out_s[:, :, 1, :]
+    row = {int(r): k for k, r in enumerate(rows)}
+    res = {
+        "Ta": (out_x[:, :, S_TA], out_s[:, :, row[S_TA], :]),
+        "Tb": (out_x[:, :, S_TB], out_s[:, :, row[S_TB], :]),
+    }
+    if with_tgo:
+        g = np.full((nb, nmax), np.nan)
+        dg = np.full((nb, nmax, m), np.nan)
+        outlet_sens_kernel(packed.GG, packed.TGI, packed.FF, packed.N, batch_of, out_x, out_s, PP, PQ, PC, PV,
+                           packed.zoh, g, dg)  # fmt: skip
+        res["Tgo"] = (g, dg)
+    return res
 
 
 def _population_task(packed, names, values):

@@ -38,10 +38,12 @@ from numba.extending import register_jitable
 from ..model.layout import N_INPUTS, N_PARAMS, S_H, S_TA, S_TM, S_X, U_GG, U_HEATER, U_TGI
 from . import kernels as _k
 from .cache import compiled
+from .jacobian import OUTLET_FUNCTION_NAME
 from .jacobian import load as _load_jacobian
 from .kernels import ATOL, H0_S, H_MAX_S, MAX_STEPS, N_OUT, NS, RTOL, STIFF_MARK, integrate_into
 
 _rhs_jacobian = register_jitable(_load_jacobian())
+_outlet_jacobian = register_jitable(_load_jacobian(OUTLET_FUNCTION_NAME))
 
 
 @compiled
@@ -294,6 +296,34 @@ def sens_population_kernel(
             T[b], GG[b], TGI[b], QQ[b], FF[b], N[b], X0[i], PP[i], zoh, h_max, S0[i], no_int,
             no_int, no_int, no_int, no_float, PQ[i], PC[i], PV[i], rows, out_x[i], out_s[i], H0_S,
         )  # fmt: skip
+
+
+@compiled(parallel=True)
+def outlet_sens_kernel(GG, TGI, FF, N, batch_of, X, S, PP, PQ, PC, PV, zoh, out_g, out_dg):
+    """The outlet gas temperature Tgo (eq. 15e) and its exact derivative dTgo/dz at every sample
+    of each run, from the run's states X[i] (nmax, NS) and state sensitivities S[i] (nmax, NS, m)
+    (:func:`sens_population_kernel` with every state's row) and the dp/dz triplets; no input
+    depends on z. Sample k >= 1 uses the inputs :func:`roastlab.sim.kernels.integrate_into`
+    gives Tgo there (sample k - 1's under a zero-order hold, k's under a linear one)."""
+    m = S.shape[3]
+    for i in prange(batch_of.shape[0]):
+        b = batch_of[i]
+        g = np.zeros(1)
+        Gx = np.zeros((1, NS))
+        Gu = np.zeros((1, N_INPUTS))
+        Gp = np.zeros((1, N_PARAMS))
+        for k in range(N[b]):
+            j = k - 1 if (zoh and k > 0) else k
+            _outlet_jacobian(X[i, k, 0], X[i, k, 1], X[i, k, 2], X[i, k, 3], X[i, k, 4], X[i, k, 5],
+                             GG[b, j], TGI[b, j], 0.0, FF[b, j], PP[i], g, Gx, Gu, Gp)  # fmt: skip
+            out_g[i, k] = g[0]
+            for c in range(m):
+                v = 0.0
+                for st in range(NS):
+                    v += Gx[0, st] * S[i, k, st, c]
+                out_dg[i, k, c] = v
+            for e in range(PQ.shape[1]):
+                out_dg[i, k, PC[i, e]] += Gp[0, PQ[i, e]] * PV[i, e]
 
 
 @functools.lru_cache(maxsize=64)

@@ -17,7 +17,7 @@ import numpy as np
 from ..errors import InputError, ParameterError
 from ..evaluate.bands import roast_spread
 from ..evaluate.validate import ValidationResult
-from ..fit.identify import NO_SECOND_READING, IdentificationResult, build_free_parameters, identify
+from ..fit.identify import NO_ET_READING, NO_SECOND_READING, IdentificationResult, build_free_parameters, identify
 from ..io.batch import Batch
 from ..io.fitspec import FitSpec, load_fit_spec
 from ..io.importers.mapping import ColumnMap
@@ -145,8 +145,9 @@ def fit(
     method, seed, starts : search (``"global"`` or ``"de"``), its seed, local polishes
     column_map : the map the logs were read with; kept in the model so it reads new logs alike
     progress : callable ``progress(done, total, text)`` or None
-    weights : {output: weight}: ``Ta`` (the bean probe, default 1) and ``Tb2`` (a second bean
-        reading compared with Tb, default 0); overrides the spec's ``[weights]``
+    weights : {output: weight}: ``Ta`` (the bean probe, default 1), ``Tb2`` (a second bean
+        reading compared with Tb, default 0) and ``ET`` (the logged ET compared with the outlet gas
+        Tgo, default 0); overrides the spec's ``[weights]``
     bed : bed laws (:class:`roastlab.model.bed.BedLaws`, its text or mapping); overrides the spec's
         ``[bed]``; default the paper's bed
     """
@@ -176,6 +177,8 @@ def fit(
     weights = {**spec_weights, **given}
     if weights.get("Tb2", 0) > 0 and all(b.Tb2_C is None or not np.isfinite(b.Tb2_C).any() for b in batches):
         raise InputError(NO_SECOND_READING, "command line" if "Tb2" in given else spec_source)
+    if weights.get("ET", 0) > 0 and all(b.ET_C is None or not np.isfinite(b.ET_C).any() for b in batches):
+        raise InputError(NO_ET_READING, "command line" if "ET" in given else spec_source)
     names_moved = {f.name for f in free} | set(fixed)
     if "Gg_kg_s" not in names_moved and all(np.all(b.Gg_kg_s == PLACEHOLDER_GG_KG_S) for b in batches):
         raise InputError(
