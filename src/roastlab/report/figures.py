@@ -200,7 +200,6 @@ def plot_fit(result, path=None, title=None, max_panels: int = 8, outputs=None, b
         if bands is not None:
             _shade_band(ax, bands[i], "tab:green", "prediction band")
             ax.legend(fontsize=8)
-        _ror_overlay(ax, result.time_s[i], result.measured[i], result.predicted[i])
         t = result.time_s[i] / 60.0
         res.plot(t, result.measured[i] - result.predicted[i], color="tab:purple", lw=1, label="Ta meas − pred")
         second = result.results[i].Tb2_measured_C if i < len(result.results) else None
@@ -210,7 +209,7 @@ def plot_fit(result, path=None, title=None, max_panels: int = 8, outputs=None, b
             ax.plot(t, second, ":", color="tab:brown", lw=1.6, label="second bean reading (Tb2)")
             res.plot(t, second - sim.Tb_C, ":", color="tab:brown", lw=1, label="Tb2 − Tb")
             res.legend(fontsize=7, loc="lower right")
-            ax.legend(fontsize=8)
+        _ror_overlay(ax, result.time_s[i], result.measured[i], result.predicted[i])
         res.axhline(0.0, color="k", lw=0.6)
         res.set_ylabel("residual\nBT meas − pred [°C]", fontsize=8)
         time_axis(res)
@@ -231,7 +230,12 @@ def _ror_overlay(ax, time_s, measured, predicted) -> None:
     ror_limits(ror, t, measured, predicted)
     ror.set_ylabel("RoR [°C/min]", color="tab:blue", fontsize=8)
     ror.tick_params(axis="y", labelcolor="tab:blue", labelsize=8)
-    ror.legend(fontsize=7, loc="lower right")
+    # one legend for both axes, on the BT axis drawn above the RoR axis so no curve covers it
+    handles, labels = ax.get_legend_handles_labels()
+    more, more_labels = ror.get_legend_handles_labels()
+    ax.set_zorder(ror.get_zorder() + 1)
+    ax.patch.set_visible(False)
+    ax.legend(handles + more, labels + more_labels, fontsize=7, loc="best")
 
 
 def _profile_panel(ax, result, i, label=None):
