@@ -160,6 +160,24 @@ def test_mpc_tracks_a_feasible_reference_with_the_true_model(model, seed):
     assert r.metrics["constraint_violations"] == 0
 
 
+def test_mpc_gauss_newton_matches_scipys_trust_region(model, reference):
+    """The MPC's default solver (box-bounded damped Gauss-Newton on the exact sensitivities)
+    tracks as SciPy's trust-region reference does, on the nominal roast and with a cold drum."""
+    for s in (None, load_scenario(next(p for p in standard_scenarios() if load_scenario(p).name == "cold drum"))):
+        gn = run_closed_loop(model, reference, MPC(), s) if s else run_closed_loop(model, reference, MPC())
+        trf = (
+            run_closed_loop(model, reference, MPC(solver="trf"), s)
+            if s
+            else run_closed_loop(model, reference, MPC(solver="trf"))
+        )
+        assert abs(gn.metrics["rmse_C"] - trf.metrics["rmse_C"]) <= 0.01 * max(1.0, trf.metrics["rmse_C"])
+        # the programs may differ along directions the cost barely sees; the roasts do not
+        assert np.abs(gn.bt_C - trf.bt_C).max() <= 1.0
+        assert gn.metrics["constraint_violations"] == 0
+    with pytest.raises(InputError, match="solver"):
+        MPC(solver="ipopt")
+
+
 def _settles(r) -> bool:
     """Stable: the BT error in the last third is at most half the first half's, and the applied
     input's moves are dying out (last 5 min travel under a quarter of the first 5 min's)."""
