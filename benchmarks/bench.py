@@ -73,7 +73,7 @@ TARGETS = {
     "cli_cold_s": ("<=", 3.0),
     "mpc_step_median_ms": ("<=", 10.0),
     "mpc_step_p99_ms": ("<=", 50.0),
-    "mpc_vs_casadi": (">=", 5.0),
+    "mpc_vs_casadi": (">=", 10.0),  # issue 26: one thread each side
     "mpc_mean_rmse_C": ("<=", 1.0),
     "mpc_over_pid_disturbed": ("<=", 0.5),
     "gym_steps_per_s": (">=", 20_000.0),
@@ -801,12 +801,24 @@ import json, resource, sys, time
 from roastlab.fleet import fit_fleet, ingest
 t0 = time.perf_counter(); r = ingest(sys.argv[1], sys.argv[2]); t1 = time.perf_counter()
 f = fit_fleet(sys.argv[1]); t2 = time.perf_counter()
+# VmHWM: this process's own high-water mark (ru_maxrss starts at the parent's size at the fork)
+hwm = [int(l.split()[1]) / 1024 for l in open("/proc/self/status") if l.startswith("VmHWM:")]
 print(json.dumps({"ingest_s": t1 - t0, "fit_s": t2 - t1, "added": r.added, "fitted": f.fitted,
-                  "peak_MB": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
+                  "peak_MB": hwm[0] if hwm else resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
 """
 
 
 def _peak_rss_MB() -> float:
+    """This process's own peak RSS [MB]: VmHWM, the high-water mark of its address space. Not
+    getrusage's ru_maxrss, which a process started by fork + exec (a Dask worker) inherits from
+    its parent's size at the fork."""
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1]) / 1024
+    except OSError:
+        pass
     import resource
 
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
