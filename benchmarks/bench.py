@@ -401,15 +401,15 @@ def _fleet_batches(count: int, seed: int = 7):
 def _peak_memory_child(count: int) -> dict:
     """Run the largest fleet identification in a fresh process and read its peak RSS."""
     code = (
-        "import json, resource, time, sys\n"
+        "import json, time, sys\n"
         f"sys.path.insert(0, {str(Path(__file__).resolve().parent)!r})\n"
-        "from bench import _fleet_batches\n"
+        "from bench import _fleet_batches, _peak_rss_MB\n"
         "from roastlab.fit.batchfit import identify_each\n"
         "from roastlab.sim.population import pack_batches\n"
         "from roastlab.model.parameters import THETA_START\n"
         f"b = _fleet_batches({count})\n"
         "t0 = time.perf_counter(); r = identify_each(pack_batches(b, '120kg', THETA_START), progress=None); dt = time.perf_counter() - t0\n"
-        "print(json.dumps({'wall_s': dt, 'peak_MB': resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, 'mean_FIT': float(r.FIT.mean())}))\n"
+        "print(json.dumps({'wall_s': dt, 'peak_MB': _peak_rss_MB(), 'mean_FIT': float(r.FIT.mean())}))\n"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     return json.loads(out.stdout.strip().splitlines()[-1])
@@ -796,15 +796,15 @@ def table(res: dict) -> str:
     return "\n".join(f"{a:<{w}}  {b:>16}  {c}" for a, b, c in rows)
 
 
-_FLEET_CHILD = """
-import json, resource, sys, time
+_FLEET_CHILD = f"""
+import json, sys, time
+sys.path.insert(0, {str(Path(__file__).resolve().parent)!r})
+from bench import _peak_rss_MB
 from roastlab.fleet import fit_fleet, ingest
 t0 = time.perf_counter(); r = ingest(sys.argv[1], sys.argv[2]); t1 = time.perf_counter()
 f = fit_fleet(sys.argv[1]); t2 = time.perf_counter()
-# VmHWM: this process's own high-water mark (ru_maxrss starts at the parent's size at the fork)
-hwm = [int(l.split()[1]) / 1024 for l in open("/proc/self/status") if l.startswith("VmHWM:")]
-print(json.dumps({"ingest_s": t1 - t0, "fit_s": t2 - t1, "added": r.added, "fitted": f.fitted,
-                  "peak_MB": hwm[0] if hwm else resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
+print(json.dumps({{"ingest_s": t1 - t0, "fit_s": t2 - t1, "added": r.added, "fitted": f.fitted,
+                  "peak_MB": _peak_rss_MB()}}))
 """
 
 

@@ -66,18 +66,14 @@ def test_generated_jacobian_matches_central_differences(codes):
         def g(xx=x, uu=u, pp=p):
             return np.array(derivatives(*xx, *uu, pp))
 
-        for j in range(NS):
-            h = 1e-6 * max(1.0, abs(x[j]))
-            e = np.zeros(NS)
+        xu = np.concatenate([x, u])
+        for j, column in enumerate(np.hstack([Jx, Ju]).T):  # d f / d x, then d f / d u
+            h = 1e-6 * max(1.0, abs(xu[j]))
+            e = np.zeros(xu.size)
             e[j] = h
-            fd = (g(xx=x + e) - g(xx=x - e)) / (2 * h)
-            np.testing.assert_allclose(Jx[:, j], fd, rtol=1e-5, atol=1e-9 * max(1.0, np.abs(fd).max()))
-        for k in range(N_INPUTS):
-            h = 1e-6 * max(1.0, abs(u[k]))
-            e = np.zeros(N_INPUTS)
-            e[k] = h
-            fd = (g(uu=u + e) - g(uu=u - e)) / (2 * h)
-            np.testing.assert_allclose(Ju[:, k], fd, rtol=1e-5, atol=1e-9 * max(1.0, np.abs(fd).max()))
+            plus, minus = xu + e, xu - e
+            fd = (g(xx=plus[:NS], uu=plus[NS:]) - g(xx=minus[:NS], uu=minus[NS:])) / (2 * h)
+            np.testing.assert_allclose(column, fd, rtol=1e-5, atol=1e-9 * max(1.0, np.abs(fd).max()))
         for name in CONTINUOUS:
             q = P[name]
             h = 1e-5 * max(abs(p[q]), 1e-6)

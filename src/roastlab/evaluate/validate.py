@@ -152,20 +152,17 @@ def score(results, plant_name: str) -> ValidationResult:
         states.append(np.column_stack([r.states, r.Tgo_C]))
     out = ValidationResult([r.name for r in results], times, meas, pred, states, rows, str(plant_name))
     out.results = list(results)
-    second = [(r.name, r.Tb2_measured_C, r.Tb_C) for r in results if r.Tb2_measured_C is not None]
-    scored = [(n, y[ok], tb[ok]) for n, y, tb in second if (ok := np.isfinite(y)).sum() >= MIN_SECOND_OUTPUT_SAMPLES]
-    if scored:
-        out.outputs["Tb2"] = {
-            "compared": "model Tb (eq. 15a) with the second measured bean reading",
-            "names": [n for n, _, _ in scored],
-            "rows": [batch_metrics(y, tb) for _, y, tb in scored],
-        }
-    et = [(r.name, r.ET_measured_C, r.Tgo_C) for r in results if getattr(r, "ET_measured_C", None) is not None]
-    scored = [(n, y[ok], g[ok]) for n, y, g in et if (ok := np.isfinite(y)).sum() >= MIN_SECOND_OUTPUT_SAMPLES]
-    if scored:
-        out.outputs["ET"] = {
-            "compared": "model outlet gas Tgo (eq. 15e) with the logged ET",
-            "names": [n for n, _, _ in scored],
-            "rows": [batch_metrics(y, g) for _, y, g in scored],
-        }
+    # further outputs: (name, what is compared, the measured and the model's series of a result)
+    for name, compared, series in (
+        ("Tb2", "model Tb (eq. 15a) with the second measured bean reading", lambda r: (r.Tb2_measured_C, r.Tb_C)),
+        ("ET", "model outlet gas Tgo (eq. 15e) with the logged ET", lambda r: (r.ET_measured_C, r.Tgo_C)),
+    ):
+        pairs = [(r.name, *series(r)) for r in results if series(r)[0] is not None]
+        scored = [(n, y[ok], m[ok]) for n, y, m in pairs if (ok := np.isfinite(y)).sum() >= MIN_SECOND_OUTPUT_SAMPLES]
+        if scored:
+            out.outputs[name] = {
+                "compared": compared,
+                "names": [n for n, _, _ in scored],
+                "rows": [batch_metrics(y, m) for _, y, m in scored],
+            }
     return out

@@ -203,22 +203,21 @@ def source_path() -> Path | None:
 
 def load(function: str = FUNCTION_NAME):
     """A generated function (``rhs_jacobian`` or ``outlet_jacobian``) as plain Python (generated
-    and cached on first use)."""
+    and cached on first use; one module per process holds both)."""
+    # a module in sys.modules under a name of its own: numba's disk cache of the kernels that
+    # compile this function in finds its globals by that name in a later process
+    name = f"roastlab_rhs_jacobian_{_sources_hash()}"
+    if name in sys.modules:
+        return getattr(sys.modules[name], function)
     path = source_path()
-    if path is not None and path.is_file():
-        text = path.read_text()
-    else:
+    text = None
+    if path is None or not path.is_file():
         text = generate_source()
         if path is not None:
             try:
                 _write_atomically(path, text)
             except OSError:
                 path = None
-    # a module in sys.modules under a name of its own: numba's disk cache of the kernels that
-    # compile this function in finds its globals by that name in a later process
-    name = f"roastlab_rhs_jacobian_{_sources_hash()}"
-    if name in sys.modules:
-        return getattr(sys.modules[name], function)
     if path is not None:
         spec = importlib.util.spec_from_file_location(name, path)
         module = importlib.util.module_from_spec(spec)

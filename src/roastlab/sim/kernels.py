@@ -71,6 +71,32 @@ def _f(x, g, T, q, f, p, out):
     out[5] = d[5]
 
 
+@compiled(inline="always")
+def interval_inputs(t, Gg, Tgi, Q, F, k, zoh):
+    """Sample interval k: its length dt [s], the inputs at its start (Gg, Tgi, heater, fan) and
+    their slopes per second inside it (zero under a zero-order hold, else linear to sample k+1)."""
+    t0 = t[k]
+    dt = t[k + 1] - t0
+    g0 = Gg[k]
+    T0 = Tgi[k]
+    q0 = Q[k]
+    f0 = F[k]
+    if zoh:
+        return dt, g0, T0, q0, f0, 0.0, 0.0, 0.0, 0.0
+    return dt, g0, T0, q0, f0, (Gg[k + 1] - g0) / dt, (Tgi[k + 1] - T0) / dt, (Q[k + 1] - q0) / dt, (F[k + 1] - f0) / dt
+
+
+@compiled(inline="always")
+def next_step(err, h, h_try, last, h_max):
+    """The step size after a trial of size ``h`` with a finite RMS error ``err``: grown after an
+    accepted step (by at most 5; back to the trial size ``h_try`` after a step cut short at a
+    sample), shrunk (by at most 5) after a rejected one."""
+    if err <= 1.0:
+        fac = 5.0 if err < 1e-10 else min(5.0, 0.9 * err**-0.2)
+        return h_try if last else min(h_max, h * fac)
+    return h * max(0.2, 0.9 * err**-0.2)
+
+
 @compiled
 def integrate_into(t, Gg, Tgi, Q, F, n, x0, p, zoh, h_max, out, h0=H0_S, with_tgo=True):
     """Integrate one batch over samples t[0..n-1]; write states and Tgo to out[:n, :N_OUT].
@@ -100,22 +126,7 @@ def integrate_into(t, Gg, Tgi, Q, F, n, x0, p, zoh, h_max, out, h0=H0_S, with_tg
     h = min(h_max, h0)
     steps = 0
     for k in range(n - 1):
-        t0 = t[k]
-        dt = t[k + 1] - t0
-        g0 = Gg[k]
-        T0 = Tgi[k]
-        q0 = Q[k]
-        f0 = F[k]
-        if zoh:
-            dg = 0.0
-            dT = 0.0
-            dq = 0.0
-            df = 0.0
-        else:
-            dg = (Gg[k + 1] - g0) / dt
-            dT = (Tgi[k + 1] - T0) / dt
-            dq = (Q[k + 1] - q0) / dt
-            df = (F[k + 1] - f0) / dt
+        dt, g0, T0, q0, f0, dg, dT, dq, df = interval_inputs(t, Gg, Tgi, Q, F, k, zoh)
         s = 0.0
         if zoh or k == 0:
             # a zero-order hold jumps at the sample, so the derivative there is new; a linear
@@ -185,11 +196,7 @@ def integrate_into(t, Gg, Tgi, Q, F, n, x0, p, zoh, h_max, out, h0=H0_S, with_tg
                     k1[i] = k7[i]  # first same as last
                 if x[2] < 0.0:
                     x[2] = 0.0
-                fac = 5.0 if err < 1e-10 else min(5.0, 0.9 * err**-0.2)
-                # after a step cut short at a sample, start the next interval at the trial size
-                h = h_try if last else min(h_max, h * fac)
-            else:
-                h = h * max(0.2, 0.9 * err**-0.2)
+            h = next_step(err, h, h_try, last, h_max)
         for i in range(NS):
             out[k + 1, i] = x[i]
         if with_tgo:

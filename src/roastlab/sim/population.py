@@ -226,9 +226,8 @@ def output_sensitivities(packed: PackedBatches, names: list[str], values: np.nda
     out_x = np.full((nb, nmax, NS), np.nan)
     out_s = np.full((nb, nmax, rows.size, m), np.nan)
     sens_population_kernel(
-        *packed.inputs, batch_of, X0, PP, packed.zoh, packed.h_max_s, S0, PQ, PC, PV, rows, out_x, out_s,
-        np.zeros(0, dtype=np.int64), np.zeros(0),
-    )  # fmt: skip
+        *packed.inputs, batch_of, X0, PP, packed.zoh, packed.h_max_s, S0, PQ, PC, PV, rows, out_x, out_s
+    )
     row = {int(r): k for k, r in enumerate(rows)}
     res = {
         "Ta": (out_x[:, :, S_TA], out_s[:, :, row[S_TA], :]),

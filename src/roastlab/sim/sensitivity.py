@@ -40,7 +40,19 @@ from . import kernels as _k
 from .cache import compiled
 from .jacobian import OUTLET_FUNCTION_NAME
 from .jacobian import load as _load_jacobian
-from .kernels import ATOL, H0_S, H_MAX_S, MAX_STEPS, N_OUT, NS, RTOL, STIFF_MARK, integrate_into
+from .kernels import (
+    ATOL,
+    H0_S,
+    H_MAX_S,
+    MAX_STEPS,
+    N_OUT,
+    NS,
+    RTOL,
+    STIFF_MARK,
+    integrate_into,
+    interval_inputs,
+    next_step,
+)
 
 _rhs_jacobian = register_jitable(_load_jacobian())
 _outlet_jacobian = register_jitable(_load_jacobian(OUTLET_FUNCTION_NAME))
@@ -171,22 +183,7 @@ def integrate_sens_into(
     steps = 0
     nc = m
     for k in range(n - 1):
-        t0 = t[k]
-        dt = t[k + 1] - t0
-        g0 = Gg[k]
-        T0 = Tgi[k]
-        q0 = Q[k]
-        f0 = F[k]
-        if zoh:
-            dg = 0.0
-            dT = 0.0
-            dq = 0.0
-            df = 0.0
-        else:
-            dg = (Gg[k + 1] - g0) / dt
-            dT = (Tgi[k + 1] - T0) / dt
-            dq = (Q[k + 1] - q0) / dt
-            df = (F[k + 1] - f0) / dt
+        dt, g0, T0, q0, f0, dg, dT, dq, df = interval_inputs(t, Gg, Tgi, Q, F, k, zoh)
         if ncol.shape[0] > 0:
             nc = min(ncol[k], m)
         s = 0.0
@@ -259,10 +256,7 @@ def integrate_sens_into(
                     x[S_X] = 0.0
                     for c in range(nc):
                         S[S_X, c] = 0.0
-                fac = 5.0 if err < 1e-10 else min(5.0, 0.9 * err**-0.2)
-                h = h_try if last else min(h_max, h * fac)
-            else:
-                h = h * max(0.2, 0.9 * err**-0.2)
+            h = next_step(err, h, h_try, last, h_max)
         for i in range(NS):
             out[k + 1, i] = x[i]
         for r in range(rows.shape[0]):
@@ -282,14 +276,13 @@ def _fill(out, outS, start, n, value):
 
 
 @compiled(parallel=True)
-def sens_population_kernel(
-    T, GG, TGI, QQ, FF, N, batch_of, X0, PP, zoh, h_max, S0, PQ, PC, PV, rows, out_x, out_s, no_int, no_float
-):
+def sens_population_kernel(T, GG, TGI, QQ, FF, N, batch_of, X0, PP, zoh, h_max, S0, PQ, PC, PV, rows, out_x, out_s):
     """Forward sensitivities of ``len(batch_of)`` runs in parallel (as
     :func:`roastlab.sim.kernels.ta_population_kernel`): run i starts from X0[i] with S0[i]
     (NS, m), parameters PP[i] and dp/dz triplets PQ[i], PC[i], PV[i] (pad with PV = 0); no input
-    depends on z (``no_int``, ``no_float``: empty int64 and float64 arrays). Writes the states to
-    out_x[i] and S[rows] to out_s[i]."""
+    depends on z. Writes the states to out_x[i] and S[rows] to out_s[i]."""
+    no_int = np.zeros(0, dtype=np.int64)
+    no_float = np.zeros(0)
     for i in prange(batch_of.shape[0]):
         b = batch_of[i]
         integrate_sens_into(
