@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..model.parameters import MODEL_OF_OUTPUT
 from ..report.result import Result, draw_curves
 from .metrics import METRIC_NAMES, absolute_error_moments, average_metrics, batch_metrics
 
@@ -152,12 +153,13 @@ def score(results, plant_name: str) -> ValidationResult:
         states.append(np.column_stack([r.states, r.Tgo_C]))
     out = ValidationResult([r.name for r in results], times, meas, pred, states, rows, str(plant_name))
     out.results = list(results)
-    # further outputs: (name, what is compared, the measured and the model's series of a result)
-    for name, compared, series in (
-        ("Tb2", "model Tb (eq. 15a) with the second measured bean reading", lambda r: (r.Tb2_measured_C, r.Tb_C)),
-        ("ET", "model outlet gas Tgo (eq. 15e) with the logged ET", lambda r: (r.ET_measured_C, r.Tgo_C)),
+    # further outputs: each measured series (<output>_measured_C) against its model quantity
+    for name, compared in (
+        ("Tb2", "model Tb (eq. 15a) with the second measured bean reading"),
+        ("ET", "model outlet gas Tgo (eq. 15e) with the logged ET"),
     ):
-        pairs = [(r.name, *series(r)) for r in results if series(r)[0] is not None]
+        model = f"{MODEL_OF_OUTPUT[name]}_C"
+        pairs = [(r.name, y, getattr(r, model)) for r in results if (y := getattr(r, f"{name}_measured_C")) is not None]
         scored = [(n, y[ok], m[ok]) for n, y, m in pairs if (ok := np.isfinite(y)).sum() >= MIN_SECOND_OUTPUT_SAMPLES]
         if scored:
             out.outputs[name] = {

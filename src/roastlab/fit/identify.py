@@ -29,6 +29,7 @@ from ..model.limits import check_value
 from ..model.parameters import (
     DEFAULT_WEIGHTS,
     FREE_NAMES,
+    MODEL_OF_OUTPUT,
     OUTPUTS,
     REGISTRY,
     THETA_NAMES,
@@ -209,8 +210,10 @@ class Objective:
         out = predict_outputs(
             self.packed, self.names, self.values_array(Z), with_tb=self.with_tb, with_tgo=self.with_tgo
         )
-        model = dict(zip(OUTPUTS, out))  # Ta -> Ta, Tb2 -> the model's Tb, ET -> the outlet gas Tgo
-        return np.concatenate([model[k][:, self.masks[k]] for k in OUTPUTS if self.masks[k].any()], axis=1)
+        model = dict(zip(("Ta", "Tb", "Tgo"), out))
+        return np.concatenate(
+            [model[MODEL_OF_OUTPUT[k]][:, self.masks[k]] for k in OUTPUTS if self.masks[k].any()], axis=1
+        )
 
     def output_ssr(self, z: np.ndarray) -> dict:
         """Per fitted output: its weight, sample count and unweighted SSR [degC^2] at ``z``."""
@@ -267,8 +270,7 @@ class Objective:
         self.nfev += 1
         V = self.values_array(z[None, :])[0]
         res = output_sensitivities(self.packed, self.names, V, self.layout, with_tgo=self.with_tgo)
-        model = {"Ta": res["Ta"][1], "Tb2": res["Tb"][1], "ET": res.get("Tgo", (None, None))[1]}
-        parts = [model[k][self.masks[k]] for k in OUTPUTS if self.masks[k].any()]
+        parts = [res[MODEL_OF_OUTPUT[k]][1][self.masks[k]] for k in OUTPUTS if self.masks[k].any()]
         J = np.concatenate(parts, axis=0) * self.sqrt_w[:, None]
         return np.where(np.isfinite(J), J, 0.0)
 

@@ -18,9 +18,11 @@ side) run with Tgi held linearly (or zero-order) between knots. The Jacobian of 
 knots, the optional constant gas flow and the drum start temperature comes from one run of
 the forward sensitivities (:func:`roastlab.sim.sensitivity.program_sensitivity`, exact
 derivatives of the integrator's steps); finite differences on the compiled integrator
-(``sensitivities="fd"``, :func:`roastlab.sim.sensitivity.ta_input_jacobian`) are the reference. The solver is SciPy's bounded
-trust-region least squares (``least_squares(method="trf")``), started from a given program
-(for transfer: the reference's own inputs). Deterministic: no random starts.
+(``sensitivities="fd"``, :func:`roastlab.sim.sensitivity.ta_input_jacobian`) are the
+reference. The solver is SciPy's bounded trust-region least squares
+(``least_squares(method="trf")``), or for a warm-started receding horizon a box-bounded
+damped Gauss-Newton (``solver="gauss-newton"``), started from a given program (for transfer:
+the reference's own inputs). Deterministic: no random starts.
 """
 
 from __future__ import annotations
@@ -352,32 +354,30 @@ def optimise_program(
     def jacobian(z):
         u, tgi, q, gg, x, out = simulate(z)
         m = z.shape[0]
+        # d Ta_i / d u (the knots' levels, then the extras' columns), unweighted
         if sensitivities == "exact":  # forward sensitivities: one run gives every column
-            _, dta_u = program_sensitivity(t, gg, tgi, q, F, x, p, zoh, which, extra_names)
+            _, du = program_sensitivity(t, gg, tgi, q, F, x, p, zoh, which, extra_names)
             counter["sims"] += 1
-            dta = np.empty((n, m))
-            # d Ta_i / d z: Tgi_k = sum_{j <= k} z_j, so column j sums the knot columns k >= j
-            dta[:, :n] = np.cumsum(dta_u[:, n - 1 :: -1], axis=1)[:, ::-1]
-            dta[:, n:] = dta_u[:, n:]
         else:  # the reference: forward differences on the compiled integrator
-            jt = np.empty((n, n))
+            du = np.empty((n, m))
             ta = np.ascontiguousarray(out[:, S_TA])
             states = np.ascontiguousarray(out[:, :6])
             delta = 1.0 if which == 0 else 1e-2 * (hi_T - lo_T)
+            jt = np.empty((n, n))
             ta_input_jacobian(t, gg, tgi, q, F, which, states, ta, p, zoh, H_MAX_S, delta, jt)
+            du[:, :n] = jt
             counter["sims"] += n // 2
-            dta = np.empty((n, m))
-            dta[:, :n] = np.cumsum(jt[:, ::-1], axis=1)[:, ::-1]
-            j = n
-            for name in extra_names:
+            for j, name in enumerate(extra_names, start=n):
                 h = 1e-3 * max(abs(z[j]), 1e-3) if name == "Gg" else 0.5
                 zp = z.copy()
                 zp[j] += h
                 _, tp, qp, gp, xp = unpack(zp)
                 outp = _run(t, gp, tp, qp, F, xp, p, zoh)
                 counter["sims"] += 1
-                dta[:, j] = (outp[:, S_TA] - out[:, S_TA]) / h
-                j += 1
+                du[:, j] = (outp[:, S_TA] - out[:, S_TA]) / h
+        # d Ta_i / d z: u_k = sum_{j <= k} z_j, so column j sums the knot columns k >= j
+        dta = du.copy()
+        dta[:, :n] = np.cumsum(du[:, n - 1 :: -1], axis=1)[:, ::-1]
         J = np.zeros((3 * n - 1 + (ror_rows.shape[0] if ror_weight else 0), m))
         active = ((u > hi_T) | (u < lo_T)).astype(float)
         J[n : 2 * n, :n] = LEVEL_PENALTY * lower * active[:, None]

@@ -155,4 +155,6 @@ class FreeParameter:
 #: Weights multiply each output's squared residuals in the objective; the default fits Ta alone,
 #: as the paper does (eq. 19).
 OUTPUTS = ("Ta", "Tb2", "ET")
+#: The model quantity each output is compared with: probe Ta, bean Tb, outlet gas Tgo.
+MODEL_OF_OUTPUT = {"Ta": "Ta", "Tb2": "Tb", "ET": "Tgo"}
 DEFAULT_WEIGHTS = {"Ta": 1.0, "Tb2": 0.0, "ET": 0.0}

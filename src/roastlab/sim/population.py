@@ -210,8 +210,9 @@ def output_sensitivities(packed: PackedBatches, names: list[str], values: np.nda
                 triplets[bb].append((PARAM_SLOTS[name], col, 1.0))
             elif name in STATE0:
                 S0[bb, STATE0[name], col] = 1.0
-                if name == "X0":  # Mbd = Mb / (1 + X0)
-                    triplets[bb].append((P["Mbd"], col, -packed.Mb[bb] / (1.0 + X0[bb, STATE0[name]]) ** 2))
+                if name == "X0":  # Mbd = dry_mass_kg(Mb, X0) = Mb / (1 + X0): d Mbd / d X0 = -Mbd / (1 + X0)
+                    x0 = X0[bb, STATE0[name]]
+                    triplets[bb].append((P["Mbd"], col, -dry_mass_kg(packed.Mb[bb], x0) / (1.0 + x0)))
             else:
                 raise KeyError(name)
     width = max(1, max(len(t) for t in triplets))
