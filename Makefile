@@ -46,13 +46,20 @@ wheel-check:
 	cd /tmp/roastlab-wheel && venv/bin/roastlab reproduce --out X && test -s X/model.json && test -s X/fig2_profiles.png
 
 # The measured figures of docs/real-roaster.md, from the real logs in ../shared/data/real.
-# Then every bed-law variant cross-validated by batch size on the Bullet (36 fits, ~8 min).
+# Then every bed-law variant and the probe depth scale's profile cross-validated by batch size on the
+# Bullet (9 variants x 9 fits, ~8 min).
 BULLET = ../shared/data/real/bullet
 real-roaster: $(STAMP)
 	$(PY) docs/real_roaster.py
 	$(VENV)/bin/roastlab compare-models --plant examples/bullet/plant.toml --map examples/bullet/map.toml \
 	  --spec examples/bullet/fit.toml $$(ls $(BULLET)/*_*g.json) \
+	  $(foreach v,$(BED_VARIANTS),--variant $(v),h_probe_m=free) \
+	  $(foreach h,$(H_PROBE_PROFILE_M),--variant $(BED_EXAMPLE),h_probe_m=$(h)) \
 	  --json docs/real-roaster-compare.json --plot docs/real-roaster-compare.png
+# each bed law with the probe's depth scale fitted, then that scale's profile under the example's laws
+BED_VARIANTS = paper probe=tumbling contact=wall contact=wall,probe=tumbling,probe_gas=mean
+BED_EXAMPLE = contact=wall,probe=tumbling,probe_gas=mean
+H_PROBE_PROFILE_M = 0.03 0.1 0.2 0.5 1
 
 # The page's screenshots for docs/app.md and its measured speed (needs Debian's chromium).
 app-screens: $(STAMP)

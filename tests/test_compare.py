@@ -64,6 +64,36 @@ def test_the_law_that_made_the_data_wins_on_cross_validation():
     assert "best by leave-one-size-out FIT: contact=wall" in text and "AIC" in text
 
 
+def test_variants_carry_parameter_overrides():
+    """A variant holds a parameter at a value or frees it within the quantity table's bounds: the
+    profile of a parameter only a change of batch size determines (h_probe_m on the Bullet)."""
+    from roastlab.errors import ParameterError
+    from roastlab.model.quantities import quantity
+    from roastlab.workflows.compare import FREE, Variant
+
+    held = Variant.parse("contact=wall,probe=tumbling,h_probe_m=0.2")
+    assert held.laws.name == "contact=wall,probe=tumbling" and held.overrides == (("h_probe_m", 0.2),)
+    assert held.name == "contact=wall,probe=tumbling,h_probe_m=0.2"
+    spec = held.spec(None)
+    assert spec.fixed["h_probe_m"] == 0.2 and "h_probe_m" not in {f.name for f in spec.free}
+    freed = Variant.parse("h_probe_m=free").spec(spec)  # a held value freed again
+    (h,) = [f for f in freed.free if f.name == "h_probe_m"]
+    assert (h.lower, h.upper) == quantity("h_probe_m").bounds and "h_probe_m" not in freed.fixed
+    assert Variant.parse("paper").spec(spec) is spec and Variant.parse(f"h_probe_m={FREE}").name == "h_probe_m=free"
+    for bad, words in [("h_probe_m=deep", "needs a number"), ("depth=1", "neither a bed option"),
+                       ("h_probe_m=-1", "h_probe_m")]:  # fmt: skip
+        with pytest.raises(ParameterError, match=words):
+            Variant.parse(bad)
+
+
+def test_a_held_parameter_changes_what_is_fitted():
+    batches = synthetic_sizes()
+    result = compare_models(batches, "120kg", None, [TRUTH, f"{TRUTH},hbm=0.05"], starts=1)
+    scores = {s.name: s for s in result.scores}
+    assert scores[TRUTH].k_free == 3 and scores[f"{TRUTH},hbm=0.05"].k_free == 2
+    assert scores[f"{TRUTH},hbm=0.05"].overrides == {"hbm": 0.05}
+
+
 def test_one_size_is_refused():
     batches = [b for b in synthetic_sizes() if b.Mb_kg == 60.0]
     with pytest.raises(InputError, match="at least two batch sizes"):

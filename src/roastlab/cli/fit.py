@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
+import argparse
 from pathlib import Path
 
-from ..errors import InputError
+from ..errors import InputError, RoastlabError
 from .common import (
     add_band_option,
     add_batch_options,
@@ -291,7 +292,15 @@ def add_parsers(sub) -> None:
 
     from ..model.bed import VARIANTS
     from ..workflows.compare import GROUP_STEP_SHARE
-    from .common import bed_arg
+
+    def variant_arg(text: str):
+        """argparse type of --variant: a Variant, or the parse error as argparse's one line."""
+        from ..workflows.compare import Variant
+
+        try:
+            return Variant.parse(text)
+        except RoastlabError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
 
     p = sub.add_parser(
         "compare-models",
@@ -312,11 +321,11 @@ def add_parsers(sub) -> None:
     p.add_argument(
         "--variant",
         action="append",
-        type=bed_arg,
-        metavar="LAWS",
-        help="a variant's bed laws, e.g. 'paper' or 'contact=wall,probe=tumbling' (repeatable; default: "
-        + "; ".join(VARIANTS)
-        + ")",
+        type=variant_arg,
+        metavar="VARIANT",
+        help="a variant: bed laws and parameters held at a value or freed within the quantity table's bounds, "
+        "e.g. 'paper', 'contact=wall,probe=tumbling' or 'probe=tumbling,h_probe_m=0.2' / 'h_probe_m=free' "
+        "(repeatable; a profile of one parameter is several variants; default: " + "; ".join(VARIANTS) + ")",
     )
     p.add_argument(
         "--group-step-kg",

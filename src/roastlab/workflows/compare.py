@@ -19,12 +19,14 @@ cross-validated FIT), not the one that fits best: more freedom always fits the f
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..errors import InputError
-from ..model.bed import VARIANTS, BedLaws
+from ..errors import InputError, ParameterError
+from ..model.bed import LAWS, VARIANTS, BedLaws
+from ..model.limits import check_value
+from ..model.parameters import FREE_NAMES, FreeParameter
 from ..report.result import Result, aligned
 
 #: Default group step as a share of the median green weight (a tenth: 490 and 500 g together).
@@ -56,12 +58,95 @@ def size_groups(batches, step_kg: float | None = None) -> tuple[list[str], float
     return [labels[k] for k in keys], step_kg
 
 
+#: The value of a variant's parameter override that frees it within its quantity-table bounds.
+FREE = "free"
+
+
+@dataclass(frozen=True)
+class Variant:
+    """One model variant: bed laws and, optionally, parameters held at a value or freed.
+
+    ``overrides`` are ``(name, value)`` pairs over the fit spec: a number holds the parameter at
+    that value (it leaves ``[free]``), ``"free"`` frees it within the fit bounds of the quantity
+    table (:mod:`roastlab.model.quantities`), started at their middle. A parameter that only a
+    change of batch size can determine (the probe's depth scale ``h_probe_m``) is chosen this way:
+    a profile of fixed values, each cross-validated by batch size.
+    """
+
+    laws: BedLaws
+    overrides: tuple = ()
+
+    @property
+    def name(self) -> str:
+        parts = [self.laws.name] if self.laws.name != "paper" or not self.overrides else []
+        parts += [f"{k}={v if v == FREE else format(v, 'g')}" for k, v in self.overrides]
+        return ",".join(parts)
+
+    @classmethod
+    def parse(cls, value) -> Variant:
+        """A Variant from itself, BedLaws or text ``"contact=wall,probe=tumbling,h_probe_m=0.2"``
+        (bed options and parameter overrides in one list; ``"paper"`` alone is the paper's bed)."""
+        if isinstance(value, Variant):
+            return value
+        if value is None or isinstance(value, (BedLaws, dict)):
+            return cls(BedLaws.parse(value))
+        if not isinstance(value, str):
+            raise ParameterError(f"a model variant must be text like 'probe=tumbling,h_probe_m=0.2', got {value!r}")
+        laws, overrides = [], []
+        for part in (p.strip() for p in value.split(",")):
+            key, _sep, val = (s.strip() for s in part.partition("="))
+            if key in FREE_NAMES:
+                if val == FREE:
+                    overrides.append((key, FREE))
+                    continue
+                try:
+                    number = float(val)
+                except ValueError:
+                    number = math.nan
+                if not math.isfinite(number):
+                    raise ParameterError(f"model variant: {part!r} needs a number or '{FREE}' (e.g. {key}=0.2)")
+                overrides.append((key, check_value(key, number)))
+            elif key in LAWS or part == "paper":
+                laws.append(part)
+            else:
+                raise ParameterError(
+                    f"model variant: {part!r} is neither a bed option ({', '.join(LAWS)}) nor a parameter "
+                    f"(e.g. h_probe_m=0.2 or h_probe_m={FREE})"
+                )
+        return cls(BedLaws.parse(",".join(laws)), tuple(overrides))
+
+    def spec(self, base):
+        """The fit spec of this variant: ``base`` (a FitSpec, or None for the default free parameters)
+        with the overrides applied; ``base`` itself when there are none."""
+        if not self.overrides:
+            return base
+        from ..fit.identify import build_free_parameters
+        from ..io.fitspec import FitSpec
+        from ..model.quantities import quantity
+
+        if base is None:
+            base = FitSpec(*build_free_parameters())
+        free, fixed = list(base.free), dict(base.fixed)
+        for name, value in self.overrides:
+            free = [f for f in free if f.name != name]
+            fixed.pop(name, None)
+            if value == FREE:
+                lo, hi = quantity(name).bounds
+                free.append(FreeParameter(name, lo, hi, 0.5 * (lo + hi)))
+            else:
+                fixed[name] = float(value)
+        if not free:
+            raise ParameterError(f"model variant {self.name}: nothing left to fit")
+        return replace(base, free=free, fixed=fixed)
+
+
 @dataclass
 class VariantScore:
     """One variant's figures (see the module docstring)."""
 
     name: str
     laws: BedLaws
+    overrides: dict
     ssr: float
     n_residuals: int
     k_free: int
@@ -153,6 +238,7 @@ class ModelComparison(Result):
                 {
                     "name": s.name,
                     "bed": s.laws.as_dict(),
+                    "overrides": dict(s.overrides),
                     "SSR": s.ssr,
                     "n_residuals": s.n_residuals,
                     "k_free": s.k_free,
@@ -211,19 +297,21 @@ def compare_models(
     ----------
     batches : list of Batch (each with its green weight ``Mb_kg``)
     plant, spec, column_map, seed, starts : as :func:`roastlab.workflows.fitting.fit`
-    variants : {name: BedLaws or its text} or a list of law texts; default
-        :data:`roastlab.model.bed.VARIANTS`
+    variants : {name: BedLaws, Variant or its text} or a list of them (:class:`Variant`: bed laws
+        and parameter overrides such as ``h_probe_m=0.2``); default :data:`roastlab.model.bed.VARIANTS`
     step_kg : the group step (default :data:`GROUP_STEP_SHARE` of the median green weight)
     progress : callable ``progress(done, total, text)``
     """
+    from ..io.fitspec import FitSpec, load_fit_spec
     from .fitting import fit
 
     if variants is None:
         variants = VARIANTS
     if isinstance(variants, dict):
-        variants = {name: BedLaws.parse(v) for name, v in variants.items()}
+        variants = {name: Variant.parse(v) for name, v in variants.items()}
     else:
-        variants = {laws.name: laws for laws in map(BedLaws.parse, variants)}
+        variants = {v.name: v for v in map(Variant.parse, variants)}
+    base = spec if spec is None or isinstance(spec, FitSpec) else load_fit_spec(spec)
     if not variants:
         raise InputError("no model variants to compare", "command line")
     batches = list(batches)
@@ -237,7 +325,8 @@ def compare_models(
     groups = {g: [b.name for b, lab in zip(batches, labels) if lab == g] for g in order}
     total, done = len(variants) * (1 + len(order)), 0
     scores = []
-    for name, laws in variants.items():
+    for name, variant in variants.items():
+        laws, spec = variant.laws, variant.spec(base)
         if progress:
             progress(done, total, f"{name}: all logs")
         full = fit(batches, plant, spec, column_map=column_map, seed=seed, starts=starts, bed=laws)
@@ -260,6 +349,7 @@ def compare_models(
             VariantScore(
                 name=name,
                 laws=laws,
+                overrides=dict(variant.overrides),
                 ssr=float(ident.SSR),
                 n_residuals=int(ident.n_residuals),
                 k_free=int(u.k_free) if u is not None else len(ident.values),
@@ -279,4 +369,4 @@ def compare_models(
     return ModelComparison(scores, groups, step)
 
 
-__all__ = ["ModelComparison", "VariantScore", "compare_models", "size_groups"]
+__all__ = ["FREE", "ModelComparison", "Variant", "VariantScore", "compare_models", "size_groups"]
