@@ -22,6 +22,7 @@ from roastlab.evaluate.metrics import average_metrics
 from roastlab.fit.baseline import describe, fit_first_order, validate_first_order
 from roastlab.io.fitspec import load_fit_spec
 from roastlab.io.importers.mapping import load_map
+from roastlab.model.bed import PAPER_BED
 from roastlab.model.parameters import REGISTRY
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -44,18 +45,34 @@ def mean(rows, key):
 
 
 def output_table(v_fit, v_val, lines):
-    """Markdown rows of each output's mean FIT and MAE (Ta vs the probe, Tb vs the second reading)."""
-    lines += ["| set | Ta FIT % | Ta MAE °C | Tb vs Tb2 FIT % | Tb vs Tb2 MAE °C |", "|---|---|---|---|---|"]
+    """Markdown rows of each output's mean FIT and MAE (Ta vs the probe, then each further output:
+    Tb vs the second bean reading, Tgo vs the logged ET; roastlab.model.parameters.MODEL_OF_OUTPUT)."""
+    from roastlab.model.parameters import MODEL_OF_OUTPUT
+
+    names = [o for o in v_fit.outputs if o in v_val.outputs]
+    head = ["set", "Ta FIT %", "Ta MAE °C"]
+    for o in names:
+        head += [f"{MODEL_OF_OUTPUT[o]} vs {o} FIT %", f"{MODEL_OF_OUTPUT[o]} vs {o} MAE °C"]
+    lines += ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for name, v in (("fit", v_fit), ("held out", v_val)):
-        o = v.output_average("Tb2")
-        lines.append(f"| {name} | {v.average['FIT']:.1f} | {v.average['MAE']:.2f} | {o['FIT']:.1f} | {o['MAE']:.2f} |")
+        cells = [name, f"{v.average['FIT']:.1f}", f"{v.average['MAE']:.2f}"]
+        for o in names:
+            a = v.output_average(o)
+            cells += [f"{a['FIT']:.1f}", f"{a['MAE']:.2f}"]
+        lines.append("| " + " | ".join(cells) + " |")
     lines.append("")
 
 
 def paper_probe_variant(example, fit_b, val_b, column_map, lines):
     """The same fit with the paper's probe (eq. 17, no immersion term) on Ta alone: the comparison row."""
     spec = load_fit_spec(example / "fit.toml")
-    spec = dataclasses.replace(spec, free=[f for f in spec.free if f.name != "h_probe_m"], weights={})
+    spec = dataclasses.replace(
+        spec,
+        free=[f for f in spec.free if f.name != "h_probe_m"],
+        fixed={k: v for k, v in spec.fixed.items() if k != "h_probe_m"},
+        weights={},
+        bed=PAPER_BED,
+    )
     model = roastlab.fit(fit_b, example / "plant.toml", spec, column_map=column_map).model
     v_fit, v_val = model.validate(fit_b), model.validate(val_b)
     lines += [
@@ -95,12 +112,14 @@ def machine(title, example, paths, lines):
     if v_fit.outputs:
         weights = result.identification.outputs
         lines += [
-            "Per output (the model's Ta against the bean probe, its Tb against the second bean reading; "
+            "Per output (the model's Ta against the bean probe, its Tb against the second bean reading, its "
+            "outlet gas Tgo against the logged ET; "
             + ", ".join(f"weight {k} {o['weight']:g}" for k, o in weights.items())
             + "):",
             "",
         ]
         output_table(v_fit, v_val, lines)
+    if "Tb2" in v_fit.outputs:
         paper_probe_variant(example, fit_b, val_b, column_map, lines)
     lines += [
         f"First-order baseline on the same inputs: {describe(base)}.",

@@ -78,8 +78,7 @@ class Variant:
 
     @property
     def name(self) -> str:
-        parts = [self.laws.name] if self.laws.name != "paper" or not self.overrides else []
-        parts += [f"{k}={v if v == FREE else format(v, 'g')}" for k, v in self.overrides]
+        parts = [self.laws.name] + [f"{k}={v if v == FREE else format(v, 'g')}" for k, v in self.overrides]
         return ",".join(parts)
 
     @classmethod
