@@ -79,7 +79,9 @@ def test_variants_carry_parameter_overrides():
     freed = Variant.parse("h_probe_m=free").spec(spec)  # a held value freed again
     (h,) = [f for f in freed.free if f.name == "h_probe_m"]
     assert (h.lower, h.upper) == quantity("h_probe_m").bounds and "h_probe_m" not in freed.fixed
-    assert Variant.parse("paper").spec(spec) is spec and Variant.parse(f"h_probe_m={FREE}").name == "paper,h_probe_m=free"
+    assert (
+        Variant.parse("paper").spec(spec) is spec and Variant.parse(f"h_probe_m={FREE}").name == "paper,h_probe_m=free"
+    )
     for bad, words in [("h_probe_m=deep", "needs a number"), ("depth=1", "neither a bed option"),
                        ("h_probe_m=-1", "h_probe_m")]:  # fmt: skip
         with pytest.raises(ParameterError, match=words):
