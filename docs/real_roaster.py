@@ -23,6 +23,7 @@ from roastlab.fit.baseline import describe, fit_first_order, validate_first_orde
 from roastlab.io.fitspec import load_fit_spec
 from roastlab.io.importers.mapping import load_map
 from roastlab.model.bed import PAPER_BED
+from roastlab.workflows.compare import Variant
 from roastlab.model.parameters import REGISTRY
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -66,13 +67,8 @@ def output_table(v_fit, v_val, lines):
 def paper_probe_variant(example, fit_b, val_b, column_map, lines):
     """The same fit with the paper's probe (eq. 17, no immersion term) on Ta alone: the comparison row."""
     spec = load_fit_spec(example / "fit.toml")
-    spec = dataclasses.replace(
-        spec,
-        free=[f for f in spec.free if f.name != "h_probe_m"],
-        fixed={k: v for k, v in spec.fixed.items() if k != "h_probe_m"},
-        weights={},
-        bed=PAPER_BED,
-    )
+    # h_probe 0 is eq. 17 bit for bit (roastlab.model.rhs.probe_coverage); on Ta alone
+    spec = dataclasses.replace(Variant(PAPER_BED, (("h_probe_m", 0.0),)).spec(spec), weights={}, bed=PAPER_BED)
     model = roastlab.fit(fit_b, example / "plant.toml", spec, column_map=column_map).model
     v_fit, v_val = model.validate(fit_b), model.validate(val_b)
     lines += [
@@ -245,7 +241,7 @@ def variants_and_bands(column_map, paths, lines):
     from roastlab.evaluate.bands import band_coverage, share_inside
     from roastlab.io.fitspec import load_fit_spec
     from roastlab.model.bed import VARIANTS
-    from roastlab.workflows.compare import FREE, Variant
+    from roastlab.workflows.compare import FREE
 
     example = ROOT / "examples" / "bullet"
     nominal = [p for p in paths if grams(p) in (490, 500)]

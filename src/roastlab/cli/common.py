@@ -171,6 +171,17 @@ def bed_arg(text: str):
         raise argparse.ArgumentTypeError(str(exc)) from None
 
 
+def variant_arg(text: str):
+    """argparse type of compare-models' --variant: bed laws and parameter overrides
+    (:class:`roastlab.workflows.compare.Variant`), or the parse error as argparse's one line."""
+    from ..workflows.compare import Variant
+
+    try:
+        return Variant.parse(text)
+    except RoastlabError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
 def add_initial_options(p: argparse.ArgumentParser) -> None:
     """--tb0, --tm0, --x0: the charge state (read back by :func:`initial_changes`)."""
     from ..model.quantities import default

@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
-from ..errors import InputError, RoastlabError
+from ..errors import InputError
 from .common import (
     add_band_option,
     add_batch_options,
@@ -292,15 +291,7 @@ def add_parsers(sub) -> None:
 
     from ..model.bed import VARIANTS
     from ..workflows.compare import GROUP_STEP_SHARE
-
-    def variant_arg(text: str):
-        """argparse type of --variant: a Variant, or the parse error as argparse's one line."""
-        from ..workflows.compare import Variant
-
-        try:
-            return Variant.parse(text)
-        except RoastlabError as exc:
-            raise argparse.ArgumentTypeError(str(exc)) from None
+    from .common import variant_arg
 
     p = sub.add_parser(
         "compare-models",

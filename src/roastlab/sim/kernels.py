@@ -87,6 +87,22 @@ def interval_inputs(t, Gg, Tgi, Q, F, k, zoh):
 
 
 @compiled(inline="always")
+def error_share(e, x_old, x_new, i):
+    """State i's share of a trial step's squared error: (e / (ATOL[i] + RTOL max(|x_old|, |x_new|)))^2
+    for its local error estimate ``e``; :func:`rms_error` turns the sum over the states into the norm."""
+    r = e / (ATOL[i] + RTOL * max(abs(x_old), abs(x_new)))
+    return r * r
+
+
+@compiled(inline="always")
+def rms_error(sum_of_shares):
+    """The step's error norm from the summed :func:`error_share`: RMS over the paper's five states (H
+    adds its error only when a heater moves it), so runs without the actuator extension take
+    exactly the steps they always took."""
+    return math.sqrt(sum_of_shares / 5.0)
+
+
+@compiled(inline="always")
 def next_step(err, h, h_try, last, h_max):
     """The step size after a trial of size ``h`` with a finite RMS error ``err``: grown after an
     accepted step (by at most 5; back to the trial size ``h_try`` after a step cut short at a
@@ -171,20 +187,16 @@ def integrate_into(t, Gg, Tgi, Q, F, n, x0, p, zoh, h_max, out, h0=H0_S, with_tg
             err = 0.0
             for i in range(NS):
                 e = h * (_E1 * k1[i] + _E3 * k3[i] + _E4 * k4[i] + _E5 * k5[i] + _E6 * k6[i] + _E7 * k7[i])
-                sc = ATOL[i] + RTOL * max(abs(x[i]), abs(xn[i]))
-                r = e / sc
-                err += r * r
-            # RMS over the paper's five states (H adds its error only when a heater moves it), so
-            # runs without the actuator extension take exactly the steps they always took
-            err = math.sqrt(err / 5.0)
-            if not (err == err) and h < 1e-6:
-                # a trial that stays non-finite down to a microsecond step: report NaN rather
-                # than loop or lie
-                for j in range(k + 1, n):
-                    for i in range(N_OUT):
-                        out[j, i] = np.nan
-                return h
+                err += error_share(e, x[i], xn[i], i)
+            err = rms_error(err)
             if not (err == err):
+                if h < 1e-6:
+                    # a trial that stays non-finite down to a microsecond step: report NaN rather
+                    # than loop or lie
+                    for j in range(k + 1, n):
+                        for i in range(N_OUT):
+                            out[j, i] = np.nan
+                    return h
                 # a non-finite trial (a stiff start overshooting into exp overflow): a smaller
                 # step, as for a large error, instead of giving up
                 h = h * 0.2
