@@ -11,6 +11,8 @@ import pytest
 from conftest import REAL_DATA
 from test_importers import fake_alog
 
+from roastlab.workflows import roaster
+
 
 def test_init_detects_an_artisan_layout_and_writes_commented_files(cli, tmp_path):
     """SYNTHETIC Artisan logs (test_importers.fake_alog) with Burner and Air events and a weight."""
@@ -225,3 +227,40 @@ def test_an_unseen_gas_drum_with_burner_events_is_fitted_with_no_hand_edits(cli,
     held = float(out.split("held out: FIT ")[1].split(" %")[0])
     base = float(out.split("baseline: ")[1].split(" %")[0])
     assert held > 80.0 and held > base + 10.0, out
+
+
+@pytest.mark.parametrize(
+    "machine, capacity_kg, heat",
+    [
+        ("Hottop KN-8828B-2K+", 0.25, "both"),  # a fixed entry: the model's digits are not a capacity
+        ("Aillio Bullet R1", 1.0, "drum"),
+        ("Giesen W6A", 6.0, "both"),
+        ("Loring S15 Falcon", 15.0, "air"),
+        ("Probatone II 12Kg", 12.0, "both"),
+        ("Diedrich IR-2.5", 2.5, "both"),
+        ("Coffeetool R500", 0.5, "both"),  # grams: the fixed entry before the family's kg rule
+        ("Coffeetool R15", 15.0, "both"),
+        ("San Franciscan SF25", 25 * 0.45359237, "both"),  # pounds
+        ("Skywalker", None, None),
+        ("Giesen", None, None),  # the family without a model number: no capacity to read
+    ],
+)
+def test_catalogue_reads_the_capacity_from_the_model_number(machine, capacity_kg, heat):
+    entry = roaster.catalogue_entry(machine)
+    if capacity_kg is None:
+        assert entry is None
+    else:
+        assert entry[0] == pytest.approx(capacity_kg) and entry[1] == heat and "(" in entry[2]  # a source
+
+
+def test_init_states_a_capacity_read_from_the_catalogue(cli, tmp_path):
+    extra = {"roastertype": "Giesen W6A", "weight": [3000.0, 0.0, "g"]}
+    logs = []
+    for k in range(2):
+        p = tmp_path / f"g{k}.alog"
+        p.write_text(fake_alog(extra=extra))
+        logs.append(p)
+    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
+    assert code == 0, err
+    plant = (tmp_path / "cfg" / "plant.toml").read_text()
+    assert "batch capacity 6 kg: the catalogue: Giesen" in plant and "Mm_kg = 18" in plant  # 3 kg per kg

@@ -13,7 +13,7 @@ What :func:`survey` detects in the logs (and says in the files' comments):
 * each log's green batch (Artisan ``weight``, RoasTime ``weightGreen``, a file name's "230g").
 
 The plant (:func:`estimate_plant`) comes from the drum's dimensions when given, else from the
-batch capacity (given, from :data:`CATALOGUE` by the log's machine name, or twice the largest
+batch capacity (given, from :data:`CATALOGUE` by the log's machine name or model number, or twice the largest
 logged batch) by the same rules the shipped examples' hand estimates follow: a drum that holds
 the capacity at a 20 % fill, length 1.25 diameters, vanes D/8 high at 0.6 D pitch, metal 3 kg
 per kg of capacity. The fit spec (:func:`fit_spec_text`) frees what these logs can determine:
@@ -48,14 +48,54 @@ OTHER_NAMES = {
     "drum speed": ("drum", "trommel", "tambour", "tambor"),
 }
 FAN_NAMES = ("air", "fan", "airflow", "ventilateur", "lüfter", "luefter", "luft", "ventilador", "aria", "風", "风")
-#: Published capacities of common roasters, by a word of Artisan's ``roastertype`` (lower case).
-#: Each: (green batch capacity [kg], how the heat enters, source).
-CATALOGUE = {
-    "aillio": (1.0, "drum", "Aillio Bullet R1: 1 kg maximum batch, induction-heated drum (aillio.com product page)"),
-    "hottop": (0.25, "both", "Hottop KN-8828B-2K+: 250 g maximum batch, electric element (hottopusa.com)"),
-    "behmor": (0.454, "both", "Behmor 1600+: 1 lb maximum batch, quartz elements (behmor.com)"),
-    "kaffelogic": (0.12, "air", "Kaffelogic Nano 7: 120 g maximum batch, hot-air (kaffelogic.com)"),
-}
+#: Pounds to kilograms (San Franciscan model numbers are pounds of green coffee per batch).
+LB_KG = 0.45359237
+
+
+@dataclass(frozen=True)
+class Machine:
+    """One catalogue entry: a roaster family recognised in Artisan's ``roastertype``.
+
+    ``pattern`` is a regular expression searched in the lower-case machine name. Its first group,
+    when it has one, is the model number, which these makers set to the rated batch in
+    ``per_unit_kg`` units (Giesen W6: 6 kg; San Franciscan SF25: 25 lb); an entry without a group
+    has the fixed ``capacity_kg``. ``heat`` says where the heater's power enters: ``"drum"``
+    (induction), ``"air"`` (hot air or a convection burner) or ``"both"``.
+    """
+
+    pattern: str
+    heat: str
+    source: str
+    capacity_kg: float | None = None
+    per_unit_kg: float = 1.0
+
+    def capacity(self, machine: str) -> float | None:
+        """The rated green batch [kg] of ``machine`` if this entry names it, else None."""
+        m = re.search(self.pattern, machine.lower())
+        if m is None:
+            return None
+        if self.capacity_kg is not None:
+            return self.capacity_kg
+        return float(m.group(1)) * self.per_unit_kg
+
+
+#: Published capacities of common roasters, first match wins (a fixed model before its family's
+#: number rule). The model lists are Artisan's machine pages (artisan-scope.org/machines/...);
+#: drum dimensions are not published by these makers, so the plant is estimated from the capacity.
+CATALOGUE = (
+    Machine(r"aillio|bullet", "drum", "Aillio Bullet R1: 1 kg maximum batch, induction-heated drum (aillio.com product page)", 1.0),
+    Machine(r"hottop", "both", "Hottop KN-8828B-2K+: 250 g maximum batch, electric element (hottopusa.com)", 0.25),
+    Machine(r"behmor", "both", "Behmor 1600+: 1 lb maximum batch, quartz elements (behmor.com)", 0.454),
+    Machine(r"kaffelogic", "air", "Kaffelogic Nano 7: 120 g maximum batch, hot-air (kaffelogic.com)", 0.12),
+    Machine(r"coffeetool\D*r\s?500", "both", "Coffeetool R500: 500 g batch (coffeetool.gr; artisan-scope.org/machines/coffeetool)", 0.5),
+    Machine(r"coffeetool\D*r\s?(\d+(?:\.\d+)?)", "both", "Coffeetool R3/R5/R15: the model number is the batch in kg (coffeetool.gr; artisan-scope.org/machines/coffeetool)"),
+    Machine(r"giesen\D*w\s?(\d+)", "both", "Giesen W1-W140: the model number is the batch in kg (giesencoffeeroasters.eu; artisan-scope.org/machines/giesen)"),
+    Machine(r"loring\D*s\s?(\d+)", "air", "Loring S7/S15/S35/S70: the model number is the batch in kg, convection burner (loring.com; artisan-scope.org/machines/loring)"),
+    Machine(r"probat\D*?(\d+)", "both", "Probat(one) 5/12/25: the model number is the batch in kg (probat.com; artisan-scope.org/machines/probat)"),
+    Machine(r"\bimf\D*rm\s?(\d+)", "both", "IMF RM5/RM15: the model number is the batch in kg (imf-srl.com; artisan-scope.org/machines/imf)"),
+    Machine(r"diedrich\D*ir\s?-?(\d+(?:\.\d+)?)", "both", "Diedrich IR-2.5/IR-5/IR-12: the model number is the batch in kg (diedrichroasters.com; artisan-scope.org/machines/diedrich)"),
+    Machine(r"(?:san\s?franciscan\D*|\b)sf\s?-?(\d+)", "both", "San Franciscan SF1-SF75: the model number is the batch in pounds (sanfranroaster.com; artisan-scope.org/machines/sf)", per_unit_kg=LB_KG),
+)  # fmt: skip
 #: Fill fraction at which a drum holds its rated batch [-] (the examples' estimates: 20-25 %).
 RATED_FILL = 0.20
 #: Drum length over diameter [-], vane height and pitch over diameter, metal per kg of capacity
@@ -225,9 +265,14 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
     )
 
 
-def catalogue_entry(machine: str):
-    low = machine.lower()
-    return next((v for k, v in CATALOGUE.items() if k in low), None)
+def catalogue_entry(machine: str) -> tuple[float, str, str] | None:
+    """``(rated batch [kg], heat path, source)`` of the first :data:`CATALOGUE` entry that names
+    ``machine`` (Artisan's ``roastertype``), or None for a machine the catalogue does not know."""
+    for entry in CATALOGUE:
+        cap = entry.capacity(machine)
+        if cap is not None and cap > 0:
+            return cap, entry.heat, entry.source
+    return None
 
 
 def batch_capacity(s: Survey, capacity_kg=None) -> tuple[float, str]:
