@@ -9,9 +9,8 @@ from pathlib import Path
 import pytest
 
 from conftest import REAL_DATA
-from test_importers import fake_alog
-
 from roastlab.workflows import roaster
+from test_importers import fake_alog
 
 
 def test_init_detects_an_artisan_layout_and_writes_commented_files(cli, tmp_path):
