@@ -172,16 +172,19 @@ def predict_ta(packed: PackedBatches, names: list[str], values: np.ndarray) -> n
     return predict_outputs(packed, names, values, with_tb=False)[0]
 
 
-def predict_outputs(packed: PackedBatches, names: list[str], values: np.ndarray, with_tb: bool = True, with_tgo=False):
+def predict_outputs(
+    packed: PackedBatches, names: list[str], values: np.ndarray, with_tb: bool = True, with_tgo=False, tol_scale=1.0
+):
     """Simulated probe reading Ta, (``with_tb``) bean temperature Tb and (``with_tgo``) outlet gas
     Tgo for every (value set, batch): arrays of shape (m, nb, nmax), NaN-padded; Tb and Tgo are
-    None when not asked for. Returns (ta, tb) or, with ``with_tgo``, (ta, tb, tgo)."""
+    None when not asked for. Returns (ta, tb) or, with ``with_tgo``, (ta, tb, tgo). ``tol_scale``
+    loosens the integrator's tolerances (:func:`roastlab.sim.kernels.integrate_into`; 1: full accuracy)."""
     m, nb = values.shape[0], packed.n_batches
     batch_of, X0, PP = run_arrays(packed, names, values)
     ta = np.full((m * nb, packed.T.shape[1]), np.nan)
     tb = np.full_like(ta, np.nan) if with_tb else np.empty((0, 0))
     tgo = np.full_like(ta, np.nan) if with_tgo else np.empty((0, 0))
-    ta_population_kernel(*packed.inputs, batch_of, X0, PP, packed.zoh, packed.h_max_s, ta, tb, tgo)
+    ta_population_kernel(*packed.inputs, batch_of, X0, PP, packed.zoh, packed.h_max_s, ta, tb, tgo, float(tol_scale))
     out = (ta.reshape(m, nb, -1), (tb.reshape(m, nb, -1) if with_tb else None))
     return (*out, tgo.reshape(m, nb, -1)) if with_tgo else out
 
