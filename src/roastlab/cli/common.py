@@ -118,6 +118,19 @@ def level_arg(text: str) -> float:
         raise argparse.ArgumentTypeError(exc.problem) from None
 
 
+def add_starts_option(p: argparse.ArgumentParser, per: str = "") -> None:
+    """``--starts N``: the starts a global search chooses for a local polish (``per``: e.g. " per fit")."""
+    from ..model.parameters import N_STARTS
+
+    p.add_argument(
+        "--starts",
+        type=count_arg("--starts", 1, 100),
+        default=N_STARTS,
+        help=f"starts chosen for a local polish{per} (default {N_STARTS}); a start inside the basin of an optimum "
+        "already found is skipped",
+    )
+
+
 def add_band_option(p: argparse.ArgumentParser, what: str, where: str) -> None:
     """``--band [LEVEL]``: ``what`` of this level (default BAND_LEVEL), from the model file's
     parameter covariance and roast-to-roast spread (:mod:`roastlab.evaluate.bands`); ``where``

@@ -9,8 +9,8 @@ from .common import (
     add_band_option,
     add_batch_options,
     add_model_options,
+    add_starts_option,
     check_targets,
-    count_arg,
     fit_inputs,
     float_arg,
     initial_changes,
@@ -256,12 +256,7 @@ def add_parsers(sub) -> None:
         "--method", choices=("global", "de"), default="global", help="global search (default) or differential evolution"
     )
     p.add_argument("--seed", type=seed_arg, default=0, help="random seed of the search (default 0)")
-    p.add_argument(
-        "--starts",
-        type=count_arg("--starts", 1, 100),
-        default=6,
-        help="starts chosen for a local polish (default 6); a start inside the basin of an optimum already found is skipped",
-    )
+    add_starts_option(p)
     p.add_argument(
         "--fix", action="append", metavar="NAME=V", help="hold a parameter fixed, e.g. --fix hgm=0.01 (repeatable)"
     )
@@ -329,12 +324,7 @@ def add_parsers(sub) -> None:
         help=f"green weights are grouped by rounding to this step [kg] (default {GROUP_STEP_SHARE:g} x the median)",
     )
     p.add_argument("--seed", type=seed_arg, default=0, help="random seed of every fit (default 0)")
-    p.add_argument(
-        "--starts",
-        type=count_arg("--starts", 1, 100),
-        default=6,
-        help="starts chosen for a local polish per fit (default 6; starts inside a found basin are skipped)",
-    )
+    add_starts_option(p, " per fit")
     p.add_argument("--json", metavar="COMPARE.json", help="write every variant's figures as JSON")
     p.add_argument("--plot", metavar="FIG.png", help="bar chart of each held-out size's FIT per variant")
     p.set_defaults(func=cmd_compare_models, baseline=None)

@@ -33,6 +33,7 @@ from ..model.parameters import (
     DEFAULT_WEIGHTS,
     FREE_NAMES,
     MODEL_OF_OUTPUT,
+    N_STARTS,
     OUTPUTS,
     REGISTRY,
     THETA_NAMES,
@@ -343,6 +344,32 @@ BASIN_FACTOR = 0.75
 SCREENING_TOL_SCALE = 100.0
 
 
+class _Basins:
+    """The optima found so far and their basin radii (:data:`BASIN_FACTOR`), in units of the
+    bounds' widths; two polishes whose ends agree to 1e-6 of every width found the same optimum."""
+
+    def __init__(self, lower: np.ndarray, width: np.ndarray):
+        self.lower, self.width, self.found = lower, width, []  # found: [[optimum, radius], ...]
+
+    def _unit(self, z) -> np.ndarray:
+        return (np.asarray(z, dtype=float) - self.lower) / self.width
+
+    def holds(self, start) -> bool:
+        """True when ``start`` lies inside the basin of an optimum already found."""
+        u = self._unit(start)
+        return any(np.linalg.norm(u - c) < BASIN_FACTOR * r for c, r in self.found)
+
+    def add(self, start, end) -> None:
+        """A polish went from ``start`` to ``end``: a new optimum, or a wider basin of a known one."""
+        u0, u = self._unit(start), self._unit(end)
+        travelled = float(np.linalg.norm(u0 - u))
+        same = next((b for b in self.found if np.max(np.abs(u - b[0])) <= 1e-6), None)
+        if same is None:
+            self.found.append([u, travelled])
+        else:
+            same[1] = max(same[1], travelled)
+
+
 def _polish(obj: Objective, z0: np.ndarray):
     scale = obj.upper - obj.lower
     res = least_squares(
@@ -367,7 +394,7 @@ def identify(
     method: str = "global",
     seed: int = 0,
     n_trial: int = 256,
-    n_starts: int = 6,
+    n_starts: int = N_STARTS,
     progress=None,
     weights: dict | None = None,
 ) -> IdentificationResult:
@@ -400,6 +427,7 @@ def identify(
             "inputs, or give other starting values in the fit spec"
         )
     rng = np.random.default_rng(seed)
+    width = obj.upper - obj.lower
     starts_log = []
     if method == "global":
         sampler = qmc.Sobol(nz, scramble=True, seed=rng)
@@ -408,11 +436,10 @@ def identify(
         ssr = obj.ssr_many(trial, SCREENING_TOL_SCALE)
         order = np.argsort(ssr[1:]) + 1
         chosen = [0]
-        scale = obj.upper - obj.lower
         for i in order:  # the best trial points that are not near-duplicates of a chosen one
             if len(chosen) >= n_starts:
                 break
-            if all(np.max(np.abs(trial[i] - trial[c]) / scale) > 0.05 for c in chosen):
+            if all(np.max(np.abs(trial[i] - trial[c]) / width) > 0.05 for c in chosen):
                 chosen.append(int(i))
         candidates = [trial[i] for i in chosen]
     else:
@@ -435,21 +462,14 @@ def identify(
         )
         candidates = [de.x]
     best = None
-    width = obj.upper - obj.lower
-    basins: list[list] = []  # [optimum, radius], in units of the bounds' widths
+    basins = _Basins(obj.lower, width)
     for k, z0 in enumerate(candidates):
-        u0 = (np.asarray(z0, dtype=float) - obj.lower) / width
-        if any(np.linalg.norm(u0 - c) < BASIN_FACTOR * r for c, r in basins):
+        if basins.holds(z0):
             starts_log.append({"start": [float(v) for v in z0], "skipped": "inside the basin of an optimum found"})
         else:
             z, ssr_k = _polish(obj, np.asarray(z0, dtype=float))
             starts_log.append({"start": [float(v) for v in z0], "end": [float(v) for v in z], "SSR": ssr_k})
-            u = (z - obj.lower) / width
-            same = next((b for b in basins if np.max(np.abs(u - b[0])) <= 1e-6), None)
-            if same is None:
-                basins.append([u, float(np.linalg.norm(u0 - u))])
-            else:
-                same[1] = max(same[1], float(np.linalg.norm(u0 - u)))
+            basins.add(z0, z)
             if best is None or ssr_k < best[1]:
                 best = (z, ssr_k)
         if progress is not None:

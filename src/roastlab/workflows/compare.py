@@ -26,7 +26,7 @@ import numpy as np
 from ..errors import InputError, ParameterError
 from ..model.bed import LAWS, VARIANTS, BedLaws
 from ..model.limits import check_value
-from ..model.parameters import FREE_NAMES, FreeParameter
+from ..model.parameters import FREE_NAMES, N_STARTS, FreeParameter
 from ..report.result import Result, aligned
 
 #: Default group step as a share of the median green weight (a tenth: 490 and 500 g together).
@@ -287,7 +287,7 @@ def compare_models(
     column_map=None,
     step_kg: float | None = None,
     seed: int = 0,
-    starts: int = 6,
+    starts: int = N_STARTS,
     progress=None,
 ) -> ModelComparison:
     """Fit each variant on ``batches`` and cross-validate it leaving one batch size out.

@@ -24,7 +24,7 @@ from ..io.importers.mapping import ColumnMap
 from ..io.plants import load_plant
 from ..metrics.profile import implausible_states
 from ..model.bed import PAPER_BED, BedLaws
-from ..model.parameters import REGISTRY, STATE0, THETA_NAMES, THETA_START
+from ..model.parameters import N_STARTS, REGISTRY, STATE0, THETA_NAMES, THETA_START
 from ..report.result import Result
 from ..sim.population import pack_batches
 from ..sim.simulate import InitialState
@@ -124,7 +124,7 @@ def fit(
     hold: str = "linear",
     method: str = "global",
     seed: int = 0,
-    starts: int = 6,
+    starts: int = N_STARTS,
     column_map: ColumnMap | None = None,
     progress=None,
     weights: dict | None = None,

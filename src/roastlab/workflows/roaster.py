@@ -34,7 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from ..io.importers.artisan import read_alog, read_artisan_csv
+from ..io.importers.artisan import WEIGHT_UNITS, read_alog, read_artisan_csv
 from ..io.importers.mapping import detect_format
 from ..io.importers.roastime import read_roastime
 from ..model.constants import GREEN_BULK_DENSITY_KG_M3
@@ -48,8 +48,6 @@ OTHER_NAMES = {
     "drum speed": ("drum", "trommel", "tambour", "tambor"),
 }
 FAN_NAMES = ("air", "fan", "airflow", "ventilateur", "lüfter", "luefter", "luft", "ventilador", "aria", "風", "风")
-#: Pounds to kilograms (San Franciscan model numbers are pounds of green coffee per batch).
-LB_KG = 0.45359237
 
 
 @dataclass(frozen=True)
@@ -85,7 +83,7 @@ class Machine:
 CATALOGUE = (
     Machine(r"aillio|bullet", "drum", "Aillio Bullet R1: 1 kg maximum batch, induction-heated drum (aillio.com product page)", 1.0),
     Machine(r"hottop", "both", "Hottop KN-8828B-2K+: 250 g maximum batch, electric element (hottopusa.com)", 0.25),
-    Machine(r"behmor", "both", "Behmor 1600+: 1 lb maximum batch, quartz elements (behmor.com)", 0.454),
+    Machine(r"behmor", "both", "Behmor 1600+: 1 lb maximum batch, quartz elements (behmor.com)", WEIGHT_UNITS["lb"]),
     Machine(r"kaffelogic", "air", "Kaffelogic Nano 7: 120 g maximum batch, hot-air (kaffelogic.com)", 0.12),
     Machine(r"coffeetool\D*r\s?500", "both", "Coffeetool R500: 500 g batch (coffeetool.gr; artisan-scope.org/machines/coffeetool)", 0.5),
     Machine(r"coffeetool\D*r\s?(\d+(?:\.\d+)?)", "both", "Coffeetool R3/R5/R15: the model number is the batch in kg (coffeetool.gr; artisan-scope.org/machines/coffeetool)"),
@@ -94,7 +92,7 @@ CATALOGUE = (
     Machine(r"probat\D*?(\d+)", "both", "Probat(one) 5/12/25: the model number is the batch in kg (probat.com; artisan-scope.org/machines/probat)"),
     Machine(r"\bimf\D*rm\s?(\d+)", "both", "IMF RM5/RM15: the model number is the batch in kg (imf-srl.com; artisan-scope.org/machines/imf)"),
     Machine(r"diedrich\D*ir\s?-?(\d+(?:\.\d+)?)", "both", "Diedrich IR-2.5/IR-5/IR-12: the model number is the batch in kg (diedrichroasters.com; artisan-scope.org/machines/diedrich)"),
-    Machine(r"(?:san\s?franciscan\D*|\b)sf\s?-?(\d+)", "both", "San Franciscan SF1-SF75: the model number is the batch in pounds (sanfranroaster.com; artisan-scope.org/machines/sf)", per_unit_kg=LB_KG),
+    Machine(r"(?:san\s?franciscan\D*|\b)sf\s?-?(\d+)", "both", "San Franciscan SF1-SF75: the model number is the batch in pounds (sanfranroaster.com; artisan-scope.org/machines/sf)", per_unit_kg=WEIGHT_UNITS["lb"]),
 )  # fmt: skip
 #: Fill fraction at which a drum holds its rated batch [-] (the examples' estimates: 20-25 %).
 RATED_FILL = 0.20
