@@ -17,22 +17,38 @@ from test_compare import synthetic_sizes
 def fitted():
     batches = [b for b in synthetic_sizes(seed=8) + synthetic_sizes(seed=9) if b.Mb_kg == 120.0]
     result = roastlab.fit(batches[:3], "120kg", bed="contact=wall", starts=2)
-    return result.model, batches
+    return result.model, batches, result.identification
 
 
 def test_spread_is_stored_and_is_the_rms_by_time():
     t = np.arange(0.0, 301.0, 10.0)
-    s = roast_spread([t, t, t[:11]], [t + 1, t - 1, t[:11] + 3], [t, t, t[:11]])
-    assert s["time_s"][0] == 0.0 and s["logs"] == 3
+    s = roast_spread([t, t, t[:11]], [t * 0 + 1, t * 0 - 1, t[:11] * 0 + 3])
+    assert s["time_s"][0] == 0.0 and s["logs"] == 3 and s["held_out"]
     assert s["rms_C"][0] == pytest.approx(
         np.sqrt((1 + 1 + 9) / 3), abs=1e-4
     )  # stored to 4 decimals  # three logs reach t = 0
     assert s["rms_C"][-1] == pytest.approx(1.0)  # past 100 s only two logs, errors +-1
-    assert roast_spread([t], [t], [t]) is None  # one log says nothing about the spread between roasts
+    assert roast_spread([t], [t]) is None  # one log says nothing about the spread between roasts
+
+
+def test_spread_is_each_log_predicted_without_it(fitted):
+    model, batches, identification = fitted
+    spread = model.doc["fit"]["spread"]
+    assert spread["held_out"]
+    v = model.validate(batches[:3])  # the fit set's own errors
+    own = [np.asarray(p) - np.asarray(m) for m, p in zip(v.measured, v.predicted)]
+    assert roast_spread(v.time_s, own)["time_s"] == spread["time_s"]
+    # rebuilt from the identification's held-out errors: each log errs more than in the fit
+    # (slightly here: two determined parameters over ~100 samples a log learn little from one log)
+    held = identification.held_out_Ta
+    for b, e in enumerate(own):
+        h = held[b, : e.size]
+        assert np.sqrt(np.nanmean(h**2)) > np.sqrt(np.nanmean(e**2))
+        assert np.nanmax(np.abs(h - e)) < 0.1  # and by what one log moves the fit: a little
 
 
 def test_band_holds_about_its_level_on_a_held_out_log(fitted):
-    model, batches = fitted
+    model, batches, _ = fitted
     assert model.doc["fit"]["spread"]["logs"] == 3
     rows = band_coverage(model, batches[3:], level=0.9)
     inside = np.mean([r["inside"] for r in rows])
@@ -46,7 +62,7 @@ def test_band_holds_about_its_level_on_a_held_out_log(fitted):
 
 
 def test_parameter_draws_follow_the_covariance(fitted):
-    model, _ = fitted
+    model, _, _ = fitted
     names, draws = parameter_draws(model, 4000, seed=1)
     assert names and draws.shape == (4000, len(names))
     for j, n in enumerate(names):
@@ -66,7 +82,7 @@ def test_levels_and_quantile():
 def test_validate_band_cli(fitted, tmp_path):
     from roastlab.io.batch import write_batch_csv
 
-    model, batches = fitted
+    model, batches, _ = fitted
     model.save(tmp_path / "m.json")
     write_batch_csv(tmp_path / "b.csv", batches[3])
     cmd = [sys.executable, "-m", "roastlab", "validate", "--model", "m.json", "b.csv", "--band", "--json", "v.json"]

@@ -10,7 +10,10 @@ sources of error, each a standard deviation at every instant t:
 * **roast to roast**: what no parameter explains (the roaster's state on the day, the beans).
   At fitting, the root mean square over the fit-set logs of the model's probe error at each time
   since CHARGE, sigma_r(t), is stored in the model file (``fit.spread``, on a
-  :data:`SPREAD_GRID_S` grid; held at its last value past the longest log).
+  :data:`SPREAD_GRID_S` grid; held at its last value past the longest log). Each log's error is
+  the one it would have had if it had been left out of the fit (cross-validated, linearised:
+  :func:`roastlab.fit.uncertainty.held_out_residuals`), because a new roast is not in the fit;
+  the fit set's own errors are smaller by what the parameters learnt from each log.
 
 The band is prediction +- sqrt((z sigma_p)^2 + (z_n sigma_r)^2), z the standard normal quantile
 of (1 + L)/2 and z_n = t_{(1+L)/2, n-1} sqrt(1 + 1/n) the prediction-interval factor of a new
@@ -35,17 +38,20 @@ SPREAD_GRID_S = 30.0
 BAND_SAMPLES = 200
 
 
-def roast_spread(time_s, measured, predicted) -> dict | None:
-    """``{"time_s": grid, "rms_C": ...}``: RMS over logs of measured - predicted probe at each grid
-    time (each log interpolated onto the grid; a time counts the logs that reach it). None for
-    fewer than two logs: one roast says nothing about the spread between roasts."""
+def roast_spread(time_s, errors_C, held_out: bool = True) -> dict | None:
+    """``{"time_s": grid, "rms_C": ..., "logs": n, "held_out": bool}``: RMS over logs of each log's
+    probe error at each grid time (each log interpolated onto the grid; a time counts the logs that
+    reach it). The errors should be each log's as predicted had it been left out of the fit
+    (``held_out``, :func:`roastlab.fit.uncertainty.held_out_residuals`): a fit follows its own logs
+    more closely than it predicts a new one, so the fit set's own errors understate the spread a new
+    roast meets. None for fewer than two logs: one roast says nothing about the spread between roasts."""
     if len(time_s) < 2:
         return None
     end = max(float(t[-1]) for t in time_s)
     grid = np.arange(0.0, end + SPREAD_GRID_S, SPREAD_GRID_S)
     sq, count = np.zeros(grid.size), np.zeros(grid.size)
-    for t, m, p in zip(time_s, measured, predicted):
-        e = np.asarray(m, float) - np.asarray(p, float)
+    for t, e in zip(time_s, errors_C):
+        t, e = np.asarray(t, float), np.asarray(e, float)
         ok = np.isfinite(e)
         if ok.sum() < 2:
             continue
@@ -56,7 +62,12 @@ def roast_spread(time_s, measured, predicted) -> dict | None:
     if not keep.any():
         return None
     rms = np.sqrt(sq[keep] / count[keep])
-    return {"time_s": grid[keep].tolist(), "rms_C": [round(float(v), 4) for v in rms], "logs": int(len(time_s))}
+    return {
+        "time_s": grid[keep].tolist(),
+        "rms_C": [round(float(v), 4) for v in rms],
+        "logs": int(len(time_s)),
+        "held_out": bool(held_out),
+    }
 
 
 def why_no_band(model) -> str | None:

@@ -62,7 +62,10 @@ class IdentificationResult:
     fixed : values held fixed; SSR : summed squared residual [degC^2] (eq. 19);
     stderr, correlation : from the Jacobian at the optimum; warnings : human-readable;
     n_residuals, nfev, wall_s, method, seed, starts : diagnostics;
-    outputs : per fitted output {"weight", "n", "SSR" (unweighted, degC^2)}.
+    outputs : per fitted output {"weight", "n", "SSR" (unweighted, degC^2)};
+    held_out_Ta : (nb, nmax) model - measured probe [degC] of each batch as predicted had it been
+    left out of the fit (:func:`roastlab.fit.uncertainty.held_out_residuals`), NaN where no
+    probe sample was fitted; None when Ta has no weight.
     """
 
     values: dict
@@ -81,6 +84,7 @@ class IdentificationResult:
     batches: list[str] = field(default_factory=list)
     outputs: dict = field(default_factory=dict)
     uncertainty: Uncertainty | None = None
+    held_out_Ta: np.ndarray | None = None
 
     @property
     def aic(self) -> float:
@@ -255,6 +259,18 @@ class Objective:
 
     def residuals(self, z: np.ndarray) -> np.ndarray:
         return self.residuals_many(z[None, :])[0]
+
+    def held_out_ta(self, z: np.ndarray, J: np.ndarray, determined: np.ndarray) -> np.ndarray | None:
+        """(nb, nmax) probe error (model - measured) [degC] of each batch had it been left out of the
+        fit, from the Jacobian ``J`` at the optimum ``z`` (:func:`uncertainty.held_out_residuals`,
+        each batch a group; every fitted output's residuals move the parameters); NaN where no
+        probe sample was fitted, None when the probe has no weight."""
+        if not self.masks["Ta"].any():
+            return None
+        r = uncertainty.held_out_residuals(J, self.residuals(z), self.batch_of_residual, determined) / self.sqrt_w
+        out = np.full(self.packed.TA.shape, np.nan)
+        out[self.masks["Ta"]] = r[self.output_of_residual == OUTPUTS.index("Ta")]
+        return out
 
     def failed_batches(self, z: np.ndarray) -> list[str]:
         """Names of the batches whose simulation at ``z`` is not finite (empty when all run)."""
@@ -482,7 +498,9 @@ def identify(
             "the bounds admit only values for which the model diverges"
         )
     labels = [free[j].name if b < 0 else f"{free[j].name}[{packed.names[b]}]" for j, b in obj.layout]
-    unc = uncertainty.from_jacobian(obj.jacobian(z), z, obj.lower, obj.upper, ssr, labels)
+    J = obj.jacobian(z)
+    unc = uncertainty.from_jacobian(J, z, obj.lower, obj.upper, ssr, labels)
+    held_out_Ta = obj.held_out_ta(z, J, ~(unc.at_lower | unc.at_upper | unc.flat))
     values: dict = {}
     for k, (j, b) in enumerate(obj.layout):
         name = free[j].name
@@ -508,4 +526,5 @@ def identify(
         batches=list(packed.names),
         outputs=obj.output_ssr(z),
         uncertainty=unc,
+        held_out_Ta=held_out_Ta,
     )

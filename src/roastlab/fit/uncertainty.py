@@ -190,6 +190,42 @@ def from_normal(jtj, z, lower, upper, ssr: float, n_residuals: int, names) -> Un
     return Uncertainty(list(names), z, lower, upper, se, cov, corr, at_lo, at_hi, flat, float(ssr), int(n_residuals))
 
 
+def held_out_residuals(J, r, groups, determined) -> np.ndarray:
+    """Each residual as it would be had its group (a batch) been left out of the fit: the
+    linearised leave-one-group-out (cross-validated) residuals.
+
+    For a least-squares fit with residuals r (n,) and Jacobian J (n, k) at its optimum, leaving
+    group i out moves the parameters by one Gauss-Newton step from the full fit,
+    dz = (A - A_i)^+ J_i' r_i with A = J'J and A_i = J_i'J_i over the ``determined`` parameters
+    (the full fit's stationarity, sum_j J_j'r_j = 0, gives the right-hand side), so the group's
+    residuals become
+
+        r_i^(-i) = r_i + J_i (A - A_i)^+ J_i' r_i      (= (I - H_ii)^-1 r_i, H = J A^-1 J')
+
+    exact for a model linear in its parameters (the grouped PRESS residual; Belsley, Kuh & Welsch
+    1980 for one residual). Parameters a bound holds stay held; one only group i determines keeps
+    its value (a zero row of A - A_i). ``groups`` (n,) labels each residual's group.
+
+    >>> J = np.array([[1.0], [1.0], [1.0], [1.0]])  # a mean fitted to two groups of two
+    >>> r = np.array([1.0, 1.0, -1.0, -1.0])
+    >>> held_out_residuals(J, r, np.array([0, 0, 1, 1]), np.array([True])).tolist()
+    [2.0, 2.0, -2.0, -2.0]
+    """
+    J = np.asarray(J, dtype=float)[:, np.asarray(determined, dtype=bool)]
+    r = np.asarray(r, dtype=float)
+    groups = np.asarray(groups)
+    out = r.copy()
+    if J.shape[1] == 0:
+        return out
+    A = J.T @ J
+    for g in np.unique(groups):
+        rows = groups == g
+        Ji = J[rows]
+        dz = np.linalg.pinv(A - Ji.T @ Ji) @ (Ji.T @ r[rows])
+        out[rows] = r[rows] + Ji @ dz
+    return out
+
+
 def from_jacobian(J, z, lower, upper, ssr: float, names) -> Uncertainty:
     """The :class:`Uncertainty` of a fit from the Jacobian ``J`` (n, k) of its residuals at ``z``."""
     J = np.asarray(J, dtype=float)

@@ -200,8 +200,18 @@ def fit(
         summary = odd[0] if len(odd) == 1 else f"{odd[0]} (and {len(odd) - 1} more batch(es) alike)"
         ident.warnings.append(summary)
         doc["fit"]["warnings"] = ident.warnings
-    # the roast-to-roast part of the prediction bands (evaluate.bands): the fit set's probe error by time
-    doc["fit"]["spread"] = roast_spread(validation.time_s, validation.measured, validation.predicted)
+    # the roast-to-roast part of the prediction bands (evaluate.bands): each log's probe error by time
+    # (each log's error as predicted without it, fit.uncertainty.held_out_residuals; the fit set's own
+    # errors when the probe was not fitted)
+    held = ident.held_out_Ta
+    if held is not None:
+        errors = [held[b, : packed.N[b]] for b in range(packed.n_batches)]
+        doc["fit"]["spread"] = roast_spread([packed.T[b, : packed.N[b]] for b in range(packed.n_batches)], errors)
+    else:
+        errors = [
+            np.asarray(p, float) - np.asarray(m, float) for m, p in zip(validation.measured, validation.predicted)
+        ]
+        doc["fit"]["spread"] = roast_spread(validation.time_s, errors, held_out=False)
     doc["metrics"] = {
         "batches": [{"name": n, **r} for n, r in zip(validation.names, validation.rows)],
         "average": validation.average,
