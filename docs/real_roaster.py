@@ -23,8 +23,8 @@ from roastlab.fit.baseline import describe, fit_first_order, validate_first_orde
 from roastlab.io.fitspec import load_fit_spec
 from roastlab.io.importers.mapping import load_map
 from roastlab.model.bed import PAPER_BED
-from roastlab.workflows.compare import Variant
 from roastlab.model.parameters import REGISTRY
+from roastlab.workflows.compare import Variant
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT.parent / "shared" / "data" / "real"
@@ -272,6 +272,43 @@ def variants_and_bands(column_map, paths, lines):
     lines.append("")
 
 
+def spread_against_refits(column_map, paths, lines):
+    """The bands' roast-to-roast spread takes each fitted log's error as predicted without it, by the
+    linearised rule (roastlab.fit.uncertainty.held_out_residuals); here against refitting the
+    example without each 490-500 g fit log in turn."""
+    from roastlab.evaluate.bands import roast_spread
+
+    example = ROOT / "examples" / "bullet"
+    fit_b = load([p for p in paths if grams(p) in (490, 500)][0::2], column_map)
+    full = roastlab.fit(fit_b, example / "plant.toml", example / "fit.toml", column_map=column_map)
+    held = full.identification.held_out_Ta
+    own_v = full.model.validate(fit_b)
+    lines += [
+        "### The bands' roast-to-roast spread: linearised leave-one-log-out against refits (Bullet, 490-500 g fit logs)",
+        "",
+        "| log | RMS error in the fit °C | linearised, left out °C | refit without it °C |",
+        "|---|---|---|---|",
+    ]
+    times, refit_errors = [], []
+    for i, b in enumerate(fit_b):
+        model = roastlab.fit(fit_b[:i] + fit_b[i + 1 :], example / "plant.toml", example / "fit.toml", column_map=column_map).model
+        v = model.validate([b])
+        e = np.asarray(v.predicted[0]) - np.asarray(v.measured[0])
+        own = np.asarray(own_v.predicted[i]) - np.asarray(own_v.measured[i])
+        times.append(np.asarray(v.time_s[0]))
+        refit_errors.append(e)
+        rms = [float(np.sqrt(np.nanmean(x**2))) for x in (own, held[i, : e.size], e)]
+        lines.append(f"| {b.name} | {rms[0]:.2f} | {rms[1]:.2f} | {rms[2]:.2f} |")
+    linear = full.model.doc["fit"]["spread"]["rms_C"]
+    refit = roast_spread(times, refit_errors)["rms_C"]
+    lines += [
+        "",
+        f"Median spread over the roast: {np.median(linear):.2f} °C linearised, {np.median(refit):.2f} °C from the refits.",
+        "",
+    ]
+    print(f"spread: linearised {np.median(linear):.2f} °C, refits {np.median(refit):.2f} °C", file=sys.stderr)
+
+
 def skywalker_et(paths, lines):
     """ET minus BT on each Skywalker log (median from 1 min after CHARGE to DROP, and at 4:00):
     whether ET can be fitted as one model quantity on every log."""
@@ -318,6 +355,7 @@ def main() -> int:
     )
     scaling(model, column_map, bullet, val, lines)
     variants_and_bands(column_map, bullet, lines)
+    spread_against_refits(column_map, bullet, lines)
     (DOCS / "real-roaster-results.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
     print("wrote docs/real-roaster-results.md, docs/real-roaster-scaling.png", file=sys.stderr)
     return 0

@@ -90,6 +90,30 @@ def test_skywalker_fit_and_validate(cli, real_data, tmp_path):
     assert code == 0 and "first-order baseline" in out, err
 
 
+def test_skywalker_fit_on_bt_alone_fails_on_its_states(cli, real_data, tmp_path):
+    """Without ET the fit heats the beans through the air with the drum metal below them: it is
+    marked failed (exit 1, the model file says why, commands using it warn); the example's ET
+    weight makes the same logs' fit physical (test above)."""
+    fit_logs = sorted(real_data.glob("*.alog"))[0:4:2]
+    theta = tmp_path / "bt-only.json"
+    common = ["--plant", EXAMPLE / "plant.toml", "--map", EXAMPLE / "map.toml"]
+    args = ("identify", *common, "--spec", EXAMPLE / "fit.toml", *fit_logs, "--out", theta, "--starts", "2")
+    code, out, err = cli(*args, "--weight", "ET=0")
+    errors = [line for line in err.splitlines() if line.startswith("error:")]
+    assert code == 1 and len(errors) == 1 and "the fit failed, non-physical states" in errors[0], err
+    assert str(theta) in errors[0] and "--weight ET=1" in errors[0]
+    assert "FIT FAILED" in out
+    doc = json.loads(theta.read_text())
+    assert (
+        doc["fit"]["failed"].startswith("non-physical states: ")
+        and "drum metal colder than the beans" in doc["fit"]["failed"]
+    )
+    code, _, err = cli("validate", "--model", theta, fit_logs[0])
+    assert code == 0 and "this model's fit failed" in err
+    code, _, err = cli(*args)
+    assert code == 0 and "failed" not in err, err
+
+
 BULLET = Path(__file__).resolve().parents[1] / "examples" / "bullet"
 
 

@@ -97,7 +97,7 @@ def test_init_and_fit_roaster_reach_the_hand_written_examples_on_the_shared_logs
 def _synthetic_hottop_logs(folder: Path, n_logs: int = 6, seed: int = 7) -> list[Path]:
     """SYNTHETIC Artisan logs of a machine no example describes: a Fahrenheit Hottop whose heater
     and fan are extra-device curves (%), 0.25 kg batches. The layout comes from
-    test_importers.fake_alog; BT and ET are roastlab's own model of the catalogue's Hottop
+    test_importers.fake_alog; BT and ET (the outlet gas) are roastlab's own model of the catalogue's Hottop
     (``roastlab init`` on the layout) with chosen heater/actuator values, plus seeded noise."""
     import numpy as np
 
@@ -138,7 +138,11 @@ def _synthetic_hottop_logs(folder: Path, n_logs: int = 6, seed: int = 7) -> list
     for p, (heater, fan) in zip(paths, layouts):
         sim = truth.predict(roastlab.load_log(p, cmap))
         bt = sim.Ta_C + rng.normal(0.0, 0.3, n)
-        p.write_text(fake_alog("F", f(bt), f(sim.Tm_C), n, {**extra, "timex": t,
+        # ET: the drum's air (the outlet gas, as a fit weighs it); at CHARGE the empty preheated drum's
+        # air, which the map reads as the drum temperature
+        et = sim.Tgo_C + rng.normal(0.0, 0.3, n)
+        et[0] = sim.Tm_C[0]
+        p.write_text(fake_alog("F", f(bt), f(et), n, {**extra, "timex": t,
                      "extratemp1": [heater.tolist()], "extratemp2": [fan.tolist()]}))  # fmt: skip
     shutil.rmtree(cfg)
     return paths
@@ -205,7 +209,8 @@ def _synthetic_gas_drum_logs(folder: Path, n_logs: int = 6, seed: int = 11) -> l
     for p, events in zip(paths, layouts):
         sim = truth.predict(roastlab.load_log(p, cmap))  # on the map's resampled grid
         bt = np.interp(t, sim.time_s, sim.Ta_C) + rng.normal(0.0, 0.3, n)
-        et = np.interp(t, sim.time_s, sim.Tm_C)
+        et = np.interp(t, sim.time_s, sim.Tgo_C) + rng.normal(0.0, 0.3, n)  # ET: the drum's air (outlet gas),
+        et[0] = sim.Tm_C[0]  # at CHARGE the empty preheated drum's, read as the drum temperature
         p.write_text(fake_alog("C", bt.tolist(), et.tolist(), n, {**extra, **events, "timex": t}))
     shutil.rmtree(cfg)
     return paths

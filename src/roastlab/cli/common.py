@@ -227,12 +227,21 @@ def initial_changes(args) -> dict:
     return changes
 
 
+def warn_if_failed(model, path) -> None:
+    """One warning line when the model file's fit failed (:attr:`FittedModel.failed`)."""
+    if model.failed:
+        print(
+            f"warning: {path}: this model's fit failed ({model.failed}); do not trust its predictions", file=sys.stderr
+        )
+
+
 def model_from_args(args, plant_spec):
     """The model of a command: --model (or the paper's theta*), with --hgm/--hbm/--pbm and variants applied."""
     from ..workflows.model import FittedModel, load_model
 
     if getattr(args, "model", None):
         model = load_model(args.model)
+        warn_if_failed(model, args.model)
     else:
         if plant_spec is None:
             raise InputError("--plant is required without --model", "command line")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 from ..errors import InputError
@@ -76,6 +77,11 @@ def cmd_identify(args) -> int:
         out.write_text(args.out, model_document_text(result.model.to_document()))
     print(result.report())
     print(f"-> {args.out}")
+    if result.failed:
+        from ..workflows.fitting import FAILED_HINT
+
+        print(f"error: {args.out}: the fit failed, {result.failed}; {FAILED_HINT}", file=sys.stderr)
+        return 1
     return 0
 
 

@@ -45,6 +45,11 @@ def cmd_fit_roaster(args) -> int:
     for w in r["warnings"]:
         print(f"warning: {w}", file=sys.stderr)
     print(f"wrote {r['model']}, {r['report']}")
+    if r["failed"]:
+        from ..workflows.fitting import FAILED_HINT
+
+        print(f"error: {r['model']}: the fit failed, {r['failed']}; {FAILED_HINT}", file=sys.stderr)
+        return 1
     return 0
 
 

@@ -12,6 +12,7 @@ from .common import (
     range_arg,
     read_inputs,
     say,
+    warn_if_failed,
     write_json_and_plot,
 )
 
@@ -30,6 +31,7 @@ def cmd_transfer(args) -> int:
             "--gg fixes the flow; --gg-min/--gg-max let the optimiser choose it: give one or the other", "command line"
         )
     model = load_model(args.model)
+    warn_if_failed(model, args.model)
     reference = read_inputs(args.reference, args.map, model)
     say(reference.notes)
     initial = {}

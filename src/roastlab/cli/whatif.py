@@ -13,6 +13,7 @@ from .common import (
     initial_changes,
     read_inputs,
     say,
+    warn_if_failed,
     write_json_and_plot,
 )
 
@@ -26,6 +27,7 @@ def cmd_whatif(args) -> int:
     outputs = Outputs([args.log, args.model, args.map])
     check_targets(outputs, args.json, plot=args.plot)
     model = load_model(args.model)
+    warn_if_failed(model, args.model)
     cmap = load_map(args.map) if args.map else model.column_map
     units = cmap.setting_units() if cmap is not None else {}
     setting_changes = [

@@ -30,6 +30,12 @@ from ..sim.population import pack_batches
 from ..sim.simulate import InitialState
 from .model import PAPER_INITIAL, PLACEHOLDER_GG_KG_S, FittedModel, load_log, provenance
 
+#: What to try when a fit fails on non-physical states (printed by the commands that fit).
+FAILED_HINT = (
+    "a drum roaster's metal runs hotter than its beans; weight the logged ET so the fit can tell the "
+    "heater's paths apart ([weights] ET = 1 in the fit spec, or --weight ET=1)"
+)
+
 
 @dataclasses.dataclass
 class FitResult(Result):
@@ -51,6 +57,11 @@ class FitResult(Result):
     def warnings(self) -> list[str]:
         return self.identification.warnings
 
+    @property
+    def failed(self) -> str | None:
+        """Why the fit failed (states the machine cannot have, :attr:`FittedModel.failed`), or None."""
+        return self.model.failed
+
     def report(self) -> str:
         """Text report in the spirit of lmfit's ``fit_report``: values, errors, fit figures, warnings."""
         ident = self.identification
@@ -60,6 +71,8 @@ class FitResult(Result):
         )
         corr = ident.correlation
         lines = [head, self.model.report(), "correlations (|r| > 0.5):"]
+        if self.failed:
+            lines.insert(1, f"FIT FAILED: {self.failed}")
         names = corr["names"]
         for a in range(len(names)):
             for b in range(a + 1, len(names)):
@@ -194,12 +207,14 @@ def fit(
         doc["bed"] = laws.as_dict()
     model = FittedModel(doc)
     validation = model.validate(batches)
-    # a fit whose states a drum roaster cannot have is reported, not hidden (metrics.profile)
+    # a fit whose states a drum roaster cannot have has failed, however small its SSR (metrics.profile);
+    # the model file is still written, marked, so it can be looked at
     odd = [f"{r.name}: {w}" for r in validation.results for w in implausible_states(r)]
     if odd:
         summary = odd[0] if len(odd) == 1 else f"{odd[0]} (and {len(odd) - 1} more batch(es) alike)"
         ident.warnings.append(summary)
         doc["fit"]["warnings"] = ident.warnings
+        doc["fit"]["failed"] = f"non-physical states: {summary}"
     # the roast-to-roast part of the prediction bands (evaluate.bands): each log's probe error by time
     # (each log's error as predicted without it, fit.uncertainty.held_out_residuals; the fit set's own
     # errors when the probe was not fitted)

@@ -116,6 +116,12 @@ class FittedModel:
         self.source: str | None = doc.get("_source")
 
     @property
+    def failed(self) -> str | None:
+        """Why this model's fit failed (its states are ones the machine cannot have:
+        :func:`roastlab.metrics.profile.implausible_states`), or None for a fit that stands."""
+        return (self.doc.get("fit") or {}).get("failed")
+
+    @property
     def bed(self) -> BedLaws:
         """The bed laws (:mod:`roastlab.model.bed`): the model file's ``bed``, else the paper's."""
         return BedLaws.parse(self.doc.get("bed"))

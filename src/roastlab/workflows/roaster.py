@@ -21,7 +21,10 @@ the paper's three coefficients and the probe constant always; the gas flow when 
 logged; the heater's gains and lag when a heater is logged (into the drum metal, and into the
 air unless the machine heats the drum itself); the fan's share of the flow when a fan is
 logged; a shell loss when the inlet is room air; the probe's immersion and the second reading's
-weight when the log has a second bean reading. Bounds come from the quantity table.
+weight when the log has a second bean reading; ET's weight (against the outlet gas) when ET is
+logged beside a heater, because a fit on BT alone can heat the beans by a path the machine does
+not have, and such a fit fails (:attr:`roastlab.workflows.model.FittedModel.failed`). Bounds come
+from the quantity table.
 """
 
 from __future__ import annotations
@@ -103,6 +106,12 @@ LENGTH_OVER_DIAMETER = 1.25
 VANE_HEIGHT_OVER_D = 1 / 8
 VANE_PITCH_OVER_D = 0.6
 METAL_KG_PER_KG = 3.0
+#: Highest gas flow a fit may reach, per kg of batch capacity [kg/s per kg] (never below
+#: :data:`GAS_FLOW_MAX_FLOOR_KG_S`): six times the paper's 120 kg plant (0.3-0.4 kg/s, dataset-I's
+#: Gg, about 0.003 kg/s per kg), so a machine's flow scales with its size instead of one bound for all.
+GAS_FLOW_MAX_KG_S_PER_KG = 0.02
+#: The gas-flow bound of the small roasters the examples fit (Skywalker, Bullet) [kg/s].
+GAS_FLOW_MAX_FLOOR_KG_S = 0.05
 #: Lower bound of the heat-transfer coefficients a small roaster's fit may reach [kW/(m2 K)]: an
 #: order below the quantity table's fit bounds (made for the paper's industrial drums), inside
 #: its plausible range (the Bullet's gas-metal coefficient ends near it).
@@ -378,13 +387,14 @@ def fit_spec_text(s: Survey, capacity_kg: float) -> str:
     def line(name, lo, hi, start, why):
         return f"{name} = [{lo:g}, {hi:g}, {start:g}]".ljust(40) + f"# {why}"
 
+    gg_hi = round(max(GAS_FLOW_MAX_FLOOR_KG_S, GAS_FLOW_MAX_KG_S_PER_KG * capacity_kg), 4)
     rows = [
         "# Written by roastlab init: what these logs can determine (see roastlab.workflows.roaster).",
         "[free]",
         line("hgm", SMALL_COEFF_FLOOR, 1.0, 0.02, "gas-metal coefficient [kW/(m2 K)]"),
         line("hbm", SMALL_COEFF_FLOOR, 1.0, 0.02, "metal-bean coefficient [kW/(m2 K)]"),
         line("Pbm", 0.05, 0.95, 0.5, "bean area touching metal [-]"),
-        line("Gg_kg_s", 0.0005, 0.05, 0.005, "gas flow [kg/s] (not logged)"),
+        line("Gg_kg_s", 0.0005, gg_hi, gg_hi / 10, "gas flow [kg/s] (not logged)"),
         line("Kt", 0.002, 0.2, 0.02, "bean-probe inverse time constant [1/s]"),
     ]
     entry = catalogue_entry(s.machine) if s.machine else None
@@ -416,13 +426,15 @@ def fit_spec_text(s: Survey, capacity_kg: float) -> str:
         rows.append(line("h_probe_m", 0.0, 0.2, 0.04, "bed depth that covers the bean probe [m]"))
     rows += ["", "[initial]", "Tb0_C = 22.0                          # green beans at room temperature",
              "X0 = 0.11                             # typical green-coffee moisture [kg/kg dry]"]  # fmt: skip
+    weights = []
     if s.second_bean:
-        rows += [
-            "",
-            "[weights]",
-            "Ta = 1.0",
-            "Tb2 = 1.0                             # the second bean reading vs the model's Tb",
-        ]
+        weights.append("Tb2 = 1.0                             # the second bean reading vs the model's Tb")
+    if s.has_et and s.heater:
+        # ET is then a reading, not the inlet (map_text): fitted against the outlet gas, it tells the
+        # heater's paths (into the air, into the drum) apart, which BT alone cannot
+        weights.append("ET = 1.0                              # the logged ET vs the model's outlet gas Tgo")
+    if weights:
+        rows += ["", "[weights]", "Ta = 1.0", *weights]
     return "\n".join(rows) + "\n"
 
 
@@ -464,7 +476,7 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0) -> dict:
     from ..io.files import Outputs
     from ..io.importers.mapping import load_map
     from ..io.modelfile import model_document_text
-    from .fitting import fit
+    from .fitting import FAILED_HINT, fit
     from .model import load_log
 
     d = Path(config_dir)
@@ -493,6 +505,11 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0) -> dict:
     lines = [
         f"# {model.plant.name if model.plant else 'roaster'}: fitted by roastlab fit-roaster",
         "",
+        *(
+            [f"**The fit failed**: {result.failed}. {FAILED_HINT[0].upper()}{FAILED_HINT[1:]}.", ""]
+            if result.failed
+            else []
+        ),
         f"{len(batches)} logs sorted by {by}, split alternately: {len(fit_b)} fit, {len(val_b)} held out "
         f"(the fit never saw them). Fit in {result.identification.wall_s:.1f} s.",
         "",
@@ -531,6 +548,7 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0) -> dict:
         "held_out": {"FIT": v_val.average["FIT"], "MAE": v_val.average["MAE"]},
         "baseline_held_out": {"FIT": bv["FIT"], "MAE": bv["MAE"]},
         "warnings": result.warnings,
+        "failed": result.failed,
         "model": d / "model.json",
         "report": d / "report.md",
     }
