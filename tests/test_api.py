@@ -66,7 +66,9 @@ def test_fit_prediction_equals_identification(sky_model):
     logs = [Path(i["path"]) for i in doc["provenance"]["inputs"] if i["role"] == "batch"]
     val = model.validate([roastlab.load_log(p, model.column_map) for p in logs])
     ssr = sum(r["SSR"] for r in val.rows)
-    assert ssr == pytest.approx(doc["fit"]["SSR"], rel=1e-9)
+    outputs = doc["fit"]["outputs"]  # the example weighs ET too: the fit's SSR sums the weighted outputs
+    assert ssr == pytest.approx(outputs["Ta"]["SSR"], rel=1e-9)
+    assert sum(o["weight"] * o["SSR"] for o in outputs.values()) == pytest.approx(doc["fit"]["SSR"], rel=1e-9)
 
 
 def test_model_file_round_trip_and_contents(tmp_path):

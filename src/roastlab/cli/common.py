@@ -227,6 +227,17 @@ def initial_changes(args) -> dict:
     return changes
 
 
+def failed_fit_status(failed: str | None, path) -> int:
+    """The exit status of a command that fitted: 0, or 1 with one line naming the model file
+    ``path``, why the fit failed (:attr:`FitResult.failed`) and what to try."""
+    if not failed:
+        return 0
+    from ..workflows.fitting import FAILED_HINT
+
+    print(f"error: {path}: the fit failed, {failed}; {FAILED_HINT}", file=sys.stderr)
+    return 1
+
+
 def warn_if_failed(model, path) -> None:
     """One warning line when the model file's fit failed (:attr:`FittedModel.failed`)."""
     if model.failed:

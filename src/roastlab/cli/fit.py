@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 from ..errors import InputError
@@ -12,6 +11,7 @@ from .common import (
     add_model_options,
     add_starts_option,
     check_targets,
+    failed_fit_status,
     fit_inputs,
     float_arg,
     initial_changes,
@@ -77,12 +77,7 @@ def cmd_identify(args) -> int:
         out.write_text(args.out, model_document_text(result.model.to_document()))
     print(result.report())
     print(f"-> {args.out}")
-    if result.failed:
-        from ..workflows.fitting import FAILED_HINT
-
-        print(f"error: {args.out}: the fit failed, {result.failed}; {FAILED_HINT}", file=sys.stderr)
-        return 1
-    return 0
+    return failed_fit_status(result.failed, args.out)
 
 
 def _identify_per_batch(args, batches, plant_spec, fix, bounds, outputs) -> int:

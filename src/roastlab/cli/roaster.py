@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .common import float_arg, progress
+from .common import failed_fit_status, float_arg, progress
 
 
 def cmd_init(args) -> int:
@@ -45,12 +45,7 @@ def cmd_fit_roaster(args) -> int:
     for w in r["warnings"]:
         print(f"warning: {w}", file=sys.stderr)
     print(f"wrote {r['model']}, {r['report']}")
-    if r["failed"]:
-        from ..workflows.fitting import FAILED_HINT
-
-        print(f"error: {r['model']}: the fit failed, {r['failed']}; {FAILED_HINT}", file=sys.stderr)
-        return 1
-    return 0
+    return failed_fit_status(r["failed"], r["model"])
 
 
 def add_parsers(sub) -> None:
