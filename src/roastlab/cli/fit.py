@@ -244,7 +244,9 @@ def add_parsers(sub) -> None:
         "[weights], of the model's bean temperature against a second bean reading) over the given batches within bounds, "
         "by a seeded global search (scattered starts polished by bounded least squares) or differential evolution. "
         "Writes the fitted model file (roastlab-model/1): plant, theta and every other fitted or held value with "
-        "standard errors and bounds, the initial states, the column map, fit-set metrics and provenance.",
+        "standard errors and bounds, the initial states, the column map, fit-set metrics and provenance. "
+        "Exit status 1 when the fit failed (states the machine cannot have, such as drum metal below the beans; "
+        "the model file is written and marked failed), 2 on bad input.",
         epilog="example: roastlab identify --plant 120kg dataset-I/ --out model.json",
     )
     add_batch_options(

@@ -72,10 +72,11 @@ def add_parsers(sub) -> None:
     p = sub.add_parser(
         "fit-roaster",
         help="fit, hold out, compare with a baseline and report, from 'roastlab init's files",
-        description="With DIR from 'roastlab init': sort LOG... by name and split them alternately (1st, 3rd, ... fit; "
+        description="With DIR from 'roastlab init': sort LOG... by when they were roasted (by name when a log has no date) and split them alternately (1st, 3rd, ... fit; "
         "2nd, 4th, ... held out), identify the model, validate it on the held-out logs, fit the first-order "
         "baseline on the same inputs, and write DIR/model.json (MODEL.json for every other command), "
-        "DIR/report.md and DIR/heldout.png.",
+        "DIR/report.md and DIR/heldout.png. Exit status 1 when the fit failed (states the machine cannot have, "
+        "such as drum metal below the beans; the files are written and say so), 2 on bad input.",
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog="example:\n  roastlab fit-roaster myroaster roasts/*.alog",
     )
