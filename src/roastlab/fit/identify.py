@@ -221,9 +221,10 @@ class Objective:
             [model[MODEL_OF_OUTPUT[k]][:, self.masks[k]] for k in OUTPUTS if self.masks[k].any()], axis=1
         )
 
-    def output_ssr(self, z: np.ndarray) -> dict:
-        """Per fitted output: its weight, sample count and unweighted SSR [degC^2] at ``z``."""
-        r = self.residuals(z) / self.sqrt_w
+    def output_ssr(self, r: np.ndarray) -> dict:
+        """Per fitted output: its weight, sample count and unweighted SSR [degC^2], from the weighted
+        residuals ``r`` (:meth:`residuals`)."""
+        r = r / self.sqrt_w
         return {
             k: {
                 "weight": self.weights[k],
@@ -260,14 +261,14 @@ class Objective:
     def residuals(self, z: np.ndarray) -> np.ndarray:
         return self.residuals_many(z[None, :])[0]
 
-    def held_out_ta(self, z: np.ndarray, J: np.ndarray, determined: np.ndarray) -> np.ndarray | None:
+    def held_out_ta(self, r: np.ndarray, J: np.ndarray, determined: np.ndarray) -> np.ndarray | None:
         """(nb, nmax) probe error (model - measured) [degC] of each batch had it been left out of the
-        fit, from the Jacobian ``J`` at the optimum ``z`` (:func:`uncertainty.held_out_residuals`,
-        each batch a group; every fitted output's residuals move the parameters); NaN where no
-        probe sample was fitted, None when the probe has no weight."""
+        fit, from the weighted residuals ``r`` and their Jacobian ``J`` at the optimum
+        (:func:`uncertainty.held_out_residuals`, each batch a group; every fitted output's residuals
+        move the parameters); NaN where no probe sample was fitted, None when the probe has no weight."""
         if not self.masks["Ta"].any():
             return None
-        r = uncertainty.held_out_residuals(J, self.residuals(z), self.batch_of_residual, determined) / self.sqrt_w
+        r = uncertainty.held_out_residuals(J, r, self.batch_of_residual, determined) / self.sqrt_w
         out = np.full(self.packed.TA.shape, np.nan)
         out[self.masks["Ta"]] = r[self.output_of_residual == OUTPUTS.index("Ta")]
         return out
@@ -498,9 +499,8 @@ def identify(
             "the bounds admit only values for which the model diverges"
         )
     labels = [free[j].name if b < 0 else f"{free[j].name}[{packed.names[b]}]" for j, b in obj.layout]
-    J = obj.jacobian(z)
+    r, J = obj.residuals(z), obj.jacobian(z)
     unc = uncertainty.from_jacobian(J, z, obj.lower, obj.upper, ssr, labels)
-    held_out_Ta = obj.held_out_ta(z, J, ~(unc.at_lower | unc.at_upper | unc.flat))
     values: dict = {}
     for k, (j, b) in enumerate(obj.layout):
         name = free[j].name
@@ -524,7 +524,7 @@ def identify(
         starts=starts_log,
         bounds={lab: [float(obj.lower[k]), float(obj.upper[k])] for k, lab in enumerate(labels)},
         batches=list(packed.names),
-        outputs=obj.output_ssr(z),
+        outputs=obj.output_ssr(r),
         uncertainty=unc,
-        held_out_Ta=held_out_Ta,
+        held_out_Ta=obj.held_out_ta(r, J, unc.determined),
     )

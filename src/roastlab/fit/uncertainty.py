@@ -111,6 +111,11 @@ class Uncertainty:
     n_residuals: int
 
     @property
+    def determined(self) -> np.ndarray:
+        """Where the data determine the parameter: neither held by a bound nor flat."""
+        return ~(self.at_lower | self.at_upper | self.flat)
+
+    @property
     def k_free(self) -> int:
         return len(self.names)
 
