@@ -11,6 +11,10 @@ Figures (medians of repeated runs):
 * ``population_speedup``: the same per-batch ratio with 1,000 parameter sets (uniform in the
   Table 1 bounds) in one population call; the baseline is timed on a sample of those same
   sets, since corners of the box are stiffer than theta* for both integrators;
+* ``population_cost``: where a population run's time goes, one thread: right-hand-side
+  evaluations per run (counted by the integrator), the cost of one evaluation as one dependent
+  chain and as four runs interleaved (equal costs: the evaluations are throughput-bound, so
+  interleaving runs on a core would not help), and the integrator's share;
 * ``max_abs_dev_C``: largest temperature difference project vs baseline over those runs;
 * ``identify_paper_s``: identification on dataset-I in-process, compile cache warm;
 * ``identify_scaling``: fleet identification (a theta per batch) of 10, 100 and 1,000
@@ -344,6 +348,80 @@ def sensitivity_bench(quiet: bool = False, repeats: int = 7) -> dict:
     return out
 
 
+def _rhs_chains(p, evaluations: int, chains: int) -> float:
+    """Seconds for ``evaluations`` right-hand-side calls made as ``chains`` interleaved dependent
+    chains (each call's state is the previous one's Euler step, as an integrator's stages depend on
+    each other), compiled, one thread. One chain is how one run calls it; several interleaved show
+    whether a run is bound by the chain's latency (they overlap, so each call gets cheaper) or by
+    the calls' throughput (they do not)."""
+    kernel = _rhs_chain_kernel()
+    kernel(p, 64, chains)
+    t0 = time.perf_counter()
+    kernel(p, evaluations, chains)
+    return time.perf_counter() - t0
+
+
+_RHS_CHAIN_KERNEL = []
+
+
+def _rhs_chain_kernel():
+    if not _RHS_CHAIN_KERNEL:
+        from numba import njit
+
+        from roastlab.model.rhs import derivatives
+
+        @njit
+        def chains_kernel(p, evaluations, chains):
+            Tb = np.empty(chains)
+            Tm = np.empty(chains)
+            X = np.empty(chains)
+            Ta = np.empty(chains)
+            for i in range(evaluations // chains):
+                if i % 1000 == 0:  # restart at a mid-roast state so the chains stay physical
+                    for c in range(chains):
+                        Tb[c], Tm[c], X[c], Ta[c] = 120.0 + c, 180.0, 0.08, 115.0
+                for c in range(chains):
+                    d = derivatives(Tb[c], Tm[c], X[c], 10.0, Ta[c], 0.0, 0.3, 450.0, 0.0, 0.0, p)
+                    Tb[c] += 1e-2 * d[0]
+                    Tm[c] += 1e-2 * d[1]
+                    X[c] += 1e-2 * d[2]
+                    Ta[c] += 1e-2 * d[4]
+            return Tb.sum() + Tm.sum() + X.sum() + Ta.sum()
+
+        _RHS_CHAIN_KERNEL.append(chains_kernel)
+    return _RHS_CHAIN_KERNEL[0]
+
+
+def population_cost(packed, thetas: np.ndarray, population_us: float, repeats: int = 7) -> dict:
+    """Where a population run's time goes (one thread): the right-hand-side evaluations the
+    integrator makes per run (:func:`roastlab.sim.kernels.count_evaluations`, over the population's
+    own sets), the cost of one evaluation as one dependent chain and as four interleaved, and what
+    is left for the integrator (stage sums, error norm, step control)."""
+    from roastlab.sim.kernels import count_evaluations
+
+    b = 0
+    inputs = [a[b] for a in packed.inputs[:5]]  # the batch's t, Gg, Tgi, heater, fan
+    evals = []
+    for theta in thetas:
+        pk = packed.PB[b].copy()
+        pk[0:3] = theta
+        evals.append(count_evaluations(*inputs, packed.x0[b], pk, packed.zoh, packed.h_max_s))
+    n = 400_000
+    with numba_threads(1):
+        one = [_rhs_chains(packed.PB[b], n, 1) / n * 1e9 for _ in range(repeats)]
+        four = [_rhs_chains(packed.PB[b], n, 4) / n * 1e9 for _ in range(repeats)]
+    per_run = float(np.mean(evals))
+    rhs_us = per_run * float(np.median(one)) / 1e3
+    return {
+        "evaluations_per_run_mean": per_run,
+        "evaluations_per_run_range": [int(min(evals)), int(max(evals))],
+        "rhs_ns_one_chain": _spread(one),
+        "rhs_ns_four_chains_interleaved": _spread(four),
+        "rhs_us_per_run": rhs_us,
+        "integrator_us_per_run": population_us - rhs_us,
+    }
+
+
 def _times(fn, repeats: int) -> np.ndarray:
     times = []
     for _ in range(repeats):
@@ -519,6 +597,8 @@ def run(quiet: bool = False, baseline_repeats: int = 5, only: str | None = None)
         "population_us_per_batch_all_cores": _spread(pop_all, 1e6),
     }
     res["max_abs_dev_C"] = dev
+    _log("population: where the time goes (one thread) ...", quiet)
+    res["population_cost"] = population_cost(packed, thetas, pop_s * 1e6)
 
     # --- identification on dataset-I -------------------------------------------------------
     _load("identify", res)
@@ -681,6 +761,14 @@ def table(res: dict) -> str:
                 f"{res['population_s_per_batch'] * 1e6:.1f} µs/batch",
                 f"one thread; all cores {res['population_s_per_batch_all_cores'] * 1e6:.1f} µs/batch "
                 f"({res['population_speedup_all_cores']:.0f}x)",
+            ),
+            (
+                "  of which the right-hand side",
+                f"{res['population_cost']['rhs_us_per_run']:.1f} µs/batch",
+                f"{res['population_cost']['evaluations_per_run_mean']:.0f} evaluations x "
+                f"{res['population_cost']['rhs_ns_one_chain']['median']:.1f} ns (4 runs interleaved: "
+                f"{res['population_cost']['rhs_ns_four_chains_interleaved']['median']:.1f} ns each); "
+                f"integrator {res['population_cost']['integrator_us_per_run']:.1f} µs",
             ),
             (
                 "identify dataset-I",

@@ -206,3 +206,37 @@ def test_bed_laws_match_reference(laws):
     assert np.max(np.abs(fast.Tgo_C - ref_tgo)) < TOL_C
     immersed = simulate("120kg", t, Gg, Tgi - 200.0, theta=theta, initial=x0, heater=heater, values={"Qe_gain_kW": 0.5})
     assert np.max(np.abs(immersed.states - fast.states)) > 0.5  # the laws act (not a comparison of two paper models)
+
+
+@pytest.mark.parametrize("zoh", [False, True])
+def test_count_evaluations_counts_every_right_hand_side_call(monkeypatch, zoh):
+    """The benchmark's cost figure: the compiled count equals the calls the same integrator makes
+    when run as Python with a counting right-hand side, and has the method's structure (a first
+    stage per restart, then six per trial)."""
+    from roastlab.model.plant import as_plant
+    from roastlab.model.rhs import pack_params
+    from roastlab.sim import kernels
+
+    t = np.arange(0.0, 601.0, 30.0)
+    Gg = 0.3 + 0.02 * np.sin(t / 50.0)
+    Tgi = 450.0 + 20.0 * np.cos(t / 70.0)
+    zeros = np.zeros_like(t)
+    p = pack_params(as_plant("120kg"), (0.01, 0.3, 0.6))
+    x0 = InitialState().vector(30.0)
+    args = (t, Gg, Tgi, zeros, zeros, x0, p, zoh, kernels.H_MAX_S)
+    compiled_count = int(kernels.count_evaluations(*args))
+
+    calls = []
+    real_f = kernels._f
+
+    def counting_f(*a):
+        calls.append(1)
+        return real_f(*a)
+
+    monkeypatch.setattr(kernels, "_f", counting_f)
+    out = np.empty((t.size, kernels.N_OUT))
+    kernels.integrate_into.py_func(t, Gg, Tgi, zeros, zeros, t.size, x0, p, zoh, kernels.H_MAX_S, out)
+    assert compiled_count == len(calls)
+    restarts = t.size - 1 if zoh else 1
+    assert (compiled_count - restarts) % 6 == 0
+    assert compiled_count >= restarts + 6 * (t.size - 1)  # at least one trial per sample interval

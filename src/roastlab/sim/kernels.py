@@ -114,7 +114,7 @@ def next_step(err, h, h_try, last, h_max):
 
 
 @compiled
-def integrate_into(t, Gg, Tgi, Q, F, n, x0, p, zoh, h_max, out, h0=H0_S, with_tgo=True, tol_scale=1.0):
+def integrate_into(t, Gg, Tgi, Q, F, n, x0, p, zoh, h_max, out, h0=H0_S, with_tgo=True, tol_scale=1.0, evals=None):
     """Integrate one batch over samples t[0..n-1]; write states and Tgo to out[:n, :N_OUT].
 
     Inputs per sample: gas flow ``Gg`` [kg/s], inlet temperature ``Tgi`` [degC], heater
@@ -125,6 +125,8 @@ def integrate_into(t, Gg, Tgi, Q, F, n, x0, p, zoh, h_max, out, h0=H0_S, with_tg
     needs only Ta, so ``with_tgo=False`` skips the outlet-gas output (column I_TGO left as is).
     ``tol_scale`` multiplies ATOL and RTOL (1: the contract's accuracy; a screening of many
     trial points that only ranks them may pass more, :data:`roastlab.fit.identify.SCREENING_TOL_SCALE`).
+    ``evals`` (an int64 array of one, or None): adds the number of right-hand-side evaluations
+    the run made (:func:`count_evaluations`; with None the count is compiled out).
     """
     x = np.empty(NS)
     for i in range(NS):
@@ -150,6 +152,8 @@ def integrate_into(t, Gg, Tgi, Q, F, n, x0, p, zoh, h_max, out, h0=H0_S, with_tg
             # a zero-order hold jumps at the sample, so the derivative there is new; a linear
             # hold is continuous, so the last stage of the previous interval is still valid
             _f(x, g0, T0, q0, f0, p, k1)
+            if evals is not None:
+                evals[0] += 1
         while s < dt:
             steps += 1
             if steps > MAX_STEPS or h < 1e-9 * dt:
@@ -186,6 +190,8 @@ def integrate_into(t, Gg, Tgi, Q, F, n, x0, p, zoh, h_max, out, h0=H0_S, with_tg
             for i in range(NS):
                 xn[i] = x[i] + h * (_B1 * k1[i] + _B3 * k3[i] + _B4 * k4[i] + _B5 * k5[i] + _B6 * k6[i])
             _f(xn, g0 + dg * a, T0 + dT * a, q0 + dq * a, f0 + df * a, p, k7)
+            if evals is not None:
+                evals[0] += 6  # stages 2-7 (stage 1 is the last step's 7th: first same as last)
             err = 0.0
             for i in range(NS):
                 e = h * (_E1 * k1[i] + _E3 * k3[i] + _E4 * k4[i] + _E5 * k5[i] + _E6 * k6[i] + _E7 * k7[i])
@@ -232,6 +238,17 @@ def failure(states: np.ndarray, t: np.ndarray) -> str | None:
             "billionth of the sample interval): these values give it a time constant far below a second"
         )
     return f"the simulation went non-finite after {after}"
+
+
+@compiled
+def count_evaluations(t, Gg, Tgi, Q, F, x0, p, zoh, h_max):
+    """How many right-hand-side evaluations :func:`integrate_into` makes for one run (accepted and
+    rejected trials alike): the integrator's cost in units of the model, for the benchmark."""
+    n = t.shape[0]
+    out = np.empty((n, N_OUT))
+    evals = np.zeros(1, dtype=np.int64)
+    integrate_into(t, Gg, Tgi, Q, F, n, x0, p, zoh, h_max, out, H0_S, False, 1.0, evals)
+    return evals[0]
 
 
 @compiled
