@@ -337,3 +337,32 @@ def test_bullet_control_decides_the_heater_on_its_steps(cli, bullet_model, tmp_p
     trace = pd.read_csv(tmp_path / "t.csv", comment="#")
     applied = trace["heater_applied"].to_numpy()
     assert set(np.unique(applied)) <= set(range(10)) and len(np.unique(applied)) > 1
+
+
+def test_a_stepped_heater_slower_than_a_step_per_sample_still_moves(cli, bullet_model, tmp_path):
+    """The Bullet's knob has whole steps and the scenario allows 8 steps/min at a 2-s sample (0.27
+    of a step per sample). Rounding each sample's rate-limited move held the knob at its charge
+    setting for the whole roast, whatever the controller asked; the knob follows the rate-limited
+    path instead, one step at a time, never faster on average than the limit."""
+    import pandas as pd
+
+    scenario = tmp_path / "heater.toml"
+    scenario.write_text(
+        '[actuator]\ndecide = "heater"\nheater_min = 1\nheater_max = 9\nheater_rate_per_min = 8\nsample_s = 2.0\n'
+    )
+    ref = REAL_DATA / "bullet" / "bullet_2020-11-05_1536_500g.json"
+    for controller in ("replay", "mpc"):
+        trace = tmp_path / f"{controller}.csv"
+        code, _, err = cli(
+            "control", "--model", bullet_model, "--reference", ref, "--map", BULLET / "map.toml",
+            "--scenario", scenario, "--controller", controller, "--out", trace,
+        )  # fmt: skip
+        assert code == 0, err
+        tr = pd.read_csv(trace, comment="#")
+        applied = tr["heater_applied"].to_numpy()
+        steps = np.diff(applied)
+        assert np.unique(applied).size > 2, controller  # it moved
+        assert set(np.unique(applied)) <= set(range(1, 10))  # on the knob's steps
+        assert np.abs(steps).max() <= 1.0  # one step at a time
+        minutes = (tr["time_s"].iloc[-1] - tr["time_s"].iloc[0]) / 60.0
+        assert np.abs(steps).sum() <= 8.0 * minutes + 1.0  # the rate limit, on average

@@ -301,10 +301,13 @@ def run_closed_loop(model, reference: Batch, controller, scenario: Scenario | st
         lo, hi = max(lim.low, u_prev - cap), min(lim.high, u_prev + cap)
         applied = min(max(u, lo), hi)
         violations += abs(applied - u) > tol
-        if lim.actuator is not None and lim.actuator.stepped:  # the machine's knob has steps
+        u_prev = applied  # the rate-limited path, before the knob's steps
+        if lim.actuator is not None and lim.actuator.stepped:
+            # the machine's knob has steps: it takes the setting nearest the rate-limited path, so a
+            # rate below one step per sample still moves it (one step each time the path has gone
+            # half a step), where rounding each sample's move would hold it still for ever
             applied = float(np.clip(lim.actuator.quantise(applied), lim.low, lim.high))
         u_app[k] = applied
-        u_prev = applied
         est = getattr(controller, "estimate", None)
         if est:
             for key, v in est.items():
