@@ -48,6 +48,7 @@ and when the run ended, so a slow figure can be told from a busy machine.
 from __future__ import annotations
 
 import contextlib
+import functools
 import json
 import os
 import subprocess
@@ -361,35 +362,32 @@ def _rhs_chains(p, evaluations: int, chains: int) -> float:
     return time.perf_counter() - t0
 
 
-_RHS_CHAIN_KERNEL = []
-
-
+@functools.cache
 def _rhs_chain_kernel():
-    if not _RHS_CHAIN_KERNEL:
-        from numba import njit
+    """The compiled chains of :func:`_rhs_chains` (built once, on first use: numba is imported late)."""
+    from numba import njit
 
-        from roastlab.model.rhs import derivatives
+    from roastlab.model.rhs import derivatives
 
-        @njit
-        def chains_kernel(p, evaluations, chains):
-            Tb = np.empty(chains)
-            Tm = np.empty(chains)
-            X = np.empty(chains)
-            Ta = np.empty(chains)
-            for i in range(evaluations // chains):
-                if i % 1000 == 0:  # restart at a mid-roast state so the chains stay physical
-                    for c in range(chains):
-                        Tb[c], Tm[c], X[c], Ta[c] = 120.0 + c, 180.0, 0.08, 115.0
+    @njit
+    def chains_kernel(p, evaluations, chains):
+        Tb = np.empty(chains)
+        Tm = np.empty(chains)
+        X = np.empty(chains)
+        Ta = np.empty(chains)
+        for i in range(evaluations // chains):
+            if i % 1000 == 0:  # restart at a mid-roast state so the chains stay physical
                 for c in range(chains):
-                    d = derivatives(Tb[c], Tm[c], X[c], 10.0, Ta[c], 0.0, 0.3, 450.0, 0.0, 0.0, p)
-                    Tb[c] += 1e-2 * d[0]
-                    Tm[c] += 1e-2 * d[1]
-                    X[c] += 1e-2 * d[2]
-                    Ta[c] += 1e-2 * d[4]
-            return Tb.sum() + Tm.sum() + X.sum() + Ta.sum()
+                    Tb[c], Tm[c], X[c], Ta[c] = 120.0 + c, 180.0, 0.08, 115.0
+            for c in range(chains):
+                d = derivatives(Tb[c], Tm[c], X[c], 10.0, Ta[c], 0.0, 0.3, 450.0, 0.0, 0.0, p)
+                Tb[c] += 1e-2 * d[0]
+                Tm[c] += 1e-2 * d[1]
+                X[c] += 1e-2 * d[2]
+                Ta[c] += 1e-2 * d[4]
+        return Tb.sum() + Tm.sum() + X.sum() + Ta.sum()
 
-        _RHS_CHAIN_KERNEL.append(chains_kernel)
-    return _RHS_CHAIN_KERNEL[0]
+    return chains_kernel
 
 
 def population_cost(packed, thetas: np.ndarray, population_us: float, repeats: int = 7) -> dict:
