@@ -396,14 +396,12 @@ def population_cost(packed, thetas: np.ndarray, population_us: float, repeats: i
     own sets), the cost of one evaluation as one dependent chain and as four interleaved, and what
     is left for the integrator (stage sums, error norm, step control)."""
     from roastlab.sim.kernels import count_evaluations
+    from roastlab.sim.population import run_arrays
 
     b = 0
     inputs = [a[b] for a in packed.inputs[:5]]  # the batch's t, Gg, Tgi, heater, fan
-    evals = []
-    for theta in thetas:
-        pk = packed.PB[b].copy()
-        pk[0:3] = theta
-        evals.append(count_evaluations(*inputs, packed.x0[b], pk, packed.zoh, packed.h_max_s))
+    _, X0, PP = run_arrays(packed, ["hgm", "hbm", "Pbm"], thetas[:, None, :])  # the population's own runs
+    evals = [count_evaluations(*inputs, x0, pp, packed.zoh, packed.h_max_s) for x0, pp in zip(X0, PP)]
     n = 400_000
     with numba_threads(1):
         one = [_rhs_chains(packed.PB[b], n, 1) / n * 1e9 for _ in range(repeats)]
