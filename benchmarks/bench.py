@@ -368,9 +368,11 @@ def _rhs_chain_kernel():
     from numba import njit
 
     from roastlab.model.rhs import derivatives
+    from roastlab.sim.kernels import parameter_tuple
 
     @njit
-    def chains_kernel(p, evaluations, chains):
+    def chains_kernel(p_array, evaluations, chains):
+        p = parameter_tuple(p_array)  # as the integrator passes them
         Tb = np.empty(chains)
         Tm = np.empty(chains)
         X = np.empty(chains)

@@ -114,13 +114,14 @@ def where(condition, a, b):
 def gas_heat_capacity_kJ_kgK(Tgi_C):
     """Specific heat of the drying air cg [kJ/(kg K)] at inlet temperature [degC] (eq. 2).
 
-    The polynomial of eq. 2 is in J/(kg K) of the absolute temperature; divided by 1000.
+    The polynomial of eq. 2 is in J/(kg K) of the absolute temperature; times 1e-3 (a product,
+    not a division, on the integrator's hot path).
 
     >>> round(gas_heat_capacity_kJ_kgK(450.0), 4)
     1.0807
     """
     T = Tgi_C + KELVIN
-    return (_A0 + T * (_A1 + T * (_A2 + T * (_A3 + T * (_A4 + T * (_A5 + T * _A6)))))) / 1000.0
+    return (_A0 + T * (_A1 + T * (_A2 + T * (_A3 + T * (_A4 + T * (_A5 + T * _A6)))))) * 1e-3
 
 
 @register_jitable
@@ -223,18 +224,26 @@ def probe_rate_C_s(Tb, Ta, Tg, p):
 
 @register_jitable
 def exchanger(Tb, Tm, X, Gg, Tgi, p):
-    """The gas path of eq. 15e: ``(T_star [degC], NTU [-], F [-], Agb, Abm [m^2], he [kW/(m^2 K)], cg [kJ/(kg K)])``.
+    """The gas path of eq. 15e: ``(T_star [degC], NTU [-], w [-], Agb, Abm [m^2], he [kW/(m^2 K)], cg [kJ/(kg K)])``.
 
     T* = (Tb + F Tm)/(1 + F) is the mean sink temperature (eq. 5/15e), NTU = he Agb (1 + F)/(Gg cg)
-    (eq. 15e), F eq. 6, the areas from :func:`bed_areas_m2`, he eq. 3, cg eq. 2.
+    (eq. 15e), F = hgm Agm/(he Agb) eq. 6, the areas from :func:`bed_areas_m2`, he eq. 3, cg eq. 2;
+    w = F/(1 + F) is the metal's share of the sink conductance, the factor of eq. 10.
+
+    Evaluated through the conductances G = he Agb (gas-bean) and C = hgm Agm (gas-metal), F = C/G:
+    multiplying eq. 5's and eq. 10's fractions by G gives T* = (G Tb + C Tm)/(G + C),
+    w = C/(G + C) and NTU = (G + C)/(Gg cg), one reciprocal for all three where F's own quotient
+    and the three divisions by (1 + F) took four (the integrator's inner loop; same values to rounding).
     """
     Agb, Abm = bed_areas_m2(p)  # section 3.1 (or the bed's contact law)
     he = bean_heat_transfer_coefficient_kW_m2K(X)  # eq. 3
     cg = gas_heat_capacity_kJ_kgK(Tgi)  # eq. 2
-    F = conductance_ratio_F(p[I_HGM], p[I_AGM], he, Agb)  # eq. 6
-    T_star = (Tb + F * Tm) / (1.0 + F)  # eq. 5/15e: mean sink temperature
-    NTU = he * Agb * (1.0 + F) / (Gg * cg)  # eq. 15e
-    return T_star, NTU, F, Agb, Abm, he, cg
+    G = he * Agb  # gas-bean conductance [kW/K]
+    C = p[I_HGM] * p[I_AGM]  # gas-metal conductance [kW/K]; F = C / G, eq. 6
+    r = 1.0 / (G + C)  # = 1 / (G (1 + F))
+    T_star = (G * Tb + C * Tm) * r  # eq. 5/15e: mean sink temperature (Tb + F Tm)/(1 + F)
+    NTU = (G + C) / (Gg * cg)  # eq. 15e: he Agb (1 + F)/(Gg cg)
+    return T_star, NTU, C * r, Agb, Abm, he, cg
 
 
 @register_jitable
@@ -255,10 +264,10 @@ def gas_heat_flows(Tb, Tm, Gg, Tgi, path, p):
     """Outlet gas temperature and heat flows ``(Tgo [degC], Qgb, Qgm, Qbm [kW])`` from the gas
     path ``path`` = :func:`exchanger` of the same instant: Tgi - Tgo from eq. 15e, Qgb eq. 9,
     Qgm eq. 10, Qbm eq. 11."""
-    T_star, NTU, F, Agb, Abm, he, cg = path
+    T_star, NTU, w, Agb, Abm, he, cg = path
     drop = (Tgi - T_star) * (1.0 - exp(-NTU))  # eq. 15e: Tgi - Tgo
     Qgb = Gg * cg * drop  # eq. 9
-    Qgm = F * (he * Agb * (Tb - Tm) + Qgb) / (1.0 + F)  # eq. 10
+    Qgm = w * (he * Agb * (Tb - Tm) + Qgb)  # eq. 10: F/(1 + F) (he Agb (Tb - Tm) + Qgb)
     Qbm = p[I_HBM] * Abm * (Tm - Tb)  # eq. 11
     return Tgi - drop, Qgb, Qgm, Qbm
 
@@ -277,7 +286,8 @@ def heat_flows(Tb, Tm, X, Gg, Tgi, p):
 def moisture_rate_1_s(Tb, X, p):
     """dX/dt [1/s] (eqs. 13, 15c); zero once X reaches 0 so X never goes negative."""
     Xn = X * X if p[I_XEXP] == 2.0 else X ** p[I_XEXP]
-    rate = -p[I_K1] * Xn / (p[I_DB] * p[I_DB]) * exp(-p[I_K2] / (Tb + KELVIN))
+    # k1/Db^2 depends on the parameters alone: the compiled integrator computes it once per run
+    rate = -(p[I_K1] / (p[I_DB] * p[I_DB])) * Xn * exp(-p[I_K2] * (1.0 / (Tb + KELVIN)))
     return where(X > 0.0, rate, 0.0)
 
 
@@ -285,10 +295,13 @@ def moisture_rate_1_s(Tb, X, p):
 def reaction_heat_rate_kW_kg(Tb, He, p):
     """Exothermic heat production Qr = dHe/dt [kW/kg dry] (eqs. 14, 15d)."""
     Het = p[I_HET]
-    return p[I_A] * (Het - He) / Het * exp(-p[I_HAR] / (Tb + KELVIN))
+    # A/Het once per run; 1/(Tb + 273.15) is the same quotient as the moisture law's (computed once)
+    return (p[I_A] / Het) * (Het - He) * exp(-p[I_HAR] * (1.0 / (Tb + KELVIN)))
 
 
-@register_jitable
+# inlined into each integrator stage (numba IR), so that with the parameters passed as a tuple
+# (roastlab.sim.kernels.integrate_into) their values are not copied into a call per evaluation
+@register_jitable(inline="always")
 def derivatives(Tb, Tm, X, He, Ta, H, Gg, Tgi, heater, fan, p):
     """Time derivatives of the six states (eqs. 15a-15d, 17, actuator lag) as a tuple.
 
@@ -304,9 +317,10 @@ def derivatives(Tb, Tm, X, He, Ta, H, Gg, Tgi, heater, fan, p):
     Mbd = p[I_MBD]
     cs = 1.099 + 0.007 * Tb  # partial heat capacity of bean solids, section 3.2
     dTb = (Qgb - Qgm + Qbm + Mbd * (Qr + p[I_LAM] * dX)) / (Mbd * (cs + p[I_CW] * X))  # eq. 15a
-    dTm = (Qgm - Qbm + heater_power_kW(H, p) - shell_loss_kW(Tm, p)) / (p[I_MM] * p[I_CM])  # eq. 15b, eq. 12's Qe
+    # eq. 15b, eq. 12's Qe; 1/(Mm cm) and 1/tau depend on the parameters alone (once per run compiled)
+    dTm = (Qgm - Qbm + heater_power_kW(H, p) - shell_loss_kW(Tm, p)) * (1.0 / (p[I_MM] * p[I_CM]))
     dTa = probe_rate_C_s(Tb, Ta, probe_gas_C(T, Tgo, path[0], path[1], p), p)  # eq. 17 (probe immersion: extension)
-    dH = (heater - H) / p[I_TAUH]  # actuator lag (extension)
+    dH = (heater - H) * (1.0 / p[I_TAUH])  # actuator lag (extension)
     return dTb, dTm, dX, Qr, dTa, dH
 
 

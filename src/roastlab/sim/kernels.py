@@ -20,8 +20,10 @@ import math
 
 import numpy as np
 from numba import prange
+from numba.extending import overload
+from numba.np.unsafe.ndarray import to_fixed_tuple
 
-from ..model.rhs import N_STATES, derivatives, outlet_gas_C
+from ..model.rhs import N_PARAMS, N_STATES, derivatives, outlet_gas_C
 from .cache import compiled
 
 #: Largest integration step [s].
@@ -58,6 +60,25 @@ _A51, _A52, _A53, _A54 = 19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729
 _A61, _A62, _A63, _A64, _A65 = 9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656
 _B1, _B3, _B4, _B5, _B6 = 35 / 384, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84
 _E1, _E3, _E4, _E5, _E6, _E7 = 71 / 57600, -71 / 16695, 71 / 1920, -17253 / 339200, 22 / 525, -1 / 40
+
+
+def parameter_tuple(p):
+    """The parameter vector ``p`` as a tuple of its values (plain Python: ``tuple(p)``).
+
+    Compiled, a tuple is a set of values, not memory: the compiler knows no store of the
+    integrator can change it, so what the right-hand side computes from the parameters alone
+    (the bed laws' branches and areas, 1/(Mm cm), k1/Db^2, the probe's coverage) is computed once
+    per run instead of once per evaluation. Same arithmetic, same values as with the array.
+    """
+    return tuple(p)
+
+
+@overload(parameter_tuple, jit_options={"cache": True})
+def _parameter_tuple_compiled(p):
+    def impl(p):
+        return to_fixed_tuple(p, N_PARAMS)
+
+    return impl
 
 
 @compiled(inline="always")
@@ -134,6 +155,7 @@ def integrate_into(t, Gg, Tgi, Q, F, n, x0, p, zoh, h_max, out, h0=H0_S, with_tg
         out[0, i] = x0[i]
     if with_tgo:
         out[0, I_TGO] = outlet_gas_C(x, Gg[0], Tgi[0], F[0], p)
+    pt = parameter_tuple(p)  # the right-hand side's parameter-only terms once per run
     k1 = np.empty(NS)
     k2 = np.empty(NS)
     k3 = np.empty(NS)
@@ -151,7 +173,7 @@ def integrate_into(t, Gg, Tgi, Q, F, n, x0, p, zoh, h_max, out, h0=H0_S, with_tg
         if zoh or k == 0:
             # a zero-order hold jumps at the sample, so the derivative there is new; a linear
             # hold is continuous, so the last stage of the previous interval is still valid
-            _f(x, g0, T0, q0, f0, p, k1)
+            _f(x, g0, T0, q0, f0, pt, k1)
             if evals is not None:
                 evals[0] += 1
         while s < dt:
@@ -170,26 +192,26 @@ def integrate_into(t, Gg, Tgi, Q, F, n, x0, p, zoh, h_max, out, h0=H0_S, with_tg
             a = s + _C2 * h
             for i in range(NS):
                 y[i] = x[i] + h * _A21 * k1[i]
-            _f(y, g0 + dg * a, T0 + dT * a, q0 + dq * a, f0 + df * a, p, k2)
+            _f(y, g0 + dg * a, T0 + dT * a, q0 + dq * a, f0 + df * a, pt, k2)
             a = s + _C3 * h
             for i in range(NS):
                 y[i] = x[i] + h * (_A31 * k1[i] + _A32 * k2[i])
-            _f(y, g0 + dg * a, T0 + dT * a, q0 + dq * a, f0 + df * a, p, k3)
+            _f(y, g0 + dg * a, T0 + dT * a, q0 + dq * a, f0 + df * a, pt, k3)
             a = s + _C4 * h
             for i in range(NS):
                 y[i] = x[i] + h * (_A41 * k1[i] + _A42 * k2[i] + _A43 * k3[i])
-            _f(y, g0 + dg * a, T0 + dT * a, q0 + dq * a, f0 + df * a, p, k4)
+            _f(y, g0 + dg * a, T0 + dT * a, q0 + dq * a, f0 + df * a, pt, k4)
             a = s + _C5 * h
             for i in range(NS):
                 y[i] = x[i] + h * (_A51 * k1[i] + _A52 * k2[i] + _A53 * k3[i] + _A54 * k4[i])
-            _f(y, g0 + dg * a, T0 + dT * a, q0 + dq * a, f0 + df * a, p, k5)
+            _f(y, g0 + dg * a, T0 + dT * a, q0 + dq * a, f0 + df * a, pt, k5)
             a = s + h
             for i in range(NS):
                 y[i] = x[i] + h * (_A61 * k1[i] + _A62 * k2[i] + _A63 * k3[i] + _A64 * k4[i] + _A65 * k5[i])
-            _f(y, g0 + dg * a, T0 + dT * a, q0 + dq * a, f0 + df * a, p, k6)
+            _f(y, g0 + dg * a, T0 + dT * a, q0 + dq * a, f0 + df * a, pt, k6)
             for i in range(NS):
                 xn[i] = x[i] + h * (_B1 * k1[i] + _B3 * k3[i] + _B4 * k4[i] + _B5 * k5[i] + _B6 * k6[i])
-            _f(xn, g0 + dg * a, T0 + dT * a, q0 + dq * a, f0 + df * a, p, k7)
+            _f(xn, g0 + dg * a, T0 + dT * a, q0 + dq * a, f0 + df * a, pt, k7)
             if evals is not None:
                 evals[0] += 6  # stages 2-7 (stage 1 is the last step's 7th: first same as last)
             err = 0.0
