@@ -240,9 +240,10 @@ def exchanger(Tb, Tm, X, Gg, Tgi, p):
     cg = gas_heat_capacity_kJ_kgK(Tgi)  # eq. 2
     G = he * Agb  # gas-bean conductance [kW/K]
     C = p[I_HGM] * p[I_AGM]  # gas-metal conductance [kW/K]; F = C / G, eq. 6
-    r = 1.0 / (G + C)  # = 1 / (G (1 + F))
+    sink = G + C  # the sink's total conductance, G (1 + F) [kW/K]
+    r = 1.0 / sink
     T_star = (G * Tb + C * Tm) * r  # eq. 5/15e: mean sink temperature (Tb + F Tm)/(1 + F)
-    NTU = (G + C) / (Gg * cg)  # eq. 15e: he Agb (1 + F)/(Gg cg)
+    NTU = sink / (Gg * cg)  # eq. 15e: he Agb (1 + F)/(Gg cg)
     return T_star, NTU, C * r, Agb, Abm, he, cg
 
 
@@ -295,7 +296,8 @@ def moisture_rate_1_s(Tb, X, p):
 def reaction_heat_rate_kW_kg(Tb, He, p):
     """Exothermic heat production Qr = dHe/dt [kW/kg dry] (eqs. 14, 15d)."""
     Het = p[I_HET]
-    # A/Het once per run; 1/(Tb + 273.15) is the same quotient as the moisture law's (computed once)
+    # A/Het depends on the parameters alone (once per run compiled); 1/(Tb + 273.15) is the same
+    # quotient as the moisture law's, which the compiler may share between the two
     return (p[I_A] / Het) * (Het - He) * exp(-p[I_HAR] * (1.0 / (Tb + KELVIN)))
 
 
