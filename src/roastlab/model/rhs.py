@@ -105,6 +105,13 @@ fmax = max
 
 
 @register_jitable
+def power(x, a):
+    """``x ** a``: the moisture law's power of X, an operation of its own so that :func:`rebind`
+    can replace it (the vectorised integrator, :mod:`roastlab.sim.lanes`)."""
+    return x**a
+
+
+@register_jitable
 def where(condition, a, b):
     """``a`` where ``condition`` holds, else ``b`` (a branch that symbolic types can also take)."""
     return a if condition else b
@@ -286,7 +293,7 @@ def heat_flows(Tb, Tm, X, Gg, Tgi, p):
 @register_jitable
 def moisture_rate_1_s(Tb, X, p):
     """dX/dt [1/s] (eqs. 13, 15c); zero once X reaches 0 so X never goes negative."""
-    Xn = X * X if p[I_XEXP] == 2.0 else X ** p[I_XEXP]
+    Xn = X * X if p[I_XEXP] == 2.0 else power(X, p[I_XEXP])
     # k1/Db^2 depends on the parameters alone: the compiled integrator computes it once per run
     rate = -(p[I_K1] / (p[I_DB] * p[I_DB])) * Xn * exp(-p[I_K2] * (1.0 / (Tb + KELVIN)))
     return where(X > 0.0, rate, 0.0)
@@ -403,21 +410,26 @@ def checked_rhs(t, x, u, p) -> np.ndarray:
     return rhs(float(t), x, u, p)
 
 
+#: The elementary operations :func:`rebind` may replace.
+OPERATIONS = ("exp", "fmax", "where", "power")
+
+
 def rebind(**operations) -> types.SimpleNamespace:
     """This module's equations evaluated with other elementary operations: the one right-hand side
     for other number types, never a copy of it.
 
-    ``operations`` replace ``exp``, ``fmax`` and ``where`` (e.g. ``casadi.exp``, ``casadi.fmax``,
-    ``casadi.if_else``). Returns a namespace of every function of this module rebuilt over those
+    ``operations`` replace ``exp``, ``fmax``, ``where`` and ``power`` (e.g. ``casadi.exp``,
+    ``casadi.fmax``, ``casadi.if_else``; branch-free arithmetic versions for
+    :mod:`roastlab.sim.lanes`). Returns a namespace of every function of this module rebuilt over those
     operations (``derivatives``, ``heat_flows`` ...); the parameter vector stays numeric.
 
     >>> ns = rebind(exp=lambda v: 1.0)  # a toy "number type": exp is 1 everywhere
     >>> ns.bean_heat_transfer_coefficient_kW_m2K(0.1) == 0.49 - 0.443
     True
     """
-    unknown = sorted(set(operations) - {"exp", "fmax", "where"})
+    unknown = sorted(set(operations) - set(OPERATIONS))
     if unknown:
-        raise ParameterError(f"unknown operation(s) {', '.join(unknown)} (allowed: exp, fmax, where)")
+        raise ParameterError(f"unknown operation(s) {', '.join(unknown)} (allowed: {', '.join(OPERATIONS)})")
     namespace = dict(globals())
     namespace.update(operations)
     functions = {}

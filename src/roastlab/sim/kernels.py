@@ -128,10 +128,17 @@ def next_step(err, h, h_try, last, h_max):
     """The step size after a trial of size ``h`` with a finite RMS error ``err``: grown after an
     accepted step (by at most 5; back to the trial size ``h_try`` after a step cut short at a
     sample), shrunk (by at most 5) after a rejected one."""
+    return next_step_given(err, err**-0.2, h, h_try, last, h_max)
+
+
+@compiled(inline="always")
+def next_step_given(err, err_pow, h, h_try, last, h_max):
+    """:func:`next_step` with ``err_pow`` = err^-0.2 computed by the caller (the lanes integrator
+    computes it for all its runs at once, :mod:`roastlab.sim.lanes`)."""
     if err <= 1.0:
-        fac = 5.0 if err < 1e-10 else min(5.0, 0.9 * err**-0.2)
+        fac = 5.0 if err < 1e-10 else min(5.0, 0.9 * err_pow)
         return h_try if last else min(h_max, h * fac)
-    return h * max(0.2, 0.9 * err**-0.2)
+    return h * max(0.2, 0.9 * err_pow)
 
 
 @compiled
