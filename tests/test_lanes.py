@@ -1,0 +1,195 @@
+"""The lanes integrator (roastlab.sim.lanes) against the scalar one it must equal, and the
+vectorisable elementary functions (roastlab.sim.vecmath) it evaluates the model with.
+
+The lanes take the scalar integrator's steps with the scalar integrator's rules; only ``exp`` and
+``power`` differ, by about an ulp, so every run must agree to rounding, with the same stops where
+the scalar integrator gives up (stiff: inf rows; non-finite: NaN rows). All inputs are SYNTHETIC,
+drawn from seeded generators here.
+"""
+
+import numba
+import numpy as np
+import pytest
+
+from roastlab.model.layout import P
+from roastlab.model.plant import as_plant
+from roastlab.model.quantities import QUANTITIES
+from roastlab.model.rhs import pack_params
+from roastlab.sim import lanes, vecmath
+from roastlab.sim.kernels import N_OUT, NS, simulate_population_kernel
+
+BULLET_LAWS = "contact=wall,probe=tumbling,probe_gas=mean"
+
+
+@numba.njit
+def _apply(name, x, a=0.0):
+    out = np.empty_like(x)
+    for i in range(x.size):
+        if name == "exp":
+            out[i] = vecmath.exp(x[i])
+        elif name == "log":
+            out[i] = vecmath.log(x[i])
+        else:
+            out[i] = vecmath.power(x[i], a)
+    return out
+
+
+@pytest.mark.filterwarnings("ignore::numba.core.errors.NumbaIRAssumptionWarning")  # see lanes.simulate_runs
+def test_vectorisable_exp_log_power_match_numpy():
+    """Compiled, as the lanes use them (they are compiler intrinsics, not Python)."""
+    rng = np.random.default_rng(0)
+    x = np.concatenate([rng.uniform(-745, 709.7, 20000), rng.uniform(-1, 1, 20000), [0.0, -0.0, 1e-300, 709.7]])
+    exp = _apply("exp", x)
+    ref = np.exp(x)
+    ok = x >= -708.0  # below, vecmath returns 0 by design (the true value is 3.3e-308 or less)
+    assert np.max(np.abs(exp[ok] - ref[ok]) / np.spacing(ref[ok])) <= 1.0
+    assert np.all(exp[x < -708.0] == 0.0)
+    pos = np.concatenate([10.0 ** rng.uniform(-320, 308, 20000), rng.uniform(0.5, 2.0, 20000)])
+    log = _apply("log", pos)
+    ref = np.log(pos)
+    assert np.max(np.abs(log - ref) / np.maximum(np.spacing(np.abs(ref)), 1e-300)) <= 3.0
+    assert list(_apply("log", np.array([0.0, np.inf]))) == [-np.inf, np.inf]
+    assert np.isnan(_apply("log", np.array([-1.0, np.nan]))).all()
+    assert np.isnan(_apply("exp", np.array([np.nan])))[0] and _apply("exp", np.array([1000.0]))[0] == np.inf
+    base = rng.uniform(1e-6, 3.0, 2000)
+    assert np.max(np.abs(_apply("power", base, -0.2) / base**-0.2 - 1.0)) < 1e-14
+    assert _apply("power", np.array([0.0]), -0.2)[0] == np.inf and _apply("power", np.array([0.0]), 2.0)[0] == 0.0
+    assert _apply("power", np.array([0.3]), 0.0)[0] == 1.0
+
+
+def _runs(seed: int, n_runs: int, bed=None, moisture="schwartzberg", actuators=False):
+    """SYNTHETIC batches of different lengths and sample intervals, and a parameter vector and initial
+    state per run, theta uniform over its plausible box (and the actuator extension when asked)."""
+    rng = np.random.default_rng(seed)
+    nb = 5
+    lengths = np.array([1, 2, 17, 31, 60])[:nb]
+    nmax = int(lengths.max())
+    T = np.zeros((nb, nmax))
+    GG, TGI, QQ, FF = (np.zeros((nb, nmax)) for _ in range(4))
+    for b in range(nb):
+        T[b] = np.concatenate([[0.0], np.cumsum(rng.uniform(1.0, 45.0, nmax - 1))])
+        GG[b] = rng.uniform(0.2, 0.6, nmax)
+        TGI[b] = rng.uniform(250.0, 550.0, nmax)
+        if actuators:
+            QQ[b] = rng.integers(0, 9, nmax)
+            FF[b] = rng.uniform(0.0, 1.0, nmax)
+    plant = as_plant("120kg")
+    PP = np.zeros((n_runs, len(P)))
+    X0 = np.zeros((n_runs, NS))
+    for i in range(n_runs):
+        theta = [rng.uniform(*QUANTITIES[k].plausible) for k in ("hgm", "hbm", "Pbm")]
+        moisture0 = rng.uniform(0.05, 0.14)
+        PP[i] = pack_params(plant, theta, moisture0, moisture, bed)
+        X0[i] = [rng.uniform(15, 40), rng.uniform(80, 220), moisture0, 0.0, rng.uniform(15, 120), 0.0]
+        if bed is not None:
+            PP[i, P["h_probe"]] = rng.uniform(0.01, 0.3)
+        if actuators:
+            PP[i, P["Qe_gain"]] = rng.uniform(0.0, 3.0)
+            PP[i, P["Tgi_gain"]] = rng.uniform(0.0, 10.0)
+            PP[i, P["tau_heater"]] = rng.uniform(5.0, 60.0)
+            PP[i, P["Gg_fan"]] = rng.uniform(0.0, 0.2)
+            PP[i, P["U_shell"]] = rng.uniform(0.0, 0.02)
+            X0[i, 5] = rng.integers(0, 9)  # the lagged heater setting at charge
+    batch_of = rng.integers(0, nb, n_runs).astype(np.int64)
+    return (T, GG, TGI, QQ, FF, lengths.astype(np.int64)), batch_of, X0, PP
+
+
+def _agree(scalar, vector):
+    """The same samples valid; every run within the 1e-3 degC the README states for the integrator
+    (a rounding difference can flip an accept/reject decision at the error threshold: then the steps
+    differ, by the local tolerance); nearly every run to rounding."""
+    assert np.array_equal(np.isnan(scalar), np.isnan(vector))
+    assert np.array_equal(np.isinf(scalar), np.isinf(vector))
+    finite = np.isfinite(scalar)
+    diff = np.abs(np.where(finite, vector, 0.0) - np.where(finite, scalar, 0.0)).max(axis=(1, 2))
+    assert diff.max() < 1e-3
+    assert np.mean(diff < 1e-9) >= 0.9
+
+
+def _both(inputs, batch_of, X0, PP, zoh):
+    nmax = inputs[0].shape[1]
+    scalar = np.full((len(batch_of), nmax, N_OUT), np.nan)
+    simulate_population_kernel(*inputs, batch_of, X0, PP, zoh, 30.0, scalar)
+    vector = np.full_like(scalar, np.nan)
+    cols = np.arange(N_OUT, dtype=np.int64)
+    lanes.simulate_runs(*inputs, batch_of, X0, PP, zoh, 30.0, cols, vector, 1.0, lanes.law_key(PP))
+    return scalar, vector
+
+
+@pytest.mark.parametrize(
+    "hold,bed,moisture,actuators",
+    [
+        ("linear", None, "schwartzberg", False),
+        ("zoh", None, "schwartzberg", True),
+        ("linear", BULLET_LAWS, "schwartzberg", True),
+        ("linear", BULLET_LAWS, "printed", False),
+    ],
+)
+def test_lanes_equal_the_scalar_integrator(hold, bed, moisture, actuators):
+    """More runs than lanes, batches of 1 to 60 samples, both holds, the example's bed laws, the
+    printed moisture law and the actuator extension, theta anywhere in its plausible box: every state
+    and Tgo as the scalar kernel's."""
+    inputs, batch_of, X0, PP = _runs(7, 3 * lanes.LANES + 5, bed, moisture, actuators)
+    scalar, vector = _both(inputs, batch_of, X0, PP, hold == "zoh")
+    _agree(scalar, vector)
+    n = inputs[5][batch_of]
+    assert np.all(np.isfinite(vector[np.arange(vector.shape[1])[None, :] < n[:, None]]))
+
+
+def test_lanes_keep_only_the_asked_columns_and_loosen_tolerance_like_the_scalar_kernel():
+    from roastlab.sim.kernels import I_TGO, ta_population_kernel
+
+    inputs, batch_of, X0, PP = _runs(11, lanes.LANES + 3)
+    nmax = inputs[0].shape[1]
+    ta, tb, tgo = (np.full((len(batch_of), nmax), np.nan) for _ in range(3))
+    ta_population_kernel(*inputs, batch_of, X0, PP, False, 30.0, ta, tb, tgo, 100.0)
+    cols = np.array([4, 0, I_TGO], dtype=np.int64)
+    out = np.full((len(batch_of), nmax, 3), np.nan)
+    lanes.simulate_runs(*inputs, batch_of, X0, PP, False, 30.0, cols, out, 100.0, lanes.law_key(PP))
+    _agree(np.stack([ta, tb, tgo], axis=2), out)
+
+
+def test_lanes_stop_where_the_scalar_integrator_stops():
+    """Process constants at their plausible floors and ceilings (stiff corners, issue 27) mixed with
+    ordinary runs: the lanes mark the same samples too stiff (inf) or non-finite (NaN), and the
+    ordinary runs beside them are unaffected."""
+    inputs, batch_of, X0, PP = _runs(5, lanes.LANES + 8)
+    rng = np.random.default_rng(5)
+    for i in range(0, PP.shape[0], 2):
+        for k in ("A", "cm", "Ha_R", "Het", "k1", "k2", "Kt", "lam", "Mm", "hbm"):
+            lo, hi = QUANTITIES[k].plausible
+            PP[i, P[k]] = (lo, hi)[rng.integers(0, 2)]
+    scalar, vector = _both(inputs, batch_of, X0, PP, False)
+    assert np.isinf(scalar).any() or np.isnan(scalar[:, 1:]).any()  # the corners do stop somewhere
+    _agree(scalar, vector)
+
+
+def test_law_key_names_one_set_of_laws_or_none():
+    _, _, _, PP = _runs(1, 4)
+    assert lanes.law_key(PP) == 2 * 4**3  # the paper's laws, Schwartzberg's exponent 2
+    _, _, _, PB = _runs(1, 4, BULLET_LAWS)
+    assert lanes.law_key(PB) == 1 + 4 + 16 + 128
+    assert lanes.law_key(np.vstack([PP, PB])) is None  # mixed laws: the scalar integrator
+    odd = PP.copy()
+    odd[:, P["x_exp"]] = 1.5  # an exponent the key cannot hold as a whole number
+    assert lanes.law_key(odd) is None
+    assert lanes.usable(PP) is None  # too few runs to fill the lanes
+    assert lanes.usable(np.repeat(PP, lanes.MIN_RUNS, axis=0)) == 128
+
+
+def test_population_takes_the_lanes_for_many_runs(monkeypatch):
+    from roastlab.io.batch import read_dataset
+    from roastlab.model.parameters import THETA_PAPER
+    from roastlab.sim.population import pack_batches, simulate_population
+    from roastlab.workflows.reproduce import default_dataset_root
+
+    calls = []
+    real = lanes.simulate_runs
+    monkeypatch.setattr(lanes, "simulate_runs", lambda *a: calls.append(len(a[6])) or real(*a))
+    batch = read_dataset(default_dataset_root() / "dataset-I").batches[0]
+    packed = pack_batches([batch], "120kg", THETA_PAPER)
+    few = simulate_population(packed, ["hbm"], np.full((3, 1, 1), 0.05))
+    many = simulate_population(packed, ["hbm"], np.linspace(0.02, 0.3, lanes.MIN_RUNS)[:, None, None])
+    assert calls == [lanes.MIN_RUNS]
+    assert np.max(np.abs(many[-1] - simulate_population(packed, ["hbm"], np.full((1, 1, 1), 0.3))[0])) < 1e-9
+    assert few.shape == (3, 1, batch.n, N_OUT)
