@@ -11,10 +11,14 @@ Figures (medians of repeated runs):
 * ``population_speedup``: the same per-batch ratio with 1,000 parameter sets (uniform in the
   Table 1 bounds) in one population call; the baseline is timed on a sample of those same
   sets, since corners of the box are stiffer than theta* for both integrators;
-* ``population_cost``: where a population run's time goes, one thread: right-hand-side
+* ``lanes_speedup_over_scalar``: the population goes through the lanes integrator
+  (:mod:`roastlab.sim.lanes`, 32 runs per core in vector instructions); the same runs through the
+  scalar integrator, one run at a time per core, both one thread, and their largest difference;
+* ``population_cost``: where a scalar integrator's run's time goes, one thread: right-hand-side
   evaluations per run (counted by the integrator), the cost of one evaluation as one dependent
-  chain and as four runs interleaved (equal costs: the evaluations are throughput-bound, so
-  interleaving runs on a core would not help), and the integrator's share;
+  chain and as four runs interleaved (equal costs: the evaluations are throughput-bound with the C
+  library's ``exp``, which is why the lanes evaluate the model with a vectorisable one), and the
+  integrator's share;
 * ``max_abs_dev_C``: largest temperature difference project vs baseline over those runs;
 * ``identify_paper_s``: identification on dataset-I in-process, compile cache warm;
 * ``identify_scaling``: fleet identification (a theta per batch) of 10, 100 and 1,000
@@ -393,8 +397,8 @@ def _rhs_chain_kernel():
 
 
 def population_cost(packed, thetas: np.ndarray, population_us: float, repeats: int = 7) -> dict:
-    """Where a population run's time goes (one thread): the right-hand-side evaluations the
-    integrator makes per run (:func:`roastlab.sim.kernels.count_evaluations`, over the population's
+    """Where a scalar integrator's run's time goes (one thread; ``population_us`` its time per run):
+    the right-hand-side evaluations the integrator makes per run (:func:`roastlab.sim.kernels.count_evaluations`, over the population's
     own sets), the cost of one evaluation as one dependent chain and as four interleaved, and what
     is left for the integrator (stage sums, error norm, step control)."""
     from roastlab.sim.kernels import count_evaluations
@@ -595,8 +599,24 @@ def run(quiet: bool = False, baseline_repeats: int = 5, only: str | None = None)
         "population_us_per_batch_all_cores": _spread(pop_all, 1e6),
     }
     res["max_abs_dev_C"] = dev
-    _log("population: where the time goes (one thread) ...", quiet)
-    res["population_cost"] = population_cost(packed, thetas, pop_s * 1e6)
+    # the same runs through the scalar integrator, one run at a time per core (what the population
+    # used before the lanes, and still uses below lanes.MIN_RUNS runs): the lanes' gain, one thread
+    from roastlab.sim.kernels import simulate_population_kernel
+    from roastlab.sim.population import run_arrays
+
+    batch_of, X0s, PPs = run_arrays(packed, ["hgm", "hbm", "Pbm"], values)
+    scalar_out = np.full((len(batch_of), packed.T.shape[1], 7), np.nan)
+    scalar_run = lambda: simulate_population_kernel(  # noqa: E731
+        *packed.inputs, batch_of, X0s, PPs, packed.zoh, packed.h_max_s, scalar_out
+    )
+    with numba_threads(1):
+        scalar_1t = _times(scalar_run, 7) / 1000
+    res["population_scalar_s_per_batch"] = float(np.median(scalar_1t))
+    res["spread"]["population_scalar_us_per_batch_1_thread"] = _spread(scalar_1t, 1e6)
+    res["lanes_speedup_over_scalar"] = res["population_scalar_s_per_batch"] / pop_s
+    res["lanes_max_abs_dev_from_scalar_C"] = float(np.nanmax(np.abs(scalar_out.reshape(pop.shape) - pop)))
+    _log("population: where the scalar integrator's time goes (one thread) ...", quiet)
+    res["population_cost"] = population_cost(packed, thetas, res["population_scalar_s_per_batch"] * 1e6)
 
     # --- identification on dataset-I -------------------------------------------------------
     _load("identify", res)
@@ -759,6 +779,12 @@ def table(res: dict) -> str:
                 f"{res['population_s_per_batch'] * 1e6:.1f} µs/batch",
                 f"one thread; all cores {res['population_s_per_batch_all_cores'] * 1e6:.1f} µs/batch "
                 f"({res['population_speedup_all_cores']:.0f}x)",
+            ),
+            (
+                "  scalar integrator, same runs",
+                f"{res['population_scalar_s_per_batch'] * 1e6:.1f} µs/batch",
+                f"one run at a time, one thread: the lanes are {res['lanes_speedup_over_scalar']:.2f}x faster "
+                f"(largest difference {res['lanes_max_abs_dev_from_scalar_C']:.1e} °C)",
             ),
             (
                 "  of which the right-hand side",

@@ -440,7 +440,9 @@ def identify_each(
         if progress is not None:
             progress(sl.stop, nb, "batches fitted")
     values = lo + Z * span
-    ta = predict_ta(packed, names, values[None])[0]
+    # the scalar integrator, as the fit itself: a batch's figures must not depend on how many batches
+    # share the call (a fleet's chunks, Dask or in-process)
+    ta = predict_ta(packed, names, values[None], use_lanes=False)[0]
     fits = np.array([fit_percent(packed.TA[b, :n], ta[b, :n]) for b, n in enumerate(packed.N)])
     mae = np.nanmean(np.abs(np.where(packed.mask(), ta - packed.TA, np.nan)), axis=1)
     stderr = standard_errors(JTJ, Z, SSR, packed.N, span)

@@ -172,21 +172,42 @@ def run_arrays(packed: PackedBatches, names: list[str], values: np.ndarray):
     return batch_of, X0.reshape(m * nb, NS), PP.reshape(m * nb, -1)
 
 
-def predict_ta(packed: PackedBatches, names: list[str], values: np.ndarray) -> np.ndarray:
-    """Simulated probe reading for every (value set, batch): shape (m, nb, nmax), NaN-padded."""
-    return predict_outputs(packed, names, values, with_tb=False)[0]
+def _lanes_key(PP: np.ndarray, use_lanes: bool | None) -> int | None:
+    """The lanes' law key for runs ``PP``, or None for the scalar kernel. ``use_lanes`` None: the
+    lanes from :data:`roastlab.sim.lanes.MIN_RUNS` runs up; True: whenever the runs share their laws;
+    False: never. A caller that splits one workload into pieces (Dask tasks, fleet chunks) decides
+    once for the whole, so every piece takes the same integrator and the results do not depend on
+    the split (the two agree to rounding, not bit for bit)."""
+    if use_lanes is None:
+        return lanes.usable(PP)
+    return lanes.law_key(PP) if use_lanes else None
+
+
+def predict_ta(
+    packed: PackedBatches, names: list[str], values: np.ndarray, use_lanes: bool | None = None
+) -> np.ndarray:
+    """Simulated probe reading for every (value set, batch): shape (m, nb, nmax), NaN-padded
+    (``use_lanes``: :func:`predict_outputs`)."""
+    return predict_outputs(packed, names, values, with_tb=False, use_lanes=use_lanes)[0]
 
 
 def predict_outputs(
-    packed: PackedBatches, names: list[str], values: np.ndarray, with_tb: bool = True, with_tgo=False, tol_scale=1.0
+    packed: PackedBatches,
+    names: list[str],
+    values: np.ndarray,
+    with_tb: bool = True,
+    with_tgo=False,
+    tol_scale=1.0,
+    use_lanes: bool | None = None,
 ):
     """Simulated probe reading Ta, (``with_tb``) bean temperature Tb and (``with_tgo``) outlet gas
     Tgo for every (value set, batch): arrays of shape (m, nb, nmax), NaN-padded; Tb and Tgo are
     None when not asked for. Returns (ta, tb) or, with ``with_tgo``, (ta, tb, tgo). ``tol_scale``
-    loosens the integrator's tolerances (:func:`roastlab.sim.kernels.integrate_into`; 1: full accuracy)."""
+    loosens the integrator's tolerances (:func:`roastlab.sim.kernels.integrate_into`; 1: full accuracy).
+    ``use_lanes``: which integrator (:func:`_lanes_key`; None: by the number of runs)."""
     m, nb = values.shape[0], packed.n_batches
     batch_of, X0, PP = run_arrays(packed, names, values)
-    key = lanes.usable(PP)
+    key = _lanes_key(PP, use_lanes)
     if key is not None:  # many runs: several at once per core
         cols = np.array([S_TA, *((S_TB,) if with_tb else ()), *((I_TGO,) if with_tgo else ())], dtype=np.int64)
         out = np.full((m * nb, packed.T.shape[1], cols.size), np.nan)
@@ -261,23 +282,28 @@ def output_sensitivities(packed: PackedBatches, names: list[str], values: np.nda
     return res
 
 
-def _population_task(packed, names, values):
+def _population_task(packed, names, values, use_lanes):
     """One Dask task of :func:`simulate_population`: single-threaded (the cluster is the parallelism)."""
     import numba
 
     numba.set_num_threads(1)
-    return simulate_population(packed, names, values)
+    return simulate_population(packed, names, values, use_lanes=use_lanes)
 
 
 def simulate_population(
-    packed: PackedBatches, names: list[str] = (), values: np.ndarray | None = None, client=None
+    packed: PackedBatches,
+    names: list[str] = (),
+    values: np.ndarray | None = None,
+    client=None,
+    use_lanes: bool | None = None,
 ) -> np.ndarray:
     """All six states and Tgo for every (value set, batch): shape (m, nb, nmax, 7), NaN-padded.
 
     With no ``names``, simulates each batch once at its packed parameters. With a
     ``dask.distributed`` ``client`` (e.g. Monte Carlo over many uncertain value sets) the value
     sets are split into one piece per worker thread and simulated there; the result is the
-    same array, value for value, as without.
+    same array, value for value, as without (every piece takes the integrator the whole population
+    would, ``use_lanes``: :func:`_lanes_key`).
 
     >>> import numpy as np
     >>> from roastlab.io.batch import Batch
@@ -292,16 +318,20 @@ def simulate_population(
     names = list(names)
     if values is None:
         values = np.zeros((1, packed.n_batches, 0))
-    if client is not None and values.shape[0] > 1:
-        slots = sum(w.get("nthreads", 1) for w in client.scheduler_info()["workers"].values())
-        cuts = np.array_split(np.arange(values.shape[0]), max(1, min(slots, values.shape[0])))
-        packed_f = client.scatter(packed, broadcast=True)
-        futures = [client.submit(_population_task, packed_f, names, values[c], pure=False) for c in cuts if len(c)]
-        return np.concatenate(client.gather(futures), axis=0)
     m, nb = values.shape[0], packed.n_batches
     batch_of, X0, PP = run_arrays(packed, names, values)
+    key = _lanes_key(PP, use_lanes)
+    if client is not None and m > 1:
+        slots = sum(w.get("nthreads", 1) for w in client.scheduler_info()["workers"].values())
+        cuts = np.array_split(np.arange(m), max(1, min(slots, m)))
+        packed_f = client.scatter(packed, broadcast=True)
+        futures = [
+            client.submit(_population_task, packed_f, names, values[c], key is not None, pure=False)
+            for c in cuts
+            if len(c)
+        ]
+        return np.concatenate(client.gather(futures), axis=0)
     out = np.full((m * nb, packed.T.shape[1], N_OUT), np.nan)
-    key = lanes.usable(PP)
     if key is not None:  # many runs: several at once per core
         cols = np.arange(N_OUT, dtype=np.int64)
         lanes.simulate_runs(*packed.inputs, batch_of, X0, PP, packed.zoh, packed.h_max_s, cols, out, 1.0, key)
