@@ -258,7 +258,6 @@ def _lane_group(T, GG, TGI, QQ, FF, N, batch_of, X0, PP, zoh, h_max, cols, out, 
             Z[_at(_PT + q, lane)] = PP[lo, q]
         for i in range(NS):
             Z[_at(_X + i, lane)] = X0[lo, i]
-        Z[_at(_DT, lane)] = 0.0
     H = np.full(W, H0_S)  # the step size each lane tries next
     DTI = np.ones(W)  # each lane's sample interval [s]
     LAST = np.zeros(W, dtype=np.bool_)
