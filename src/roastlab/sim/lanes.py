@@ -264,6 +264,7 @@ def _lane_group(T, GG, TGI, QQ, FF, N, batch_of, X0, PP, zoh, h_max, cols, out, 
     run = np.full(W, -1, dtype=np.int64)
     K = np.zeros(W, dtype=np.int64)
     STEPS = np.zeros(W, dtype=np.int64)
+    FRESH = np.zeros(W, dtype=np.bool_)  # lanes whose first stage must be evaluated anew
     xl = np.empty(NS)
     with_tgo = _wants_tgo(cols)
     nxt = lo
@@ -271,9 +272,10 @@ def _lane_group(T, GG, TGI, QQ, FF, N, batch_of, X0, PP, zoh, h_max, cols, out, 
     for lane in range(W):
         while nxt < hi and run[lane] < 0:
             active += _start(lane, nxt, T, GG, TGI, QQ, FF, N, batch_of, X0, PP, zoh, h_max, cols, out, with_tgo, Z,
-                             H, DTI, run, K, STEPS, key)  # fmt: skip
+                             H, DTI, run, K, STEPS, FRESH)  # fmt: skip
             nxt += 1
     while active > 0:
+        _first_stages(Z, FRESH, key)
         for lane in range(W):
             s = Z[_at(_S, lane)]
             last = s + H[lane] >= DTI[lane] * (1.0 - 1e-12)
@@ -342,13 +344,13 @@ def _lane_group(T, GG, TGI, QQ, FF, N, batch_of, X0, PP, zoh, h_max, cols, out, 
                     if k == n - 1:
                         done = True
                     else:
-                        _interval(lane, k, b, T, GG, TGI, QQ, FF, zoh, Z, DTI, False, key)
+                        _interval(lane, k, b, T, GG, TGI, QQ, FF, zoh, Z, DTI, False, FRESH)
             if done:
                 run[lane] = -1
                 active -= 1
                 while nxt < hi and run[lane] < 0:
                     active += _start(lane, nxt, T, GG, TGI, QQ, FF, N, batch_of, X0, PP, zoh, h_max, cols, out,
-                                     with_tgo, Z, H, DTI, run, K, STEPS, key)  # fmt: skip
+                                     with_tgo, Z, H, DTI, run, K, STEPS, FRESH)  # fmt: skip
                     nxt += 1
 
 
@@ -369,9 +371,10 @@ def _mark(out, r, j0, n, cols, value):
 
 
 @compiled(error_model="numpy")
-def _interval(lane, k, b, T, GG, TGI, QQ, FF, zoh, Z, DTI, first, key):
-    """Lane ``lane`` enters sample interval k of batch b: its inputs and slopes, s = 0, and the first
-    stage anew where integrate_into evaluates it anew (a zero-order hold's jump, or the first interval)."""
+def _interval(lane, k, b, T, GG, TGI, QQ, FF, zoh, Z, DTI, first, FRESH):
+    """Lane ``lane`` enters sample interval k of batch b: its inputs and slopes, s = 0, and marked
+    FRESH where integrate_into evaluates the first stage anew (a zero-order hold's jump, or the first
+    interval; :func:`_first_stages` does it for every marked lane at once before the next trial)."""
     dt, g0, t0, q0, f0, dg, dT, dq, df = interval_inputs(T[b], GG[b], TGI[b], QQ[b], FF[b], k, zoh)
     DTI[lane] = dt
     Z[_at(_S, lane)] = 0.0
@@ -383,20 +386,29 @@ def _interval(lane, k, b, T, GG, TGI, QQ, FF, zoh, Z, DTI, first, key):
     Z[_at(_DT, lane)] = dT
     Z[_at(_DQ, lane)] = dq
     Z[_at(_DF, lane)] = df
-    if zoh or first:
-        # the right-hand side at the lane's state through the one vectorised evaluation (every lane
-        # is evaluated; only this lane's result is kept): one compiled copy of the model, not two
+    FRESH[lane] = zoh or first
+
+
+@compiled(error_model="numpy")
+def _first_stages(Z, FRESH, key):
+    """The first stage anew for the lanes marked FRESH (a run's start; every interval under a
+    zero-order hold), all of them in one vectorised evaluation at their states and interval starts;
+    the other lanes' results are discarded (their first stage is the last step's seventh)."""
+    for lane in range(LANES):
         for i in range(NS):
             Z[_at(_Y + i, lane)] = Z[_at(_X + i, lane)]
         Z[_at(_A, lane)] = 0.0
-        _evaluate(Z, key)
-        for i in range(NS):
-            Z[_at(_k(1, i), lane)] = Z[_at(_KO + i, lane)]
+    _evaluate(Z, key)
+    for lane in range(LANES):
+        if FRESH[lane]:
+            for i in range(NS):
+                Z[_at(_k(1, i), lane)] = Z[_at(_KO + i, lane)]
+            FRESH[lane] = False
 
 
 @compiled(error_model="numpy")
 def _start(lane, r, T, GG, TGI, QQ, FF, N, batch_of, X0, PP, zoh, h_max, cols, out, with_tgo, Z, H, DTI, run, K,
-           STEPS, key):  # fmt: skip
+           STEPS, FRESH):  # fmt: skip
     """Put run r on lane ``lane``: its parameters, initial state and first output row. Returns 1, or 0
     for a run of one sample (nothing to integrate: the row is written and the lane stays free)."""
     b = batch_of[r]
@@ -412,7 +424,7 @@ def _start(lane, r, T, GG, TGI, QQ, FF, N, batch_of, X0, PP, zoh, h_max, cols, o
     K[lane] = 0
     STEPS[lane] = 0
     H[lane] = min(h_max, H0_S)
-    _interval(lane, 0, b, T, GG, TGI, QQ, FF, zoh, Z, DTI, True, key)
+    _interval(lane, 0, b, T, GG, TGI, QQ, FF, zoh, Z, DTI, True, FRESH)
     return 1
 
 
