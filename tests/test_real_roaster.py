@@ -134,8 +134,31 @@ def test_roastime_import_reads_settings_events_and_weight(bullet_data):
     assert b.heater is not None and set(np.unique(b.heater)) <= set(range(0, 10))
     assert b.fan is not None and b.fan.min() >= 0 and b.fan.max() <= 12
     assert "FCs" in b.events and 0 < b.events["FCs"] < b.time_s[-1]
-    assert b.initial["Tm0_C"] == pytest.approx(245.1)  # drumChargeTemperature of that log
+    assert b.initial["Tm0_C"] == pytest.approx(245.0)  # preheatTemperature of that log (IR at charge 245.1)
     assert np.isnan(b.Tb2_C[0]) and np.isfinite(b.Tb2_C[5:]).all()  # IR counts once the beans are in view
+
+
+def test_drum_at_charge_is_the_preheat_where_the_log_starts_after_the_charge(bullet_data):
+    """The IR reading stamped at charge is already falling in a log that starts late; the preheat is not."""
+    from roastlab.io.importers import import_log, load_map
+    from roastlab.io.importers.roastime import DRUM_AT_CHARGE, read_roastime
+
+    path = bullet_data / "bullet_2020-11-05_1536_500g.json"
+    log = read_roastime(path)
+    ir = log.channels["drumTemperature"][:3]
+    assert np.all(np.diff(ir) < -5)  # the beans are already falling past the IR sensor
+    assert log.fields["drumChargeTemperature"] == pytest.approx(ir[0])
+    assert log.fields[DRUM_AT_CHARGE] - ir[0] > 40
+    assert import_log(path, load_map(BULLET / "map.toml")).initial["Tm0_C"] == log.fields[DRUM_AT_CHARGE]
+    assert log.unit == "2779"
+
+
+def test_init_says_when_the_logs_come_from_several_units(bullet_data):
+    from roastlab.workflows.roaster import survey
+
+    s = survey([bullet_data / "bullet_2020-07-31_0152_490g.json", bullet_data / "bullet_2020-07-14_1803_550g.json"])
+    assert len(s.notes) == 1 and "2 units" in s.notes[0] and "2779: 1" in s.notes[0] and "1447: 1" in s.notes[0]
+    assert not survey([bullet_data / "bullet_2020-07-31_0152_490g.json"]).notes
 
 
 def test_roastime_without_weight_is_refused_with_the_way_out(cli, bullet_data, tmp_path):

@@ -27,6 +27,8 @@ def cmd_init(args) -> int:
     print(f"  second bean reading: {s.second_bean or 'none'}; ET: {'yes' if s.has_et else 'no'}")
     masses = sorted({round(i.batch_kg * 1000) for i in s.logs})
     print(f"  green batches: {', '.join(f'{g} g' for g in masses)}")
+    for note in s.notes:
+        print(f"  logs: {note}")
     for note in r["notes"]:
         print(f"  plant: {note}")
     print(f"wrote {args.out}/map.toml, plant.toml, fit.toml; next: roastlab fit-roaster {args.out} LOG...")

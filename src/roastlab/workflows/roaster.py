@@ -39,7 +39,7 @@ import numpy as np
 from ..errors import InputError
 from ..io.importers.artisan import WEIGHT_UNITS, read_alog, read_artisan_csv
 from ..io.importers.mapping import detect_format
-from ..io.importers.roastime import read_roastime
+from ..io.importers.roastime import DRUM_AT_CHARGE, read_roastime
 from ..model.constants import GREEN_BULK_DENSITY_KG_M3
 
 #: Names of a heater/burner and a fan/air channel in Artisan's languages (lower case, substrings).
@@ -139,6 +139,7 @@ class LogInfo:
     fan_max: float = 0.0
     started_epoch_s: float | None = None
     unused: dict = field(default_factory=dict)  # other logged controls: {"damper": channel, ...}
+    unit: str = ""  # the roaster unit the log names (RoasTime serialNumber), else empty
 
 
 @dataclass
@@ -222,6 +223,7 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
             for what, names_ in OTHER_NAMES.items()
             if (ch := _find([n for n in others if n not in (heater, fan)], names_))
         },
+        log.unit,
     )
 
 
@@ -256,6 +258,18 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
     heater_unit = "percent" if "percent" in units else (units.pop() if units else None)
     fan_units = {i.fan_unit for i in infos if i.fan}
     fan_unit = "percent" if "percent" in fan_units else (fan_units.pop() if fan_units else None)
+    notes = []
+    serials: dict[str, int] = {}
+    for i in infos:
+        if i.unit:
+            serials[i.unit] = serials.get(i.unit, 0) + 1
+    if len(serials) > 1:
+        notes.append(
+            f"the logs come from {len(serials)} units of this roaster (serial number: logs; "
+            + ", ".join(f"{u}: {k}" for u, k in sorted(serials.items(), key=lambda kv: -kv[1]))
+            + "): one fit treats them as one drum, so the differences between units count as its error; "
+            "fit one unit's logs for that unit's model"
+        )
     return Survey(
         infos,
         first.format,
@@ -269,6 +283,7 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
         max(i.heater_max for i in infos),
         max(i.fan_max for i in infos),
         {k: v for i in infos for k, v in i.unused.items()},
+        notes,
     )
 
 
@@ -373,7 +388,7 @@ def map_text(s: Survey) -> str:
         lines += ["[Tb2]", f'column = "{s.second_bean}"   # a second bean reading (infrared)', "start_s = 10.0", ""]
     initial = []
     if s.format == "roastime":
-        initial.append('Tm0_C = "drumChargeTemperature"   # the drum just before the beans drop')
+        initial.append(f'Tm0_C = "{DRUM_AT_CHARGE}"   # the drum at charge: the preheat it was held at')
     elif s.has_et:
         initial.append('Tm0_C = "ET"          # ET at CHARGE as the drum temperature')
     if initial:

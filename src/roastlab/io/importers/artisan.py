@@ -74,6 +74,7 @@ class ArtisanLog:
     fields: dict = field(default_factory=dict)  # scalar fields of the log (e.g. RoasTime's drum charge temperature)
     machine: str = ""  # the roaster as the log names it (Artisan's roastertype; "Aillio Bullet" for RoasTime)
     started_epoch_s: float | None = None  # when the roast started (Artisan roastepoch, RoasTime dateTime)
+    unit: str = ""  # which roaster of that make (RoasTime serialNumber); empty when the log does not say
 
 
 # Tokens of a Python literal that JSON spells differently. Strings come first so that words,

@@ -44,7 +44,7 @@ A map is a TOML file::
     [ET]                       # the roaster's ET, drawn beside the model (default: an Artisan
     column = "ET"              # log's ET channel); never an input
     [initial]                  # initial states from the log: a scalar field or a channel at CHARGE
-    Tm0_C = "drumChargeTemperature"
+    Tm0_C = "preheatTemperature"
 
 The fit spec decides what the settings drive: free ``Qe_gain_kW`` (heater -> heat into the
 drum metal), ``Tgi_gain_C`` (heater -> inlet gas), ``tau_heater_s`` (its lag) and
