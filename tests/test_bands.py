@@ -74,7 +74,18 @@ def test_parameter_draws_follow_the_covariance(fitted):
 
 def test_levels_and_quantile():
     assert _new_roast_quantile(0.9, 1000) == pytest.approx(1.645, abs=0.01)
-    assert _new_roast_quantile(0.9, 3) > 2.5  # three logs: wide
+    assert _new_roast_quantile(0.9, 3) > 2.3  # three logs: wide
+
+
+@pytest.mark.parametrize("n_logs", [2, 3, 9])
+def test_new_roast_factor_covers_its_level_by_simulation(n_logs):
+    """A new zero-mean error falls inside +-factor x RMS(n earlier errors about zero) at the band's level."""
+    rng = np.random.default_rng(7)
+    trials = 200_000
+    rms = np.sqrt(np.mean(rng.standard_normal((trials, n_logs)) ** 2, axis=1))
+    new = rng.standard_normal(trials)
+    inside = np.mean(np.abs(new) <= _new_roast_quantile(0.9, n_logs) * rms)
+    assert inside == pytest.approx(0.9, abs=0.004)
     with pytest.raises(ParameterError, match="band level"):
         prediction_bands(None, [], level=1.5)
 

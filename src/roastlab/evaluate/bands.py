@@ -16,8 +16,9 @@ sources of error, each a standard deviation at every instant t:
   the fit set's own errors are smaller by what the parameters learnt from each log.
 
 The band is prediction +- sqrt((z sigma_p)^2 + (z_n sigma_r)^2), z the standard normal quantile
-of (1 + L)/2 and z_n = t_{(1+L)/2, n-1} sqrt(1 + 1/n) the prediction-interval factor of a new
-roast when sigma_r was estimated from n logs (Student's t). :func:`band_coverage` says how often measured samples fall inside it (calibration:
+of (1 + L)/2 and z_n = t_{(1+L)/2, n} the prediction-interval factor of a new roast when
+sigma_r was estimated from n logs (Student's t with n degrees of freedom: the band is centred on
+the model, so no mean error is estimated and sigma_r^2 = sum e^2 / n keeps all n). :func:`band_coverage` says how often measured samples fall inside it (calibration:
 about L of them should) and how wide it is.
 """
 
@@ -101,13 +102,19 @@ def _z(level: float) -> float:
 
 
 def _new_roast_quantile(level: float, n_logs: int) -> float:
-    """Half-width factor of a band for a new roast from the spread of ``n_logs`` fitted ones: the
-    prediction interval of a new draw from a normal population whose variance is estimated from n
-    draws, t_{(1+L)/2, n-1} sqrt(1 + 1/n) (Student's t; it tends to the normal quantile as n grows)."""
+    """Half-width factor of a band for a new roast from the spread of ``n_logs`` fitted ones.
+
+    The band is centred on the model's prediction, and sigma_r is the root mean square of n logs'
+    errors about zero (:func:`roast_spread`), not about their mean. For a new error e and n errors
+    e_i from N(0, s^2), n sigma_r^2 / s^2 is chi-squared with n degrees of freedom, independent of
+    e, so e / sigma_r follows Student's t with n degrees of freedom: the factor is t_{(1+L)/2, n}.
+    (The textbook t_{n-1} sqrt(1 + 1/n) is for a band centred on the sample mean, which spends one
+    degree of freedom on the mean and adds its error; this band does neither.) It tends to the
+    normal quantile as n grows; tests/test_bands.py checks its coverage by simulation."""
     from scipy.stats import t
 
-    n = max(int(n_logs), 2)
-    return float(t.ppf(0.5 + level / 2.0, n - 1) * np.sqrt(1.0 + 1.0 / n))
+    n = max(int(n_logs), 1)
+    return float(t.ppf(0.5 + level / 2.0, n))
 
 
 def parameter_draws(model, samples: int, seed: int) -> tuple[list[str], np.ndarray]:
