@@ -102,3 +102,20 @@ def test_validate_band_cli(fitted, tmp_path):
     assert "90% prediction band" in out.stdout and "median width" in out.stdout
     bad = subprocess.run(cmd[:-3] + ["--band", "2"], capture_output=True, text=True, cwd=tmp_path)
     assert bad.returncode == 2 and "band level" in bad.stderr
+
+
+def test_a_band_says_when_a_batch_size_lies_outside_the_fitted_ones():
+    """The spread keeps the fitted green weights' range; a batch outside it gets a note, inside none."""
+    from types import SimpleNamespace
+
+    from roastlab.evaluate.bands import sizes_outside
+
+    t = [np.arange(0.0, 300.0, 5.0)] * 3
+    e = [np.full(60, 2.0), np.full(60, -1.0), np.full(60, 0.5)]
+    spread = roast_spread(t, e, batch_kg=[0.49, 0.5, 0.49])
+    assert spread["batch_kg"] == [0.49, 0.5]
+    model = SimpleNamespace(doc={"fit": {"spread": spread}})
+    assert sizes_outside(model, [0.49, 0.5, 0.495]) is None
+    note = sizes_outside(model, [0.35, 0.49, 0.8, 0.35])
+    assert note.startswith("0.35 kg, 0.8 kg lie outside") and "0.49-0.5 kg" in note
+    assert sizes_outside(SimpleNamespace(doc={"fit": {"spread": roast_spread(t, e)}}), [0.35]) is None  # older file

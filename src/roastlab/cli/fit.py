@@ -184,7 +184,7 @@ def cmd_compare_models(args) -> int:
 def _band_table(model, batches, level, plant_spec, changes) -> tuple[dict, list]:
     """Print and return how often each batch's measured probe lies inside the model's band, and
     the bands (drawn by --plot)."""
-    from ..evaluate.bands import coverage, prediction_bands, share_inside
+    from ..evaluate.bands import coverage, prediction_bands, share_inside, sizes_outside
 
     if changes or plant_spec not in (None, model.plant):
         raise InputError(
@@ -195,6 +195,8 @@ def _band_table(model, batches, level, plant_spec, changes) -> tuple[dict, list]
               "the band is the parameters' alone")  # fmt: skip
     bands = prediction_bands(model, batches, level)
     rows = coverage(batches, bands)
+    plant_kg = model.plant.Mb_kg if model.plant is not None else None
+    note = sizes_outside(model, [r["Mb_kg"] or plant_kg for r in rows])
     print(f"\n{level:.0%} prediction band (parameters and roast-to-roast spread, roastlab.evaluate.bands):")
     print(f"{'batch':<36} {'kg':>6} {'inside':>7} {'median width':>13}")
     for r in rows:
@@ -202,7 +204,9 @@ def _band_table(model, batches, level, plant_spec, changes) -> tuple[dict, list]
         print(f"{r['name'][:36]:<36} {kg:>6} {r['inside']:>7.0%} {r['median_width_C']:>10.1f} °C")
     inside = share_inside(rows)
     print(f"{'all samples':<36} {'':>6} {inside:>7.0%}   (a calibrated band holds about {level:.0%})")
-    return {"level": level, "inside_all": inside, "batches": rows}, bands
+    if note:
+        print(f"note: {note}")
+    return {"level": level, "inside_all": inside, "batches": rows, **({"note": note} if note else {})}, bands
 
 
 def _safe_stem(name: str, taken: set) -> str:

@@ -39,13 +39,15 @@ SPREAD_GRID_S = 30.0
 BAND_SAMPLES = 200
 
 
-def roast_spread(time_s, errors_C, held_out: bool = True) -> dict | None:
-    """``{"time_s": grid, "rms_C": ..., "logs": n, "held_out": bool}``: RMS over logs of each log's
+def roast_spread(time_s, errors_C, held_out: bool = True, batch_kg=None) -> dict | None:
+    """``{"time_s": grid, "rms_C": ..., "logs": n, "held_out": bool, "batch_kg": [lo, hi]}``: RMS over logs of each log's
     probe error at each grid time (each log interpolated onto the grid; a time counts the logs that
     reach it). The errors should be each log's as predicted had it been left out of the fit
     (``held_out``, :func:`roastlab.fit.uncertainty.held_out_residuals`): a fit follows its own logs
     more closely than it predicts a new one, so the fit set's own errors understate the spread a new
-    roast meets. None for fewer than two logs: one roast says nothing about the spread between roasts."""
+    roast meets. ``batch_kg``: the logs' green weights [kg]; their range is kept, because the spread
+    is that of roasts of those sizes (:func:`sizes_outside`). None for fewer than two logs: one roast
+    says nothing about the spread between roasts."""
     if len(time_s) < 2:
         return None
     end = max(float(t[-1]) for t in time_s)
@@ -63,12 +65,38 @@ def roast_spread(time_s, errors_C, held_out: bool = True) -> dict | None:
     if not keep.any():
         return None
     rms = np.sqrt(sq[keep] / count[keep])
-    return {
+    out = {
         "time_s": grid[keep].tolist(),
         "rms_C": [round(float(v), 4) for v in rms],
         "logs": int(len(time_s)),
         "held_out": bool(held_out),
     }
+    if batch_kg is not None and len(batch_kg):
+        out["batch_kg"] = [float(min(batch_kg)), float(max(batch_kg))]
+    return out
+
+
+def sizes_outside(model, batch_kg) -> str | None:
+    """A note for the roaster when a green weight in ``batch_kg`` [kg] lies outside the range the
+    model's roast-to-roast spread was measured at (``fit.spread.batch_kg``), else None.
+
+    The spread says how far roasts of the fitted sizes stray from the model; it holds nothing about
+    the error of predicting another batch size, which is larger (docs/real-roaster.md measures the
+    band's coverage at the fitted sizes and at others). Older model files without the range give None."""
+    spread = (model.doc.get("fit") or {}).get("spread") or {}
+    rng = spread.get("batch_kg")
+    if not rng:
+        return None
+    lo, hi = rng
+    odd = sorted({round(float(m), 4) for m in batch_kg if m and not (lo - 1e-9 <= m <= hi + 1e-9)})
+    if not odd:
+        return None
+    fitted = f"{lo:g} kg" if lo == hi else f"{lo:g}-{hi:g} kg"
+    return (
+        f"{', '.join(f'{m:g} kg' for m in odd)} {'lies' if len(odd) == 1 else 'lie'} outside the batch sizes the band's spread between roasts was "
+        f"measured at ({fitted}): the band does not hold the error of a batch-size change, so expect fewer "
+        "measured samples inside it"
+    )
 
 
 def why_no_band(model) -> str | None:

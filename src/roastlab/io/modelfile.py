@@ -13,7 +13,7 @@ A model file is JSON::
      "map": {the column map as TOML-shaped data} or null,
      "fit": {"SSR": ..., "n_residuals": ..., "method": ..., "seed": ..., "correlation": ..., "warnings": [...],
              "outputs": {"Ta" | "Tb2" | "ET": {"weight": w, "n": n, "SSR": unweighted}},
-             "spread": {"time_s", "rms_C", "logs", "held_out"} (the bands' roast-to-roast part),
+             "spread": {"time_s", "rms_C", "logs", "held_out", "batch_kg"} (the bands' roast-to-roast part),
              "failed": why, when the fitted states are ones the machine cannot have},
      "metrics": {"batches": [...], "average": {...}},
      "provenance": {"roastlab": version, "created": ISO 8601, "inputs": [{"role", "path", "sha256"}]}

@@ -219,14 +219,16 @@ def fit(
     # (each log's error as predicted without it, fit.uncertainty.held_out_residuals; the fit set's own
     # errors when the probe was not fitted)
     held = ident.held_out_Ta
+    masses = [b.Mb_kg or plant.Mb_kg for b in batches]  # the green weights the spread was measured at
     if held is not None:
         errors = [held[b, : packed.N[b]] for b in range(packed.n_batches)]
-        doc["fit"]["spread"] = roast_spread([packed.T[b, : packed.N[b]] for b in range(packed.n_batches)], errors)
+        times = [packed.T[b, : packed.N[b]] for b in range(packed.n_batches)]
+        doc["fit"]["spread"] = roast_spread(times, errors, batch_kg=masses)
     else:
         errors = [
             np.asarray(p, float) - np.asarray(m, float) for m, p in zip(validation.measured, validation.predicted)
         ]
-        doc["fit"]["spread"] = roast_spread(validation.time_s, errors, held_out=False)
+        doc["fit"]["spread"] = roast_spread(validation.time_s, errors, held_out=False, batch_kg=masses)
     doc["metrics"] = {
         "batches": [{"name": n, **r} for n, r in zip(validation.names, validation.rows)],
         "average": validation.average,

@@ -178,6 +178,9 @@ class WhatIf(Result):
     levels: dict = field(default_factory=dict)
     #: the changed probe BT's prediction band (:class:`roastlab.evaluate.bands.Band`) when asked for
     band: object | None = None
+    #: why the band may hold fewer samples than its level (a batch size the spread was not measured
+    #: at, :func:`roastlab.evaluate.bands.sizes_outside`), else None
+    band_note: str | None = None
 
     def band_line(self, units: str = "C") -> str | None:
         """The changed probe BT's band in one line: its level, median width and BT at DROP."""
@@ -223,6 +226,8 @@ class WhatIf(Result):
         )
         if self.band is not None:
             lines.append(self.band_line(units))
+            if self.band_note:
+                lines.append(f"note: {self.band_note}")
         if any(r["projected"] for r in self.rows):
             lines.append("* past the logged DROP: where the curve would reach it at the rate of rise of its last 2 min")
         lines += [f"note: {w}" for w in self.warnings()]
@@ -274,6 +279,7 @@ class WhatIf(Result):
             "median_width_C": round(b.median_width_C, 2),
             "DROP_lower_C": round(float(b.lower_C[-1]), 2),
             "DROP_upper_C": round(float(b.upper_C[-1]), 2),
+            **({"note": self.band_note} if self.band_note else {}),
         }
 
     def to_frame(self):
@@ -387,9 +393,11 @@ def whatif(
                     "projected": [k for k, v in projected.items() if v] if key == "FCs_s" else [],
                 }
             )
-    band = None
+    band, band_note = None, None
     if band_level is not None:
-        from ..evaluate.bands import prediction_bands
+        from ..evaluate.bands import prediction_bands, sizes_outside
 
         band = prediction_bands(model, [changed_batch], band_level, **changes)[0]
-    return WhatIf(batch, as_run, changed, labels, rows, levels, band)
+        plant_kg = model.plant.Mb_kg if model.plant is not None else None
+        band_note = sizes_outside(model, [changes.get("batch_kg") or changed_batch.Mb_kg or plant_kg])
+    return WhatIf(batch, as_run, changed, labels, rows, levels, band, band_note)
