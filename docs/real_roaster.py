@@ -339,13 +339,13 @@ def skywalker_et(paths, lines):
         "| log | ET - BT, median 1:00-DROP [°C] | at 4:00 [°C] |",
         "|---|---|---|",
     ]
+    from roastlab.metrics.profile import et_minus_bt_C
+
     medians = []
     for path in paths:
         log = read_alog(path)
         t, et, bt = log.time_s, log.channels["ET"], log.channels["BT"]
-        end = log.events.get("DROP", t[-1])
-        ok = (t >= 60) & (t <= end) & (et > 0) & (bt > 0)  # Artisan writes -1 where a reading dropped out
-        med = float(np.median(et[ok] - bt[ok]))
+        med = et_minus_bt_C(t, et, bt, log.events.get("DROP"))
         i = int(np.searchsorted(t, 240.0))
         medians.append(med)
         lines.append(f"| {path.stem} | {med:+.1f} | {et[i] - bt[i]:+.1f} |")
@@ -353,8 +353,8 @@ def skywalker_et(paths, lines):
     lines += [
         "",
         f"ET reads below BT through the roast on {below} of {len(medians)} logs and above it on the others: "
-        "the channel does not measure the same thing on every log, so no one model temperature can be "
-        "fitted to it across them.",
+        "the channel does not measure the same thing on every log. The example's map (`[ET] above_BT = true`) "
+        "drops ET on the logs where it reads below BT, and takes their drum at charge from BT.",
         "",
     ]
 

@@ -286,3 +286,57 @@ def test_a_map_names_et_where_the_log_calls_it_something_else(tmp_path):
     assert b.ET_C[0] == pytest.approx(205.0)
     with pytest.raises(InputError, match="ET: no channel 'Nope'"):
         import_log(p, load_map(write_map(tmp_path, ROOM_AIR_MAP + '[ET]\ncolumn = "Nope"\n')))
+
+
+def test_et_below_bt_through_the_roast_is_dropped_when_the_map_asks(tmp_path):
+    """[ET] above_BT: a log whose ET reads below BT from 1:00 on loses ET (with a note) and its drum
+    at charge falls back to the next source; a log whose ET runs above BT keeps both; without the
+    flag nothing changes. Synthetic logs (fake_alog)."""
+    from roastlab.errors import InputError
+    from roastlab.metrics.profile import et_minus_bt_C
+
+    n = 120
+    bt = [130.0 - 0.2 * i if i < 30 else 124.0 + 0.5 * (i - 30) for i in range(n)]
+    low, high = tmp_path / "low.alog", tmp_path / "high.alog"
+    low.write_text(fake_alog(bt=bt, et=[b - 30.0 for b in bt], n=n))  # an ET 30 degC under the beans
+    high.write_text(fake_alog(bt=bt, et=[b + 15.0 for b in bt], n=n))
+    flagged = ROOM_AIR_MAP + '[ET]\ncolumn = "ET"\nabove_BT = true\n[initial]\nTm0_C = ["ET", "BT"]\n'
+    b = import_log(low, load_map(write_map(tmp_path, flagged)))
+    assert b.ET_C is None and any("below BT" in note and "neither fitted nor scored" in note for note in b.notes)
+    assert b.initial["Tm0_C"] == pytest.approx(bt[5])  # BT at CHARGE (index 5), not ET's
+    b = import_log(high, load_map(write_map(tmp_path, flagged)))
+    assert b.ET_C is not None and b.initial["Tm0_C"] == pytest.approx(bt[5] + 15.0)
+    plain = ROOM_AIR_MAP + '[ET]\ncolumn = "ET"\n[initial]\nTm0_C = "ET"\n'
+    b = import_log(low, load_map(write_map(tmp_path, plain)))
+    assert b.ET_C is not None and b.initial["Tm0_C"] == pytest.approx(bt[5] - 30.0)
+    only_et = ROOM_AIR_MAP + '[ET]\ncolumn = "ET"\nabove_BT = true\n[initial]\nTm0_C = ["ET"]\n'
+    with pytest.raises(InputError, match="initial.Tm0_C: no field or channel"):
+        import_log(low, load_map(write_map(tmp_path, only_et)))
+    for bad, words in (("above_BT = 1", "true or false"), ("above_BT = true\n[initial]\nTm0_C = []", "list of names")):
+        with pytest.raises(InputError, match=words):
+            load_map(write_map(tmp_path, ROOM_AIR_MAP + '[ET]\ncolumn = "ET"\n' + bad + "\n"))
+    # the rule's window starts past the charge dip and skips Artisan's -1
+    t = np.arange(0.0, 300.0, 5.0)
+    et = np.where(t < 60, 500.0, 100.0)
+    et[20] = -1.0
+    assert et_minus_bt_C(t, et, np.full(t.size, 120.0)) == pytest.approx(-20.0)
+    assert et_minus_bt_C(t[:5], et[:5], np.full(5, 120.0)) is None
+
+
+def test_the_skywalker_examples_drop_et_on_the_three_oldest_logs(real_data):
+    """On the shared Skywalker logs the example's map drops ET where it reads below BT: the three
+    September-October 2025 logs (docs/real-roaster.md), and keeps it on the 13 later ones."""
+    cmap = load_map(Path(__file__).resolve().parents[1] / "examples" / "skywalker" / "map.toml")
+    dropped = sorted(p.stem for p in real_data.glob("*.alog") if import_log(p, cmap).ET_C is None)
+    assert dropped == ["roast_25-09-27_1236_R14", "roast_25-10-04_1155", "roast_25-10-04_1229"]
+
+
+def test_init_flags_an_et_that_reads_below_bt_unlike_the_machines_other_logs():
+    """A sensor that moved shows as logs far below the others (flagged); one sensor's spread about a
+    small negative offset does not (numbers: the Skywalker's medians and a synthetic spread)."""
+    from roastlab.metrics.profile import et_not_drum_air
+
+    sky = [-32.2, -38.1, -31.3, 8.9, 1.7, 24.8, 21.9, 28.1, 12.7, 16.8, 18.6, 19.8, 23.0, 17.3, 21.9, 16.8]
+    assert et_not_drum_air(sky) == [True] * 3 + [False] * 13
+    assert not any(et_not_drum_air([8.3, -6.7, -2.9, 0.4, 3.1, -10.3]))
+    assert et_not_drum_air([-30.0, None, 20.0]) == [False] * 3  # two known logs say nothing about a spread

@@ -242,6 +242,54 @@ def display_temp_delta(delta_C: float, units: str = "C") -> float:
 METAL_BELOW_BEANS_SHARE = 0.5
 
 
+#: ET is compared with BT from this long after CHARGE [s], past the charge dip, when the probe
+#: still carries the preheat's heat (:func:`et_minus_bt_C`).
+ET_CHECK_FROM_S = 60.0
+
+
+def et_minus_bt_C(time_s, et_C, bt_C, drop_s: float | None = None) -> float | None:
+    """Median of ET - BT [degC] from :data:`ET_CHECK_FROM_S` after CHARGE to DROP (``drop_s``,
+    default the log's end), over samples where both read (Artisan's -1 and NaN are skipped); None
+    with fewer than two such samples.
+
+    A roaster's ET that reads the drum's air, the air that heats the beans, runs above BT through
+    the roast; a channel that reads below BT through it measures something else (a thermocouple
+    moved out of the drum, into the exhaust after room air has mixed in, or off the drum). A map's
+    ``[ET] above_BT = true`` drops such a log's ET (mapping.import_log) rather than fit a model
+    temperature to it; the Skywalker's three oldest logs are such a case (docs/real-roaster.md).
+    """
+    t = np.asarray(time_s, float)
+    et, bt = np.asarray(et_C, float), np.asarray(bt_C, float)
+    end = t[-1] if drop_s is None else drop_s
+    ok = (
+        (t >= ET_CHECK_FROM_S)
+        & (t <= end)
+        & np.isfinite(et)
+        & np.isfinite(bt)
+        & (et > -1.0 + 1e-9)
+        & (bt > -1.0 + 1e-9)
+    )
+    if ok.sum() < 2:
+        return None
+    return float(np.median(et[ok] - bt[ok]))
+
+
+def et_not_drum_air(differences_C) -> list[bool]:
+    """For each log's ET - BT (:func:`et_minus_bt_C`, None where unknown) of one machine: True where
+    ET reads below BT and far below the machine's other logs, i.e. below both 0 and the logs'
+    median minus three robust standard deviations (1.4826 x the median absolute deviation). A
+    sensor that moved between roasts shows so (the Skywalker's three oldest logs, 31-38 °C below
+    BT against a median of 17 °C above); the noise of one sensor does not, nor does an ET that runs
+    a little below BT on every log. ``roastlab init`` then writes ``[ET] above_BT = true``."""
+    d = np.array([np.nan if v is None else v for v in differences_C], dtype=float)
+    ok = np.isfinite(d)
+    if ok.sum() < 3:
+        return [False] * len(d)
+    med = float(np.median(d[ok]))
+    sd = 1.4826 * float(np.median(np.abs(d[ok] - med)))
+    return [bool(ok[i] and d[i] < min(0.0, med - 3.0 * sd)) for i in range(len(d))]
+
+
 def implausible_states(result) -> list[str]:
     """What a simulation's states say that the machine cannot do (empty when nothing).
 

@@ -40,6 +40,7 @@ from ..errors import InputError
 from ..io.importers.artisan import WEIGHT_UNITS, read_alog, read_artisan_csv
 from ..io.importers.mapping import detect_format
 from ..io.importers.roastime import DRUM_AT_CHARGE, read_roastime
+from ..metrics.profile import et_minus_bt_C, et_not_drum_air
 from ..model.constants import GREEN_BULK_DENSITY_KG_M3
 
 #: Names of a heater/burner and a fan/air channel in Artisan's languages (lower case, substrings).
@@ -140,6 +141,7 @@ class LogInfo:
     started_epoch_s: float | None = None
     unused: dict = field(default_factory=dict)  # other logged controls: {"damper": channel, ...}
     unit: str = ""  # the roaster unit the log names (RoasTime serialNumber), else empty
+    et_minus_bt_C: float | None = None  # median ET - BT through the roast (metrics.profile.et_minus_bt_C)
 
 
 @dataclass
@@ -159,6 +161,7 @@ class Survey:
     fan_max: float = 0.0
     unused: dict = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
+    et_not_air: list[str] = field(default_factory=list)  # logs whose ET is not the drum's air
 
 
 def _unit_of(values: np.ndarray) -> str:
@@ -224,6 +227,9 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
             if (ch := _find([n for n in others if n not in (heater, fan)], names_))
         },
         log.unit,
+        et_minus_bt_C(log.time_s, log.channels["ET"], log.channels["BT"], log.events.get("DROP"))
+        if "ET" in names
+        else None,
     )
 
 
@@ -270,6 +276,12 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
             + "): one fit treats them as one drum, so the differences between units count as its error; "
             "fit one unit's logs for that unit's model"
         )
+    odd = [i.path.name for i, bad in zip(infos, et_not_drum_air([i.et_minus_bt_C for i in infos])) if bad]
+    if odd:
+        notes.append(
+            f"ET reads below BT through the roast on {len(odd)} log(s) ({', '.join(odd[:3])}{' ...' if len(odd) > 3 else ''}), "
+            "unlike the others: not the drum's air there, so the map drops ET on such logs ([ET] above_BT)"
+        )
     return Survey(
         infos,
         first.format,
@@ -284,6 +296,7 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
         max(i.fan_max for i in infos),
         {k: v for i in infos for k, v in i.unused.items()},
         notes,
+        odd,
     )
 
 
@@ -389,6 +402,15 @@ def map_text(s: Survey) -> str:
     initial = []
     if s.format == "roastime":
         initial.append(f'Tm0_C = "{DRUM_AT_CHARGE}"   # the drum at charge: the preheat it was held at')
+    elif s.has_et and s.et_not_air:
+        lines += [
+            "[ET]",
+            'column = "ET"',
+            f"above_BT = true        # ET reads below BT through the roast on {len(s.et_not_air)} log(s), unlike the "
+            "others: not the drum's air there, dropped on such logs",
+            "",
+        ]
+        initial.append('Tm0_C = ["ET", "BT"]  # the drum at CHARGE: ET then, else BT (the probe in the empty drum)')
     elif s.has_et:
         initial.append('Tm0_C = "ET"          # ET at CHARGE as the drum temperature')
     if initial:

@@ -43,8 +43,9 @@ A map is a TOML file::
     column = "drumTemperature" # e.g. the Bullet's infrared channel
     [ET]                       # the roaster's ET, drawn beside the model (default: an Artisan
     column = "ET"              # log's ET channel); never an input
-    [initial]                  # initial states from the log: a scalar field or a channel at CHARGE
-    Tm0_C = "preheatTemperature"
+    above_BT = true            # drop it on a log where it reads below BT through the roast
+    [initial]                  # initial states from the log: a scalar field or a channel at CHARGE,
+    Tm0_C = "preheatTemperature"  # or a list tried in order: ["ET", "BT"]
 
 The fit spec decides what the settings drive: free ``Qe_gain_kW`` (heater -> heat into the
 drum metal), ``Tgi_gain_C`` (heater -> inlet gas), ``tau_heater_s`` (its lag) and
@@ -65,6 +66,7 @@ from pathlib import Path
 import numpy as np
 
 from ...errors import InputError
+from ...metrics.profile import ET_CHECK_FROM_S, et_minus_bt_C
 from ...model.actuators import UNIT_DEFAULTS, Actuator
 from ...model.limits import check_value
 from ...model.pitot import gas_flow_pitot_kg_s
@@ -165,7 +167,7 @@ TABLE_KEYS = {
     "heater": {"column", "unit", "min", "max", "step", "rate_per_min"},
     "fan": {"column", "unit", "min", "max", "step", "rate_per_min"},
     "Tb2": {"column", "unit", "offset_C", "start_s"},
-    "ET": {"column", "unit", "offset_C"},
+    "ET": {"column", "unit", "offset_C", "above_BT"},
     "initial": set(INITIAL_FROM_LOG),
     "Gg": {"column", "unit", "density_kg_m3", "constant_kg_s", "identify", "pitot"},
     "pitot": {"dp_column", "T_column", "section_m2", "rho0_kg_m3", "T_unit"},
@@ -181,6 +183,16 @@ def _table(data: dict, key: str, src) -> dict:
         allowed = ", ".join(sorted(TABLE_KEYS[key]))
         raise InputError(f"unknown key(s) {', '.join(unknown)} (allowed: {allowed})", src, f"[{key}]")
     return value
+
+
+def _initial_sources(table: dict, key: str, src) -> str | list[str]:
+    """An ``[initial]`` entry: one field or channel name, or a list of them tried in order."""
+    v = table.get(key)
+    if isinstance(v, list):
+        if not v or not all(isinstance(x, str) and x for x in v):
+            raise InputError(f"must be a name or a list of names, got {v!r}", src, f"initial.{key}")
+        return list(v)
+    return _check_str(table, key, src, "initial")
 
 
 def _check_str(table: dict, key: str, src, where: str, required: bool = True, choices=None):
@@ -249,6 +261,11 @@ def map_from_mapping(data: dict, path: str | Path) -> ColumnMap:
                 "offset_C": _check_num(t, "offset_C", path, key, default=0.0),
             }
             setattr(m, key, m_t)
+    if m.ET is not None and "above_BT" in data["ET"]:
+        flag = data["ET"]["above_BT"]
+        if not isinstance(flag, bool):
+            raise InputError(f"must be true or false, got {flag!r}", path, "ET.above_BT")
+        m.ET["above_BT"] = flag
     if m.Tb2 is not None:
         start = _check_num(data["Tb2"], "start_s", path, "Tb2", default=0.0)
         if not 0 <= start <= 3600:
@@ -265,7 +282,7 @@ def map_from_mapping(data: dict, path: str | Path) -> ColumnMap:
             setattr(m, key, spec)
     if "initial" in data:
         t = _table(data, "initial", path)
-        m.initial = {k: _check_str(t, k, path, "initial") for k in t}
+        m.initial = {k: _initial_sources(t, k, path) for k in t}
     if "batch_kg" in data:
         m.batch_kg = check_value("batch_kg", _check_num(data, "batch_kg", path, "map"), str(path))
     if "Gg" in data:
@@ -491,20 +508,34 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
         series = {k: channel(spec, k) + (spec.get("offset_C") or 0.0) for k, spec in settings.items()}
         if et_spec is None and fmt != "roastime" and "ET" in available:
             et_spec = {"column": "ET"}  # Artisan's ET (temp1): drawn beside the model, never an input
+        rejected = set()  # channels that do not read what the map says (no initial state from them)
         if et_spec is not None:
             settings["ET"] = et_spec
             series["ET"] = channel(et_spec, "ET") + (et_spec.get("offset_C") or 0.0)
+            gap = et_minus_bt_C(time_s, series["ET"], Ta, log.events.get("DROP")) if et_spec.get("above_BT") else None
+            if gap is not None and gap < 0:  # not the drum's air on this log (metrics.profile.et_minus_bt_C)
+                default_notes.append(
+                    f"ET reads {-gap:.0f} degC below BT through the roast (median from "
+                    f"{ET_CHECK_FROM_S:g} s): not the drum's air on this log, so it is neither fitted nor scored"
+                )
+                del settings["ET"], series["ET"]
+                et_spec, rejected = None, {cmap.ET["column"]}
         Mb = log.weight_in_kg
         drop_known = log.drop_index is not None
         events = dict(log.events)
-        for state, source in cmap.initial.items():
-            if source in log.fields:
-                initial[state] = float(log.fields[source])
-            elif source in available and np.isfinite(available[source][0]):
-                initial[state] = float(available[source][0])  # the channel's reading at CHARGE
+        for state, sources in cmap.initial.items():
+            for source in [sources] if isinstance(sources, str) else sources:
+                if source in rejected:
+                    continue
+                if source in log.fields:
+                    initial[state] = float(log.fields[source])
+                    break
+                if source in available and np.isfinite(available[source][0]):
+                    initial[state] = float(available[source][0])  # the channel's reading at CHARGE
+                    break
             else:
-                have = ", ".join(sorted(set(log.fields) | set(available)))
-                raise InputError(f"initial.{state}: no field or channel {source!r} in the log (has: {have})", path)
+                have = ", ".join(sorted((set(log.fields) | set(available)) - rejected))
+                raise InputError(f"initial.{state}: no field or channel {sources!r} in the log (has: {have})", path)
     else:
         needed = [cmap.time["column"], cmap.Ta["column"]]
         needed += [cmap.Tgi["column"]] if "column" in cmap.Tgi else []
