@@ -116,6 +116,9 @@ def test_a_program_step_through_the_api_holds_for_its_span_only(client, data_dir
     bt = np.array(banded["curves"]["BT_model"], dtype=float)
     assert np.all(lower <= bt + 1e-9) and np.all(bt <= upper + 1e-9) and banded["band"]["median_width_C"] > 0.5
     assert w["band"] is None  # asked for only: the live what-if stays fast
+    assert "note" not in banded["band"] and "note" not in r["band"]  # the fitted batch size
+    heavier = client.post("/api/whatif", json={"batch_kg": 0.8, "band": True}, headers=H).json()
+    assert "0.8 kg lies outside the batch sizes" in heavier["band"]["note"]
     bad = client.post("/api/whatif", json={"program": [{"setting": "heater", "value": "lots"}]}, headers=H)
     assert bad.status_code == 400 and "program step 1" in bad.json()["error"]
     off = client.post("/api/whatif", json={"program": [{**step, "value": 40}]}, headers=H)

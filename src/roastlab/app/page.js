@@ -212,7 +212,8 @@ function drawTable() {
   $("figures").textContent = (m ? `model as run against this log: FIT ${m.FIT_pct.toFixed(1)} %, MAE ${dtemp(m.MAE_C).toFixed(2)} ${unit()}` : "") +
     (b && b.lower ? `; ${Math.round(b.level * 100)} % band median width ${dtemp(b.median_width_C).toFixed(1)} ${unit()}` : b && b.why ? `; ${b.why}` : "") +
     (state.changed && state.changedBand ? `; changed: ${dtemp(state.changedBand.median_width_C).toFixed(1)} ${unit()}` : "");
-  $("warnings").textContent = (t.warnings || []).map((w) => "note: " + w).join("\n");
+  const bandNotes = [b && b.note, state.changed && state.changedBand && state.changedBand.note];
+  $("warnings").textContent = [...(t.warnings || []), ...new Set(bandNotes.filter(Boolean))].map((w) => "note: " + w).join("\n");
 }
 
 function changes() {

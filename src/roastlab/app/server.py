@@ -167,21 +167,24 @@ def band(model, batch) -> dict:
     """The as-run prediction band of :func:`roastlab.evaluate.bands.prediction_bands` (level
     :data:`~roastlab.evaluate.bands.BAND_LEVEL`) or, for a model without standard errors or a
     roast-to-roast spread, ``{"why": ...}``."""
-    from ..evaluate.bands import BAND_LEVEL, prediction_bands, why_no_band
+    from ..evaluate.bands import BAND_LEVEL, prediction_bands, sizes_outside, why_no_band
 
     why = why_no_band(model)
     if why is not None:
         return {"why": why}
-    return band_dict(prediction_bands(model, [batch], BAND_LEVEL)[0])
+    plant_kg = model.plant.Mb_kg if model.plant is not None else None
+    return band_dict(prediction_bands(model, [batch], BAND_LEVEL)[0], sizes_outside(model, [batch.Mb_kg or plant_kg]))
 
 
-def band_dict(b) -> dict:
-    """A :class:`~roastlab.evaluate.bands.Band` as the page draws it."""
+def band_dict(b, note: str | None = None) -> dict:
+    """A :class:`~roastlab.evaluate.bands.Band` as the page draws it; ``note``: why it may hold
+    fewer samples than its level (:func:`roastlab.evaluate.bands.sizes_outside`)."""
     return {
         "level": b.level,
         "lower": _series(b.lower_C),
         "upper": _series(b.upper_C),
         "median_width_C": round(b.median_width_C, 2),
+        **({"note": note} if note else {}),
     }
 
 
@@ -364,7 +367,7 @@ def create_app(data_dir: str | Path):
         return {
             "curves": curves(None, w.changed, session.et),
             "table": w.to_json_dict(),
-            "band": band_dict(w.band) if w.band is not None else None,
+            "band": band_dict(w.band, w.band_note) if w.band is not None else None,
             "server_ms": round((time.perf_counter() - t0) * 1e3, 2),
         }
 

@@ -77,18 +77,25 @@ def roast_spread(time_s, errors_C, held_out: bool = True, batch_kg=None) -> dict
 
 
 def sizes_outside(model, batch_kg) -> str | None:
-    """A note for the roaster when a green weight in ``batch_kg`` [kg] lies outside the range the
-    model's roast-to-roast spread was measured at (``fit.spread.batch_kg``), else None.
+    """A note for the roaster when a green weight in ``batch_kg`` [kg] is not one of the sizes the
+    model's roast-to-roast spread was measured at (``fit.spread.batch_kg``, grouped into sizes as
+    ``roastlab compare-models`` groups them), else None.
 
     The spread says how far roasts of the fitted sizes stray from the model; it holds nothing about
     the error of predicting another batch size, which is larger (docs/real-roaster.md measures the
     band's coverage at the fitted sizes and at others). Older model files without the range give None."""
+    from ..workflows.compare import GROUP_STEP_SHARE
+
     spread = (model.doc.get("fit") or {}).get("spread") or {}
     rng = spread.get("batch_kg")
     if not rng:
         return None
     lo, hi = rng
-    odd = sorted({round(float(m), 4) for m in batch_kg if m and not (lo - 1e-9 <= m <= hi + 1e-9)})
+    # one size as roastlab compare-models groups them (workflows.compare.size_groups): weights that
+    # round to the same multiple of a tenth of the fitted weight (490 and 500 g together)
+    step = GROUP_STEP_SHARE * 0.5 * (lo + hi)
+    first, last = round(lo / step), round(hi / step)
+    odd = sorted({round(float(m), 4) for m in batch_kg if m and not first <= round(m / step) <= last})
     if not odd:
         return None
     fitted = f"{lo:g} kg" if lo == hi else f"{lo:g}-{hi:g} kg"
