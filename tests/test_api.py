@@ -22,7 +22,7 @@ def sky_model(tmp_path_factory):
     folder = REAL_DATA / "skywalker"
     if not folder.is_dir():
         pytest.skip("../shared/data/real is absent")
-    logs = sorted(folder.glob("*.alog"))
+    logs = sorted(folder.glob("*.alog"))[3:]  # from October 2025 on, ET reads the drum's air (the map)
     batches = [roastlab.load_log(p, EXAMPLE / "map.toml") for p in logs[0:4:2]]
     from roastlab.io.importers import load_map
 

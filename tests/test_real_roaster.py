@@ -391,3 +391,14 @@ def test_a_stepped_heater_slower_than_a_step_per_sample_still_moves(cli, bullet_
         assert np.abs(steps).max() <= 1.0  # one step at a time
         minutes = (tr["time_s"].iloc[-1] - tr["time_s"].iloc[0]) / 60.0
         assert np.abs(steps).sum() <= 8.0 * minutes + 1.0  # the rate limit, on average
+
+
+def test_skywalker_logs_whose_et_the_map_drops_say_so_when_et_is_weighed(cli, real_data, tmp_path):
+    """The three oldest Skywalker logs' ET reads below BT: fitting ET on them alone is refused in one
+    line that says why and what to do."""
+    old = sorted(real_data.glob("*.alog"))[:3]
+    common = ["--plant", EXAMPLE / "plant.toml", "--map", EXAMPLE / "map.toml", "--spec", EXAMPLE / "fit.toml"]
+    code, _, err = cli("identify", *common, *old[:2], "--out", tmp_path / "m.json")
+    last = err.strip().splitlines()[-1]
+    assert code == 2 and "dropped ET on all 2 log(s)" in last and "--weight ET=0" in last, err
+    assert not (tmp_path / "m.json").exists()

@@ -296,8 +296,8 @@ def add_parsers(sub) -> None:
     add_model_options(p, with_model=False)
     p.set_defaults(func=cmd_identify)
 
+    from ..evaluate.metrics import GROUP_STEP_SHARE
     from ..model.bed import VARIANTS
-    from ..workflows.compare import GROUP_STEP_SHARE
     from .common import variant_arg
 
     p = sub.add_parser(

@@ -84,7 +84,7 @@ def sizes_outside(model, batch_kg) -> str | None:
     The spread says how far roasts of the fitted sizes stray from the model; it holds nothing about
     the error of predicting another batch size, which is larger (docs/real-roaster.md measures the
     band's coverage at the fitted sizes and at others). Older model files without the range give None."""
-    from ..workflows.compare import GROUP_STEP_SHARE
+    from .metrics import GROUP_STEP_SHARE, size_key
 
     spread = (model.doc.get("fit") or {}).get("spread") or {}
     rng = spread.get("batch_kg")
@@ -94,8 +94,8 @@ def sizes_outside(model, batch_kg) -> str | None:
     # one size as roastlab compare-models groups them (workflows.compare.size_groups): weights that
     # round to the same multiple of a tenth of the fitted weight (490 and 500 g together)
     step = GROUP_STEP_SHARE * 0.5 * (lo + hi)
-    first, last = round(lo / step), round(hi / step)
-    odd = sorted({round(float(m), 4) for m in batch_kg if m and not first <= round(m / step) <= last})
+    first, last = size_key(lo, step), size_key(hi, step)
+    odd = sorted({round(float(m), 4) for m in batch_kg if m and not first <= size_key(m, step) <= last})
     if not odd:
         return None
     fitted = f"{lo:g} kg" if lo == hi else f"{lo:g}-{hi:g} kg"

@@ -13,6 +13,18 @@ from __future__ import annotations
 
 import numpy as np
 
+#: One batch size: green weights that round to the same multiple of this share of a typical
+#: (median) weight are one size (a tenth: 490 and 500 g together). Used to group logs by size
+#: (roastlab.workflows.compare.size_groups) and to say when a band meets a size its spread was not
+#: measured at (roastlab.evaluate.bands.sizes_outside).
+GROUP_STEP_SHARE = 0.1
+
+
+def size_key(mass_kg: float, step_kg: float) -> int:
+    """The size a green weight [kg] belongs to, in steps of ``step_kg`` (:data:`GROUP_STEP_SHARE`)."""
+    return round(mass_kg / step_kg)
+
+
 METRIC_NAMES = ("n", "SSR", "norm", "MAE", "MPE", "MAPE", "FIT", "rho")
 
 

@@ -24,13 +24,11 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..errors import InputError, ParameterError
+from ..evaluate.metrics import GROUP_STEP_SHARE, size_key
 from ..model.bed import LAWS, VARIANTS, BedLaws
 from ..model.limits import check_value
 from ..model.parameters import FREE_NAMES, N_STARTS, FreeParameter
 from ..report.result import Result, aligned
-
-#: Default group step as a share of the median green weight (a tenth: 490 and 500 g together).
-GROUP_STEP_SHARE = 0.1
 
 
 def size_groups(batches, step_kg: float | None = None) -> tuple[list[str], float]:
@@ -49,7 +47,7 @@ def size_groups(batches, step_kg: float | None = None) -> tuple[list[str], float
         step_kg = float(np.median(masses)) * GROUP_STEP_SHARE
     if not (step_kg > 0 and math.isfinite(step_kg)):
         raise InputError(f"group step must be a positive mass in kg, got {step_kg!r}", "command line")
-    keys = [round(m / step_kg) for m in masses]
+    keys = [size_key(m, step_kg) for m in masses]
     labels = {}
     for key in set(keys):
         members = [m for m, k in zip(masses, keys) if k == key]

@@ -191,7 +191,14 @@ def fit(
     if weights.get("Tb2", 0) > 0 and all(b.Tb2_C is None or not np.isfinite(b.Tb2_C).any() for b in batches):
         raise InputError(NO_SECOND_READING, "command line" if "Tb2" in given else spec_source)
     if weights.get("ET", 0) > 0 and all(b.ET_C is None or not np.isfinite(b.ET_C).any() for b in batches):
-        raise InputError(NO_ET_READING, "command line" if "ET" in given else spec_source)
+        dropped = sum(any("not the drum's air" in n for n in b.notes) for b in batches)
+        message = NO_ET_READING
+        if dropped:  # the map's [ET] above_BT dropped it on every log given (io.importers.mapping)
+            message = (
+                f"the ET output has a weight, but the map dropped ET on all {dropped} log(s) given (it reads below BT "
+                "through the roast there): add logs whose ET is the drum's air, or pass --weight ET=0"
+            )
+        raise InputError(message, "command line" if "ET" in given else spec_source)
     names_moved = {f.name for f in free} | set(fixed)
     if "Gg_kg_s" not in names_moved and all(np.all(b.Gg_kg_s == PLACEHOLDER_GG_KG_S) for b in batches):
         raise InputError(
