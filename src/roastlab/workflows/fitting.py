@@ -20,7 +20,7 @@ from ..evaluate.validate import ValidationResult
 from ..fit.identify import NO_ET_READING, NO_SECOND_READING, IdentificationResult, build_free_parameters, identify
 from ..io.batch import Batch
 from ..io.fitspec import FitSpec, load_fit_spec
-from ..io.importers.mapping import ColumnMap
+from ..io.importers.mapping import ET_NOT_DRUM_AIR, ColumnMap
 from ..io.plants import load_plant
 from ..metrics.profile import implausible_states
 from ..model.bed import PAPER_BED, BedLaws
@@ -191,7 +191,7 @@ def fit(
     if weights.get("Tb2", 0) > 0 and all(b.Tb2_C is None or not np.isfinite(b.Tb2_C).any() for b in batches):
         raise InputError(NO_SECOND_READING, "command line" if "Tb2" in given else spec_source)
     if weights.get("ET", 0) > 0 and all(b.ET_C is None or not np.isfinite(b.ET_C).any() for b in batches):
-        dropped = sum(any("not the drum's air" in n for n in b.notes) for b in batches)
+        dropped = sum(any(ET_NOT_DRUM_AIR in n for n in b.notes) for b in batches)
         message = NO_ET_READING
         if dropped:  # the map's [ET] above_BT dropped it on every log given (io.importers.mapping)
             message = (

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import math
 import re
+from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -265,14 +266,11 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
     fan_units = {i.fan_unit for i in infos if i.fan}
     fan_unit = "percent" if "percent" in fan_units else (fan_units.pop() if fan_units else None)
     notes = []
-    serials: dict[str, int] = {}
-    for i in infos:
-        if i.unit:
-            serials[i.unit] = serials.get(i.unit, 0) + 1
+    serials = Counter(i.unit for i in infos if i.unit)
     if len(serials) > 1:
         notes.append(
             f"the logs come from {len(serials)} units of this roaster (serial number: logs; "
-            + ", ".join(f"{u}: {k}" for u, k in sorted(serials.items(), key=lambda kv: -kv[1]))
+            + ", ".join(f"{u}: {k}" for u, k in serials.most_common())
             + "): one fit treats them as one drum, so the differences between units count as its error; "
             "fit one unit's logs for that unit's model"
         )

@@ -159,6 +159,9 @@ class ColumnMap:
         return bool(self.Gg.get("identify"))
 
 
+#: The import note of a log whose ET a map's ``[ET] above_BT`` dropped (a fit that weighs ET looks for it).
+ET_NOT_DRUM_AIR = "not the drum's air on this log"
+
 #: Keys each map table may hold; anything else is a typo worth reporting.
 TABLE_KEYS = {
     "time": {"column", "unit"},
@@ -516,7 +519,7 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
             if gap is not None and gap < 0:  # not the drum's air on this log (metrics.profile.et_minus_bt_C)
                 default_notes.append(
                     f"ET reads {-gap:.0f} degC below BT through the roast (median from "
-                    f"{ET_CHECK_FROM_S:g} s): not the drum's air on this log, so it is neither fitted nor scored"
+                    f"{ET_CHECK_FROM_S:g} s): {ET_NOT_DRUM_AIR}, so it is neither fitted nor scored"
                 )
                 del settings["ET"], series["ET"]
                 et_spec, rejected = None, {cmap.ET["column"]}

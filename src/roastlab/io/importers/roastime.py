@@ -58,9 +58,8 @@ FIELDS = (
 #: the log's first sample, and a log can start after the beans began to fall: in
 #: ``bullet_2020-11-05_1536_500g`` the probe falls from the first sample and the IR reads 195, 183,
 #: 171 °C over the first 2 s against a preheat of 245 °C. Where the log starts before the charge
-#: the two agree within 3 °C on 25 of the 28 shared logs. Measured on the Bullet example (fit on
-#: nine 490-500 g logs, eight held out): held-out FIT 86.2 % / MAE 3.98 °C with the preheat
-#: against 83.0 % / 5.17 °C with the stamped IR reading (docs/real-roaster.md).
+#: the two agree within 3 °C on 26 of the 28 shared logs. docs/real-roaster.md measures the
+#: Bullet example with each.
 DRUM_AT_CHARGE = "preheatTemperature"
 #: Largest sample rate accepted [1/s] (RoasTime records 2).
 MAX_SAMPLE_RATE = 100.0
