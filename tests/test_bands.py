@@ -119,3 +119,26 @@ def test_a_band_says_when_a_batch_size_lies_outside_the_fitted_ones():
     note = sizes_outside(model, [0.35, 0.49, 0.8, 0.35])
     assert note.startswith("0.35 kg, 0.8 kg lie outside") and "0.49-0.5 kg" in note
     assert sizes_outside(SimpleNamespace(doc={"fit": {"spread": roast_spread(t, e)}}), [0.35]) is None  # older file
+
+
+def test_draws_follow_a_product_ridge_in_logarithms():
+    """Two coefficients the data pin only as a product (hbm Pbm, correlation -0.99, 30 % each):
+    the draws keep the product within its linearised spread and stay positive. Drawn in the values
+    instead, a normal draw leaves the hyperbola and spreads the product twice as wide."""
+    from types import SimpleNamespace
+
+    params = {
+        "hbm": {"value": 0.086, "stderr": 0.026, "bounds": [0.001, 1.0]},
+        "Pbm": {"value": 0.134, "stderr": 0.040, "bounds": [0.05, 0.95]},
+    }
+    corr = {"names": ["hbm", "Pbm"], "matrix": [[1.0, -0.99], [-0.99, 1.0]]}
+    model = SimpleNamespace(parameters=params, initial={}, doc={"fit": {"correlation": corr}})
+    names, draws = parameter_draws(model, 20000, seed=3)
+    product = draws[:, 0] * draws[:, 1]
+    linearised = np.sqrt(0.3**2 + 0.3**2 - 2 * 0.99 * 0.3 * 0.3)  # sd of log(hbm Pbm)
+    assert np.std(np.log(product)) == pytest.approx(linearised, rel=0.15) and np.all(draws > 0)
+    rng = np.random.default_rng(3)
+    se = np.array([0.026, 0.040])
+    C = np.array([[1.0, -0.99], [-0.99, 1.0]]) * np.outer(se, se)
+    linear = np.array([0.086, 0.134]) + rng.multivariate_normal([0, 0], C, 20000)
+    assert np.std(np.log(np.abs(linear[:, 0] * linear[:, 1]))) > 2 * np.std(np.log(product))

@@ -154,7 +154,14 @@ def _new_roast_quantile(level: float, n_logs: int) -> float:
 
 def parameter_draws(model, samples: int, seed: int) -> tuple[list[str], np.ndarray]:
     """(names, (samples, k) values) of the model's fitted scalar parameters drawn from N(z*, C),
-    clipped into their bounds; parameters without a standard error stay at their value."""
+    clipped into their bounds; parameters without a standard error stay at their value.
+
+    A parameter whose value and bounds are positive (a coefficient, an area share, a flow) is drawn
+    as its logarithm, from the same linearisation: sd(log z) = se / z, the same correlations. Heat
+    paths act through products (hbm Pbm, the metal-bean conductance; section 3.1), and the fit pins
+    a product where it leaves the factors free: in the logarithms that ridge is a straight line,
+    which a normal draw follows; in the values it is a hyperbola, which a normal draw leaves, and
+    the band then shows a spread of the product that the data do not have. Each draw stays positive."""
     corr = (model.doc.get("fit") or {}).get("correlation") or {}
     names = [n for n in corr.get("names", []) if n in model.parameters or n in model.initial]
     entries = {**model.parameters, **model.initial}
@@ -172,12 +179,16 @@ def parameter_draws(model, samples: int, seed: int) -> tuple[list[str], np.ndarr
     index = [corr["names"].index(n) for n in keep]
     R = np.array([[corr["matrix"][i][j] if corr["matrix"][i][j] is not None else 0.0 for j in index] for i in index])
     np.fill_diagonal(R, 1.0)
-    se = np.array(ses)
+    vals = np.array(vals)
+    log = np.array([v > 0 and (entries[n].get("bounds") or [0.0])[0] >= 0 for n, v in zip(keep, vals)])
+    centre = np.where(log, np.log(np.where(log, vals, 1.0)), vals)
+    se = np.where(log, np.array(ses) / np.where(log, vals, 1.0), np.array(ses))  # sd of log z = se / z
     C = R * np.outer(se, se)
     w, V = np.linalg.eigh(0.5 * (C + C.T))
     L = V * np.sqrt(np.clip(w, 0.0, None))  # C = L L' (a covariance that is only semi-definite still samples)
     rng = np.random.default_rng(seed)
-    draws = np.asarray(vals) + rng.standard_normal((samples, len(keep))) @ L.T
+    draws = centre + rng.standard_normal((samples, len(keep))) @ L.T
+    draws[:, log] = np.exp(draws[:, log])
     for j, n in enumerate(keep):
         b = entries[n].get("bounds")
         if b:
