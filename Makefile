@@ -47,7 +47,7 @@ wheel-check:
 
 # The measured figures of docs/real-roaster.md, from the real logs in ../shared/data/real.
 # Then every bed-law variant and the probe depth scale's profile cross-validated by batch size on the
-# Bullet (9 variants x 9 fits, ~8 min).
+# Bullet (11 variants x 9 fits, ~10 min).
 BULLET = ../shared/data/real/bullet
 real-roaster: $(STAMP)
 	$(PY) docs/real_roaster.py
@@ -55,10 +55,13 @@ real-roaster: $(STAMP)
 	  --spec examples/bullet/fit.toml $$(ls $(BULLET)/*_*g.json) \
 	  $(foreach v,$(BED_VARIANTS),--variant $(v),h_probe_m=free) \
 	  $(foreach h,$(H_PROBE_PROFILE_M),--variant $(BED_EXAMPLE),h_probe_m=$(h)) \
+	  --variant $(BED_BEFORE),h_probe_m=0.2 \
 	  --json docs/real-roaster-compare.json --plot docs/real-roaster-compare.png
 # each bed law with the probe's depth scale fitted, then that scale's profile under the example's laws
-BED_VARIANTS = paper probe=tumbling contact=wall contact=wall,probe=tumbling,probe_gas=mean
-BED_EXAMPLE = contact=wall,probe=tumbling,probe_gas=mean
+BED_VARIANTS = paper probe=tumbling contact=wall probe=tumbling,probe_gas=mean contact=wall,probe=tumbling,probe_gas=mean
+BED_EXAMPLE = probe=tumbling,probe_gas=mean
+# the example's laws until 2026-11-25, held at its depth scale, for comparison
+BED_BEFORE = contact=wall,probe=tumbling,probe_gas=mean
 H_PROBE_PROFILE_M = 0.03 0.1 0.2 0.5 1
 
 # The page's screenshots for docs/app.md and its measured speed (needs Debian's chromium).

@@ -196,7 +196,7 @@ def test_bullet_fit_and_whatif(cli, bullet_data, tmp_path):
     from roastlab.io.fitspec import load_fit_spec
 
     spec = load_fit_spec(BULLET / "fit.toml")
-    assert doc["bed"] == spec.bed.as_dict() and spec.bed.name == "contact=wall,probe=tumbling,probe_gas=mean"
+    assert doc["bed"] == spec.bed.as_dict() and spec.bed.name == "probe=tumbling,probe_gas=mean"
     assert doc["parameters"]["h_probe_m"] == {**doc["parameters"]["h_probe_m"], "how": "fixed", "value": 0.2}
     code, out, err = cli(
         "whatif",
@@ -260,8 +260,11 @@ def test_bullet_whatif_heavier_batch_judged_on_the_beans(cli, bullet_model, tmp_
     assert rows["probe", "DROP_C"]["measured"] == pytest.approx(190.0, abs=1.0)
     code, _, err = cli("whatif", log, "--model", bullet_model, "--batch-kg", "0.4", "--json", tmp_path / "l.json")
     lighter = {(r["reading"], r["key"]): r for r in json.loads((tmp_path / "l.json").read_text())["rows"]}
-    assert lighter["beans", "DROP_C"]["changed"] > lighter["beans", "DROP_C"]["as_run"] + 2.0
-    assert lighter["beans", "FCs_s"]["changed"] < lighter["beans", "FCs_s"]["as_run"] - 20.0
+    # (the beans respond less to the batch mass with the paper's contact law, the example's since
+    # 2026-11-25: +1.5 °C at DROP and first crack 18 s sooner on this three-log fit, +3.0 °C and 36 s
+    # on the nine-log fit of the docs)
+    assert lighter["beans", "DROP_C"]["changed"] > lighter["beans", "DROP_C"]["as_run"] + 1.0
+    assert lighter["beans", "FCs_s"]["changed"] < lighter["beans", "FCs_s"]["as_run"] - 10.0
     # far beyond the drum: one line with the capacity, exit 2
     code, _, err = cli("whatif", log, "--model", bullet_model, "--batch-kg", "240")
     assert code == 2 and "drum holds" in err and err.count("\n") == 1

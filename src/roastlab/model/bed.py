@@ -113,6 +113,7 @@ VARIANTS: dict[str, BedLaws] = {
         PAPER_BED,
         BedLaws(probe="tumbling"),
         BedLaws(contact="wall"),
+        BedLaws(probe="tumbling", probe_gas="mean"),
         BedLaws(contact="wall", probe="tumbling", probe_gas="mean"),
     )
 }
