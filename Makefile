@@ -47,7 +47,7 @@ wheel-check:
 
 # The measured figures of docs/real-roaster.md, from the real logs in ../shared/data/real.
 # Then every bed-law variant and the probe depth scale's profile cross-validated by batch size on the
-# Bullet (11 variants x 9 fits, ~10 min).
+# Bullet (11 variants x 9 fits, ~15 min).
 BULLET = ../shared/data/real/bullet
 real-roaster: $(STAMP)
 	$(PY) docs/real_roaster.py

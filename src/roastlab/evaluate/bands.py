@@ -152,12 +152,22 @@ def _new_roast_quantile(level: float, n_logs: int) -> float:
     return float(t.ppf(0.5 + level / 2.0, n))
 
 
+def _ratio_scale(name: str, value: float, bounds) -> bool:
+    """True for a parameter drawn as its logarithm (:func:`parameter_draws`): positive, bounded
+    below by zero or more, and not a temperature on a scale with an arbitrary zero (degC; a gain in
+    degC per unit is a ratio and is drawn as a logarithm)."""
+    from ..model.parameters import REGISTRY
+
+    unit = REGISTRY[name].unit if name in REGISTRY else ""
+    return value > 0 and (bounds or [0.0])[0] >= 0 and unit != "degC"
+
+
 def parameter_draws(model, samples: int, seed: int) -> tuple[list[str], np.ndarray]:
     """(names, (samples, k) values) of the model's fitted scalar parameters drawn from N(z*, C),
     clipped into their bounds; parameters without a standard error stay at their value.
 
-    A parameter whose value and bounds are positive (a coefficient, an area share, a flow) is drawn
-    as its logarithm, from the same linearisation: sd(log z) = se / z, the same correlations. Heat
+    A parameter whose value and bounds are positive (a coefficient, an area share, a flow; not a
+    temperature in degC, :func:`_ratio_scale`) is drawn as its logarithm, from the same linearisation: sd(log z) = se / z, the same correlations. Heat
     paths act through products (hbm Pbm, the metal-bean conductance; section 3.1), and the fit pins
     a product where it leaves the factors free: in the logarithms that ridge is a straight line,
     which a normal draw follows; in the values it is a hyperbola, which a normal draw leaves, and
@@ -180,7 +190,7 @@ def parameter_draws(model, samples: int, seed: int) -> tuple[list[str], np.ndarr
     R = np.array([[corr["matrix"][i][j] if corr["matrix"][i][j] is not None else 0.0 for j in index] for i in index])
     np.fill_diagonal(R, 1.0)
     vals = np.array(vals)
-    log = np.array([v > 0 and (entries[n].get("bounds") or [0.0])[0] >= 0 for n, v in zip(keep, vals)])
+    log = np.array([_ratio_scale(n, v, entries[n].get("bounds")) for n, v in zip(keep, vals)])
     centre = np.where(log, np.log(np.where(log, vals, 1.0)), vals)
     se = np.where(log, np.array(ses) / np.where(log, vals, 1.0), np.array(ses))  # sd of log z = se / z
     C = R * np.outer(se, se)
