@@ -172,8 +172,7 @@ def band(model, batch) -> dict:
     why = why_no_band(model)
     if why is not None:
         return {"why": why}
-    plant_kg = model.plant.Mb_kg if model.plant is not None else None
-    return band_dict(prediction_bands(model, [batch], BAND_LEVEL)[0], sizes_outside(model, [batch.Mb_kg or plant_kg]))
+    return band_dict(prediction_bands(model, [batch], BAND_LEVEL)[0], sizes_outside(model, [batch.Mb_kg]))
 
 
 def band_dict(b, note: str | None = None) -> dict:

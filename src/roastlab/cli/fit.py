@@ -195,8 +195,7 @@ def _band_table(model, batches, level, plant_spec, changes) -> tuple[dict, list]
               "the band is the parameters' alone")  # fmt: skip
     bands = prediction_bands(model, batches, level)
     rows = coverage(batches, bands)
-    plant_kg = model.plant.Mb_kg if model.plant is not None else None
-    note = sizes_outside(model, [r["Mb_kg"] or plant_kg for r in rows])
+    note = sizes_outside(model, [r["Mb_kg"] for r in rows])
     print(f"\n{level:.0%} prediction band (parameters and roast-to-roast spread, roastlab.evaluate.bands):")
     print(f"{'batch':<36} {'kg':>6} {'inside':>7} {'median width':>13}")
     for r in rows:

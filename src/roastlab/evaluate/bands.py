@@ -79,7 +79,8 @@ def roast_spread(time_s, errors_C, held_out: bool = True, batch_kg=None) -> dict
 def sizes_outside(model, batch_kg) -> str | None:
     """A note for the roaster when a green weight in ``batch_kg`` [kg] is not one of the sizes the
     model's roast-to-roast spread was measured at (``fit.spread.batch_kg``, grouped into sizes as
-    ``roastlab compare-models`` groups them), else None.
+    ``roastlab compare-models`` groups them), else None. A weight of None or 0 (a batch without its
+    own) is the model plant's batch mass, as a prediction takes it.
 
     The spread says how far roasts of the fitted sizes stray from the model; it holds nothing about
     the error of predicting another batch size, which is larger (docs/real-roaster.md measures the
@@ -91,6 +92,8 @@ def sizes_outside(model, batch_kg) -> str | None:
     if not rng:
         return None
     lo, hi = rng
+    plant_kg = model.plant.Mb_kg if getattr(model, "plant", None) is not None else None
+    batch_kg = [m or plant_kg for m in batch_kg]
     # one size as roastlab compare-models groups them (workflows.compare.size_groups): weights that
     # round to the same multiple of a tenth of the fitted weight (490 and 500 g together)
     step = GROUP_STEP_SHARE * 0.5 * (lo + hi)

@@ -398,6 +398,5 @@ def whatif(
         from ..evaluate.bands import prediction_bands, sizes_outside
 
         band = prediction_bands(model, [changed_batch], band_level, **changes)[0]
-        plant_kg = model.plant.Mb_kg if model.plant is not None else None
-        band_note = sizes_outside(model, [changes.get("batch_kg") or changed_batch.Mb_kg or plant_kg])
+        band_note = sizes_outside(model, [changes.get("batch_kg") or changed_batch.Mb_kg])
     return WhatIf(batch, as_run, changed, labels, rows, levels, band, band_note)
