@@ -340,3 +340,74 @@ def test_init_flags_an_et_that_reads_below_bt_unlike_the_machines_other_logs():
     assert et_not_drum_air(sky) == [True] * 3 + [False] * 13
     assert not any(et_not_drum_air([8.3, -6.7, -2.9, 0.4, 3.1, -10.3]))
     assert et_not_drum_air([-30.0, None, 20.0]) == [False] * 3  # two known logs say nothing about a spread
+
+
+def test_the_room_temperature_a_log_records_sets_the_inlet_air_and_the_beans_at_charge(tmp_path):
+    """[Tgi] room = true: the inlet air is the room temperature the log records (Artisan's
+    ambientTemp in the profile's mode, RoasTime's typed text with the map's room_unit for a bare
+    number), the constant where a log has none or where the entry is no room's (with a note);
+    [initial] Tb0_C = "Tgi" starts the beans at that air. Synthetic logs (fake_alog, a RoasTime
+    JSON written here)."""
+    from roastlab.errors import InputError
+    from roastlab.io.importers.artisan import room_from_text
+
+    room_map = ROOM_AIR_MAP.replace("constant_C = 22.0\n", "constant_C = 22.0\nroom = true\n")
+    room_map += '[initial]\nTb0_C = "Tgi"\n'
+    cmap = load_map(write_map(tmp_path, room_map))
+    for mode, value, want in (("C", 8.0, 8.0), ("F", 50.0, 10.0)):
+        p = tmp_path / f"room_{mode}.alog"
+        p.write_text(
+            fake_alog(mode, extra={"ambientTemp": value})
+            if mode == "C"
+            else fake_alog(
+                "F",
+                [266.0 + 0.9 * i for i in range(120)],
+                [300.0 + 0.9 * i for i in range(120)],
+                120,
+                {"ambientTemp": value},
+            )
+        )
+        b = import_log(p, cmap)
+        assert np.all(b.Tgi_C == pytest.approx(want)) and b.initial["Tb0_C"] == pytest.approx(want)
+    unset = tmp_path / "unset.alog"
+    unset.write_text(fake_alog(extra={"ambientTemp": 0.0}))  # Artisan's "not entered"
+    b = import_log(unset, cmap)
+    assert np.all(b.Tgi_C == 22.0) and b.initial["Tb0_C"] == 22.0 and not b.notes
+    # without room = true the log's entry is not read
+    b = import_log(tmp_path / "room_C.alog", load_map(write_map(tmp_path, ROOM_AIR_MAP)))
+    assert np.all(b.Tgi_C == 22.0)
+
+    def roastime(ambient, key="ambientTemp"):
+        d = {
+            "sampleRate": 1,
+            "weightGreen": 500,
+            "beanTemperature": [150.0 - 2 * i if i < 30 else 90 + i for i in range(200)],
+            "drumTemperature": [200.0] * 200,
+            "actions": {"actionTimeList": [{"index": 0, "value": 6, "ctrlType": 0}]},
+            key: ambient,
+        }
+        p = tmp_path / f"rt_{key}_{len(str(ambient))}.json"
+        p.write_text(json.dumps(d))
+        return p
+
+    rt_map = room_map.replace("[Ta]", 'format = "roastime"\n[Ta]') + ""
+    for unit, text, key, want in (
+        ("F", "72", "ambientTemp", 22.222),
+        ("F", "18 C", "ambient", 18.0),
+        ("C", "64 F", "ambient", 17.778),
+        ("C", "19.5", "ambientTemp", 19.5),
+    ):
+        m = load_map(write_map(tmp_path, rt_map.replace("room = true\n", f'room = true\nroom_unit = "{unit}"\n')))
+        b = import_log(roastime(text, key), m)
+        assert b.Tgi_C[0] == pytest.approx(want, abs=1e-3) and b.initial["Tb0_C"] == pytest.approx(want, abs=1e-3)
+    for text, words in (("85", "not a room's (85 degC)"), ("warm", "not a number")):
+        b = import_log(roastime(text), load_map(write_map(tmp_path, rt_map)))  # a bare 85 read as degC
+        assert b.Tgi_C[0] == 22.0 and any(words in note and "constant_C used" in note for note in b.notes)
+    assert room_from_text("21,5 °C") == room_from_text("21,5 °C") and room_from_text("21,5 °C").value == 21.5
+    for bad, words in (("room = 1", "true or false"), ('room_unit = "K"', "room_unit needs room")):
+        with pytest.raises(InputError, match=words):
+            load_map(write_map(tmp_path, ROOM_AIR_MAP.replace("constant_C = 22.0\n", f"constant_C = 22.0\n{bad}\n")))
+    with pytest.raises(InputError, match="needs constant_C"):
+        load_map(write_map(tmp_path, SKY_MAP.replace('column = "ET"\n', 'column = "ET"\nroom = true\n', 1)))
+    with pytest.raises(InputError, match="room_unit"):
+        load_map(write_map(tmp_path, room_map.replace("room = true\n", 'room = true\nroom_unit = "K"\n')))

@@ -163,6 +163,31 @@ def test_init_says_when_the_logs_come_from_several_units(bullet_data):
     assert not survey([bullet_data / "bullet_2020-07-31_0152_490g.json"]).notes
 
 
+def test_init_offers_the_room_temperature_the_logs_record_and_reads_its_unit(bullet_data, tmp_path):
+    """The Bullet owner typed the room in degF ("72", "42" in a cold garage; "64 F" on another unit):
+    init offers [Tgi] room with room_unit F, and the map, uncommented, reads 72 as 22.2 degC."""
+    from roastlab.io.importers import import_log, load_map
+    from roastlab.workflows.roaster import init_roaster
+
+    logs = [
+        bullet_data / n
+        for n in (
+            "bullet_2020-08-15_1802_450g.json",
+            "bullet_2020-12-19_2247_490g.json",
+            "bullet_2020-07-23_0209_350g.json",
+        )
+    ]
+    init_roaster(logs, tmp_path / "cfg")
+    text = (tmp_path / "cfg" / "map.toml").read_text()
+    assert "# 2 of 3 logs record the room temperature" in text and '# room_unit = "F"' in text
+    assert np.all(import_log(logs[0], load_map(tmp_path / "cfg" / "map.toml")).Tgi_C == 22.0)  # an option, off
+    on = tmp_path / "on.toml"
+    on.write_text(text.replace("# room = true", "room = true").replace('# room_unit = "F"', 'room_unit = "F"'))
+    assert import_log(logs[0], load_map(on)).Tgi_C[0] == pytest.approx((72 - 32) / 1.8)
+    assert import_log(logs[1], load_map(on)).Tgi_C[0] == pytest.approx((42 - 32) / 1.8)
+    assert import_log(logs[2], load_map(on)).Tgi_C[0] == 22.0  # records none: the constant
+
+
 def test_roastime_without_weight_is_refused_with_the_way_out(cli, bullet_data, tmp_path):
     code, _, err = cli(
         "import",

@@ -38,8 +38,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from ..io.importers.artisan import WEIGHT_UNITS, read_alog, read_artisan_csv
-from ..io.importers.mapping import detect_format
+from ..io.importers.artisan import WEIGHT_UNITS, RoomReading, read_alog, read_artisan_csv
+from ..io.importers.mapping import bare_room_unit, detect_format
 from ..io.importers.roastime import DRUM_AT_CHARGE, read_roastime
 from ..metrics.profile import et_minus_bt_C, et_not_drum_air
 from ..model.constants import GREEN_BULK_DENSITY_KG_M3
@@ -143,6 +143,7 @@ class LogInfo:
     unused: dict = field(default_factory=dict)  # other logged controls: {"damper": channel, ...}
     unit: str = ""  # the roaster unit the log names (RoasTime serialNumber), else empty
     et_minus_bt_C: float | None = None  # median ET - BT through the roast (metrics.profile.et_minus_bt_C)
+    room: RoomReading | None = None  # the room temperature the log records, as written
 
 
 @dataclass
@@ -163,6 +164,8 @@ class Survey:
     unused: dict = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
     et_not_air: list[str] = field(default_factory=list)  # logs whose ET is not the drum's air
+    rooms: int = 0  # logs that record the room temperature
+    room_unit: str | None = None  # the unit of their bare numbers (mapping.bare_room_unit); None if none is bare
 
 
 def _unit_of(values: np.ndarray) -> str:
@@ -231,6 +234,7 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
         et_minus_bt_C(log.time_s, log.channels["ET"], log.channels["BT"], log.events.get("DROP"))
         if "ET" in names
         else None,
+        log.room,
     )
 
 
@@ -295,6 +299,8 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
         {k: v for i in infos for k, v in i.unused.items()},
         notes,
         odd,
+        sum(i.room is not None for i in infos),
+        bare_room_unit(i.room for i in infos) if any(i.room and i.room.unit is None for i in infos) else None,
     )
 
 
@@ -373,7 +379,19 @@ def map_text(s: Survey) -> str:
     ]
     room_air = bool(s.heater)
     if room_air:
-        lines += ["[Tgi]", "constant_C = 22.0     # room air drawn into the drum: the heat comes from the heater", ""]
+        lines += ["[Tgi]", "constant_C = 22.0     # room air drawn into the drum: the heat comes from the heater"]
+        if s.rooms:  # an option, not the default: on the shared logs it helps one machine and not the other
+            lines += [
+                f"# {s.rooms} of {len(s.logs)} logs record the room temperature; to take the inlet air from it "
+                "(the constant where a log has none), uncomment (docs/real-roaster.md measures both ways):",
+                "# room = true",
+            ]
+            if s.room_unit:
+                lines.append(
+                    f'# room_unit = "{s.room_unit}"    # the unit of a bare number the owner typed'
+                    + (" (some read as degC are no room's)" if s.room_unit == "F" else "")
+                )
+        lines.append("")
     elif s.has_et:
         lines += ["[Tgi]", 'column = "ET"         # no heater logged: ET taken as the inlet gas', ""]
     else:

@@ -52,6 +52,47 @@ def events_internal_to_external(v: float) -> float:
     return float(round(v * 10) - 10)
 
 
+@dataclass(frozen=True)
+class RoomReading:
+    """The room temperature a log records, as written: Artisan's ``ambientTemp`` (in the profile's
+    mode), RoasTime's ``ambientTemp`` / ``ambient`` (text the owner typed: ``"72"``, ``"64 F"``).
+
+    ``unit`` is ``"C"`` or ``"F"`` where the log says which, None for a bare number (the column
+    map's ``[Tgi] room_unit`` decides); ``value`` is NaN where the text is not a temperature.
+    """
+
+    value: float
+    unit: str | None
+    text: str
+
+
+_ROOM_TEXT = re.compile(r"\s*([-+]?\d+(?:[.,]\d+)?)\s*(?:°|deg(?:rees?)?)?\s*([CF])?\s*\Z", re.I)
+
+
+def room_from_text(value) -> RoomReading | None:
+    """A :class:`RoomReading` from a log's room-temperature entry; None where there is none.
+
+    >>> room_from_text("64 F")
+    RoomReading(value=64.0, unit='F', text='64 F')
+    >>> room_from_text("72").unit is None, room_from_text("") is None, room_from_text(None) is None
+    (True, True, True)
+    >>> import math; math.isnan(room_from_text("warm").value)
+    True
+    """
+    if value is None or isinstance(value, bool):
+        return None
+    if isinstance(value, (int, float)):
+        return RoomReading(float(value), None, f"{value:g}") if math.isfinite(value) else None
+    text = str(value).strip()[:40]
+    if not text:
+        return None
+    m = _ROOM_TEXT.match(text)
+    if m is None:
+        return RoomReading(math.nan, None, text)
+    unit = m.group(2).upper() if m.group(2) else None
+    return RoomReading(float(m.group(1).replace(",", ".")), unit, text)
+
+
 @dataclass
 class ArtisanLog:
     """A parsed Artisan profile, in degC, time aligned so that CHARGE is t = 0.
@@ -75,6 +116,7 @@ class ArtisanLog:
     machine: str = ""  # the roaster as the log names it (Artisan's roastertype; "Aillio Bullet" for RoasTime)
     started_epoch_s: float | None = None  # when the roast started (Artisan roastepoch, RoasTime dateTime)
     unit: str = ""  # which roaster of that make (RoasTime serialNumber); empty when the log does not say
+    room: RoomReading | None = None  # the room temperature the log records, as written; None if it does not
 
 
 # Tokens of a Python literal that JSON spells differently. Strings come first so that words,
@@ -308,7 +350,15 @@ def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: boo
         str(data.get("title", "")),
         machine=str(data.get("roastertype", "") or "")[:100],
         started_epoch_s=epoch_or_none(data.get("roastepoch")),
+        room=_alog_room(data.get("ambientTemp"), mode),
     )
+
+
+def _alog_room(value, mode: str) -> RoomReading | None:
+    """Artisan's ``ambientTemp``, in the profile's mode; Artisan writes 0 where none was entered."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value == 0:
+        return None
+    return RoomReading(float(value), mode, f"{value:g} {mode}")
 
 
 def epoch_or_none(value) -> float | None:

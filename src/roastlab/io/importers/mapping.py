@@ -20,7 +20,9 @@ A map is a TOML file::
     offset_C = 0.0
 
     [Tgi]                      # or a constant, e.g. room air drawn into an induction drum
-    constant_C = 22.0
+    constant_C = 22.0          # where a log records no room temperature
+    room = true                # the room temperature the log records (Artisan ambientTemp,
+    room_unit = "F"            # RoasTime ambient); a bare number's unit (default C)
 
     [Gg]                       # exactly one of: column, constant_kg_s, identify, [Gg.pitot]
     column = "flow"
@@ -46,6 +48,7 @@ A map is a TOML file::
     above_BT = true            # drop it on a log where it reads below BT through the roast
     [initial]                  # initial states from the log: a scalar field or a channel at CHARGE,
     Tm0_C = "preheatTemperature"  # or a list tried in order: ["ET", "BT"]
+    Tb0_C = "Tgi"              # "Tgi": the inlet gas at CHARGE (with room = true, the room's)
 
 The fit spec decides what the settings drive: free ``Qe_gain_kW`` (heater -> heat into the
 drum metal), ``Tgi_gain_C`` (heater -> inlet gas), ``tau_heater_s`` (its lag) and
@@ -65,14 +68,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ...errors import InputError
+from ...errors import InputError, ParameterError
 from ...metrics.profile import ET_CHECK_FROM_S, et_minus_bt_C
 from ...model.actuators import UNIT_DEFAULTS, Actuator
 from ...model.limits import check_value
 from ...model.pitot import gas_flow_pitot_kg_s
 from ..batch import Batch, read_table
 from ..files import as_path, finite_number, read_input_bytes, read_toml
-from .artisan import read_alog, read_artisan_csv
+from .artisan import f_to_c, read_alog, read_artisan_csv
 from .roastime import read_roastime
 
 FORMATS = ("auto", "alog", "artisan-csv", "roastime", "csv", "parquet")
@@ -166,7 +169,7 @@ ET_NOT_DRUM_AIR = "not the drum's air on this log"
 TABLE_KEYS = {
     "time": {"column", "unit"},
     "Ta": {"column", "unit", "offset_C"},
-    "Tgi": {"column", "unit", "offset_C", "constant_C"},
+    "Tgi": {"column", "unit", "offset_C", "constant_C", "room", "room_unit"},
     "heater": {"column", "unit", "min", "max", "step", "rate_per_min"},
     "fan": {"column", "unit", "min", "max", "step", "rate_per_min"},
     "Tb2": {"column", "unit", "offset_C", "start_s"},
@@ -257,7 +260,21 @@ def map_from_mapping(data: dict, path: str | Path) -> ColumnMap:
                 if "column" in t:
                     raise InputError("give column or constant_C, not both", path, "Tgi")
                 m.Tgi = {"constant_C": check_value("Tgi_C", _check_num(t, "constant_C", path, key), str(path))}
+                room = t.get("room", False)
+                if not isinstance(room, bool):
+                    raise InputError(f"must be true or false, got {room!r}", path, "Tgi.room")
+                if room:
+                    m.Tgi["room"] = True
+                    m.Tgi["room_unit"] = (
+                        _check_str(t, "room_unit", path, key, required=False, choices=("C", "F")) or "C"
+                    )
+                elif "room_unit" in t:
+                    raise InputError("room_unit needs room = true", path, "Tgi")
                 continue
+            if "room" in t or "room_unit" in t:
+                raise InputError(
+                    "room = true needs constant_C (the inlet air where a log records no room)", path, "Tgi"
+                )
             m_t = {
                 "column": _check_str(t, "column", path, key),
                 "unit": _check_str(t, "unit", path, key, required=False, choices=TEMP_UNITS) or "C",
@@ -502,6 +519,12 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
 
         Ta = channel(cmap.Ta, "Ta") + (cmap.Ta.get("offset_C") or 0.0)
         Tgi = _constant_or(cmap.Tgi, len(time_s), lambda: channel(cmap.Tgi, "Tgi") + (cmap.Tgi.get("offset_C") or 0.0))
+        if cmap.Tgi.get("room"):
+            room_C, note = room_temperature_C(log.room, cmap.Tgi["room_unit"])
+            if room_C is not None:
+                Tgi = np.full(len(time_s), room_C)
+            if note:
+                default_notes.append(note)
         extra = {}
         if "column" in gg:
             extra["Gg"] = channel(gg, "Gg")
@@ -530,6 +553,9 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
             for source in [sources] if isinstance(sources, str) else sources:
                 if source in rejected:
                     continue
+                if source == "Tgi":  # the inlet gas at CHARGE: the room's, read above, or the map's
+                    initial[state] = float(Tgi[0])
+                    break
                 if source in log.fields:
                     initial[state] = float(log.fields[source])
                     break
@@ -665,6 +691,47 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
     batch.initial.update(initial)
     batch.notes = notes
     return batch.validate()
+
+
+def room_temperature_C(room, bare_unit: str) -> tuple[float | None, str | None]:
+    """The room temperature [degC] a log records (:class:`~.artisan.RoomReading`) and a note.
+
+    A number without a unit is in ``bare_unit`` (the map's ``[Tgi] room_unit``: RoasTime keeps
+    what the owner typed, "72" in a °F kitchen). Where the log has none: (None, None), the
+    map's constant stands. Where it is not a temperature, or not a room's (outside the
+    registry's limits of ``T_room_C``): (None, a note saying so), the constant stands.
+
+    >>> from roastlab.io.importers.artisan import room_from_text
+    >>> round(room_temperature_C(room_from_text("72"), "F")[0], 2), room_temperature_C(room_from_text("18 C"), "F")[0]
+    (22.22, 18.0)
+    >>> room_temperature_C(room_from_text("85"), "C")[1]
+    "room temperature '85' in the log is not a room's (85 degC): the map's constant_C used"
+    """
+    if room is None:
+        return None, None
+    unit = room.unit or bare_unit
+    value_C = float(f_to_c(room.value)) if unit == "F" else room.value
+    try:
+        return check_value("T_room_C", value_C), None
+    except ParameterError:
+        shown = "not a number" if not np.isfinite(value_C) else f"{value_C:.0f} degC"
+        return None, f"room temperature {room.text!r} in the log is not a room's ({shown}): the map's constant_C used"
+
+
+def bare_room_unit(rooms) -> str:
+    """The unit a set of logs' bare room temperatures are in: ``"F"`` where one of them is no
+    room's read as degC but is one read as degF (``"72"``), else ``"C"`` (what ``roastlab init``
+    writes as ``[Tgi] room_unit``; a user who knows better edits it).
+
+    >>> from roastlab.io.importers.artisan import room_from_text
+    >>> bare_room_unit([room_from_text(t) for t in ("42", "72", "18 C")]), bare_room_unit([room_from_text("21")])
+    ('F', 'C')
+    """
+    for room in rooms:
+        if room is not None and room.unit is None and room_temperature_C(room, "C")[0] is None:
+            if room_temperature_C(room, "F")[0] is not None:
+                return "F"
+    return "C"
 
 
 def _constant_or(spec: dict, n: int, read) -> np.ndarray:

@@ -16,6 +16,8 @@ Fields used (see ``../shared/data/real/README.md`` for what each holds on a Bull
 * scalar fields ``preheatTemperature``, ``drumChargeTemperature``, ``beanChargeTemperature``,
   ``beanDropTemperature``, ``drumDropTemperature`` [degC], kept in ``fields`` so a map can set
   an initial state from them (the drum temperature at charge: :data:`DRUM_AT_CHARGE`);
+* ``ambientTemp`` / ``ambient``: the room temperature the owner typed, kept as written in
+  ``ArtisanLog.room`` (a bare number's unit is the column map's ``[Tgi] room_unit``);
 * ``serialNumber``: the roaster unit, kept as ``ArtisanLog.unit`` (a RoasTime library can hold
   roasts downloaded from other owners' Bullets; the shared logs come from six units).
 
@@ -33,7 +35,7 @@ import numpy as np
 from ...errors import InputError
 from ..files import read_input_text
 from ..modelfile import parse_json_document
-from .artisan import ArtisanLog, epoch_or_none, number_list
+from .artisan import ArtisanLog, epoch_or_none, number_list, room_from_text
 
 #: RoasTime's control types in ``actions.actionTimeList`` and the channel each becomes.
 CONTROL_TYPES = {0: "heater", 1: "fan", 2: "drum"}
@@ -61,6 +63,9 @@ FIELDS = (
 #: the two agree within 3 °C on 26 of the 28 shared logs. docs/real-roaster.md measures the
 #: Bullet example with each.
 DRUM_AT_CHARGE = "preheatTemperature"
+#: Where RoasTime keeps the room temperature the owner typed (text, e.g. ``"72"`` or ``"64 F"``):
+#: ``ambientTemp`` in older files, ``ambient`` in later ones.
+ROOM_KEYS = ("ambientTemp", "ambient")
 #: Largest sample rate accepted [1/s] (RoasTime records 2).
 MAX_SAMPLE_RATE = 100.0
 
@@ -183,6 +188,8 @@ def read_roastime(path: str | Path, keep_after_drop: bool = False) -> ArtisanLog
         ),
     )
     log.fields = {k: v for k in FIELDS if (v := _number(data, k, path, -100, 1000, required=False)) is not None}
+    # the room temperature the owner typed (older RoasTime: ambientTemp, later: ambient), as written
+    log.room = room_from_text(next((data[k] for k in ROOM_KEYS if data.get(k) not in (None, "")), None))
     serial = data.get("serialNumber")
     if isinstance(serial, (int, str)) and not isinstance(serial, bool) and str(serial).strip():
         log.unit = str(serial).strip()[:40]
