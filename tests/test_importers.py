@@ -400,7 +400,7 @@ def test_the_room_temperature_a_log_records_sets_the_inlet_air_and_the_beans_at_
         m = load_map(write_map(tmp_path, rt_map.replace("room = true\n", f'room = true\nroom_unit = "{unit}"\n')))
         b = import_log(roastime(text, key), m)
         assert b.Tgi_C[0] == pytest.approx(want, abs=1e-3) and b.initial["Tb0_C"] == pytest.approx(want, abs=1e-3)
-    for text, words in (("85", "not a room's (85 degC)"), ("warm", "not a number")):
+    for text, words in (("85", "not a room's (85 degC)"), ("warm", "not a number"), (10**400, "not a number")):
         b = import_log(roastime(text), load_map(write_map(tmp_path, rt_map)))  # a bare 85 read as degC
         assert b.Tgi_C[0] == 22.0 and any(words in note and "constant_C used" in note for note in b.notes)
     assert room_from_text("21,5 °C") == room_from_text("21,5 °C") and room_from_text("21,5 °C").value == 21.5

@@ -82,7 +82,8 @@ def room_from_text(value) -> RoomReading | None:
     if value is None or isinstance(value, bool):
         return None
     if isinstance(value, (int, float)):
-        return RoomReading(float(value), None, f"{value:g}") if math.isfinite(value) else None
+        v = _float_or_nan(value)
+        return RoomReading(v, None, f"{v:g}" if math.isfinite(v) else str(value)[:40])
     text = str(value).strip()[:40]
     if not text:
         return None
@@ -356,9 +357,18 @@ def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: boo
 
 def _alog_room(value, mode: str) -> RoomReading | None:
     """Artisan's ``ambientTemp``, in the profile's mode; Artisan writes 0 where none was entered."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value == 0:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
         return None
-    return RoomReading(float(value), mode, f"{value:g} {mode}")
+    v = _float_or_nan(value)
+    return RoomReading(v, mode, f"{v:g} {mode}") if math.isfinite(v) and v != 0 else None
+
+
+def _float_or_nan(value: int | float) -> float:
+    """A parsed number as a float; NaN for one beyond float range (a JSON integer can be)."""
+    try:
+        return float(value)
+    except OverflowError:
+        return math.nan
 
 
 def epoch_or_none(value) -> float | None:
