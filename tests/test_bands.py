@@ -121,6 +121,31 @@ def test_a_band_says_when_a_batch_size_lies_outside_the_fitted_ones():
     assert sizes_outside(SimpleNamespace(doc={"fit": {"spread": roast_spread(t, e)}}), [0.35]) is None  # older file
 
 
+def test_a_band_says_when_a_log_comes_from_another_roaster_of_the_make():
+    """The spread keeps the roasters its logs name (serial numbers); a log of another unit gets a
+    note, joined with the size note by band_note; logs that name none, or a file without units, none."""
+    from types import SimpleNamespace
+
+    from roastlab.evaluate.bands import band_note, units_outside
+
+    t = [np.arange(0.0, 300.0, 5.0)] * 3
+    e = [np.full(60, 2.0), np.full(60, -1.0), np.full(60, 0.5)]
+    spread = roast_spread(t, e, batch_kg=[0.49, 0.5, 0.49], units=["2779", "2779", ""])
+    assert spread["units"] == ["2779"]
+    model = SimpleNamespace(doc={"fit": {"spread": spread}}, plant=None)
+    assert units_outside(model, ["2779", ""]) is None
+    note = units_outside(model, ["2054", "2779", "1447"])
+    assert note.startswith("units 1447, 2054 are not the roaster") and "(2779)" in note
+    assert units_outside(SimpleNamespace(doc={"fit": {"spread": roast_spread(t, e)}}), ["2054"]) is None
+    assert "units" not in roast_spread(t, e, units=["", "", ""])
+    batch = SimpleNamespace(Mb_kg=0.2, unit="2054")
+    both = band_note(model, [batch])
+    assert both.startswith("0.2 kg lies outside") and " and unit 2054 is not the roaster" in both
+    assert "holds neither the error of a batch-size change nor the difference between two drums" in both
+    assert band_note(model, [batch], batch_kg=0.5).startswith("unit 2054")  # a what-if's weight replaces the log's
+    assert band_note(model, [SimpleNamespace(Mb_kg=0.49, unit="2779")]) is None
+
+
 def test_draws_follow_a_product_ridge_in_logarithms():
     """Two coefficients the data pin only as a product (hbm Pbm, correlation -0.99, 30 % each):
     the draws keep the product within its linearised spread and stay positive. Drawn in the values

@@ -167,17 +167,17 @@ def band(model, batch) -> dict:
     """The as-run prediction band of :func:`roastlab.evaluate.bands.prediction_bands` (level
     :data:`~roastlab.evaluate.bands.BAND_LEVEL`) or, for a model without standard errors or a
     roast-to-roast spread, ``{"why": ...}``."""
-    from ..evaluate.bands import BAND_LEVEL, prediction_bands, sizes_outside, why_no_band
+    from ..evaluate.bands import BAND_LEVEL, band_note, prediction_bands, why_no_band
 
     why = why_no_band(model)
     if why is not None:
         return {"why": why}
-    return band_dict(prediction_bands(model, [batch], BAND_LEVEL)[0], sizes_outside(model, [batch.Mb_kg]))
+    return band_dict(prediction_bands(model, [batch], BAND_LEVEL)[0], band_note(model, [batch]))
 
 
 def band_dict(b, note: str | None = None) -> dict:
     """A :class:`~roastlab.evaluate.bands.Band` as the page draws it; ``note``: why it may hold
-    fewer samples than its level (:func:`roastlab.evaluate.bands.sizes_outside`)."""
+    fewer samples than its level (:func:`roastlab.evaluate.bands.band_note`)."""
     return {
         "level": b.level,
         "lower": _series(b.lower_C),

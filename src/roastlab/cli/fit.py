@@ -184,7 +184,7 @@ def cmd_compare_models(args) -> int:
 def _band_table(model, batches, level, plant_spec, changes) -> tuple[dict, list]:
     """Print and return how often each batch's measured probe lies inside the model's band, and
     the bands (drawn by --plot)."""
-    from ..evaluate.bands import coverage, prediction_bands, share_inside, sizes_outside
+    from ..evaluate.bands import band_note, coverage, prediction_bands, share_inside
 
     if changes or plant_spec not in (None, model.plant):
         raise InputError(
@@ -195,7 +195,7 @@ def _band_table(model, batches, level, plant_spec, changes) -> tuple[dict, list]
               "the band is the parameters' alone")  # fmt: skip
     bands = prediction_bands(model, batches, level)
     rows = coverage(batches, bands)
-    note = sizes_outside(model, [r["Mb_kg"] for r in rows])
+    note = band_note(model, batches)
     print(f"\n{level:.0%} prediction band (parameters and roast-to-roast spread, roastlab.evaluate.bands):")
     print(f"{'batch':<36} {'kg':>6} {'inside':>7} {'median width':>13}")
     for r in rows:

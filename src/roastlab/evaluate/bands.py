@@ -39,15 +39,17 @@ SPREAD_GRID_S = 30.0
 BAND_SAMPLES = 200
 
 
-def roast_spread(time_s, errors_C, held_out: bool = True, batch_kg=None) -> dict | None:
+def roast_spread(time_s, errors_C, held_out: bool = True, batch_kg=None, units=None) -> dict | None:
     """``{"time_s": grid, "rms_C": ..., "logs": n, "held_out": bool, "batch_kg": [lo, hi]}``: RMS over logs of each log's
     probe error at each grid time (each log interpolated onto the grid; a time counts the logs that
     reach it). The errors should be each log's as predicted had it been left out of the fit
     (``held_out``, :func:`roastlab.fit.uncertainty.held_out_residuals`): a fit follows its own logs
     more closely than it predicts a new one, so the fit set's own errors understate the spread a new
     roast meets. ``batch_kg``: the logs' green weights [kg]; their range is kept, because the spread
-    is that of roasts of those sizes (:func:`sizes_outside`). None for fewer than two logs: one roast
-    says nothing about the spread between roasts."""
+    is that of roasts of those sizes (:func:`sizes_outside`). ``units``: the roasters the logs name
+    (RoasTime's serial number; empty where a log does not say); those named are kept, because the
+    spread is that of those drums' roasts (:func:`units_outside`). None for fewer than two logs: one
+    roast says nothing about the spread between roasts."""
     if len(time_s) < 2:
         return None
     end = max(float(t[-1]) for t in time_s)
@@ -73,7 +75,20 @@ def roast_spread(time_s, errors_C, held_out: bool = True, batch_kg=None) -> dict
     }
     if batch_kg is not None and len(batch_kg):
         out["batch_kg"] = [float(min(batch_kg)), float(max(batch_kg))]
+    if units and any(units):
+        out["units"] = sorted({str(u) for u in units if u})
     return out
+
+
+def _note(*parts) -> str | None:
+    """One sentence from the (why, what the band does not hold) parts that apply:
+    ``why and why: the band holds neither ... nor ..., so expect fewer measured samples inside it``."""
+    parts = [p for p in parts if p]
+    if not parts:
+        return None
+    whys, missing = [p[0] for p in parts], [p[1] for p in parts]
+    holds = f"does not hold {missing[0]}" if len(missing) == 1 else f"holds neither {missing[0]} nor {missing[1]}"
+    return f"{' and '.join(whys)}: the band {holds}, so expect fewer measured samples inside it"
 
 
 def sizes_outside(model, batch_kg) -> str | None:
@@ -85,6 +100,11 @@ def sizes_outside(model, batch_kg) -> str | None:
     The spread says how far roasts of the fitted sizes stray from the model; it holds nothing about
     the error of predicting another batch size, which is larger (docs/real-roaster.md measures the
     band's coverage at the fitted sizes and at others). Older model files without the range give None."""
+    return _note(_sizes_outside(model, batch_kg))
+
+
+def _sizes_outside(model, batch_kg) -> tuple[str, str] | None:
+    """:func:`sizes_outside`'s (why, what the band does not hold), or None."""
     from .metrics import GROUP_STEP_SHARE, size_key
 
     spread = (model.doc.get("fit") or {}).get("spread") or {}
@@ -103,10 +123,41 @@ def sizes_outside(model, batch_kg) -> str | None:
         return None
     fitted = f"{lo:g} kg" if lo == hi else f"{lo:g}-{hi:g} kg"
     return (
-        f"{', '.join(f'{m:g} kg' for m in odd)} {'lies' if len(odd) == 1 else 'lie'} outside the batch sizes the band's spread between roasts was "
-        f"measured at ({fitted}): the band does not hold the error of a batch-size change, so expect fewer "
-        "measured samples inside it"
+        f"{', '.join(f'{m:g} kg' for m in odd)} {'lies' if len(odd) == 1 else 'lie'} outside the batch sizes the "
+        f"band's spread between roasts was measured at ({fitted})",
+        "the error of a batch-size change",
     )
+
+
+def units_outside(model, units) -> str | None:
+    """A note for the roaster when a roaster unit in ``units`` (a log's serial number, empty where the
+    log names none) is not one the model's roast-to-roast spread was measured on
+    (``fit.spread.units``), else None. The spread holds how one drum's roasts stray; a second
+    drum of the same make adds its own difference (docs/real-roaster.md: on the shared Bullet logs
+    the band held 86 % of the fit's unit's other-size samples, far fewer on other units'). Model
+    files without units (the logs named none, or an older roastlab) give None."""
+    return _note(_units_outside(model, units))
+
+
+def _units_outside(model, units) -> tuple[str, str] | None:
+    """:func:`units_outside`'s (why, what the band does not hold), or None."""
+    fitted = ((model.doc.get("fit") or {}).get("spread") or {}).get("units")
+    odd = sorted({str(u) for u in units if u} - set(fitted or ()))
+    if not fitted or not odd:
+        return None
+    return (
+        f"{'unit' if len(odd) == 1 else 'units'} {', '.join(odd)} {'is' if len(odd) == 1 else 'are'} not the "
+        f"roaster the band's spread between roasts was measured on ({', '.join(fitted)})",
+        "the difference between two drums of one make",
+    )
+
+
+def band_note(model, batches, batch_kg=None) -> str | None:
+    """Why a band of ``model`` may hold fewer samples of ``batches`` than its level: their sizes
+    (:func:`sizes_outside`; ``batch_kg`` replaces each batch's weight, as a what-if does) and their
+    roasters (:func:`units_outside`), in one sentence; None when neither applies."""
+    masses = [batch_kg or b.Mb_kg for b in batches]
+    return _note(_sizes_outside(model, masses), _units_outside(model, [b.unit for b in batches]))
 
 
 def why_no_band(model) -> str | None:

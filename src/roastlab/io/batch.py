@@ -70,6 +70,7 @@ class Batch:
     Tb2_C: np.ndarray | None = None
     events: dict = field(default_factory=dict)
     ET_C: np.ndarray | None = None
+    unit: str = ""  # which roaster of its make recorded it (RoasTime serial number), empty if unknown
 
     @property
     def n(self) -> int:

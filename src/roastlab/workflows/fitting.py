@@ -230,12 +230,14 @@ def fit(
     if held is not None:
         errors = [held[b, : packed.N[b]] for b in range(packed.n_batches)]
         times = [packed.T[b, : packed.N[b]] for b in range(packed.n_batches)]
-        doc["fit"]["spread"] = roast_spread(times, errors, batch_kg=masses)
+        doc["fit"]["spread"] = roast_spread(times, errors, batch_kg=masses, units=[b.unit for b in batches])
     else:
         errors = [
             np.asarray(p, float) - np.asarray(m, float) for m, p in zip(validation.measured, validation.predicted)
         ]
-        doc["fit"]["spread"] = roast_spread(validation.time_s, errors, held_out=False, batch_kg=masses)
+        doc["fit"]["spread"] = roast_spread(
+            validation.time_s, errors, held_out=False, batch_kg=masses, units=[b.unit for b in batches]
+        )
     doc["metrics"] = {
         "batches": [{"name": n, **r} for n, r in zip(validation.names, validation.rows)],
         "average": validation.average,

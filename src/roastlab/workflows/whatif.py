@@ -179,7 +179,7 @@ class WhatIf(Result):
     #: the changed probe BT's prediction band (:class:`roastlab.evaluate.bands.Band`) when asked for
     band: object | None = None
     #: why the band may hold fewer samples than its level (a batch size the spread was not measured
-    #: at, :func:`roastlab.evaluate.bands.sizes_outside`), else None
+    #: at, a roaster it was not measured on: :func:`roastlab.evaluate.bands.band_note`), else None
     band_note: str | None = None
 
     def band_line(self, units: str = "C") -> str | None:
@@ -393,10 +393,10 @@ def whatif(
                     "projected": [k for k, v in projected.items() if v] if key == "FCs_s" else [],
                 }
             )
-    band, band_note = None, None
+    band, note = None, None
     if band_level is not None:
-        from ..evaluate.bands import prediction_bands, sizes_outside
+        from ..evaluate.bands import band_note, prediction_bands
 
         band = prediction_bands(model, [changed_batch], band_level, **changes)[0]
-        band_note = sizes_outside(model, [changes.get("batch_kg") or changed_batch.Mb_kg])
-    return WhatIf(batch, as_run, changed, labels, rows, levels, band, band_note)
+        note = band_note(model, [changed_batch], changes.get("batch_kg"))
+    return WhatIf(batch, as_run, changed, labels, rows, levels, band, note)

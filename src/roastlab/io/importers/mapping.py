@@ -499,6 +499,7 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
     Mb = None
     initial: dict = {}
     events: dict = {}
+    unit = ""
     settings = {k: spec for k, spec in (("heater", cmap.heater), ("fan", cmap.fan), ("Tb2", cmap.Tb2)) if spec}
     et_spec = cmap.ET
     if fmt in ("alog", "artisan-csv", "roastime"):
@@ -547,6 +548,7 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
                 del settings["ET"], series["ET"]
                 et_spec, rejected = None, {cmap.ET["column"]}
         Mb = log.weight_in_kg
+        unit = log.unit
         drop_known = log.drop_index is not None
         events = dict(log.events)
         for state, sources in cmap.initial.items():
@@ -687,6 +689,7 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
         Tb2_C=series.get("Tb2"),
         ET_C=series.get("ET"),
         events=events,
+        unit=unit,
     )
     batch.initial.update(initial)
     batch.notes = notes
