@@ -55,6 +55,7 @@ def data_dir(tmp_path_factory):
         fit.model.save(d / "bullet-model.json")
         (d / "logs").mkdir()
         shutil.copy(bullet / "bullet_2020-10-01_2053_500g.json", d / "logs" / "bullet-500g.json")  # a temp copy
+        shutil.copy(bullet / "bullet_2021-01-21_2313_800g.json", d / "logs" / "bullet-800g-unit2054.json")
     return d
 
 
@@ -118,7 +119,10 @@ def test_a_program_step_through_the_api_holds_for_its_span_only(client, data_dir
     assert w["band"] is None  # asked for only: the live what-if stays fast
     assert "note" not in banded["band"] and "note" not in r["band"]  # the fitted batch size
     heavier = client.post("/api/whatif", json={"batch_kg": 0.8, "band": True}, headers=H).json()
-    assert "0.8 kg lies outside the batch sizes" in heavier["band"]["note"]
+    assert "0.8 kg lies outside the batch sizes" in heavier["band"]["note"] and "unit" not in heavier["band"]["note"]
+    other = client.post("/api/open", json={"log": "logs/bullet-800g-unit2054.json", "model": "bullet-model.json"},
+                        headers=H).json()  # fmt: skip
+    assert "0.8 kg lies outside" in other["band"]["note"] and "unit 2054 is not the roaster" in other["band"]["note"]
     bad = client.post("/api/whatif", json={"program": [{"setting": "heater", "value": "lots"}]}, headers=H)
     assert bad.status_code == 400 and "program step 1" in bad.json()["error"]
     off = client.post("/api/whatif", json={"program": [{**step, "value": 40}]}, headers=H)
