@@ -188,6 +188,26 @@ def test_init_offers_the_room_temperature_the_logs_record_and_reads_its_unit(bul
     assert import_log(logs[2], load_map(on)).Tgi_C[0] == 22.0  # records none: the constant
 
 
+def test_init_and_the_bullet_example_use_the_cross_validated_bed(bullet_data, tmp_path):
+    """One fact: the laws leave-one-size-out chose (roastlab.model.bed.CROSS_VALIDATED) and the probe's
+    depth scale at the drum's diameter are the example's and what init writes for a roaster with a
+    second bean reading (there with its own estimated diameter)."""
+    from roastlab.io.fitspec import load_fit_spec
+    from roastlab.io.plants import load_plant
+    from roastlab.model.bed import CROSS_VALIDATED, PROBE_DEPTH_OVER_DIAMETER
+    from roastlab.workflows.roaster import init_roaster
+
+    example = load_fit_spec(BULLET / "fit.toml")
+    assert example.bed == CROSS_VALIDATED
+    assert example.fixed["h_probe_m"] == pytest.approx(
+        PROBE_DEPTH_OVER_DIAMETER * load_plant(BULLET / "plant.toml").Dch_m
+    )
+    summary = init_roaster([bullet_data / "bullet_2020-07-31_0152_490g.json"], tmp_path / "cfg")
+    spec = load_fit_spec(tmp_path / "cfg" / "fit.toml")
+    assert spec.bed == CROSS_VALIDATED and "h_probe_m" not in {f.name for f in spec.free}
+    assert spec.fixed["h_probe_m"] == pytest.approx(PROBE_DEPTH_OVER_DIAMETER * summary["plant"]["Dch_m"], rel=1e-3)
+
+
 def test_roastime_without_weight_is_refused_with_the_way_out(cli, bullet_data, tmp_path):
     code, _, err = cli(
         "import",

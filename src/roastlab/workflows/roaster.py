@@ -20,7 +20,8 @@ per kg of capacity. The fit spec (:func:`fit_spec_text`) frees what these logs c
 the paper's three coefficients and the probe constant always; the gas flow when none is
 logged; the heater's gains and lag when a heater is logged (into the drum metal, and into the
 air unless the machine heats the drum itself); the fan's share of the flow when a fan is
-logged; a shell loss when the inlet is room air; the probe's immersion and the second reading's
+logged; a shell loss when the inlet is room air; the probe's immersion (under the bed laws
+cross-validation chose, its depth scale held at the drum's diameter) and the second reading's
 weight when the log has a second bean reading; ET's weight (against the outlet gas) when ET is
 logged beside a heater, because a fit on BT alone can heat the beans by a path the machine does
 not have, and such a fit fails (:attr:`roastlab.workflows.model.FittedModel.failed`). Bounds come
@@ -42,6 +43,7 @@ from ..io.importers.artisan import WEIGHT_UNITS, RoomReading, read_alog, read_ar
 from ..io.importers.mapping import bare_room_unit, detect_format
 from ..io.importers.roastime import DRUM_AT_CHARGE, read_roastime
 from ..metrics.profile import et_minus_bt_C, et_not_drum_air
+from ..model.bed import CROSS_VALIDATED, PROBE_DEPTH_OVER_DIAMETER
 from ..model.constants import GREEN_BULK_DENSITY_KG_M3
 
 #: Names of a heater/burner and a fan/air channel in Artisan's languages (lower case, substrings).
@@ -434,8 +436,9 @@ def map_text(s: Survey) -> str:
     return "\n".join(lines)
 
 
-def fit_spec_text(s: Survey, capacity_kg: float) -> str:
-    """The fit spec, freeing what the logs can determine (module docstring), bounds from the table."""
+def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
+    """The fit spec, freeing what the logs can determine (module docstring), bounds from the table;
+    ``diameter_m``: the drum's (the probe's depth scale, :data:`~roastlab.model.bed.PROBE_DEPTH_OVER_DIAMETER`)."""
 
     def line(name, lo, hi, start, why):
         return f"{name} = [{lo:g}, {hi:g}, {start:g}]".ljust(40) + f"# {why}"
@@ -475,10 +478,20 @@ def fit_spec_text(s: Survey, capacity_kg: float) -> str:
         rows.append(line("U_shell_kW_m2K", 0.0, 0.1, 0.01, "drum shell heat loss to the room [kW/(m2 K)]"))
     if s.fan and s.fan_unit == "level":
         rows.append(line("Gg_fan_kg_s", 0.0, 0.01, 0.001, "air flow per fan step [kg/s]"))
-    if s.second_bean:
-        rows.append(line("h_probe_m", 0.0, 0.2, 0.04, "bed depth that covers the bean probe [m]"))
     rows += ["", "[initial]", "Tb0_C = 22.0                          # green beans at room temperature",
              "X0 = 0.11                             # typical green-coffee moisture [kg/kg dry]"]  # fmt: skip
+    if s.second_bean:  # the probe's immersion in the bed: the laws and depth scale cross-validation chose
+        rows += [
+            "",
+            "# The probe's immersion in the bed (a second bean reading shows it): the laws chosen by",
+            "# leave-one-size-out cross-validation (roastlab.model.bed.CROSS_VALIDATED, docs/real-roaster.md)",
+            "[bed]",
+            *(f'{k} = "{v}"' for k, v in CROSS_VALIDATED.as_dict().items()),
+            "",
+            "[fixed]",
+            f"h_probe_m = {PROBE_DEPTH_OVER_DIAMETER * diameter_m:.4g}".ljust(38)
+            + "# bed depth that covers the probe [m]: the drum's diameter; only other batch sizes determine it",
+        ]
     weights = []
     if s.second_bean:
         weights.append("Tb2 = 1.0                             # the second bean reading vs the model's Tb")
@@ -511,7 +524,7 @@ def init_roaster(paths, out_dir, *, batch_kg=None, capacity_kg=None, diameter_m=
         o.folder(out)
         o.write_text(out / "map.toml", map_text(s) + "\n")
         o.write_text(out / "plant.toml", plant_text(plant, notes))
-        o.write_text(out / "fit.toml", fit_spec_text(s, cap))
+        o.write_text(out / "fit.toml", fit_spec_text(s, cap, plant["Dch_m"]))
     return {"survey": s, "plant": plant, "notes": notes}
 
 
