@@ -302,7 +302,7 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
         notes,
         odd,
         sum(i.room is not None for i in infos),
-        bare_room_unit(i.room for i in infos) if any(i.room and i.room.unit is None for i in infos) else None,
+        bare_room_unit(i.room for i in infos),
     )
 
 

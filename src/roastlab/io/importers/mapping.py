@@ -721,20 +721,20 @@ def room_temperature_C(room, bare_unit: str) -> tuple[float | None, str | None]:
         return None, f"room temperature {room.text!r} in the log is not a room's ({shown}): the map's constant_C used"
 
 
-def bare_room_unit(rooms) -> str:
-    """The unit a set of logs' bare room temperatures are in: ``"F"`` where one of them is no
-    room's read as degC but is one read as degF (``"72"``), else ``"C"`` (what ``roastlab init``
-    writes as ``[Tgi] room_unit``; a user who knows better edits it).
+def bare_room_unit(rooms) -> str | None:
+    """The unit a set of logs' bare room temperatures are in (what ``roastlab init`` writes as
+    ``[Tgi] room_unit``; a user who knows better edits it): ``"F"`` where one of them is no room's
+    read as degC but is one read as degF (``"72"``), else ``"C"``; None when none is bare.
 
     >>> from roastlab.io.importers.artisan import room_from_text
-    >>> bare_room_unit([room_from_text(t) for t in ("42", "72", "18 C")]), bare_room_unit([room_from_text("21")])
-    ('F', 'C')
+    >>> [bare_room_unit([room_from_text(t) for t in ts]) for ts in (("42", "72", "18 C"), ("21",), ("18 C",))]
+    ['F', 'C', None]
     """
-    for room in rooms:
-        if room is not None and room.unit is None and room_temperature_C(room, "C")[0] is None:
-            if room_temperature_C(room, "F")[0] is not None:
-                return "F"
-    return "C"
+    bare = [r for r in rooms if r is not None and r.unit is None]
+    if not bare:
+        return None
+    as_F = any(room_temperature_C(r, "C")[0] is None and room_temperature_C(r, "F")[0] is not None for r in bare)
+    return "F" if as_F else "C"
 
 
 def _constant_or(spec: dict, n: int, read) -> np.ndarray:
