@@ -227,17 +227,16 @@ def fit(
     # errors when the probe was not fitted)
     held = ident.held_out_Ta
     masses = [b.Mb_kg or plant.Mb_kg for b in batches]  # the green weights the spread was measured at
+    units = [b.unit for b in batches]  # and the roasters (serial numbers) it was measured on
     if held is not None:
         errors = [held[b, : packed.N[b]] for b in range(packed.n_batches)]
         times = [packed.T[b, : packed.N[b]] for b in range(packed.n_batches)]
-        doc["fit"]["spread"] = roast_spread(times, errors, batch_kg=masses, units=[b.unit for b in batches])
+        doc["fit"]["spread"] = roast_spread(times, errors, batch_kg=masses, units=units)
     else:
         errors = [
             np.asarray(p, float) - np.asarray(m, float) for m, p in zip(validation.measured, validation.predicted)
         ]
-        doc["fit"]["spread"] = roast_spread(
-            validation.time_s, errors, held_out=False, batch_kg=masses, units=[b.unit for b in batches]
-        )
+        doc["fit"]["spread"] = roast_spread(validation.time_s, errors, held_out=False, batch_kg=masses, units=units)
     doc["metrics"] = {
         "batches": [{"name": n, **r} for n, r in zip(validation.names, validation.rows)],
         "average": validation.average,
