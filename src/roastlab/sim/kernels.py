@@ -73,7 +73,7 @@ def parameter_tuple(p):
     return tuple(p)
 
 
-@overload(parameter_tuple, jit_options={"cache": True})
+@overload(parameter_tuple)
 def _parameter_tuple_compiled(p):
     def impl(p):
         return to_fixed_tuple(p, N_PARAMS)
