@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 import roastlab
-from roastlab.evaluate.metrics import average_metrics
+from roastlab.evaluate.metrics import average_metrics, mean_gap
 from roastlab.fit.baseline import describe, fit_first_order, validate_first_order
 from roastlab.io.fitspec import load_fit_spec
 from roastlab.io.importers.mapping import load_map
@@ -145,7 +145,7 @@ def machine(title, example, paths, lines):
         f"MAE {v_val.average['MAE']:.2f} °C; baseline held-out {mean(b_val, 'FIT'):.1f} %",
         file=sys.stderr,
     )
-    return model, column_map, (v_val.average["FIT"], v_val.average["MAE"])
+    return model, column_map, (v_val.average["FIT"], v_val.average["MAE"], [r["FIT"] for r in v_val.rows])
 
 
 def scaling(model, column_map, paths, nominal_val, lines):
@@ -194,9 +194,15 @@ def scaling(model, column_map, paths, nominal_val, lines):
     lines.append("")
     for name, rows in groups.items():
         if rows:
+            gap = mean_gap([r["FIT"] for r in rows], nominal_val[2])
+            interval = (
+                ""
+                if np.isnan(gap["low"])
+                else f" ({100 * gap['level']:.0f} % interval {gap['low']:+.1f} to {gap['high']:+.1f}, Welch's t)"
+            )
             lines.append(
-                f"- {name}: mean FIT {mean(rows, 'FIT'):.1f} % ({len(rows)} logs), "
-                f"{mean(rows, 'FIT') - nominal_val[0]:+.1f} points against the held-out 490-500 g logs."
+                f"- {name}: mean FIT {mean(rows, 'FIT'):.1f} % ({len(rows)} log{'s' * (len(rows) > 1)}), "
+                f"{gap['gap']:+.1f} points{interval} against the {gap['n_reference']} held-out 490-500 g logs."
             )
     ir = [second[n]["FIT"] for n in v.names]
     lines.append(

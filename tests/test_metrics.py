@@ -39,3 +39,26 @@ def test_absolute_error_moments():
     em = absolute_error_moments([np.array([-1.0, 1.0]), np.array([3.0])])
     assert em["mean_abs_error"] == pytest.approx(5 / 3)
     assert em["var_abs_error"] == pytest.approx(np.var([1, 1, 3], ddof=1))
+
+
+def test_mean_gap_is_welchs_interval_by_hand():
+    """The gap's interval against Welch's formula written out: means 3 and 4, variances 2.5 and 4,
+    se = sqrt(2.5/5 + 4/3), Satterthwaite dof = se^4 / ((2.5/5)^2/4 + (4/3)^2/2) = 3.533."""
+    from scipy.stats import t
+
+    from roastlab.evaluate.metrics import mean_gap
+
+    g = mean_gap([1, 2, 3, 4, 5], [2, 4, 6], level=0.9)
+    se = np.sqrt(2.5 / 5 + 4 / 3)
+    dof = se**4 / ((2.5 / 5) ** 2 / 4 + (4 / 3) ** 2 / 2)
+    assert dof == pytest.approx(3.533, abs=1e-3)
+    half = t.ppf(0.95, dof) * se
+    assert g["gap"] == -1.0 and (g["n"], g["n_reference"]) == (5, 3)
+    assert (g["se"], g["dof"]) == pytest.approx((se, dof))
+    assert (g["low"], g["high"]) == pytest.approx((-1.0 - half, -1.0 + half))
+    # a wider level, a wider interval; one log alone has no spread to say how far it pins the gap
+    assert mean_gap([1, 2, 3, 4, 5], [2, 4, 6], level=0.99)["low"] < g["low"]
+    one = mean_gap([70.0], [80.0, 82.0])
+    assert one["gap"] == -11.0 and np.isnan(one["low"]) and np.isnan(one["high"])
+    with pytest.raises(ValueError):
+        mean_gap([], [1.0])
