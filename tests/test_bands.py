@@ -102,6 +102,10 @@ def test_validate_band_cli(fitted, tmp_path):
     assert "90% prediction band" in out.stdout and "median width" in out.stdout
     bad = subprocess.run(cmd[:-3] + ["--band", "2"], capture_output=True, text=True, cwd=tmp_path)
     assert bad.returncode == 2 and "band level" in bad.stderr
+    # a band with a changed initial state is refused before the validation prints anything
+    changed = subprocess.run(cmd[:-2] + ["--tm0", "200"], capture_output=True, text=True, cwd=tmp_path)
+    assert changed.returncode == 2 and "--band scores the model as fitted" in changed.stderr
+    assert changed.stdout == "" and changed.stderr.count("\n") == 1
 
 
 def test_a_band_says_when_a_batch_size_lies_outside_the_fitted_ones():

@@ -121,6 +121,11 @@ def cmd_validate(args) -> int:
     changes = initial_changes(args)
     if args.tgi_offset is not None:
         changes["Tgi_offset_C"] = args.tgi_offset
+    if args.band is not None and (changes or plant_spec not in (None, model.plant)):
+        # said before the validation runs, not after its table
+        raise InputError(
+            "--band scores the model as fitted: drop --plant/--tgi-offset/--tb0/--tm0/--x0", "command line"
+        )
     result = model.validate(batches, plant=plant_spec, **changes)
     say(result.notes)
     th = model.theta
@@ -132,7 +137,7 @@ def cmd_validate(args) -> int:
     doc = result.to_json_dict()
     bands = None
     if args.band is not None:
-        doc["band"], bands = _band_table(model, batches, args.band, plant_spec, changes)
+        doc["band"], bands = _band_table(model, batches, args.band)
     with outputs as out:
         if args.json:
             out.write_text(args.json, json_text(doc))
@@ -181,15 +186,11 @@ def cmd_compare_models(args) -> int:
     return 0
 
 
-def _band_table(model, batches, level, plant_spec, changes) -> tuple[dict, list]:
+def _band_table(model, batches, level) -> tuple[dict, list]:
     """Print and return how often each batch's measured probe lies inside the model's band, and
     the bands (drawn by --plot)."""
     from ..evaluate.bands import band_note, coverage, prediction_bands, share_inside
 
-    if changes or plant_spec not in (None, model.plant):
-        raise InputError(
-            "--band scores the model as fitted: drop --plant/--tgi-offset/--tb0/--tm0/--x0", "command line"
-        )
     if not (model.doc.get("fit") or {}).get("spread"):
         print("note: the model file has no roast-to-roast spread (fitted on one log, or by an older roastlab): "
               "the band is the parameters' alone")  # fmt: skip
