@@ -9,7 +9,13 @@ import pytest
 
 import roastlab
 from roastlab.errors import ParameterError
-from roastlab.evaluate.bands import _new_roast_quantile, band_coverage, parameter_draws, prediction_bands, roast_spread
+from roastlab.evaluate.bands import (
+    _new_roast_quantile,
+    band_coverage,
+    parameter_covariance,
+    prediction_bands,
+    roast_spread,
+)
 from test_compare import synthetic_sizes
 
 
@@ -61,15 +67,32 @@ def test_band_holds_about_its_level_on_a_held_out_log(fitted):
     assert band.sigma_parameters_C.max() > 0  # the fitted parameters' covariance propagates
 
 
-def test_parameter_draws_follow_the_covariance(fitted):
-    model, _, _ = fitted
-    names, draws = parameter_draws(model, 4000, seed=1)
-    assert names and draws.shape == (4000, len(names))
-    for j, n in enumerate(names):
-        se = model.parameters[n]["stderr"]
-        assert np.std(draws[:, j]) == pytest.approx(se, rel=0.1)
-    again = parameter_draws(model, 4000, seed=1)[1]
-    assert np.array_equal(draws, again)  # the same seed, the same band
+def test_parameter_part_is_the_covariance_through_difference_quotients(fitted):
+    """sigma_p(t) = sqrt(g' C g) with g = dTa/dz: the band's exact sensitivities against central
+    differences of two re-simulations per parameter (FittedModel.with_values), and C from the
+    file's correlation and standard errors (hgm and hbm, correlated -0.99; Pbm on its bound)."""
+    model, batches, _ = fitted
+    names, C = parameter_covariance(model)
+    se = [model.parameters[n]["stderr"] for n in names]
+    assert names == ["hgm", "hbm"] and np.allclose(np.sqrt(np.diag(C)), se)
+    r = model.doc["fit"]["correlation"]["matrix"][0][1]
+    assert C[0, 1] == pytest.approx(r * se[0] * se[1])
+    batch = batches[3]
+    band = prediction_bands(model, [batch])[0]
+    g = []
+    for n, s_n in zip(names, se):
+        v, h = model.parameters[n]["value"], 0.01 * s_n
+        up = model.with_values(**{n: v + h}).predict(batch).Ta_C
+        down = model.with_values(**{n: v - h}).predict(batch).Ta_C
+        g.append((up - down) / (2 * h))
+    g = np.array(g).T  # (samples, 2)
+    by_differences = np.sqrt(np.einsum("tk,kl,tl->t", g, C, g))
+    assert band.sigma_parameters_C.max() > 0.01
+    assert np.allclose(band.sigma_parameters_C, by_differences, rtol=0.02, atol=1e-3)
+    # the correlation matters: the data pin a combination of hgm and hbm, so the band is narrower
+    # than if their errors were independent
+    independent = np.sqrt(np.einsum("tk,k,tk->t", g, np.diag(C), g))
+    assert np.median(band.sigma_parameters_C) < 0.5 * np.median(independent)
 
 
 def test_levels_and_quantile():
@@ -148,26 +171,3 @@ def test_a_band_says_when_a_log_comes_from_another_roaster_of_the_make():
     assert "holds neither the error of a batch-size change nor the difference between two drums" in both
     assert band_note(model, [batch], batch_kg=0.5).startswith("unit 2054")  # a what-if's weight replaces the log's
     assert band_note(model, [SimpleNamespace(Mb_kg=0.49, unit="2779")]) is None
-
-
-def test_draws_follow_a_product_ridge_in_logarithms():
-    """Two coefficients the data pin only as a product (hbm Pbm, correlation -0.99, 30 % each):
-    the draws keep the product within its linearised spread and stay positive. Drawn in the values
-    instead, a normal draw leaves the hyperbola and spreads the product twice as wide."""
-    from types import SimpleNamespace
-
-    params = {
-        "hbm": {"value": 0.086, "stderr": 0.026, "bounds": [0.001, 1.0]},
-        "Pbm": {"value": 0.134, "stderr": 0.040, "bounds": [0.05, 0.95]},
-    }
-    corr = {"names": ["hbm", "Pbm"], "matrix": [[1.0, -0.99], [-0.99, 1.0]]}
-    model = SimpleNamespace(parameters=params, initial={}, doc={"fit": {"correlation": corr}})
-    names, draws = parameter_draws(model, 20000, seed=3)
-    product = draws[:, 0] * draws[:, 1]
-    linearised = np.sqrt(0.3**2 + 0.3**2 - 2 * 0.99 * 0.3 * 0.3)  # sd of log(hbm Pbm)
-    assert np.std(np.log(product)) == pytest.approx(linearised, rel=0.15) and np.all(draws > 0)
-    rng = np.random.default_rng(3)
-    se = np.array([0.026, 0.040])
-    C = np.array([[1.0, -0.99], [-0.99, 1.0]]) * np.outer(se, se)
-    linear = np.array([0.086, 0.134]) + rng.multivariate_normal([0, 0], C, 20000)
-    assert np.std(np.log(np.abs(linear[:, 0] * linear[:, 1]))) > 2 * np.std(np.log(product))

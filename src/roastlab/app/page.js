@@ -229,8 +229,8 @@ function changes() {
   return body;
 }
 
-// The changed curve's prediction band costs its 200 parameter draws again (~5-10 ms on the
-// server): asked for once the changes have stood still for BAND_WAIT_MS, not on every drag step.
+// The changed curve's prediction band costs a sensitivity run of the simulation again (a few ms
+// on the server): asked for once the changes have stood still for BAND_WAIT_MS, not on every drag step.
 const BAND_WAIT_MS = 300;
 let bandTimer = null;
 function bandSoon(body) {

@@ -3,10 +3,17 @@
 A band of level L (default :data:`BAND_LEVEL`) around a prediction combines two independent
 sources of error, each a standard deviation at every instant t:
 
-* **the parameters**: the fitted values are drawn from their normal approximation N(z*, C)
-  (covariance C = the fit's correlation times its standard errors, :mod:`roastlab.fit.uncertainty`;
-  parameters a bound holds stay at their value), clipped into their bounds, and every draw is
-  simulated by the compiled population simulation; sigma_p(t) is the spread of the draws;
+* **the parameters**: the fit's covariance C (its correlation times its standard errors,
+  :mod:`roastlab.fit.uncertainty`; parameters a bound holds have none and stay at their value)
+  propagated to first order, sigma_p(t)^2 = g(t)' C g(t) with g = dTa/dz the exact derivatives of
+  the simulated probe reading from the compiled forward-sensitivity integrator over the population
+  (:func:`roastlab.sim.population.output_sensitivities`): the delta method, in the same
+  linearisation that gave C (lmfit's ``eval_uncertainty`` does the same with difference quotients).
+  Until 2026-11-25 the band drew 200 value sets from N(z*, C) (positive parameters as logarithms)
+  and simulated each: where the data pin a combination of parameters that each have a standard
+  error larger than their value, the draws leave the fit's linear ridge and the band measured the
+  draws, not the data: on the Skywalker, sigma_p 17-22 degC against 0.3-0.4 degC to first order;
+  on the Bullet the two agree (0.23-0.29 against 0.18-0.26 degC);
 * **roast to roast**: what no parameter explains (the roaster's state on the day, the beans).
   At fitting, the root mean square over the fit-set logs of the model's probe error at each time
   since CHARGE, sigma_r(t), is stored in the model file (``fit.spread``, on a
@@ -24,7 +31,6 @@ about L of them should) and how wide it is.
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -35,8 +41,6 @@ from ..errors import ParameterError
 BAND_LEVEL = 0.9
 #: Time grid of the stored roast-to-roast spread [s].
 SPREAD_GRID_S = 30.0
-#: Parameter draws per band (the compiled population simulation runs them together).
-BAND_SAMPLES = 200
 
 
 def roast_spread(time_s, errors_C, held_out: bool = True, batch_kg=None, units=None) -> dict | None:
@@ -206,58 +210,27 @@ def _new_roast_quantile(level: float, n_logs: int) -> float:
     return float(t.ppf(0.5 + level / 2.0, n))
 
 
-def _ratio_scale(name: str, value: float, bounds) -> bool:
-    """True for a parameter drawn as its logarithm (:func:`parameter_draws`): positive, bounded
-    below by zero or more, and not a temperature on a scale with an arbitrary zero (degC; a gain in
-    degC per unit is a ratio and is drawn as a logarithm)."""
-    from ..model.parameters import REGISTRY
-
-    unit = REGISTRY[name].unit if name in REGISTRY else ""
-    return value > 0 and (bounds or [0.0])[0] >= 0 and unit != "degC"
-
-
-def parameter_draws(model, samples: int, seed: int) -> tuple[list[str], np.ndarray]:
-    """(names, (samples, k) values) of the model's fitted scalar parameters drawn from N(z*, C),
-    clipped into their bounds; parameters without a standard error stay at their value.
-
-    A parameter whose value and bounds are positive (a coefficient, an area share, a flow; not a
-    temperature in degC, :func:`_ratio_scale`) is drawn as its logarithm, from the same linearisation: sd(log z) = se / z, the same correlations. Heat
-    paths act through products (hbm Pbm, the metal-bean conductance; section 3.1), and the fit pins
-    a product where it leaves the factors free: in the logarithms that ridge is a straight line,
-    which a normal draw follows; in the values it is a hyperbola, which a normal draw leaves, and
-    the band then shows a spread of the product that the data do not have. Each draw stays positive."""
+def parameter_covariance(model) -> tuple[list[str], np.ndarray]:
+    """(names, C): the fitted parameters (and initial states) that have a standard error, and their
+    covariance C = R * se se' from the model file's correlation R (``fit.correlation``); a missing
+    correlation entry counts as 0. Empty when the file has none."""
     corr = (model.doc.get("fit") or {}).get("correlation") or {}
-    names = [n for n in corr.get("names", []) if n in model.parameters or n in model.initial]
     entries = {**model.parameters, **model.initial}
-    vals, ses, keep = [], [], []
-    for n in names:
-        e = entries[n]
+    keep, ses = [], []
+    for n in corr.get("names", []):
+        e = entries.get(n) or {}
         se = e.get("stderr")
         if e.get("value") is None or not isinstance(se, (int, float)) or not np.isfinite(se) or se <= 0:
             continue
         keep.append(n)
-        vals.append(float(e["value"]))
         ses.append(float(se))
     if not keep:
-        return [], np.zeros((samples, 0))
+        return [], np.zeros((0, 0))
     index = [corr["names"].index(n) for n in keep]
     R = np.array([[corr["matrix"][i][j] if corr["matrix"][i][j] is not None else 0.0 for j in index] for i in index])
     np.fill_diagonal(R, 1.0)
-    vals = np.array(vals)
-    log = np.array([_ratio_scale(n, v, entries[n].get("bounds")) for n, v in zip(keep, vals)])
-    centre = np.where(log, np.log(np.where(log, vals, 1.0)), vals)
-    se = np.where(log, np.array(ses) / np.where(log, vals, 1.0), np.array(ses))  # sd of log z = se / z
-    C = R * np.outer(se, se)
-    w, V = np.linalg.eigh(0.5 * (C + C.T))
-    L = V * np.sqrt(np.clip(w, 0.0, None))  # C = L L' (a covariance that is only semi-definite still samples)
-    rng = np.random.default_rng(seed)
-    draws = centre + rng.standard_normal((samples, len(keep))) @ L.T
-    draws[:, log] = np.exp(draws[:, log])
-    for j, n in enumerate(keep):
-        b = entries[n].get("bounds")
-        if b:
-            draws[:, j] = np.clip(draws[:, j], b[0], b[1])
-    return keep, draws
+    se = np.array(ses)
+    return keep, R * np.outer(se, se)
 
 
 @dataclass
@@ -283,30 +256,27 @@ class Band:
         return float(np.median(self.width_C))
 
 
-def prediction_bands(
-    model, batches, level: float = BAND_LEVEL, samples: int = BAND_SAMPLES, seed: int = 0, plant=None, **changes
-) -> list[Band]:
-    """The level-``level`` band of the probe prediction for each batch (module docstring)."""
-    from ..sim.population import predict_outputs
+def prediction_bands(model, batches, level: float = BAND_LEVEL, plant=None, **changes) -> list[Band]:
+    """The level-``level`` band of the probe prediction for each batch (module docstring); ``plant``
+    and ``changes`` as :meth:`roastlab.workflows.model.FittedModel.apply` (a what-if's band)."""
+    from ..sim.population import output_sensitivities
 
     z = _z(level)
     applied = model.apply(list(batches), plant, **changes)
     center = model.simulate(applied)
-    names, draws = parameter_draws(model, samples, seed)
+    names, C = parameter_covariance(model)
     sigma_p = None
     if names:
+        entries = {**model.parameters, **model.initial}
         base_names = list(applied.names)
-        values = np.repeat(applied.values, samples, axis=0)  # (samples, nb, k0)
+        values = applied.values[0]  # (nb, k0): the one value set, per batch
         extra = [n for n in names if n not in base_names]
         if extra:
-            values = np.concatenate([values, np.zeros(values.shape[:2] + (len(extra),))], axis=2)
+            held = np.array([float(entries[n]["value"]) for n in extra])
+            values = np.concatenate([values, np.broadcast_to(held, (values.shape[0], len(extra)))], axis=1)
         all_names = base_names + extra
-        for j, n in enumerate(names):
-            values[:, :, all_names.index(n)] = draws[:, j : j + 1]
-        ta, _ = predict_outputs(applied.packed, all_names, values, with_tb=False)
-        with warnings.catch_warnings():  # padding past a batch's end is NaN in every draw
-            warnings.simplefilter("ignore", RuntimeWarning)
-            sigma_p = np.nanstd(ta, axis=0)  # (nb, nmax)
+        _, g = output_sensitivities(applied.packed, all_names, values, [(all_names.index(n), -1) for n in names])["Ta"]
+        sigma_p = np.sqrt(np.clip(np.einsum("btk,kl,btl->bt", g, C, g), 0.0, None))  # (nb, nmax), NaN-padded
     spread = (model.doc.get("fit") or {}).get("spread")
     z_roasts = _new_roast_quantile(level, spread["logs"]) if spread else 0.0
     out = []
@@ -326,11 +296,11 @@ def share_inside(rows: list[dict]) -> float:
     return sum(r["inside"] * r["n"] for r in rows if r["n"]) / n if n else float("nan")
 
 
-def band_coverage(model, batches, level: float = BAND_LEVEL, samples: int = BAND_SAMPLES, seed: int = 0) -> list[dict]:
+def band_coverage(model, batches, level: float = BAND_LEVEL) -> list[dict]:
     """Per batch: ``{"name", "n", "inside" (share of measured probe samples inside the band),
     "median_width_C", "Mb_kg"}``."""
     batches = list(batches)
-    return coverage(batches, prediction_bands(model, batches, level, samples, seed))
+    return coverage(batches, prediction_bands(model, batches, level))
 
 
 def coverage(batches, bands: list[Band]) -> list[dict]:
