@@ -80,17 +80,24 @@ def test_init_and_fit_roaster_reach_the_hand_written_examples_on_the_shared_logs
     example.mkdir()
     for name in ("map.toml", "plant.toml", "fit.toml"):
         shutil.copy(Path(__file__).resolve().parents[1] / "examples" / machine / name, example / name)
-    held = {}
+    held, inside, width = {}, {}, {}
     for cfg in ("cfg", "example"):
         code, out, err = cli("fit-roaster", tmp_path / cfg, *logs)
         assert code == 0, err
         held[cfg] = float(out.split("held out: FIT ")[1].split(" %")[0])
         base = float(out.split("baseline: ")[1].split(" %")[0])
+        inside[cfg] = float(out.split("band:")[1].split(" %")[0])
+        width[cfg] = float(out.split("median width ")[1].split(" °C")[0])
     assert abs(held["cfg"] - held["example"]) <= 2.0 and held["cfg"] > base + 20, held
+    # the 90 % band on the held-out logs: about its level and not uselessly wide (measured
+    # 2026-11-25: Skywalker 96 %, 34.5 °C; Bullet 94 %, 19.0 °C; 100 % and 70 °C on the Skywalker
+    # while the band drew parameter sets instead of propagating the covariance)
+    assert 85.0 <= inside["cfg"] <= 98.0 and width["cfg"] < 40.0, (inside, width)
     doc = json.loads((tmp_path / "cfg" / "model.json").read_text())
     assert doc["format"] == "roastlab-model/1"
     report = (tmp_path / "cfg" / "report.md").read_text()
     assert "sorted by date" in report and "held out" in report
+    assert "| inside the 90 % band |" in report and "lie inside the 90 % prediction band" in report
     assert (tmp_path / "cfg" / "heldout.png").stat().st_size > 20_000
 
 

@@ -36,7 +36,7 @@ def cmd_init(args) -> int:
 
 
 def cmd_fit_roaster(args) -> int:
-    from ..workflows.roaster import fit_roaster
+    from ..workflows.roaster import band_sentence, fit_roaster
 
     r = fit_roaster(args.dir, args.logs, progress=progress("fit-roaster"), seed=args.seed)
     f, h, b = r["fit"], r["held_out"], r["baseline_held_out"]
@@ -44,6 +44,10 @@ def cmd_fit_roaster(args) -> int:
     print(
         f"held out: FIT {h['FIT']:.1f} %, MAE {h['MAE']:.2f} °C (first-order baseline: {b['FIT']:.1f} %, {b['MAE']:.2f} °C)"
     )
+    if r["band"] is not None:
+        print(f"band:     {band_sentence(r['band'])}")
+        if r["band"]["note"]:
+            print(f"note: {r['band']['note']}")
     for w in r["warnings"]:
         print(f"warning: {w}", file=sys.stderr)
     print(f"wrote {r['model']}, {r['report']}")

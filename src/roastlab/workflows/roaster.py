@@ -528,6 +528,36 @@ def init_roaster(paths, out_dir, *, batch_kg=None, capacity_kg=None, diameter_m=
     return {"survey": s, "plant": plant, "notes": notes}
 
 
+def held_out_band(model, batches) -> dict | None:
+    """How well the model's prediction band is calibrated on logs it was not fitted on: ``{"level",
+    "inside_all" (share of all measured probe samples inside it), "median_width_C", "batches" (rows
+    of :func:`roastlab.evaluate.bands.band_coverage`), "note"}``; None when the model file can carry
+    no band (:func:`roastlab.evaluate.bands.why_no_band`)."""
+    from ..evaluate.bands import BAND_LEVEL, band_coverage, band_note, share_inside, why_no_band
+
+    if why_no_band(model) is not None:
+        return None
+    rows = band_coverage(model, batches, BAND_LEVEL)
+    widths = [r["median_width_C"] for r in rows]
+    return {
+        "level": BAND_LEVEL,
+        "inside_all": share_inside(rows),
+        "median_width_C": float(np.median(widths)) if widths else float("nan"),
+        "batches": rows,
+        "note": band_note(model, batches),
+    }
+
+
+def band_sentence(band: dict) -> str:
+    """:func:`held_out_band` in words: the share inside against the level and the width (its note apart)."""
+    level = f"{100 * band['level']:.0f} %"
+    return (
+        f"{100 * band['inside_all']:.0f} % of the held-out logs' probe samples lie inside the {level} prediction "
+        f"band (parameters and spread between roasts; a calibrated band holds about {level}), median width "
+        f"{band['median_width_C']:.1f} °C"
+    )
+
+
 def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0) -> dict:
     """Fit, validate and report a roaster set up by :func:`init_roaster`.
 
@@ -600,8 +630,21 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0) -> dict:
         "![held out](heldout.png)",
         "",
     ]
-    lines += ["| held-out log | FIT % | MAE °C |", "|---|---|---|"]
-    lines += [f"| {n} | {r['FIT']:.1f} | {r['MAE']:.2f} |" for n, r in zip(v_val.names, v_val.rows)]
+    band = held_out_band(model, val_b)
+    if band is None:
+        lines += ["| held-out log | FIT % | MAE °C |", "|---|---|---|"]
+        lines += [f"| {n} | {r['FIT']:.1f} | {r['MAE']:.2f} |" for n, r in zip(v_val.names, v_val.rows)]
+    else:
+        level = f"{100 * band['level']:.0f} %"
+        lines += [
+            f"| held-out log | FIT % | MAE °C | inside the {level} band | its median width °C |",
+            "|---|---|---|---|---|",
+        ]
+        lines += [
+            f"| {n} | {r['FIT']:.1f} | {r['MAE']:.2f} | {100 * b['inside']:.0f} % | {b['median_width_C']:.1f} |"
+            for n, r, b in zip(v_val.names, v_val.rows, band["batches"])
+        ]
+        lines += ["", f"{band_sentence(band)}." + (f" Note: {band['note']}." if band["note"] else "")]
     from ..report.figures import figure_bytes
 
     fig = v_val.plot()
@@ -613,6 +656,7 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0) -> dict:
         "fit": {"FIT": v_fit.average["FIT"], "MAE": v_fit.average["MAE"]},
         "held_out": {"FIT": v_val.average["FIT"], "MAE": v_val.average["MAE"]},
         "baseline_held_out": {"FIT": bv["FIT"], "MAE": bv["MAE"]},
+        "band": band,
         "warnings": result.warnings,
         "failed": result.failed,
         "model": d / "model.json",
