@@ -131,6 +131,32 @@ def test_validate_band_cli(fitted, tmp_path):
     assert changed.stdout == "" and changed.stderr.count("\n") == 1
 
 
+def test_validate_band_reports_each_batch_size(fitted, tmp_path):
+    """Logs of two sizes: a line and a JSON entry per size, its share the samples-weighted share of its logs."""
+    import json
+
+    from roastlab.io.batch import write_batch_csv
+    from test_compare import synthetic_sizes
+
+    model, batches, _ = fitted
+    model.save(tmp_path / "m.json")
+    other = [b for b in synthetic_sizes(seed=10) if b.Mb_kg == 180.0]
+    names = []
+    for k, b in enumerate([batches[3], *other]):
+        write_batch_csv(tmp_path / f"b{k}.csv", b)
+        names.append(f"b{k}.csv")
+    cmd = [sys.executable, "-m", "roastlab", "validate", "--model", "m.json", *names, "--band", "--json", "v.json"]
+    out = subprocess.run(cmd, capture_output=True, text=True, cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    assert "size 120 kg (1 log)" in out.stdout and "size 180 kg (2 logs)" in out.stdout
+    band = json.loads((tmp_path / "v.json").read_text())["band"]
+    heavy = [r for r in band["batches"] if r["Mb_kg"] == 180.0]
+    by_size = {g["size"]: g for g in band["by_size"]}
+    assert by_size["180 kg"]["logs"] == 2 and by_size["180 kg"]["n"] == sum(r["n"] for r in heavy)
+    want = sum(r["n"] * r["inside"] for r in heavy) / sum(r["n"] for r in heavy)
+    assert by_size["180 kg"]["inside"] == pytest.approx(want)
+
+
 def test_a_band_says_when_a_batch_size_lies_outside_the_fitted_ones():
     """The spread keeps the fitted green weights' range; a batch outside it gets a note, inside none."""
     from types import SimpleNamespace

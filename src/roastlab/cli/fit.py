@@ -189,7 +189,7 @@ def cmd_compare_models(args) -> int:
 def _band_table(model, batches, level) -> tuple[dict, list]:
     """Print and return how often each batch's measured probe lies inside the model's band, and
     the bands (drawn by --plot)."""
-    from ..evaluate.bands import band_note, coverage, prediction_bands, share_inside
+    from ..evaluate.bands import band_note, coverage, inside_by_size, prediction_bands, share_inside
 
     if not (model.doc.get("fit") or {}).get("spread"):
         print("note: the model file has no roast-to-roast spread (fitted on one log, or by an older roastlab): "
@@ -202,11 +202,16 @@ def _band_table(model, batches, level) -> tuple[dict, list]:
     for r in rows:
         kg = "" if not r["Mb_kg"] else f"{r['Mb_kg']:.3g}"
         print(f"{r['name'][:36]:<36} {kg:>6} {r['inside']:>7.0%} {r['median_width_C']:>10.1f} °C")
+    sizes = inside_by_size(rows)
+    for g in sizes:
+        label = f"size {g['size']} ({g['logs']} log{'s' * (g['logs'] > 1)})"
+        print(f"{label:<36} {'':>6} {g['inside']:>7.0%}")
     inside = share_inside(rows)
     print(f"{'all samples':<36} {'':>6} {inside:>7.0%}   (a calibrated band holds about {level:.0%})")
     if note:
         print(f"note: {note}")
-    return {"level": level, "inside_all": inside, "batches": rows, **({"note": note} if note else {})}, bands
+    doc = {"level": level, "inside_all": inside, "batches": rows, **({"by_size": sizes} if sizes else {})}
+    return {**doc, **({"note": note} if note else {})}, bands
 
 
 def _safe_stem(name: str, taken: set) -> str:
@@ -357,6 +362,6 @@ def add_parsers(sub) -> None:
         "--tgi-offset", type=float_arg("--tgi-offset"), help="what-if: add this to the inlet gas / ET [degC]"
     )
     add_band_option(p, "score the model's prediction band", "the share of each batch's measured probe samples "
-                    "inside it and its median width")  # fmt: skip
+                    "inside it and its median width, then the share per batch size when the logs have several")  # fmt: skip
     add_model_options(p)
     p.set_defaults(func=cmd_validate)

@@ -296,6 +296,32 @@ def share_inside(rows: list[dict]) -> float:
     return sum(r["inside"] * r["n"] for r in rows if r["n"]) / n if n else float("nan")
 
 
+def inside_by_size(rows: list[dict]) -> list[dict]:
+    """The rows of :func:`band_coverage` by batch size (:func:`roastlab.evaluate.metrics.size_labels`,
+    lightest first): ``[{"size", "logs", "n", "inside"}]``, the share of that size's samples inside
+    the band; empty unless every row has a green weight and they make more than one size.
+
+    >>> rows = [{"Mb_kg": 0.5, "n": 100, "inside": 0.9}, {"Mb_kg": 0.49, "n": 100, "inside": 1.0},
+    ...         {"Mb_kg": 0.2, "n": 50, "inside": 0.2}]
+    >>> [(g["size"], g["logs"], round(g["inside"], 2)) for g in inside_by_size(rows)]
+    [('0.2 kg', 1, 0.2), ('0.49-0.5 kg', 2, 0.95)]
+    """
+    from .metrics import size_labels
+
+    masses = [r.get("Mb_kg") for r in rows]
+    if not rows or not all(isinstance(m, (int, float)) and m > 0 for m in masses):
+        return []
+    labels, _ = size_labels(masses)
+    if len(set(labels)) < 2:
+        return []
+    out = []
+    for label in sorted(set(labels), key=lambda lab: min(m for m, x in zip(masses, labels) if x == lab)):
+        members = [r for r, x in zip(rows, labels) if x == label]
+        out.append({"size": label, "logs": len(members), "n": sum(r["n"] for r in members),
+                    "inside": share_inside(members)})  # fmt: skip
+    return out
+
+
 def band_coverage(model, batches, level: float = BAND_LEVEL) -> list[dict]:
     """Per batch: ``{"name", "n", "inside" (share of measured probe samples inside the band),
     "median_width_C", "Mb_kg"}``."""

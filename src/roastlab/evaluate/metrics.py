@@ -11,6 +11,8 @@ With measured Y, predicted Yhat and e = Y - Yhat over n samples:
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 #: One batch size: green weights that round to the same multiple of this share of a typical
@@ -23,6 +25,28 @@ GROUP_STEP_SHARE = 0.1
 def size_key(mass_kg: float, step_kg: float) -> int:
     """The size a green weight [kg] belongs to, in steps of ``step_kg`` (:data:`GROUP_STEP_SHARE`)."""
     return round(mass_kg / step_kg)
+
+
+def size_labels(masses_kg, step_kg: float | None = None) -> tuple[list[str], float]:
+    """A size-group label per green weight [kg] and the step used: weights that round to the same
+    multiple of ``step_kg`` (default :data:`GROUP_STEP_SHARE` of the median weight) are one size,
+    labelled by their weights ("0.49-0.5 kg"). ValueError for a step that is not a positive mass.
+
+    >>> size_labels([0.49, 0.5, 0.2, 0.49])[0]
+    ['0.49-0.5 kg', '0.49-0.5 kg', '0.2 kg', '0.49-0.5 kg']
+    """
+    masses = [float(m) for m in masses_kg]
+    if step_kg is None:
+        step_kg = float(np.median(masses)) * GROUP_STEP_SHARE
+    if not (step_kg > 0 and math.isfinite(step_kg)):
+        raise ValueError(f"group step must be a positive mass in kg, got {step_kg!r}")
+    keys = [size_key(m, step_kg) for m in masses]
+    labels = {}
+    for key in set(keys):
+        members = [m for m, k in zip(masses, keys) if k == key]
+        lo, hi = min(members), max(members)
+        labels[key] = f"{lo:.3g} kg" if lo == hi else f"{lo:.3g}-{hi:.3g} kg"
+    return [labels[k] for k in keys], step_kg
 
 
 METRIC_NAMES = ("n", "SSR", "norm", "MAE", "MPE", "MAPE", "FIT", "rho")

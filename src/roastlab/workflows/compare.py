@@ -24,7 +24,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..errors import InputError, ParameterError
-from ..evaluate.metrics import GROUP_STEP_SHARE, size_key
+from ..evaluate.metrics import size_labels
 from ..model.bed import LAWS, VARIANTS, BedLaws
 from ..model.limits import check_value
 from ..model.parameters import FREE_NAMES, N_STARTS, FreeParameter
@@ -32,9 +32,8 @@ from ..report.result import Result, aligned
 
 
 def size_groups(batches, step_kg: float | None = None) -> tuple[list[str], float]:
-    """A size-group label per batch and the step used: batches whose green weights round to the same
-    multiple of ``step_kg`` (default :data:`GROUP_STEP_SHARE` of the median weight) form a group,
-    labelled by their weights ("0.49-0.5 kg")."""
+    """A size-group label per batch and the step used (:func:`roastlab.evaluate.metrics.size_labels`
+    of their green weights); a batch without a weight is an :class:`~roastlab.errors.InputError`."""
     masses = []
     for b in batches:
         m = getattr(b, "Mb_kg", None)
@@ -43,17 +42,10 @@ def size_groups(batches, step_kg: float | None = None) -> tuple[list[str], float
                 "no green weight: a leave-one-size-out comparison groups logs by their batch mass", b.source or b.name
             )
         masses.append(float(m))
-    if step_kg is None:
-        step_kg = float(np.median(masses)) * GROUP_STEP_SHARE
-    if not (step_kg > 0 and math.isfinite(step_kg)):
-        raise InputError(f"group step must be a positive mass in kg, got {step_kg!r}", "command line")
-    keys = [size_key(m, step_kg) for m in masses]
-    labels = {}
-    for key in set(keys):
-        members = [m for m, k in zip(masses, keys) if k == key]
-        lo, hi = min(members), max(members)
-        labels[key] = f"{lo:.3g} kg" if lo == hi else f"{lo:.3g}-{hi:.3g} kg"
-    return [labels[k] for k in keys], step_kg
+    try:
+        return size_labels(masses, step_kg)
+    except ValueError as exc:
+        raise InputError(str(exc), "command line") from None
 
 
 #: The value of a variant's parameter override that frees it within its quantity-table bounds.
@@ -296,7 +288,7 @@ def compare_models(
     plant, spec, column_map, seed, starts : as :func:`roastlab.workflows.fitting.fit`
     variants : {name: BedLaws, Variant or its text} or a list of them (:class:`Variant`: bed laws
         and parameter overrides such as ``h_probe_m=0.2``); default :data:`roastlab.model.bed.VARIANTS`
-    step_kg : the group step (default :data:`GROUP_STEP_SHARE` of the median green weight)
+    step_kg : the group step (default :data:`roastlab.evaluate.metrics.GROUP_STEP_SHARE` of the median green weight)
     progress : callable ``progress(done, total, text)``
     """
     from ..io.fitspec import FitSpec, load_fit_spec

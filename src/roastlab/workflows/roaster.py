@@ -531,9 +531,10 @@ def init_roaster(paths, out_dir, *, batch_kg=None, capacity_kg=None, diameter_m=
 def held_out_band(model, batches) -> dict | None:
     """How well the model's prediction band is calibrated on logs it was not fitted on: ``{"level",
     "inside_all" (share of all measured probe samples inside it), "median_width_C", "batches" (rows
-    of :func:`roastlab.evaluate.bands.band_coverage`), "note"}``; None when the model file can carry
+    of :func:`roastlab.evaluate.bands.band_coverage`), "by_size" (:func:`~roastlab.evaluate.bands.inside_by_size`),
+    "note"}``; None when the model file can carry
     no band (:func:`roastlab.evaluate.bands.why_no_band`)."""
-    from ..evaluate.bands import BAND_LEVEL, band_coverage, band_note, share_inside, why_no_band
+    from ..evaluate.bands import BAND_LEVEL, band_coverage, band_note, inside_by_size, share_inside, why_no_band
 
     if why_no_band(model) is not None:
         return None
@@ -544,6 +545,7 @@ def held_out_band(model, batches) -> dict | None:
         "inside_all": share_inside(rows),
         "median_width_C": float(np.median(widths)) if widths else float("nan"),
         "batches": rows,
+        "by_size": inside_by_size(rows),
         "note": band_note(model, batches),
     }
 
@@ -645,6 +647,9 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0) -> dict:
             for n, r, b in zip(v_val.names, v_val.rows, band["batches"])
         ]
         lines += ["", f"{band_sentence(band)}." + (f" Note: {band['note']}." if band["note"] else "")]
+        if band["by_size"]:
+            lines += ["", "| batch size | held-out logs | inside the band |", "|---|---|---|"]
+            lines += [f"| {g['size']} | {g['logs']} | {100 * g['inside']:.0f} % |" for g in band["by_size"]]
     from ..report.figures import figure_bytes
 
     fig = v_val.plot()
