@@ -145,7 +145,14 @@ def machine(title, example, paths, lines):
         f"MAE {v_val.average['MAE']:.2f} °C; baseline held-out {mean(b_val, 'FIT'):.1f} %",
         file=sys.stderr,
     )
-    return model, column_map, (v_val.average["FIT"], v_val.average["MAE"], [r["FIT"] for r in v_val.rows])
+    return model, column_map, (v_val.average["FIT"], v_val.average["MAE"], v_val.rows)
+
+
+def gap_text(gap: dict) -> str:
+    """A :func:`roastlab.evaluate.metrics.mean_gap` as "-8.2 (90 % interval -17.0 to +0.5)"."""
+    if np.isnan(gap["low"]):
+        return f"{gap['gap']:+.1f}"
+    return f"{gap['gap']:+.1f} ({100 * gap['level']:.0f} % interval {gap['low']:+.1f} to {gap['high']:+.1f})"
 
 
 def scaling(model, column_map, paths, nominal_val, lines):
@@ -191,18 +198,22 @@ def scaling(model, column_map, paths, nominal_val, lines):
         f"the same unit as the fit ({', '.join(fit_units)})": same,
         "other units": [r for r, u in zip(v.rows, units) if u not in fit_units],
     }
-    lines.append("")
+    lines += [
+        "",
+        "Each group against the held-out 490-500 g logs, the gap of the means with its 90 % interval "
+        "(Welch's t over the logs, `roastlab.evaluate.metrics.mean_gap`); MPE is signed, positive where "
+        "the model reads low:",
+        "",
+    ]
+    nominal_rows = nominal_val[2]
     for name, rows in groups.items():
         if rows:
-            gap = mean_gap([r["FIT"] for r in rows], nominal_val[2])
-            interval = (
-                ""
-                if np.isnan(gap["low"])
-                else f" ({100 * gap['level']:.0f} % interval {gap['low']:+.1f} to {gap['high']:+.1f}, Welch's t)"
-            )
+            fit_gap = mean_gap([r["FIT"] for r in rows], [r["FIT"] for r in nominal_rows])
+            bias_gap = mean_gap([r["MPE"] for r in rows], [r["MPE"] for r in nominal_rows])
             lines.append(
                 f"- {name}: mean FIT {mean(rows, 'FIT'):.1f} % ({len(rows)} log{'s' * (len(rows) > 1)}), "
-                f"{gap['gap']:+.1f} points{interval} against the {gap['n_reference']} held-out 490-500 g logs."
+                f"{gap_text(fit_gap)} points against the {fit_gap['n_reference']} held-out 490-500 g logs; "
+                f"mean MPE {mean(rows, 'MPE'):+.1f} %, {gap_text(bias_gap)} points against theirs."
             )
     ir = [second[n]["FIT"] for n in v.names]
     lines.append(
