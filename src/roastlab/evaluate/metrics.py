@@ -109,7 +109,7 @@ def absolute_error_moments(errors: list[np.ndarray]) -> dict[str, float]:
     }
 
 
-#: Confidence level of the interval on a difference of mean FIT between two sets of logs.
+#: Confidence level of the interval on a difference of means between two sets of logs (FIT, MPE).
 GAP_LEVEL = 0.9
 
 
