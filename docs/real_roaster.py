@@ -190,10 +190,15 @@ def scaling(model, column_map, paths, nominal_val, lines):
             f"| {row2['FIT']:.1f} | {row2['MPE']:+.2f} |"
         )
     same = [r for r, u in zip(v.rows, units) if u in fit_units]
+    def span(masses):  # "200-470 g" over the batch masses of a group
+        return f"{min(masses)} g" if min(masses) == max(masses) else f"{min(masses)}-{max(masses)} g"
+
+    # lighter and heavier than the fit's logs, from whatever weights the folder holds
+    lighter = sorted(g for g in by_mass if g < 490)
+    heavier = sorted(g for g in by_mass if g > 500)
     groups = {
-        "200-470 g": [r for g, rs in by_mass.items() if g <= 470 for r in rs],
-        "550 g": by_mass.get(550, []),
-        "800-900 g": [r for g, rs in by_mass.items() if g >= 800 for r in rs],
+        **({f"lighter, {span(lighter)}": [r for g in lighter for r in by_mass[g]]} if lighter else {}),
+        **({f"heavier, {span(heavier)}": [r for g in heavier for r in by_mass[g]]} if heavier else {}),
         "every other size": list(v.rows),
         f"the same unit as the fit ({', '.join(fit_units)})": same,
         "other units": [r for r, u in zip(v.rows, units) if u not in fit_units],
