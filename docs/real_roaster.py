@@ -36,6 +36,16 @@ def grams(path: Path) -> int | None:
     return int(m.group(1)) if m else None
 
 
+#: The Bullet's fit batch sizes [g]: the roaster's nominal 0.5 kg as its owner weighed it.
+NOMINAL_G = (490, 500)
+
+
+def nominal_size(path: Path) -> bool:
+    """A Bullet log of the fit's batch size (:data:`NOMINAL_G`)."""
+    g = grams(path)
+    return g is not None and NOMINAL_G[0] <= g <= NOMINAL_G[1]
+
+
 def unit(path: Path) -> str:
     """The roaster unit that recorded a RoasTime log (its serial number; roastime.read_roastime)."""
     from roastlab.io.importers.roastime import read_roastime
@@ -162,13 +172,13 @@ def scaling(model, column_map, paths, nominal_val, lines):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    others = [p for p in paths if grams(p) not in (490, 500)]
+    others = [p for p in paths if not nominal_size(p)]
     batches = load(others, column_map)
     v = model.validate(batches)
     by_mass: dict[int, list] = {}
     for p, row in zip(others, v.rows):
         by_mass.setdefault(grams(p), []).append(row)
-    fit_units = sorted({unit(p) for p in paths if grams(p) in (490, 500)})
+    fit_units = sorted({unit(p) for p in paths if nominal_size(p)})
     units = [unit(p) for p in others]
     lines += [
         "### Batch-size scaling on the Bullet",
@@ -194,8 +204,8 @@ def scaling(model, column_map, paths, nominal_val, lines):
         return f"{min(masses)} g" if min(masses) == max(masses) else f"{min(masses)}-{max(masses)} g"
 
     # lighter and heavier than the fit's logs, from whatever weights the folder holds
-    lighter = sorted(g for g in by_mass if g < 490)
-    heavier = sorted(g for g in by_mass if g > 500)
+    lighter = sorted(g for g in by_mass if g < NOMINAL_G[0])
+    heavier = sorted(g for g in by_mass if g > NOMINAL_G[1])
     groups = {
         **({f"lighter, {span(lighter)}": [r for g in lighter for r in by_mass[g]]} if lighter else {}),
         **({f"heavier, {span(heavier)}": [r for g in heavier for r in by_mass[g]]} if heavier else {}),
@@ -282,8 +292,8 @@ def variants_and_bands(column_map, paths, lines):
     from roastlab.workflows.compare import FREE
 
     example = ROOT / "examples" / "bullet"
-    nominal = [p for p in paths if grams(p) in (490, 500)]
-    others = [p for p in paths if grams(p) not in (490, 500)]
+    nominal = [p for p in paths if nominal_size(p)]
+    others = [p for p in paths if not nominal_size(p)]
     fit_b, val_b, oth_b = load(nominal[0::2], column_map), load(nominal[1::2], column_map), load(others, column_map)
     lines += [
         "### Bed-law variants (fitted on the same 490-500 g logs: `fit.toml` with each variant's laws and "
@@ -320,7 +330,7 @@ def spread_against_refits(column_map, paths, lines):
     from roastlab.evaluate.bands import roast_spread
 
     example = ROOT / "examples" / "bullet"
-    fit_b = load([p for p in paths if grams(p) in (490, 500)][0::2], column_map)
+    fit_b = load([p for p in paths if nominal_size(p)][0::2], column_map)
     full = roastlab.fit(fit_b, example / "plant.toml", example / "fit.toml", column_map=column_map)
     held = full.identification.held_out_Ta
     own_v = full.model.validate(fit_b)
@@ -390,7 +400,7 @@ def main() -> int:
     machine("Skywalker (heater and fan settings, shell loss)", ROOT / "examples" / "skywalker", sky, lines)
     skywalker_et(sky, lines)
     bullet = sorted(p for p in (DATA / "bullet").glob("*.json") if grams(p) is not None)
-    nominal = [p for p in bullet if grams(p) in (490, 500)]
+    nominal = [p for p in bullet if nominal_size(p)]
     model, column_map, val = machine(
         "Aillio Bullet R1, 490-500 g batches", ROOT / "examples" / "bullet", nominal, lines
     )
