@@ -57,6 +57,10 @@ real-roaster: $(STAMP)
 	  $(foreach h,$(H_PROBE_PROFILE_M),--variant $(BED_EXAMPLE),h_probe_m=$(h)) \
 	  --variant $(BED_BEFORE),h_probe_m=0.2 \
 	  --json docs/real-roaster-compare.json --plot docs/real-roaster-compare.png
+	$(VENV)/bin/roastlab compare-models --plant examples/bullet/plant.toml --map examples/bullet/map.toml \
+	  --spec examples/bullet/fit.toml $$(ls $(BULLET)/*_*g.json) --group-by unit \
+	  --variant $(BED_EXAMPLE) --variant paper,h_probe_m=free \
+	  --json docs/real-roaster-roasters.json --plot docs/real-roaster-roasters.png
 # each bed law with the probe's depth scale fitted, then that scale's profile under the example's laws
 BED_VARIANTS = paper probe=tumbling contact=wall probe=tumbling,probe_gas=mean contact=wall,probe=tumbling,probe_gas=mean
 # the laws cross-validation chose, as the code holds them (roastlab.model.bed.CROSS_VALIDATED)

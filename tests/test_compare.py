@@ -122,3 +122,57 @@ def test_cli(tmp_path):
         [*cmd[:4], "--plant", "120kg", "--variant", "probe=up", *paths], capture_output=True, text=True
     )
     assert bad.returncode == 2 and "unknown probe law" in bad.stderr and "Traceback" not in bad.stderr
+
+
+def test_leave_one_roaster_out_predicts_each_unit_from_the_others():
+    """group_by="unit": each roaster's logs predicted by the variant fitted on the other roasters'
+    logs, the same figure as fitting on them by hand; the summary, JSON and figure name it so."""
+    import dataclasses
+
+    import roastlab
+
+    batches = synthetic_sizes()
+    units = ["2779", "2054", "2779", "1447", "2054", "2779"]  # SYNTHETIC serial numbers, sizes mixed
+    batches = [dataclasses.replace(b, unit=u) for b, u in zip(batches, units)]
+    result = compare_models(batches, "120kg", None, [TRUTH], group_by="unit", starts=1)
+    assert result.groups == {
+        "unit 1447": ["synthetic_120kg_1"],
+        "unit 2054": ["synthetic_60kg_1", "synthetic_180kg_0"],
+        "unit 2779": ["synthetic_60kg_0", "synthetic_120kg_0", "synthetic_180kg_1"],
+    }
+    (score,) = result.scores
+    train = [b for b in batches if b.unit != "2054"]
+    by_hand = roastlab.fit(train, "120kg", bed=TRUTH, starts=1).model.validate([b for b in batches if b.unit == "2054"])
+    assert score.cv_by_group["unit 2054"] == pytest.approx(by_hand.average["FIT"], abs=1e-6)
+    assert "best by leave-one-roaster-out FIT" in result.summary() and "LORO FIT" in result.summary()
+    doc = result.to_json_dict()
+    assert doc["group_by"] == "unit" and doc["step_kg"] is None and "loro_FIT" in doc["variants"][0]
+    with pytest.raises(InputError, match="names no roaster"):
+        compare_models(synthetic_sizes(), "120kg", None, [TRUTH], group_by="unit", starts=1)
+    one = [dataclasses.replace(b, unit="2779") for b in synthetic_sizes()]
+    with pytest.raises(InputError, match="logs of at least two roasters"):
+        compare_models(one, "120kg", None, [TRUTH], group_by="unit", starts=1)
+    with pytest.raises(InputError, match="group logs by one of size, unit"):
+        compare_models(batches, "120kg", None, [TRUTH], group_by="day", starts=1)
+
+
+def test_the_lowest_aic_is_weighed_against_the_best_by_one_standard_error():
+    """The paired per-group FIT difference of two variants and its standard error, by hand; a
+    difference within one standard error is said to be no difference."""
+    from roastlab.model.bed import BedLaws
+    from roastlab.workflows.compare import ModelComparison, VariantScore
+
+    def score(name, aic, by_group):
+        return VariantScore(name, BedLaws(), {}, 1.0, 100, 3, aic, aic, [], 80.0, float(np.mean(list(by_group.values()))),
+                            by_group)  # fmt: skip
+
+    groups = {"a": ["x"], "b": ["y"], "c": ["z"]}
+    best = score("best", 110.0, {"a": 80.0, "b": 70.0, "c": 75.0})
+    close = score("close", 100.0, {"a": 70.0, "b": 76.0, "c": 78.0})  # differences +10, -6, -3: mean 1/3
+    far = score("far", 100.0, {"a": 70.0, "b": 60.0, "c": 66.0})  # +10, +10, +9
+    diff, se = ModelComparison([best, close], groups, 1.0).cv_difference(best, close)
+    assert diff == pytest.approx(1 / 3) and se == pytest.approx(np.std([10, -6, -3], ddof=1) / np.sqrt(3))
+    text = ModelComparison([best, close], groups, 1.0).summary()
+    assert "within one standard error of best, 0.3 ± 4.9 points over 3 groups" in text and "prefer" not in text
+    text = ModelComparison([best, far], groups, 1.0).summary()
+    assert "predicts unseen sizes worse by 9.7 ± 0.3 points over 3 groups: prefer best" in text

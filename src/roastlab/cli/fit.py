@@ -176,6 +176,7 @@ def cmd_compare_models(args) -> int:
         args.variant or None,
         column_map=load_map(args.map) if args.map else None,
         step_kg=args.group_step_kg,
+        group_by=args.group_by,
         seed=args.seed,
         starts=args.starts,
         progress=progress("compare-models"),
@@ -303,15 +304,17 @@ def add_parsers(sub) -> None:
 
     from ..evaluate.metrics import GROUP_STEP_SHARE
     from ..model.bed import VARIANTS
+    from ..workflows.compare import GROUPINGS
     from .common import variant_arg
 
     p = sub.add_parser(
         "compare-models",
-        help="fit model variants (bed laws) on the same logs; AIC, BIC and leave-one-size-out FIT",
+        help="fit model variants (bed laws) on the same logs; AIC, BIC and leave-one-size-out (or -roaster-out) FIT",
         description="Fit each model variant on all the logs (summed SSR, AIC, BIC, free parameters, parameters on "
         "a bound, fit-set FIT) and cross-validate it by batch size: the logs are grouped by green weight, and for "
         "each group the variant is fitted on the other groups and predicts that one with nothing refitted. The "
-        "variant to prefer is the one with the highest leave-one-size-out FIT, not the best fit. Each fit is a "
+        "variant to prefer is the one with the highest leave-one-size-out FIT, not the best fit. With --group-by unit "
+        "the groups are the roasters that recorded the logs instead (leave-one-roaster-out). Each fit is a "
         "full identification, so this takes (variants x (groups + 1)) fits: minutes on real logs. It writes no "
         "model file: fit the chosen variant with 'roastlab identify --bed LAWS ... --out MODEL.json'.",
         epilog="example: roastlab compare-models --plant examples/bullet/plant.toml --map examples/bullet/map.toml "
@@ -329,6 +332,13 @@ def add_parsers(sub) -> None:
         help="a variant: bed laws and parameters held at a value or freed within the quantity table's bounds, "
         "e.g. 'paper', 'contact=wall,probe=tumbling' or 'probe=tumbling,h_probe_m=0.2' / 'h_probe_m=free' "
         "(repeatable; a profile of one parameter is several variants; default: " + "; ".join(VARIANTS) + ")",
+    )
+    p.add_argument(
+        "--group-by",
+        choices=GROUPINGS,
+        default="size",
+        help="cross-validate by batch size (default; leave-one-size-out) or by the roaster that recorded each log "
+        "(unit: RoasTime's serial number; leave-one-roaster-out, each drum predicted from the make's other drums)",
     )
     p.add_argument(
         "--group-step-kg",

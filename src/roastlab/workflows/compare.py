@@ -14,6 +14,10 @@ For each variant (a set of bed laws, :mod:`roastlab.model.bed`) :func:`compare_m
 
 The variant to prefer is the one that predicts the sizes it never saw best (the highest
 cross-validated FIT), not the one that fits best: more freedom always fits the fit set better.
+
+``group_by="unit"`` groups the logs by the roaster that recorded them instead (``Batch.unit``,
+RoasTime's serial number): **leave-one-roaster-out**, each drum predicted by a model fitted on the
+other drums of the make, the cross-machine test of the same claim.
 """
 
 from __future__ import annotations
@@ -46,6 +50,30 @@ def size_groups(batches, step_kg: float | None = None) -> tuple[list[str], float
         return size_labels(masses, step_kg)
     except ValueError as exc:
         raise InputError(str(exc), "command line") from None
+
+
+#: How compare-models may group the logs: by green weight or by the roaster that recorded them.
+GROUPINGS = ("size", "unit")
+#: Each grouping's words: the cross-validation's name, a group's kind, what the figure's x axis holds.
+_GROUP_WORDS = {
+    "size": ("leave-one-size-out", "size group", "held-out batch size (fitted on every other size)"),
+    "unit": ("leave-one-roaster-out", "roaster", "held-out roaster (fitted on every other roaster of the make)"),
+}
+
+
+def unit_groups(batches) -> list[str]:
+    """A group label per batch, ``"unit 2779"``, from the roaster that recorded it (``Batch.unit``);
+    a batch whose log names no roaster is an :class:`~roastlab.errors.InputError`."""
+    labels = []
+    for b in batches:
+        u = str(getattr(b, "unit", "") or "")
+        if not u:
+            raise InputError(
+                "the log names no roaster (RoasTime's serialNumber): leave-one-roaster-out groups logs by it",
+                b.source or b.name,
+            )
+        labels.append(f"unit {u}")
+    return labels
 
 
 #: The value of a variant's parameter override that frees it within its quantity-table bounds.
@@ -156,12 +184,33 @@ class ModelComparison(Result):
 
     scores: list[VariantScore]
     groups: dict[str, list[str]]
-    step_kg: float
+    step_kg: float | None
+    group_by: str = "size"
 
     @property
     def best(self) -> VariantScore:
-        """The variant with the highest leave-one-size-out FIT."""
+        """The variant with the highest cross-validated FIT."""
         return max(self.scores, key=lambda s: s.cv_FIT)
+
+    @property
+    def cv_name(self) -> str:
+        """``"leave-one-size-out"`` or ``"leave-one-roaster-out"``."""
+        return _GROUP_WORDS[self.group_by][0]
+
+    @property
+    def cv_short(self) -> str:
+        """``"LOSO"`` or ``"LORO"``: the cross-validation's initials, for table columns and JSON keys."""
+        return "".join(w[0] for w in self.cv_name.split("-")).upper()
+
+    def cv_difference(self, a: VariantScore, b: VariantScore) -> tuple[float, float]:
+        """How much better ``a`` predicts the held-out groups than ``b``: the mean over groups of the
+        paired FIT difference [points] and its standard error (sd / sqrt(groups)), the yardstick of
+        the one-standard-error rule of cross-validation (Breiman et al. 1984; Hastie, Tibshirani and
+        Friedman, *Elements of Statistical Learning*, 7.10): a difference within one standard error
+        does not single out either variant."""
+        d = np.array([a.cv_by_group[g] - b.cv_by_group[g] for g in self.groups])
+        se = float(np.std(d, ddof=1) / np.sqrt(d.size)) if d.size > 1 else float("nan")
+        return float(d.mean()), se
 
     def to_frame(self):
         import pandas as pd
@@ -177,7 +226,7 @@ class ModelComparison(Result):
                     "BIC": s.bic,
                     "on bound": len(s.on_bound),
                     "fit FIT %": s.fit_FIT,
-                    "LOSO FIT %": s.cv_FIT,
+                    f"{self.cv_short} FIT %": s.cv_FIT,
                     **{f"{g} %": v for g, v in s.cv_by_group.items()},
                 }
             )
@@ -185,11 +234,12 @@ class ModelComparison(Result):
 
     def summary(self) -> str:
         groups = list(self.groups)
+        step = f" (step {self.step_kg:.3g} kg)" if self.group_by == "size" else ""
         head = (
             f"{len(self.scores)} variant(s) on {sum(len(v) for v in self.groups.values())} log(s) in "
-            f"{len(groups)} size group(s) (step {self.step_kg:.3g} kg); probe FIT %"
+            f"{len(groups)} {_GROUP_WORDS[self.group_by][1]}(s){step}; probe FIT %"
         )
-        cols = ["variant", "k", "SSR °C²", "AIC", "BIC", "on bound", "fit FIT", "LOSO FIT", *groups]
+        cols = ["variant", "k", "SSR °C²", "AIC", "BIC", "on bound", "fit FIT", f"{self.cv_short} FIT", *groups]
         table = [cols]
         for s in self.scores:
             table.append(
@@ -208,18 +258,30 @@ class ModelComparison(Result):
         lines = [head, "", *aligned(table)]
         best = self.best
         by_aic = min(self.scores, key=lambda s: s.aic)
-        lines += ["", f"best by leave-one-size-out FIT: {best.name} ({best.cv_FIT:.1f} %)"]
+        lines += ["", f"best by {self.cv_name} FIT: {best.name} ({best.cv_FIT:.1f} %)"]
+        unseen = "sizes" if self.group_by == "size" else "roasters"
         if by_aic is not best:
-            lines.append(
-                f"lowest AIC: {by_aic.name} (fits the logs best, predicts unseen sizes worse: prefer {best.name})"
-            )
+            diff, se = self.cv_difference(best, by_aic)
+            by = f"{diff:.1f} ± {se:.1f} points over {len(groups)} groups"
+            if diff > se:
+                lines.append(
+                    f"lowest AIC: {by_aic.name} (fits the logs best, predicts unseen {unseen} worse by {by}: "
+                    f"prefer {best.name})"
+                )
+            else:
+                lines.append(
+                    f"lowest AIC: {by_aic.name} (fits the logs best; on unseen {unseen} within one standard error "
+                    f"of {best.name}, {by}: cross-validation does not tell the two apart)"
+                )
         for s in self.scores:
             if s.on_bound:
                 lines.append(f"{s.name}: on a bound: {', '.join(s.on_bound)}")
         return "\n".join(lines)
 
     def to_json_dict(self) -> dict:
+        key = self.cv_short.lower()  # loso_FIT (by size, as before) or loro_FIT (by roaster)
         return {
+            "group_by": self.group_by,
             "step_kg": self.step_kg,
             "groups": self.groups,
             "best": self.best.name,
@@ -235,9 +297,9 @@ class ModelComparison(Result):
                     "BIC": s.bic,
                     "on_bound": s.on_bound,
                     "fit_FIT": s.fit_FIT,
-                    "loso_FIT": s.cv_FIT,
-                    "loso_FIT_by_group": s.cv_by_group,
-                    "loso_FIT_by_batch": s.cv_by_batch,
+                    f"{key}_FIT": s.cv_FIT,
+                    f"{key}_FIT_by_group": s.cv_by_group,
+                    f"{key}_FIT_by_batch": s.cv_by_batch,
                     "warnings": s.warnings,
                 }
                 for s in self.scores
@@ -252,7 +314,7 @@ class ModelComparison(Result):
             ax.bar(x + (i - (len(self.scores) - 1) / 2) * width, [s.cv_by_group[g] for g in groups], width,
                    label=f"{s.name} (mean {s.cv_FIT:.1f} %)")  # fmt: skip
         ax.set_xticks(x, groups)
-        ax.set_xlabel("held-out batch size (fitted on every other size)")
+        ax.set_xlabel(_GROUP_WORDS[self.group_by][2])
         ax.set_ylabel("probe FIT [%]")
         ax.set_ylim(max(min(0.0, ax.get_ylim()[0]), -50.0), 100.0)
         ax.axhline(0.0, color="0.5", lw=0.6)
@@ -264,7 +326,8 @@ class ModelComparison(Result):
 
         fig = new_figure(figsize=(9, 5.2))
         self._draw(fig.add_subplot(1, 1, 1))
-        title = title or "Leave-one-size-out: each batch size predicted by a model fitted on the others"
+        kind = "batch size" if self.group_by == "size" else "roaster"
+        title = title or f"{self.cv_name.capitalize()}: each {kind} predicted by a model fitted on the others"
         return finish_figure(fig, path, title, outputs)
 
 
@@ -276,11 +339,12 @@ def compare_models(
     *,
     column_map=None,
     step_kg: float | None = None,
+    group_by: str = "size",
     seed: int = 0,
     starts: int = N_STARTS,
     progress=None,
 ) -> ModelComparison:
-    """Fit each variant on ``batches`` and cross-validate it leaving one batch size out.
+    """Fit each variant on ``batches`` and cross-validate it leaving one batch size (or one roaster) out.
 
     Parameters
     ----------
@@ -289,6 +353,8 @@ def compare_models(
     variants : {name: BedLaws, Variant or its text} or a list of them (:class:`Variant`: bed laws
         and parameter overrides such as ``h_probe_m=0.2``); default :data:`roastlab.model.bed.VARIANTS`
     step_kg : the group step (default :data:`roastlab.evaluate.metrics.GROUP_STEP_SHARE` of the median green weight)
+    group_by : ``"size"`` (by green weight) or ``"unit"`` (by the roaster that recorded each log,
+        :func:`unit_groups`: leave-one-roaster-out)
     progress : callable ``progress(done, total, text)``
     """
     from ..io.fitspec import FitSpec, load_fit_spec
@@ -303,12 +369,19 @@ def compare_models(
     base = spec if spec is None or isinstance(spec, FitSpec) else load_fit_spec(spec)
     if not variants:
         raise InputError("no model variants to compare", "command line")
+    if group_by not in GROUPINGS:
+        raise InputError(f"group logs by one of {', '.join(GROUPINGS)}, got {group_by!r}", "command line")
     batches = list(batches)
-    labels, step = size_groups(batches, step_kg)
-    order = sorted(set(labels), key=lambda g: float(g.split()[0].split("-")[0]))
+    if group_by == "size":
+        labels, step = size_groups(batches, step_kg)
+        order = sorted(set(labels), key=lambda g: float(g.split()[0].split("-")[0]))
+    else:
+        labels, step = unit_groups(batches), None
+        order = sorted(set(labels))
     if len(order) < 2:
+        need = "at least two batch sizes" if group_by == "size" else "logs of at least two roasters"
         raise InputError(
-            f"every log is in one size group ({order[0]}): leave-one-size-out needs at least two batch sizes",
+            f"every log is in one group ({order[0]}): {_GROUP_WORDS[group_by][0]} needs {need}",
             batches[0].source or batches[0].name,
         )
     groups = {g: [b.name for b, lab in zip(batches, labels) if lab == g] for g in order}
@@ -355,7 +428,16 @@ def compare_models(
     if progress:
         progress(total, total, "done")
     scores.sort(key=lambda s: -s.cv_FIT)
-    return ModelComparison(scores, groups, step)
+    return ModelComparison(scores, groups, step, group_by)
 
 
-__all__ = ["FREE", "ModelComparison", "Variant", "VariantScore", "compare_models", "size_groups"]
+__all__ = [
+    "FREE",
+    "GROUPINGS",
+    "ModelComparison",
+    "Variant",
+    "VariantScore",
+    "compare_models",
+    "size_groups",
+    "unit_groups",
+]
