@@ -150,7 +150,7 @@ def test_leave_one_roaster_out_predicts_each_unit_from_the_others():
     with pytest.raises(InputError, match="names no roaster"):
         compare_models(synthetic_sizes(), "120kg", None, [TRUTH], group_by="unit", starts=1)
     one = [dataclasses.replace(b, unit="2779") for b in synthetic_sizes()]
-    with pytest.raises(InputError, match="logs of at least two roasters"):
+    with pytest.raises(InputError, match="at least logs of two roasters"):
         compare_models(one, "120kg", None, [TRUTH], group_by="unit", starts=1)
     with pytest.raises(InputError, match="group logs by one of size, unit"):
         compare_models(batches, "120kg", None, [TRUTH], group_by="day", starts=1)

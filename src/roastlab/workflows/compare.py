@@ -54,10 +54,23 @@ def size_groups(batches, step_kg: float | None = None) -> tuple[list[str], float
 
 #: How compare-models may group the logs: by green weight or by the roaster that recorded them.
 GROUPINGS = ("size", "unit")
-#: Each grouping's words: the cross-validation's name, a group's kind, what the figure's x axis holds.
+#: Each grouping's words: the cross-validation's name, what one group is (singular, plural, as the
+#: others the fit used), and what it needs at least.
 _GROUP_WORDS = {
-    "size": ("leave-one-size-out", "size group", "held-out batch size (fitted on every other size)"),
-    "unit": ("leave-one-roaster-out", "roaster", "held-out roaster (fitted on every other roaster of the make)"),
+    "size": {
+        "cv": "leave-one-size-out",
+        "kind": "batch size",
+        "kinds": "sizes",
+        "other": "size",
+        "need": "two batch sizes",
+    },
+    "unit": {
+        "cv": "leave-one-roaster-out",
+        "kind": "roaster",
+        "kinds": "roasters",
+        "other": "roaster of the make",
+        "need": "logs of two roasters",
+    },
 }
 
 
@@ -195,7 +208,7 @@ class ModelComparison(Result):
     @property
     def cv_name(self) -> str:
         """``"leave-one-size-out"`` or ``"leave-one-roaster-out"``."""
-        return _GROUP_WORDS[self.group_by][0]
+        return _GROUP_WORDS[self.group_by]["cv"]
 
     @property
     def cv_short(self) -> str:
@@ -234,10 +247,11 @@ class ModelComparison(Result):
 
     def summary(self) -> str:
         groups = list(self.groups)
-        step = f" (step {self.step_kg:.3g} kg)" if self.group_by == "size" else ""
+        words = _GROUP_WORDS[self.group_by]
+        step = f" (step {self.step_kg:.3g} kg)" if self.step_kg is not None else ""
         head = (
             f"{len(self.scores)} variant(s) on {sum(len(v) for v in self.groups.values())} log(s) in "
-            f"{len(groups)} {_GROUP_WORDS[self.group_by][1]}(s){step}; probe FIT %"
+            f"{len(groups)} {words['kinds']}{step}; probe FIT %"
         )
         cols = ["variant", "k", "SSR °C²", "AIC", "BIC", "on bound", "fit FIT", f"{self.cv_short} FIT", *groups]
         table = [cols]
@@ -259,7 +273,7 @@ class ModelComparison(Result):
         best = self.best
         by_aic = min(self.scores, key=lambda s: s.aic)
         lines += ["", f"best by {self.cv_name} FIT: {best.name} ({best.cv_FIT:.1f} %)"]
-        unseen = "sizes" if self.group_by == "size" else "roasters"
+        unseen = words["kinds"]
         if by_aic is not best:
             diff, se = self.cv_difference(best, by_aic)
             by = f"{diff:.1f} ± {se:.1f} points over {len(groups)} groups"
@@ -314,7 +328,8 @@ class ModelComparison(Result):
             ax.bar(x + (i - (len(self.scores) - 1) / 2) * width, [s.cv_by_group[g] for g in groups], width,
                    label=f"{s.name} (mean {s.cv_FIT:.1f} %)")  # fmt: skip
         ax.set_xticks(x, groups)
-        ax.set_xlabel(_GROUP_WORDS[self.group_by][2])
+        words = _GROUP_WORDS[self.group_by]
+        ax.set_xlabel(f"held-out {words['kind']} (fitted on every other {words['other']})")
         ax.set_ylabel("probe FIT [%]")
         ax.set_ylim(max(min(0.0, ax.get_ylim()[0]), -50.0), 100.0)
         ax.axhline(0.0, color="0.5", lw=0.6)
@@ -326,7 +341,7 @@ class ModelComparison(Result):
 
         fig = new_figure(figsize=(9, 5.2))
         self._draw(fig.add_subplot(1, 1, 1))
-        kind = "batch size" if self.group_by == "size" else "roaster"
+        kind = _GROUP_WORDS[self.group_by]["kind"]
         title = title or f"{self.cv_name.capitalize()}: each {kind} predicted by a model fitted on the others"
         return finish_figure(fig, path, title, outputs)
 
@@ -379,9 +394,9 @@ def compare_models(
         labels, step = unit_groups(batches), None
         order = sorted(set(labels))
     if len(order) < 2:
-        need = "at least two batch sizes" if group_by == "size" else "logs of at least two roasters"
+        words = _GROUP_WORDS[group_by]
         raise InputError(
-            f"every log is in one group ({order[0]}): {_GROUP_WORDS[group_by][0]} needs {need}",
+            f"every log is in one group ({order[0]}): {words['cv']} needs at least {words['need']}",
             batches[0].source or batches[0].name,
         )
     groups = {g: [b.name for b, lab in zip(batches, labels) if lab == g] for g in order}
