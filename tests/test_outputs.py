@@ -55,6 +55,7 @@ VALUES = {
     "--bed",
     "--variant",
     "--group-step-kg",
+    "--group-by",
     "--band",
     "--moisture",
     "--heater",
