@@ -190,29 +190,25 @@ def cmd_compare_models(args) -> int:
 def _band_table(model, batches, level) -> tuple[dict, list]:
     """Print and return how often each batch's measured probe lies inside the model's band, and
     the bands (drawn by --plot)."""
-    from ..evaluate.bands import band_note, coverage, inside_by_size, prediction_bands, share_inside
+    from ..evaluate.bands import band_report
 
     if not (model.doc.get("fit") or {}).get("spread"):
         print("note: the model file has no roast-to-roast spread (fitted on one log, or by an older roastlab): "
               "the band is the parameters' alone")  # fmt: skip
-    bands = prediction_bands(model, batches, level)
-    rows = coverage(batches, bands)
-    note = band_note(model, batches)
+    report, bands = band_report(model, batches, level)
     print(f"\n{level:.0%} prediction band (parameters and roast-to-roast spread, roastlab.evaluate.bands):")
     print(f"{'batch':<36} {'kg':>6} {'inside':>7} {'median width':>13}")
-    for r in rows:
+    for r in report["batches"]:
         kg = "" if not r["Mb_kg"] else f"{r['Mb_kg']:.3g}"
         print(f"{r['name'][:36]:<36} {kg:>6} {r['inside']:>7.0%} {r['median_width_C']:>10.1f} °C")
-    sizes = inside_by_size(rows)
-    for g in sizes:
+    for g in report["by_size"]:
         label = f"size {g['size']} ({g['logs']} log{'s' * (g['logs'] > 1)})"
         print(f"{label:<36} {'':>6} {g['inside']:>7.0%}")
-    inside = share_inside(rows)
-    print(f"{'all samples':<36} {'':>6} {inside:>7.0%}   (a calibrated band holds about {level:.0%})")
-    if note:
-        print(f"note: {note}")
-    doc = {"level": level, "inside_all": inside, "batches": rows, **({"by_size": sizes} if sizes else {})}
-    return {**doc, **({"note": note} if note else {})}, bands
+    print(f"{'all samples':<36} {'':>6} {report['inside_all']:>7.0%}   (a calibrated band holds about {level:.0%})")
+    if report["note"]:
+        print(f"note: {report['note']}")
+    keep = ("level", "inside_all", "batches", "by_size", "note")  # the JSON as before: empty ones left out
+    return {k: report[k] for k in keep if report[k] or k in ("level", "inside_all", "batches")}, bands
 
 
 def _safe_stem(name: str, taken: set) -> str:

@@ -322,6 +322,26 @@ def inside_by_size(rows: list[dict]) -> list[dict]:
     return out
 
 
+def band_report(model, batches, level: float = BAND_LEVEL) -> tuple[dict, list[Band]]:
+    """How the level-``level`` band of ``model`` holds the measured probe of ``batches``, and the
+    bands: ``({"level", "inside_all" (share of all samples inside), "median_width_C" (median over the
+    batches), "batches" (:func:`band_coverage` rows), "by_size" (:func:`inside_by_size`), "note"
+    (:func:`band_note` or None)}, [Band, ...])``."""
+    batches = list(batches)
+    bands = prediction_bands(model, batches, level)
+    rows = coverage(batches, bands)
+    widths = [r["median_width_C"] for r in rows]
+    doc = {
+        "level": level,
+        "inside_all": share_inside(rows),
+        "median_width_C": float(np.median(widths)) if widths else float("nan"),
+        "batches": rows,
+        "by_size": inside_by_size(rows),
+        "note": band_note(model, batches),
+    }
+    return doc, bands
+
+
 def band_coverage(model, batches, level: float = BAND_LEVEL) -> list[dict]:
     """Per batch: ``{"name", "n", "inside" (share of measured probe samples inside the band),
     "median_width_C", "Mb_kg"}``."""

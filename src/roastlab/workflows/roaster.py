@@ -529,25 +529,14 @@ def init_roaster(paths, out_dir, *, batch_kg=None, capacity_kg=None, diameter_m=
 
 
 def held_out_band(model, batches) -> dict | None:
-    """How well the model's prediction band is calibrated on logs it was not fitted on: ``{"level",
-    "inside_all" (share of all measured probe samples inside it), "median_width_C", "batches" (rows
-    of :func:`roastlab.evaluate.bands.band_coverage`), "by_size" (:func:`~roastlab.evaluate.bands.inside_by_size`),
-    "note"}``; None when the model file can carry
-    no band (:func:`roastlab.evaluate.bands.why_no_band`)."""
-    from ..evaluate.bands import BAND_LEVEL, band_coverage, band_note, inside_by_size, share_inside, why_no_band
+    """How well the model's 90 % prediction band holds logs it was not fitted on
+    (:func:`roastlab.evaluate.bands.band_report`); None when the model file can carry no band
+    (:func:`roastlab.evaluate.bands.why_no_band`)."""
+    from ..evaluate.bands import BAND_LEVEL, band_report, why_no_band
 
     if why_no_band(model) is not None:
         return None
-    rows = band_coverage(model, batches, BAND_LEVEL)
-    widths = [r["median_width_C"] for r in rows]
-    return {
-        "level": BAND_LEVEL,
-        "inside_all": share_inside(rows),
-        "median_width_C": float(np.median(widths)) if widths else float("nan"),
-        "batches": rows,
-        "by_size": inside_by_size(rows),
-        "note": band_note(model, batches),
-    }
+    return band_report(model, batches, BAND_LEVEL)[0]
 
 
 def band_sentence(band: dict) -> str:
