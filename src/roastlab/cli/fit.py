@@ -207,8 +207,9 @@ def _band_table(model, batches, level) -> tuple[dict, list]:
     print(f"{'all samples':<36} {'':>6} {report['inside_all']:>7.0%}   (a calibrated band holds about {level:.0%})")
     if report["note"]:
         print(f"note: {report['note']}")
-    keep = ("level", "inside_all", "batches", "by_size", "note")  # the JSON as before: empty ones left out
-    return {k: report[k] for k in keep if report[k] or k in ("level", "inside_all", "batches")}, bands
+    doc = {"level": level, "inside_all": report["inside_all"], "batches": report["batches"]}
+    doc.update({k: report[k] for k in ("by_size", "note") if report[k]})  # only when there are several sizes, a note
+    return doc, bands
 
 
 def _safe_stem(name: str, taken: set) -> str:
