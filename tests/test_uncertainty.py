@@ -81,6 +81,31 @@ def test_the_two_fitters_agree_on_the_same_batch(one_batch, hgm_bounds):
     assert doc["AIC"] == pytest.approx(one.aic) and len(doc["covariance"]) == 2
 
 
+def test_standard_errors_do_not_depend_on_the_parameters_units():
+    """A parameter measured in units that make it 1e9 (the reaction's pre-exponential factor A
+    beside a flow in kg/s) keeps its own standard error: the straight line's slope expressed in
+    units 1e-9 times as large has a standard error 1e9 times as large, with the same correlation.
+    A plain pseudo-inverse cut that direction (singular values below 1e-15 of the largest) and
+    gave it a variance of about 0; the held-out residuals, which invert the same matrix, stay put."""
+    rng = np.random.default_rng(1)
+    x = np.linspace(0.0, 10.0, 25)
+    y = 1.5 + 0.7 * x + rng.normal(0.0, 0.3, x.size)
+    X = np.column_stack([np.ones_like(x), x])
+    coef, *_ = np.linalg.lstsq(X, y, rcond=None)
+    r = X @ coef - y
+    ssr = float(r @ r)
+    u = uncertainty.from_jacobian(X, coef, [-10, -10], [10, 10], ssr, ["a", "b"])
+    k = 1e-9  # the slope in units 1e-9 times as large: the value x 1e9, the Jacobian column x 1e-9
+    Xs = X * np.array([1.0, k])
+    us = uncertainty.from_jacobian(Xs, coef / [1.0, k], [-10, -1e10], [10, 1e10], ssr, ["a", "b"])
+    assert us.stderr[0] == pytest.approx(u.stderr[0], rel=1e-8)
+    assert us.stderr[1] == pytest.approx(u.stderr[1] / k, rel=1e-8)
+    assert us.correlation[0, 1] == pytest.approx(u.correlation[0, 1], rel=1e-8)
+    groups = np.repeat(np.arange(5), 5)
+    held = uncertainty.held_out_residuals(X, r, groups, np.ones(2, bool))
+    assert np.allclose(uncertainty.held_out_residuals(Xs, r, groups, np.ones(2, bool)), held, atol=1e-9)
+
+
 def test_held_out_residuals_equal_refits_without_each_group_for_a_linear_model():
     """The linearised leave-one-group-out rule is exact when the model is linear in its parameters:
     checked against refitting (numpy lstsq) without each group, on seeded synthetic data."""

@@ -58,16 +58,37 @@ def at_bounds(z, lower, upper) -> tuple[np.ndarray, np.ndarray]:
     return z - lower <= tol, upper - z <= tol
 
 
+def scaled_pinv(a: np.ndarray) -> np.ndarray:
+    """The pseudo-inverse of a symmetric positive semi-definite matrix ``a`` (a normal matrix J'J),
+    taken in units where each parameter's column of J has length 1: a^+ = D (D a D)^+ D with
+    D = diag(a)^-1/2 (1 where the diagonal is 0).
+
+    Equal to ``np.linalg.pinv(a)`` when ``a`` is invertible, but independent of the parameters'
+    units: a plain pseudo-inverse cuts singular values below 1e-15 of the largest, so a parameter
+    whose magnitude is 1e8 (the reaction's pre-exponential factor A beside a flow in kg/s) loses
+    its direction and gets a variance of 0 instead of its own.
+
+    >>> a = np.diag([1e12, 1e-12])
+    >>> scaled_pinv(a).diagonal().tolist()
+    [1e-12, 1000000000000.0]
+    >>> np.linalg.pinv(a).diagonal().tolist()
+    [1e-12, 0.0]
+    """
+    d = np.sqrt(np.abs(np.diag(a)))
+    d = np.where(d > 0.0, 1.0 / np.where(d > 0.0, d, 1.0), 1.0)
+    return np.linalg.pinv(a * np.outer(d, d)) * np.outer(d, d)
+
+
 def covariance(jtj: np.ndarray, ssr: float, n_residuals: int, determined: np.ndarray) -> np.ndarray:
     """cov = s^2 (J'J)^+ over the ``determined`` parameters, s^2 = SSR / (n - k); NaN rows and
-    columns elsewhere (and everywhere when n <= k)."""
+    columns elsewhere (and everywhere when n <= k). The pseudo-inverse is :func:`scaled_pinv`."""
     k_all = jtj.shape[0]
     cov = np.full((k_all, k_all), np.nan)
     idx = np.flatnonzero(determined)
     dof = int(n_residuals) - idx.size
     if idx.size == 0 or dof <= 0 or not np.all(np.isfinite(jtj[np.ix_(idx, idx)])):
         return cov
-    cov[np.ix_(idx, idx)] = np.linalg.pinv(jtj[np.ix_(idx, idx)]) * (float(ssr) / dof)
+    cov[np.ix_(idx, idx)] = scaled_pinv(jtj[np.ix_(idx, idx)]) * (float(ssr) / dof)
     return cov
 
 
@@ -226,7 +247,7 @@ def held_out_residuals(J, r, groups, determined) -> np.ndarray:
     for g in np.unique(groups):
         rows = groups == g
         Ji = J[rows]
-        dz = np.linalg.pinv(A - Ji.T @ Ji) @ (Ji.T @ r[rows])
+        dz = scaled_pinv(A - Ji.T @ Ji) @ (Ji.T @ r[rows])
         out[rows] = r[rows] + Ji @ dz
     return out
 
