@@ -47,24 +47,28 @@ wheel-check:
 
 # The measured figures of docs/real-roaster.md, from the real logs in ../shared/data/real.
 # Then every bed-law variant and the probe depth scale's profile cross-validated by batch size on the
-# Bullet (11 variants x 9 fits, ~15 min).
+# Bullet (12 variants x 9 fits), then by roaster (3 variants x 6 fits): about 40 min on 2 cores.
 BULLET = ../shared/data/real/bullet
 real-roaster: $(STAMP)
 	$(PY) docs/real_roaster.py
 	$(VENV)/bin/roastlab compare-models --plant examples/bullet/plant.toml --map examples/bullet/map.toml \
 	  --spec examples/bullet/fit.toml $$(ls $(BULLET)/*_*g.json) \
-	  $(foreach v,$(BED_VARIANTS),--variant $(v),h_probe_m=free) \
-	  $(foreach h,$(H_PROBE_PROFILE_M),--variant $(BED_EXAMPLE),h_probe_m=$(h)) \
-	  --variant $(BED_BEFORE),h_probe_m=0.2 \
+	  --variant $(BED_EXAMPLE) \
+	  $(foreach v,$(BED_VARIANTS),--variant $(v),h_probe_m=free,$(PAPER_EXOTHERM)) \
+	  $(foreach h,$(H_PROBE_PROFILE_M),--variant $(BED_EXAMPLE),h_probe_m=$(h),$(PAPER_EXOTHERM)) \
+	  --variant $(BED_BEFORE),h_probe_m=0.2,$(PAPER_EXOTHERM) \
 	  --json docs/real-roaster-compare.json --plot docs/real-roaster-compare.png
 	$(VENV)/bin/roastlab compare-models --plant examples/bullet/plant.toml --map examples/bullet/map.toml \
 	  --spec examples/bullet/fit.toml $$(ls $(BULLET)/*_*g.json) --group-by unit \
-	  --variant $(BED_EXAMPLE) --variant paper,h_probe_m=free \
+	  --variant $(BED_EXAMPLE) --variant $(BED_EXAMPLE),$(PAPER_EXOTHERM) --variant paper,h_probe_m=free,$(PAPER_EXOTHERM) \
 	  --json docs/real-roaster-roasters.json --plot docs/real-roaster-roasters.png
 # each bed law with the probe's depth scale fitted, then that scale's profile under the example's laws
 BED_VARIANTS = paper probe=tumbling contact=wall probe=tumbling,probe_gas=mean contact=wall,probe=tumbling,probe_gas=mean
 # the laws cross-validation chose, as the code holds them (roastlab.model.bed.CROSS_VALIDATED)
 BED_EXAMPLE = $(shell $(PY) -c "from roastlab.model.bed import CROSS_VALIDATED as b; print(b.name)")
+# the paper's exothermic rate law (Schwartzberg's A and Ha/R, the quantity table's defaults), held in the
+# rows that compare bed laws; the example fits it (examples/bullet/fit.toml)
+PAPER_EXOTHERM = $(shell $(PY) -c "from roastlab.model.quantities import QUANTITIES as q; print(f'A={q[\"A\"].default:g},Ha_R={q[\"Ha_R\"].default:g}')")
 # the example's laws until 2026-11-25, held at its depth scale, for comparison
 BED_BEFORE = contact=wall,probe=tumbling,probe_gas=mean
 H_PROBE_PROFILE_M = 0.03 0.1 0.2 0.5 1

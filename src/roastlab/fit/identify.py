@@ -387,6 +387,11 @@ class _Basins:
             same[1] = max(same[1], travelled)
 
 
+#: Why a start was given up: its least-squares polish met values (far out along a parameter that spans
+#: several decades, such as the reaction's A) where the sensitivities overflow and SciPy refuses them.
+POLISH_OVERFLOW = "its polish met values where the model's sensitivities overflow"
+
+
 def _polish(obj: Objective, z0: np.ndarray):
     scale = obj.upper - obj.lower
     res = least_squares(
@@ -484,13 +489,22 @@ def identify(
         if basins.holds(z0):
             starts_log.append({"start": [float(v) for v in z0], "skipped": "inside the basin of an optimum found"})
         else:
-            z, ssr_k = _polish(obj, np.asarray(z0, dtype=float))
+            try:
+                z, ssr_k = _polish(obj, np.asarray(z0, dtype=float))
+            except ValueError:  # the polish met values where the model's sensitivities overflow
+                starts_log.append({"start": [float(v) for v in z0], "skipped": POLISH_OVERFLOW})
+                continue
             starts_log.append({"start": [float(v) for v in z0], "end": [float(v) for v in z], "SSR": ssr_k})
             basins.add(z0, z)
             if best is None or ssr_k < best[1]:
                 best = (z, ssr_k)
-        if progress is not None:
+        if progress is not None and best is not None:
             progress(k + 1, len(candidates), f"SSR {best[1]:.6g}, {obj.nfev} simulations")
+    if best is None:
+        raise ParameterError(
+            f"every start of the fit ({len(candidates)}) ran into values where the model overflows: "
+            "narrow the bounds of the parameters that span several decades (e.g. A)"
+        )
     z, ssr = best
     failed = obj.failed_batches(z)
     if failed:
