@@ -288,6 +288,37 @@ def test_a_start_inside_a_found_basin_is_not_polished_and_the_optimum_stays(monk
         assert fast.values[name] == pytest.approx(every.values[name], rel=1e-6), name
 
 
+def test_a_polish_that_overflows_gives_up_its_start_not_the_fit(monkeypatch):
+    """A start whose least-squares polish meets values where the sensitivities overflow (SciPy's
+    ValueError on a non-finite matrix; the reaction's A freed over many decades did this) is logged
+    as given up and the fit goes on from the other starts; when every start fails, one clear error."""
+    from roastlab.errors import ParameterError
+    from roastlab.fit import identify as ident
+
+    packed = shipped_packed()
+    free, fixed = build_free_parameters()
+    monkeypatch.setattr(ident, "BASIN_FACTOR", 0.0)  # polish every start
+    real_polish, calls = ident._polish, []
+
+    def first_fails(obj, z0):
+        calls.append(z0)
+        if len(calls) == 1:
+            raise ValueError("array must not contain infs or NaNs")
+        return real_polish(obj, z0)
+
+    monkeypatch.setattr(ident, "_polish", first_fails)
+    result = identify(packed, free, fixed, seed=0)
+    assert result.starts[0]["skipped"] == ident.POLISH_OVERFLOW
+    assert all("SSR" in s for s in result.starts[1:]) and np.isfinite(result.SSR)
+
+    def always_fails(obj, z0):
+        raise ValueError("array must not contain infs or NaNs")
+
+    monkeypatch.setattr(ident, "_polish", always_fails)
+    with pytest.raises(ParameterError, match="every start of the fit"):
+        identify(packed, free, fixed, seed=0)
+
+
 def test_screening_tolerance_ranks_trial_points_as_the_full_accuracy_does():
     """Trial points are scored with the integrator's tolerances loosened by
     SCREENING_TOL_SCALE: the scores move (the option acts) but the best ones keep their order."""
