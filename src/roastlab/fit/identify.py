@@ -394,18 +394,21 @@ POLISH_OVERFLOW = "its polish met values where the model's sensitivities overflo
 
 def _polish(obj: Objective, z0: np.ndarray):
     scale = obj.upper - obj.lower
-    res = least_squares(
-        obj.residuals,
-        z0,
-        jac=obj.jacobian,
-        bounds=(obj.lower, obj.upper),
-        method="trf",
-        x_scale=scale,
-        ftol=1e-12,
-        xtol=1e-10,
-        gtol=1e-10,
-        max_nfev=200,
-    )
+    # far out along a parameter spanning decades (A) SciPy's products overflow; the start is then
+    # given up (identify catches the ValueError) or the step rejected, so no warning is printed
+    with np.errstate(over="ignore", invalid="ignore"):
+        res = least_squares(
+            obj.residuals,
+            z0,
+            jac=obj.jacobian,
+            bounds=(obj.lower, obj.upper),
+            method="trf",
+            x_scale=scale,
+            ftol=1e-12,
+            xtol=1e-10,
+            gtol=1e-10,
+            max_nfev=200,
+        )
     return res.x, float(res.fun @ res.fun)
 
 
