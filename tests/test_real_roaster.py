@@ -1,6 +1,7 @@
 """Fitting a real roaster whose logs lack Tgi and Gg (examples/skywalker), and the baseline."""
 
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -206,6 +207,9 @@ def test_init_and_the_bullet_example_use_the_cross_validated_bed(bullet_data, tm
     spec = load_fit_spec(tmp_path / "cfg" / "fit.toml")
     assert spec.bed == CROSS_VALIDATED and "h_probe_m" not in {f.name for f in spec.free}
     assert spec.fixed["h_probe_m"] == pytest.approx(PROBE_DEPTH_OVER_DIAMETER * summary["plant"]["Dch_m"], rel=1e-3)
+    # the exotherm's rate law: the Bullet example fits it, init (a machine we have not seen) keeps the paper's
+    exotherm = {"A", "Ha_R"}
+    assert exotherm <= {f.name for f in example.free} and not exotherm & {f.name for f in spec.free}
 
 
 def test_roastime_without_weight_is_refused_with_the_way_out(cli, bullet_data, tmp_path):
@@ -283,6 +287,22 @@ def bullet_model(tmp_path_factory):
     path = tmp_path_factory.mktemp("bullet") / "bullet.json"
     result.model.save(path)
     return path
+
+
+def test_bullet_example_fits_a_later_steeper_exotherm_than_the_papers(bullet_model):
+    """The example frees eq. 14's rate law (A, Ha/R; Het held), and three nominal logs already ask for
+    a steeper one than Schwartzberg's: about the paper's rate near 150 degC, more near 200 degC, less
+    near 100 degC (docs/real-roaster.md, 'The beans' exotherm, fitted'). init keeps the paper's law."""
+    from roastlab.model.quantities import QUANTITIES
+
+    doc = json.loads(bullet_model.read_text())
+    p = {k: doc["parameters"][k]["value"] for k in ("A", "Ha_R")}
+    assert {doc["parameters"][k]["how"] for k in p} == {"fitted"}
+    paper = {k: QUANTITIES[k].default for k in p}
+    rate = lambda q, T_C: q["A"] * math.exp(-q["Ha_R"] / (T_C + 273.15))  # noqa: E731
+    assert p["Ha_R"] > 1.3 * paper["Ha_R"]
+    assert 0.5 < rate(p, 150.0) / rate(paper, 150.0) < 2.0
+    assert rate(p, 200.0) > 1.5 * rate(paper, 200.0) and rate(p, 100.0) < 0.6 * rate(paper, 100.0)
 
 
 def test_bullet_whatif_heavier_batch_judged_on_the_beans(cli, bullet_model, tmp_path):
