@@ -318,6 +318,13 @@ def test_a_polish_that_overflows_gives_up_its_start_not_the_fit(monkeypatch):
     with pytest.raises(ParameterError, match="every start of the fit"):
         identify(packed, free, fixed, seed=0)
 
+    def another_error(obj, z0):
+        raise ValueError("x0 is infeasible")
+
+    monkeypatch.setattr(ident, "_polish", another_error)  # any other error is not hidden as an overflow
+    with pytest.raises(ValueError, match="infeasible"):
+        identify(packed, free, fixed, seed=0)
+
 
 def test_screening_tolerance_ranks_trial_points_as_the_full_accuracy_does():
     """Trial points are scored with the integrator's tolerances loosened by

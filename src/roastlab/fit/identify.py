@@ -494,7 +494,9 @@ def identify(
         else:
             try:
                 z, ssr_k = _polish(obj, np.asarray(z0, dtype=float))
-            except ValueError:  # the polish met values where the model's sensitivities overflow
+            except ValueError as exc:  # SciPy refuses a non-finite matrix: the sensitivities overflowed
+                if "infs or NaNs" not in str(exc):
+                    raise
                 starts_log.append({"start": [float(v) for v in z0], "skipped": POLISH_OVERFLOW})
                 continue
             starts_log.append({"start": [float(v) for v in z0], "end": [float(v) for v in z], "SSR": ssr_k})
