@@ -14,16 +14,23 @@ from roastlab.model.parameters import THETA_START
 from roastlab.sim.population import pack_batches
 
 
-def test_linear_regression_known_answer():
-    """A straight-line fit y = a + b x: the covariance is s^2 (X'X)^-1 with s^2 = SSR / (n - 2),
-    computed here by hand from the closed-form sums (no pseudo-inverse involved)."""
-    rng = np.random.default_rng(0)
+def line_fit(seed):
+    """A seeded synthetic straight line y = 1.5 + 0.7 x + noise fitted by least squares: x, the
+    design matrix X (the Jacobian), the coefficients, the residuals (model - measured) and the SSR."""
+    rng = np.random.default_rng(seed)
     x = np.linspace(0.0, 10.0, 25)
     y = 1.5 + 0.7 * x + rng.normal(0.0, 0.3, x.size)
     X = np.column_stack([np.ones_like(x), x])
     coef, *_ = np.linalg.lstsq(X, y, rcond=None)
     r = X @ coef - y
     ssr = float(r @ r)
+    return x, X, coef, r, ssr
+
+
+def test_linear_regression_known_answer():
+    """A straight-line fit y = a + b x: the covariance is s^2 (X'X)^-1 with s^2 = SSR / (n - 2),
+    computed here by hand from the closed-form sums (no pseudo-inverse involved)."""
+    x, X, coef, r, ssr = line_fit(0)
     u = uncertainty.from_jacobian(X, coef, [-10, -10], [10, 10], ssr, ["a", "b"])
     n = x.size
     s2 = ssr / (n - 2)
@@ -87,13 +94,7 @@ def test_standard_errors_do_not_depend_on_the_parameters_units():
     units 1e-9 times as large has a standard error 1e9 times as large, with the same correlation.
     A plain pseudo-inverse cut that direction (singular values below 1e-15 of the largest) and
     gave it a variance of about 0; the held-out residuals, which invert the same matrix, stay put."""
-    rng = np.random.default_rng(1)
-    x = np.linspace(0.0, 10.0, 25)
-    y = 1.5 + 0.7 * x + rng.normal(0.0, 0.3, x.size)
-    X = np.column_stack([np.ones_like(x), x])
-    coef, *_ = np.linalg.lstsq(X, y, rcond=None)
-    r = X @ coef - y
-    ssr = float(r @ r)
+    _, X, coef, r, ssr = line_fit(1)
     u = uncertainty.from_jacobian(X, coef, [-10, -10], [10, 10], ssr, ["a", "b"])
     k = 1e-9  # the slope in units 1e-9 times as large: the value x 1e9, the Jacobian column x 1e-9
     Xs = X * np.array([1.0, k])
