@@ -307,7 +307,7 @@ def test_a_polish_that_overflows_gives_up_its_start_not_the_fit(monkeypatch):
         return real_polish(obj, z0)
 
     monkeypatch.setattr(ident, "_polish", first_fails)
-    result = identify(packed, free, fixed, seed=0)
+    result = identify(packed, free, fixed, seed=0, n_starts=3)
     assert result.starts[0]["skipped"] == ident.POLISH_OVERFLOW
     assert all("SSR" in s for s in result.starts[1:]) and np.isfinite(result.SSR)
 
@@ -316,14 +316,14 @@ def test_a_polish_that_overflows_gives_up_its_start_not_the_fit(monkeypatch):
 
     monkeypatch.setattr(ident, "_polish", always_fails)
     with pytest.raises(ParameterError, match="every start of the fit"):
-        identify(packed, free, fixed, seed=0)
+        identify(packed, free, fixed, seed=0, n_starts=3)
 
     def another_error(obj, z0):
         raise ValueError("x0 is infeasible")
 
     monkeypatch.setattr(ident, "_polish", another_error)  # any other error is not hidden as an overflow
     with pytest.raises(ValueError, match="infeasible"):
-        identify(packed, free, fixed, seed=0)
+        identify(packed, free, fixed, seed=0, n_starts=3)
 
 
 def test_screening_tolerance_ranks_trial_points_as_the_full_accuracy_does():
