@@ -47,7 +47,8 @@ wheel-check:
 
 # The measured figures of docs/real-roaster.md, from the real logs in ../shared/data/real.
 # Then every bed-law variant and the probe depth scale's profile cross-validated by batch size on the
-# Bullet (12 variants x 9 fits), then by roaster (3 variants x 6 fits): about 40 min on 2 cores.
+# Bullet (12 variants x 9 fits), then by roaster (3 variants x 6 fits): 77 min on 2 cores on 2026-11-25
+# (part of it beside a test run, with the example's exotherm bounds wider than now).
 BULLET = ../shared/data/real/bullet
 real-roaster: $(STAMP)
 	$(PY) docs/real_roaster.py
