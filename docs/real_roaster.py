@@ -38,6 +38,8 @@ def grams(path: Path) -> int | None:
 
 #: The Bullet's fit batch sizes [g]: the roaster's nominal 0.5 kg as its owner weighed it.
 NOMINAL_G = (490, 500)
+#: The same, as the tables and figures name it.
+NOMINAL = f"{NOMINAL_G[0]}-{NOMINAL_G[1]} g"
 
 
 def nominal_size(path: Path) -> bool:
@@ -183,8 +185,8 @@ def scaling(model, column_map, paths, nominal_val, lines):
     lines += [
         "### Batch-size scaling on the Bullet",
         "",
-        "Model fitted on the 490-500 g logs only (above); each other log predicted with its own green "
-        "weight and nothing refitted. The unit is the roaster's serial number in the log: the 490-500 g "
+        f"Model fitted on the {NOMINAL} logs only (above); each other log predicted with its own green "
+        f"weight and nothing refitted. The unit is the roaster's serial number in the log: the {NOMINAL} "
         f"logs all come from unit {', '.join(fit_units)}; the other units' logs test the batch size and "
         "another drum of the same make at once.",
         "",
@@ -215,7 +217,7 @@ def scaling(model, column_map, paths, nominal_val, lines):
     }
     lines += [
         "",
-        "Each group against the held-out 490-500 g logs, the gap of the means with its 90 % interval "
+        f"Each group against the held-out {NOMINAL} logs, the gap of the means with its 90 % interval "
         "(Welch's t over the logs, `roastlab.evaluate.metrics.mean_gap`); MPE is signed, positive where "
         "the model reads low:",
         "",
@@ -227,7 +229,7 @@ def scaling(model, column_map, paths, nominal_val, lines):
             bias_gap = mean_gap([r["MPE"] for r in rows], [r["MPE"] for r in nominal_rows])
             lines.append(
                 f"- {name}: mean FIT {mean(rows, 'FIT'):.1f} % ({len(rows)} log{'s' * (len(rows) > 1)}), "
-                f"{gap_text(fit_gap)} points against the {fit_gap['n_reference']} held-out 490-500 g logs; "
+                f"{gap_text(fit_gap)} points against the {fit_gap['n_reference']} held-out {NOMINAL} logs; "
                 f"mean MPE {mean(rows, 'MPE'):+.1f} %, {gap_text(bias_gap)} points against theirs."
             )
     ir = [second[n]["FIT"] for n in v.names]
@@ -244,12 +246,12 @@ def scaling(model, column_map, paths, nominal_val, lines):
     ax.scatter(ms[own], fits[own], color="C3", label="bean probe Ta, the fit's unit")
     ax.scatter(ms[~own], fits[~own], facecolors="none", edgecolors="C3", label="bean probe Ta, other units")
     ax.scatter(ms, [second[n]["FIT"] for n in v.names], color="C1", marker="x", label="IR reading vs model Tb")
-    ax.axhline(nominal_val[0], color="C0", ls="--", label=f"held-out 490-500 g ({nominal_val[0]:.1f} %)")
+    ax.axhline(nominal_val[0], color="C0", ls="--", label=f"held-out {NOMINAL} ({nominal_val[0]:.1f} %)")
     floor = max(78.0, nominal_val[0] - 6.0)  # issue 25: >= 78 % and within 6 points of the nominal logs
     ax.axhspan(floor, max(floor, nominal_val[0]), color="C0", alpha=0.1, label="target: >= 78 % and within 6 points")
     ax.set_xlabel("green batch mass [g]")
     ax.set_ylabel("FIT [%]")
-    ax.set_title("Aillio Bullet: model fitted on 490-500 g")
+    ax.set_title(f"Aillio Bullet: model fitted on {NOMINAL}")
     ax.set_ylim(min(0.0, float(np.min(fits)) - 5.0), 100)  # a log predicted worse than its mean stays in view
     ax.legend(fontsize=8, loc="lower center")
     ax.grid(alpha=0.3)
@@ -296,10 +298,10 @@ def variants_and_bands(column_map, paths, lines):
     others = [p for p in paths if not nominal_size(p)]
     fit_b, val_b, oth_b = load(nominal[0::2], column_map), load(nominal[1::2], column_map), load(others, column_map)
     lines += [
-        "### Bed-law variants (fitted on the same 490-500 g logs: `fit.toml` with each variant's laws and "
+        f"### Bed-law variants (fitted on the same {NOMINAL} logs: `fit.toml` with each variant's laws and "
         "h_probe_m free, then the example's `fit.toml` as it is)",
         "",
-        "| variant | held-out 490-500 g Ta FIT % / MAE °C | other sizes Ta FIT % | other sizes Tb vs IR FIT % "
+        f"| variant | held-out {NOMINAL} Ta FIT % / MAE °C | other sizes Ta FIT % | other sizes Tb vs IR FIT % "
         "| 90 % band: inside, held out | inside, other sizes | of them, the fit's unit | median width °C |",
         "|---|---|---|---|---|---|---|---|",
     ]
@@ -335,7 +337,7 @@ def spread_against_refits(column_map, paths, lines):
     held = full.identification.held_out_Ta
     own_v = full.model.validate(fit_b)
     lines += [
-        "### The bands' roast-to-roast spread: linearised leave-one-log-out against refits (Bullet, 490-500 g fit logs)",
+        f"### The bands' roast-to-roast spread: linearised leave-one-log-out against refits (Bullet, {NOMINAL} fit logs)",
         "",
         "| log | RMS error in the fit °C | linearised, left out °C | refit without it °C |",
         "|---|---|---|---|",
@@ -402,7 +404,7 @@ def main() -> int:
     bullet = sorted(p for p in (DATA / "bullet").glob("*.json") if grams(p) is not None)
     nominal = [p for p in bullet if nominal_size(p)]
     model, column_map, val = machine(
-        "Aillio Bullet R1, 490-500 g batches", ROOT / "examples" / "bullet", nominal, lines
+        f"Aillio Bullet R1, {NOMINAL} batches", ROOT / "examples" / "bullet", nominal, lines
     )
     scaling(model, column_map, bullet, val, lines)
     variants_and_bands(column_map, bullet, lines)
