@@ -152,8 +152,38 @@ def test_leave_one_roaster_out_predicts_each_unit_from_the_others():
     one = [dataclasses.replace(b, unit="2779") for b in synthetic_sizes()]
     with pytest.raises(InputError, match="at least logs of two roasters"):
         compare_models(one, "120kg", None, [TRUTH], group_by="unit", starts=1)
-    with pytest.raises(InputError, match="group logs by one of size, unit"):
+    with pytest.raises(InputError, match="group logs by one of size, unit, log"):
         compare_models(batches, "120kg", None, [TRUTH], group_by="day", starts=1)
+
+
+def test_leave_one_log_out_scores_each_roast_and_its_band():
+    """group_by="log": each log predicted by the variant fitted on all the others; its FIT and the
+    share of its samples inside that model's band are those of fitting without it by hand."""
+    import roastlab
+    from roastlab.evaluate.bands import band_coverage
+    from roastlab.workflows.compare import log_groups
+
+    batches = synthetic_sizes()[:4]
+    result = compare_models(batches, "120kg", None, [TRUTH], group_by="log", starts=1)
+    assert list(result.groups) == [b.name for b in batches]
+    (score,) = result.scores
+    held = batches[1]
+    by_hand = roastlab.fit([b for b in batches if b is not held], "120kg", bed=TRUTH, starts=1).model
+    assert score.cv_by_group[held.name] == pytest.approx(by_hand.validate([held]).average["FIT"], abs=1e-6)
+    (row,) = band_coverage(by_hand, [held])
+    assert score.cv_band_by_group[held.name] == pytest.approx(row["inside"], abs=1e-9)
+    assert 0.0 <= score.cv_band_inside <= 1.0 and score.cv_band_width_C > 0.0
+    text = result.summary()
+    assert "LOLO FIT" in text and "LOLO band in" in text and "best by leave-one-log-out FIT" in text
+    doc = result.to_json_dict()
+    assert doc["group_by"] == "log" and doc["variants"][0]["lolo_band_inside"] == pytest.approx(score.cv_band_inside)
+    assert log_groups([batches[0], batches[0], batches[1]]) == [
+        batches[0].name,
+        f"{batches[0].name} #2",
+        batches[1].name,
+    ]
+    with pytest.raises(InputError, match="at least two logs"):
+        compare_models(batches[:1], "120kg", None, [TRUTH], group_by="log", starts=1)
 
 
 def test_the_lowest_aic_is_weighed_against_the_best_by_one_standard_error():

@@ -299,6 +299,7 @@ def add_parsers(sub) -> None:
     add_model_options(p, with_model=False)
     p.set_defaults(func=cmd_identify)
 
+    from ..evaluate.bands import BAND_LEVEL
     from ..evaluate.metrics import GROUP_STEP_SHARE
     from ..model.bed import VARIANTS
     from ..workflows.compare import GROUPINGS
@@ -306,12 +307,16 @@ def add_parsers(sub) -> None:
 
     p = sub.add_parser(
         "compare-models",
-        help="fit model variants (bed laws) on the same logs; AIC, BIC and leave-one-size-out (or -roaster-out) FIT",
+        help="fit model variants (bed laws) on the same logs; AIC, BIC, leave-one-size-out (or -roaster-, -log-out) FIT "
+        "and band calibration",
         description="Fit each model variant on all the logs (summed SSR, AIC, BIC, free parameters, parameters on "
         "a bound, fit-set FIT) and cross-validate it by batch size: the logs are grouped by green weight, and for "
         "each group the variant is fitted on the other groups and predicts that one with nothing refitted. The "
         "variant to prefer is the one with the highest leave-one-size-out FIT, not the best fit. With --group-by unit "
-        "the groups are the roasters that recorded the logs instead (leave-one-roaster-out). Each fit is a "
+        "the groups are the roasters that recorded the logs instead (leave-one-roaster-out), with --group-by log "
+        f"each log alone (leave-one-log-out). Each held-out group is also scored against the {BAND_LEVEL:.0%} prediction band of "
+        "the model fitted without it: the share of its samples inside is the band's cross-validated calibration. "
+        "Each fit is a "
         "full identification, so this takes (variants x (groups + 1)) fits: minutes on real logs. It writes no "
         "model file: fit the chosen variant with 'roastlab identify --bed LAWS ... --out MODEL.json'.",
         epilog="example: roastlab compare-models --plant examples/bullet/plant.toml --map examples/bullet/map.toml "
@@ -334,8 +339,9 @@ def add_parsers(sub) -> None:
         "--group-by",
         choices=GROUPINGS,
         default="size",
-        help="cross-validate by batch size (default; leave-one-size-out) or by the roaster that recorded each log "
-        "(unit: RoasTime's serial number; leave-one-roaster-out, each drum predicted from the make's other drums)",
+        help="cross-validate by batch size (default; leave-one-size-out), by the roaster that recorded each log "
+        "(unit: RoasTime's serial number; leave-one-roaster-out, each drum predicted from the make's other drums) "
+        "or by log (leave-one-log-out: each roast predicted from all the others, the test of a new roast's band)",
     )
     p.add_argument(
         "--group-step-kg",

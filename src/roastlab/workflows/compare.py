@@ -17,7 +17,16 @@ cross-validated FIT), not the one that fits best: more freedom always fits the f
 
 ``group_by="unit"`` groups the logs by the roaster that recorded them instead (``Batch.unit``,
 RoasTime's serial number): **leave-one-roaster-out**, each drum predicted by a model fitted on the
-other drums of the make, the cross-machine test of the same claim.
+other drums of the make, the cross-machine test of the same claim. ``group_by="log"`` makes each log
+its own group: **leave-one-log-out**, each roast predicted by a model fitted on all the others, the
+test of how well a new roast of the sizes and drums already seen is predicted.
+
+Every held-out group is also scored against the prediction band of the model fitted without it
+(:func:`roastlab.evaluate.bands.band_coverage`, level :data:`~roastlab.evaluate.bands.BAND_LEVEL`):
+the share of the held-out measured probe samples inside the band is its **cross-validated
+calibration**, about the level when the band is honest for the groups left out (a band measured
+on the other logs of one drum and size says nothing of another drum or size, so it is expected to
+hold fewer of those).
 """
 
 from __future__ import annotations
@@ -28,6 +37,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..errors import InputError, ParameterError
+from ..evaluate.bands import BAND_LEVEL, band_coverage, share_inside, why_no_band
 from ..evaluate.metrics import size_labels
 from ..model.bed import LAWS, VARIANTS, BedLaws
 from ..model.limits import check_value
@@ -53,7 +63,7 @@ def size_groups(batches, step_kg: float | None = None) -> tuple[list[str], float
 
 
 #: How compare-models may group the logs: by green weight or by the roaster that recorded them.
-GROUPINGS = ("size", "unit")
+GROUPINGS = ("size", "unit", "log")
 #: Each grouping's words: the cross-validation's name, what one group is (singular, plural, as the
 #: others the fit used), and what it needs at least.
 _GROUP_WORDS = {
@@ -71,6 +81,13 @@ _GROUP_WORDS = {
         "other": "roaster of the make",
         "need": "logs of two roasters",
     },
+    "log": {
+        "cv": "leave-one-log-out",
+        "kind": "log",
+        "kinds": "logs",
+        "other": "log",
+        "need": "two logs",
+    },
 }
 
 
@@ -86,6 +103,17 @@ def unit_groups(batches) -> list[str]:
                 b.source or b.name,
             )
         labels.append(f"unit {u}")
+    return labels
+
+
+def log_groups(batches) -> list[str]:
+    """A group label per batch, its own name (``#2``, ``#3``, ... added to repeated names): every
+    log a group of one, for leave-one-log-out."""
+    seen: dict[str, int] = {}
+    labels = []
+    for b in batches:
+        seen[b.name] = seen.get(b.name, 0) + 1
+        labels.append(b.name if seen[b.name] == 1 else f"{b.name} #{seen[b.name]}")
     return labels
 
 
@@ -188,6 +216,12 @@ class VariantScore:
     cv_by_group: dict[str, float]
     cv_by_batch: dict[str, float] = field(default_factory=dict)
     warnings: list[str] = field(default_factory=list)
+    #: cross-validated calibration: the share of held-out measured probe samples inside the band of
+    #: the model fitted without them (NaN where that model carries no band), overall and per group
+    cv_band_inside: float = math.nan
+    cv_band_by_group: dict[str, float] = field(default_factory=dict)
+    #: the median over the held-out logs of each log's median band width [degC]
+    cv_band_width_C: float = math.nan
 
 
 @dataclass
@@ -240,6 +274,7 @@ class ModelComparison(Result):
                     "on bound": len(s.on_bound),
                     "fit FIT %": s.fit_FIT,
                     f"{self.cv_short} FIT %": s.cv_FIT,
+                    f"{self.cv_short} band inside %": 100.0 * s.cv_band_inside,
                     **{f"{g} %": v for g, v in s.cv_by_group.items()},
                 }
             )
@@ -253,7 +288,8 @@ class ModelComparison(Result):
             f"{len(self.scores)} variant(s) on {sum(len(v) for v in self.groups.values())} log(s) in "
             f"{len(groups)} {words['kinds']}{step}; probe FIT %"
         )
-        cols = ["variant", "k", "SSR °C²", "AIC", "BIC", "on bound", "fit FIT", f"{self.cv_short} FIT", *groups]
+        cols = ["variant", "k", "SSR °C²", "AIC", "BIC", "on bound", "fit FIT", f"{self.cv_short} FIT",
+                f"{self.cv_short} band in", *groups]  # fmt: skip
         table = [cols]
         for s in self.scores:
             table.append(
@@ -266,10 +302,15 @@ class ModelComparison(Result):
                     str(len(s.on_bound)),
                     f"{s.fit_FIT:.1f}",
                     f"{s.cv_FIT:.1f}",
+                    _percent(s.cv_band_inside),
                     *(f"{s.cv_by_group[g]:.1f}" for g in groups),
                 ]
             )
         lines = [head, "", *aligned(table)]
+        lines.append(
+            f"{self.cv_short} band in: the share of the held-out logs' measured probe samples inside the "
+            f"{BAND_LEVEL:.0%} band of the model fitted without them (about {BAND_LEVEL:.0%} when the band is honest)"
+        )
         best = self.best
         by_aic = min(self.scores, key=lambda s: s.aic)
         lines += ["", f"best by {self.cv_name} FIT: {best.name} ({best.cv_FIT:.1f} %)"]
@@ -314,6 +355,10 @@ class ModelComparison(Result):
                     f"{key}_FIT": s.cv_FIT,
                     f"{key}_FIT_by_group": s.cv_by_group,
                     f"{key}_FIT_by_batch": s.cv_by_batch,
+                    f"{key}_band_inside": _finite_or_none(s.cv_band_inside),
+                    f"{key}_band_inside_by_group": {g: _finite_or_none(v) for g, v in s.cv_band_by_group.items()},
+                    f"{key}_band_median_width_C": _finite_or_none(s.cv_band_width_C),
+                    "band_level": BAND_LEVEL,
                     "warnings": s.warnings,
                 }
                 for s in self.scores
@@ -327,7 +372,10 @@ class ModelComparison(Result):
         for i, s in enumerate(self.scores):
             ax.bar(x + (i - (len(self.scores) - 1) / 2) * width, [s.cv_by_group[g] for g in groups], width,
                    label=f"{s.name} (mean {s.cv_FIT:.1f} %)")  # fmt: skip
-        ax.set_xticks(x, groups)
+        long = max(map(len, groups)) > 12  # log names: slanted, to stay readable
+        ax.set_xticks(
+            x, groups, rotation=35 if long else 0, ha="right" if long else "center", fontsize=7 if long else None
+        )
         words = _GROUP_WORDS[self.group_by]
         ax.set_xlabel(f"held-out {words['kind']} (fitted on every other {words['other']})")
         ax.set_ylabel("probe FIT [%]")
@@ -344,6 +392,16 @@ class ModelComparison(Result):
         kind = _GROUP_WORDS[self.group_by]["kind"]
         title = title or f"{self.cv_name.capitalize()}: each {kind} predicted by a model fitted on the others"
         return finish_figure(fig, path, title, outputs)
+
+
+def _percent(share: float) -> str:
+    """A share as ``"87 %"`` for the summary table, ``"-"`` when there is none (NaN)."""
+    return f"{100.0 * share:.0f} %" if math.isfinite(share) else "-"
+
+
+def _finite_or_none(x: float) -> float | None:
+    """``x``, or None (JSON null) where it is NaN."""
+    return float(x) if math.isfinite(x) else None
 
 
 def compare_models(
@@ -368,8 +426,9 @@ def compare_models(
     variants : {name: BedLaws, Variant or its text} or a list of them (:class:`Variant`: bed laws
         and parameter overrides such as ``h_probe_m=0.2``); default :data:`roastlab.model.bed.VARIANTS`
     step_kg : the group step (default :data:`roastlab.evaluate.metrics.GROUP_STEP_SHARE` of the median green weight)
-    group_by : ``"size"`` (by green weight) or ``"unit"`` (by the roaster that recorded each log,
-        :func:`unit_groups`: leave-one-roaster-out)
+    group_by : ``"size"`` (by green weight), ``"unit"`` (by the roaster that recorded each log,
+        :func:`unit_groups`: leave-one-roaster-out) or ``"log"`` (each log alone, :func:`log_groups`:
+        leave-one-log-out)
     progress : callable ``progress(done, total, text)``
     """
     from ..io.fitspec import FitSpec, load_fit_spec
@@ -390,9 +449,12 @@ def compare_models(
     if group_by == "size":
         labels, step = size_groups(batches, step_kg)
         order = sorted(set(labels), key=lambda g: float(g.split()[0].split("-")[0]))
-    else:
+    elif group_by == "unit":
         labels, step = unit_groups(batches), None
         order = sorted(set(labels))
+    else:
+        labels, step = log_groups(batches), None
+        order = list(labels)
     if len(order) < 2:
         words = _GROUP_WORDS[group_by]
         raise InputError(
@@ -411,7 +473,7 @@ def compare_models(
         ident = full.identification
         u = ident.uncertainty
         on_bound = [n for n, b in zip(u.names, u.on_bound) if b] if u is not None else []
-        by_group, by_batch = {}, {}
+        by_group, by_batch, band_by_group, band_rows = {}, {}, {}, []
         for g in order:
             if progress:
                 progress(done, total, f"{name}: without {g}")
@@ -421,6 +483,12 @@ def compare_models(
             v = model.validate(test)
             by_group[g] = float(v.average["FIT"])
             by_batch.update({n: float(r["FIT"]) for n, r in zip(v.names, v.rows)})
+            if why_no_band(model) is None:
+                rows = band_coverage(model, test)
+                band_rows += rows
+                band_by_group[g] = share_inside(rows)
+            else:
+                band_by_group[g] = math.nan
             done += 1
         scores.append(
             VariantScore(
@@ -438,6 +506,9 @@ def compare_models(
                 cv_by_group=by_group,
                 cv_by_batch=by_batch,
                 warnings=list(ident.warnings),
+                cv_band_inside=share_inside(band_rows) if band_rows else math.nan,
+                cv_band_by_group=band_by_group,
+                cv_band_width_C=float(np.median([r["median_width_C"] for r in band_rows])) if band_rows else math.nan,
             )
         )
     if progress:
@@ -453,6 +524,7 @@ __all__ = [
     "Variant",
     "VariantScore",
     "compare_models",
+    "log_groups",
     "size_groups",
     "unit_groups",
 ]
