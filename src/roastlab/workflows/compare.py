@@ -117,6 +117,9 @@ def log_groups(batches) -> list[str]:
     return labels
 
 
+#: The summary gives each held-out group a column up to this many groups, else a table of its own.
+MAX_GROUP_COLUMNS = 10
+
 #: The value of a variant's parameter override that frees it within its quantity-table bounds.
 FREE = "free"
 
@@ -288,8 +291,9 @@ class ModelComparison(Result):
             f"{len(self.scores)} variant(s) on {sum(len(v) for v in self.groups.values())} log(s) in "
             f"{len(groups)} {words['kinds']}{step}; probe FIT %"
         )
+        wide = len(groups) <= MAX_GROUP_COLUMNS  # few groups: one column each; many: a table of their own
         cols = ["variant", "k", "SSR °C²", "AIC", "BIC", "on bound", "fit FIT", f"{self.cv_short} FIT",
-                f"{self.cv_short} band in", *groups]  # fmt: skip
+                f"{self.cv_short} band in", *(groups if wide else ())]  # fmt: skip
         table = [cols]
         for s in self.scores:
             table.append(
@@ -303,10 +307,18 @@ class ModelComparison(Result):
                     f"{s.fit_FIT:.1f}",
                     f"{s.cv_FIT:.1f}",
                     _percent(s.cv_band_inside),
-                    *(f"{s.cv_by_group[g]:.1f}" for g in groups),
+                    *(f"{s.cv_by_group[g]:.1f}" for g in (groups if wide else ())),
                 ]
             )
         lines = [head, "", *aligned(table)]
+        if not wide:
+            one = len(self.scores) == 1
+            by_group = [[f"held-out {words['kind']}", *(h if one else f"{s.name}: {h}" for s in self.scores
+                                                        for h in ("FIT", "band in"))]]  # fmt: skip
+            for g in groups:
+                by_group.append([g, *(v for s in self.scores for v in (f"{s.cv_by_group[g]:.1f}",
+                                                                       _percent(s.cv_band_by_group.get(g, math.nan))))])  # fmt: skip
+            lines += ["", *aligned(by_group)]
         lines.append(
             f"{self.cv_short} band in: the share of the held-out logs' measured probe samples inside the "
             f"{BAND_LEVEL:.0%} band of the model fitted without them (about {BAND_LEVEL:.0%} when the band is honest)"
@@ -365,30 +377,54 @@ class ModelComparison(Result):
             ],
         }
 
-    def _draw(self, ax) -> None:
+    def _draw(self, ax, band_ax=None) -> None:
+        """Each held-out group's FIT per variant on ``ax``; on ``band_ax`` (if given) the share of its
+        samples inside the band, against the band's level."""
         groups = list(self.groups)
         x = np.arange(len(groups))
         width = 0.8 / max(len(self.scores), 1)
         for i, s in enumerate(self.scores):
-            ax.bar(x + (i - (len(self.scores) - 1) / 2) * width, [s.cv_by_group[g] for g in groups], width,
-                   label=f"{s.name} (mean {s.cv_FIT:.1f} %)")  # fmt: skip
-        long = max(map(len, groups)) > 12  # log names: slanted, to stay readable
-        ax.set_xticks(
-            x, groups, rotation=35 if long else 0, ha="right" if long else "center", fontsize=7 if long else None
-        )
+            at = x + (i - (len(self.scores) - 1) / 2) * width
+            bars = ax.bar(at, [s.cv_by_group[g] for g in groups], width, label=f"{s.name} ({s.cv_FIT:.1f} %)")
+            if band_ax is not None:
+                inside = [100.0 * s.cv_band_by_group.get(g, math.nan) for g in groups]
+                band_ax.bar(at, inside, width, color=bars.patches[0].get_facecolor())
         words = _GROUP_WORDS[self.group_by]
-        ax.set_xlabel(f"held-out {words['kind']} (fitted on every other {words['other']})")
         ax.set_ylabel("probe FIT [%]")
         ax.set_ylim(max(min(0.0, ax.get_ylim()[0]), -50.0), 100.0)
         ax.axhline(0.0, color="0.5", lw=0.6)
-        ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, frameon=False)
         ax.grid(axis="y", alpha=0.3)
+        bottom = ax
+        if band_ax is not None:
+            band_ax.axhline(100.0 * BAND_LEVEL, color="0.2", lw=1.0, ls="--")
+            band_ax.annotate(f"level {BAND_LEVEL:.0%}", (1.0, 100.0 * BAND_LEVEL), xycoords=("axes fraction", "data"),
+                             xytext=(3, 0), textcoords="offset points", va="center", fontsize=8)  # fmt: skip
+            band_ax.set_ylim(0.0, 100.0)
+            band_ax.set_ylabel(f"inside the {BAND_LEVEL:.0%} band [%]")
+            band_ax.grid(axis="y", alpha=0.3)
+            ax.tick_params(labelbottom=False)
+            bottom = band_ax
+        long = max(map(len, groups)) > 12  # log names: slanted, to stay readable
+        bottom.set_xticks(
+            x, groups, rotation=35 if long else 0, ha="right" if long else "center", fontsize=7 if long else None
+        )
+        bottom.set_xlabel(f"held-out {words['kind']} (fitted on every other {words['other']})")
+        handles, labels = ax.get_legend_handles_labels()
+        if band_ax is not None:  # the variant's share of all held-out samples inside its band
+            labels = [f"{lab[:-1]}; {_percent(s.cv_band_inside)} in the band)" for lab, s in zip(labels, self.scores)]
+        legend = {"fontsize": 8, "ncol": 2, "frameon": False, "title": "variant (mean FIT over held-out groups)",
+                  "title_fontsize": 8}  # fmt: skip
+        if ax.figure.get_layout_engine() is not None:  # below everything, however tall the slanted names
+            ax.figure.legend(handles, labels, loc="outside lower center", **legend)
+        else:
+            bottom.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, -0.16), **legend)
 
     def _figure(self, path, outputs, title=None):
         from ..report.figures import finish_figure, new_figure
 
-        fig = new_figure(figsize=(9, 5.2))
-        self._draw(fig.add_subplot(1, 1, 1))
+        fig = new_figure(figsize=(9, 7.5), layout="constrained")
+        ax, band_ax = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 2]})
+        self._draw(ax, band_ax)
         kind = _GROUP_WORDS[self.group_by]["kind"]
         title = title or f"{self.cv_name.capitalize()}: each {kind} predicted by a model fitted on the others"
         return finish_figure(fig, path, title, outputs)
