@@ -48,7 +48,9 @@ wheel-check:
 # The measured figures of docs/real-roaster.md, from the real logs in ../shared/data/real.
 # Then every bed-law variant and the probe depth scale's profile cross-validated by batch size on the
 # Bullet (12 variants x 9 fits), then by roaster (3 variants x 6 fits): 77 min on 2 cores on 2026-11-25
-# (part of it beside a test run, with the example's exotherm bounds wider than now).
+# (part of it beside a test run, with the example's exotherm bounds wider than now). Then the band's
+# calibration: the example leave-one-log-out on the 17 nominal logs (18 fits) and on 16 splits of
+# them into 9 fit and 8 held out (docs/band_splits.py): about 13 min more.
 BULLET = ../shared/data/real/bullet
 real-roaster: $(STAMP)
 	$(PY) docs/real_roaster.py
@@ -63,10 +65,17 @@ real-roaster: $(STAMP)
 	  --spec examples/bullet/fit.toml $$(ls $(BULLET)/*_*g.json) --group-by unit \
 	  --variant $(BED_EXAMPLE) --variant $(BED_EXAMPLE),$(PAPER_EXOTHERM) --variant paper,h_probe_m=free,$(PAPER_EXOTHERM) \
 	  --json docs/real-roaster-roasters.json --plot docs/real-roaster-roasters.png
+	$(VENV)/bin/roastlab compare-models --plant examples/bullet/plant.toml --map examples/bullet/map.toml \
+	  --spec examples/bullet/fit.toml $(BULLET_NOMINAL) --group-by log \
+	  --variant $(BED_EXAMPLE) --json docs/real-roaster-logs.json --plot docs/real-roaster-logs.png
+	$(PY) docs/band_splits.py
 # each bed law with the probe's depth scale fitted, then that scale's profile under the example's laws
 BED_VARIANTS = paper probe=tumbling contact=wall probe=tumbling,probe_gas=mean contact=wall,probe=tumbling,probe_gas=mean
 # the laws cross-validation chose, as the code holds them (roastlab.model.bed.CROSS_VALIDATED)
 BED_EXAMPLE = $(shell $(PY) -c "from roastlab.model.bed import CROSS_VALIDATED as b; print(b.name)")
+# the Bullet's logs of the fit's batch size (docs/real_roaster.py's NOMINAL_G)
+BULLET_NOMINAL = $(shell cd docs && ../$(PY) -c "from real_roaster import DATA, grams, nominal_size as n; \
+  print(' '.join(str(p) for p in sorted((DATA / 'bullet').glob('*.json')) if grams(p) and n(p)))")
 # the paper's exothermic rate law (Schwartzberg's A and Ha/R, the quantity table's defaults), held in the
 # rows that compare bed laws; the example fits it (examples/bullet/fit.toml)
 PAPER_EXOTHERM = $(shell $(PY) -c "from roastlab.model.quantities import QUANTITIES as q; print(f'A={q[\"A\"].default:g},Ha_R={q[\"Ha_R\"].default:g}')")
