@@ -62,7 +62,7 @@ def size_groups(batches, step_kg: float | None = None) -> tuple[list[str], float
         raise InputError(str(exc), "command line") from None
 
 
-#: How compare-models may group the logs: by green weight or by the roaster that recorded them.
+#: How compare-models may group the logs: by green weight, by the roaster that recorded them, or each log alone.
 GROUPINGS = ("size", "unit", "log")
 #: Each grouping's words: the cross-validation's name, what one group is (singular, plural, as the
 #: others the fit used), and what it needs at least.
@@ -385,7 +385,9 @@ class ModelComparison(Result):
         width = 0.8 / max(len(self.scores), 1)
         for i, s in enumerate(self.scores):
             at = x + (i - (len(self.scores) - 1) / 2) * width
-            bars = ax.bar(at, [s.cv_by_group[g] for g in groups], width, label=f"{s.name} ({s.cv_FIT:.1f} %)")
+            # the legend: the variant's mean FIT and (with the band panel) its share of all held-out samples in the band
+            in_band = f"; {_percent(s.cv_band_inside)} in the band" if band_ax is not None else ""
+            bars = ax.bar(at, [s.cv_by_group[g] for g in groups], width, label=f"{s.name} ({s.cv_FIT:.1f} %{in_band})")
             if band_ax is not None:
                 inside = [100.0 * s.cv_band_by_group.get(g, math.nan) for g in groups]
                 band_ax.bar(at, inside, width, color=bars.patches[0].get_facecolor())
@@ -410,8 +412,6 @@ class ModelComparison(Result):
         )
         bottom.set_xlabel(f"held-out {words['kind']} (fitted on every other {words['other']})")
         handles, labels = ax.get_legend_handles_labels()
-        if band_ax is not None:  # the variant's share of all held-out samples inside its band
-            labels = [f"{lab[:-1]}; {_percent(s.cv_band_inside)} in the band)" for lab, s in zip(labels, self.scores)]
         legend = {"fontsize": 8, "ncol": 2, "frameon": False, "title": "variant (mean FIT over held-out groups)",
                   "title_fontsize": 8}  # fmt: skip
         if ax.figure.get_layout_engine() is not None:  # below everything, however tall the slanted names
