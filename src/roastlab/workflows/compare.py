@@ -412,7 +412,8 @@ class ModelComparison(Result):
         )
         bottom.set_xlabel(f"held-out {words['kind']} (fitted on every other {words['other']})")
         handles, labels = ax.get_legend_handles_labels()
-        legend = {"fontsize": 8, "ncol": 2, "frameon": False, "title": "variant (mean FIT over held-out groups)",
+        legend = {"fontsize": 8, "ncol": 2, "frameon": False, "title": "variant (mean FIT over held-out groups"
+                  + ("; share of all held-out samples in the band)" if band_ax is not None else ")"),
                   "title_fontsize": 8}  # fmt: skip
         if ax.figure.get_layout_engine() is not None:  # below everything, however tall the slanted names
             ax.figure.legend(handles, labels, loc="outside lower center", **legend)
