@@ -39,7 +39,8 @@ def held_out_rms(model, batches) -> float:
     for b, r in zip(batches, model.simulate(model.apply(batches))):
         times.append(r.time_s)
         errors.append(np.asarray(b.Ta_C, float)[: r.time_s.size] - r.Ta_C)
-    return float(np.median(roast_spread(times, errors)["rms_C"]))
+    spread = roast_spread(times, errors)  # None for a single held-out log: no spread between roasts
+    return float(np.median(spread["rms_C"])) if spread else float("nan")
 
 
 def main() -> int:
