@@ -320,7 +320,9 @@ def add_parsers(sub) -> None:
         "full identification, so this takes (variants x (groups + 1)) fits: minutes on real logs. It writes no "
         "model file: fit the chosen variant with 'roastlab identify --bed LAWS ... --out MODEL.json'.",
         epilog="example: roastlab compare-models --plant examples/bullet/plant.toml --map examples/bullet/map.toml "
-        "--spec examples/bullet/fit.toml logs/*.json --json compare.json --plot compare.png",
+        "--spec examples/bullet/fit.toml logs/*.json --json compare.json --plot compare.png. With one --variant "
+        "(e.g. probe=tumbling,probe_gas=mean) and --group-by log it gives each log's FIT and band share from fits "
+        "on the others: the band's calibration on your own roasts.",
     )
     p.add_argument("batches", nargs="+", metavar="BATCH", help=FIT_HELP_COMPARE)
     p.add_argument("--plant", help="plant preset or PLANT.toml (default: the dataset's)")
@@ -351,7 +353,11 @@ def add_parsers(sub) -> None:
     p.add_argument("--seed", type=seed_arg, default=0, help="random seed of every fit (default 0)")
     add_starts_option(p, " per fit")
     p.add_argument("--json", metavar="COMPARE.json", help="write every variant's figures as JSON")
-    p.add_argument("--plot", metavar="FIG.png", help="bar chart of each held-out size's FIT per variant")
+    p.add_argument(
+        "--plot",
+        metavar="FIG.png",
+        help="bar charts of each held-out group's FIT per variant and of its share inside the band",
+    )
     p.set_defaults(func=cmd_compare_models, baseline=None)
 
     p = sub.add_parser(
