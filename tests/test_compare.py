@@ -184,6 +184,10 @@ def test_leave_one_log_out_scores_each_roast_and_its_band():
     ]
     with pytest.raises(InputError, match="at least two logs"):
         compare_models(batches[:1], "120kg", None, [TRUTH], group_by="log", starts=1)
+    assert score.cv_band_parameters_only == []
+    two = compare_models(batches[:2], "120kg", None, [TRUTH], group_by="log", starts=1)  # each fit on one log
+    assert two.scores[0].cv_band_parameters_only == [b.name for b in batches[:2]]
+    assert "the fit had one log, so its band is the parameters' alone" in two.summary()
 
 
 def test_the_lowest_aic_is_weighed_against_the_best_by_one_standard_error():

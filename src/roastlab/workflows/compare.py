@@ -225,6 +225,8 @@ class VariantScore:
     cv_band_by_group: dict[str, float] = field(default_factory=dict)
     #: the median over the held-out logs of each log's median band width [degC]
     cv_band_width_C: float = math.nan
+    #: held-out groups whose fit had one log: no roast-to-roast spread, a band of the parameters alone
+    cv_band_parameters_only: list[str] = field(default_factory=list)
 
 
 @dataclass
@@ -343,6 +345,11 @@ class ModelComparison(Result):
         for s in self.scores:
             if s.on_bound:
                 lines.append(f"{s.name}: on a bound: {', '.join(s.on_bound)}")
+            if s.cv_band_parameters_only:
+                lines.append(
+                    f"{s.name}: without {', '.join(s.cv_band_parameters_only)} the fit had one log, so its band is the "
+                    "parameters' alone (no spread between roasts) and holds few of the held-out samples"
+                )
         return "\n".join(lines)
 
     def to_json_dict(self) -> dict:
@@ -370,6 +377,7 @@ class ModelComparison(Result):
                     f"{key}_band_inside": _finite_or_none(s.cv_band_inside),
                     f"{key}_band_inside_by_group": {g: _finite_or_none(v) for g, v in s.cv_band_by_group.items()},
                     f"{key}_band_median_width_C": _finite_or_none(s.cv_band_width_C),
+                    f"{key}_band_parameters_only": s.cv_band_parameters_only,
                     "band_level": BAND_LEVEL,
                     "warnings": s.warnings,
                 }
@@ -510,7 +518,7 @@ def compare_models(
         ident = full.identification
         u = ident.uncertainty
         on_bound = [n for n, b in zip(u.names, u.on_bound) if b] if u is not None else []
-        by_group, by_batch, band_by_group, band_rows = {}, {}, {}, []
+        by_group, by_batch, band_by_group, band_rows, no_spread = {}, {}, {}, [], []
         for g in order:
             if progress:
                 progress(done, total, f"{name}: without {g}")
@@ -524,6 +532,8 @@ def compare_models(
                 rows = band_coverage(model, test)
                 band_rows += rows
                 band_by_group[g] = share_inside(rows)
+                if not (model.doc.get("fit") or {}).get("spread"):
+                    no_spread.append(g)
             else:
                 band_by_group[g] = math.nan
             done += 1
@@ -546,6 +556,7 @@ def compare_models(
                 cv_band_inside=share_inside(band_rows) if band_rows else math.nan,
                 cv_band_by_group=band_by_group,
                 cv_band_width_C=float(np.median([r["median_width_C"] for r in band_rows])) if band_rows else math.nan,
+                cv_band_parameters_only=no_spread,
             )
         )
     if progress:
