@@ -374,9 +374,9 @@ class ModelComparison(Result):
                     f"{key}_FIT": s.cv_FIT,
                     f"{key}_FIT_by_group": s.cv_by_group,
                     f"{key}_FIT_by_batch": s.cv_by_batch,
-                    f"{key}_band_inside": _finite_or_none(s.cv_band_inside),
-                    f"{key}_band_inside_by_group": {g: _finite_or_none(v) for g, v in s.cv_band_by_group.items()},
-                    f"{key}_band_median_width_C": _finite_or_none(s.cv_band_width_C),
+                    f"{key}_band_inside": s.cv_band_inside,  # NaN (no band) becomes null where written
+                    f"{key}_band_inside_by_group": s.cv_band_by_group,
+                    f"{key}_band_median_width_C": s.cv_band_width_C,
                     f"{key}_band_parameters_only": s.cv_band_parameters_only,
                     "band_level": BAND_LEVEL,
                     "warnings": s.warnings,
@@ -442,11 +442,6 @@ class ModelComparison(Result):
 def _percent(share: float) -> str:
     """A share as ``"87 %"`` for the summary table, ``"-"`` when there is none (NaN)."""
     return f"{100.0 * share:.0f} %" if math.isfinite(share) else "-"
-
-
-def _finite_or_none(x: float) -> float | None:
-    """``x``, or None (JSON null) where it is NaN."""
-    return float(x) if math.isfinite(x) else None
 
 
 def compare_models(
