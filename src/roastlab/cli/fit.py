@@ -314,7 +314,7 @@ def add_parsers(sub) -> None:
         "each group the variant is fitted on the other groups and predicts that one with nothing refitted. The "
         "variant to prefer is the one with the highest leave-one-size-out FIT, not the best fit. With --group-by unit "
         "the groups are the roasters that recorded the logs instead (leave-one-roaster-out), with --group-by log "
-        f"each log alone (leave-one-log-out). Each held-out group is also scored against the {BAND_LEVEL:.0%} prediction band of "
+        f"each log alone (leave-one-log-out). Each held-out group is also scored against the {100 * BAND_LEVEL:.0f} % prediction band of "
         "the model fitted without it: the share of its samples inside is the band's cross-validated calibration. "
         "Each fit is a "
         "full identification, so this takes (variants x (groups + 1)) fits: minutes on real logs. It writes no "

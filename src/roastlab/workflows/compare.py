@@ -323,7 +323,7 @@ class ModelComparison(Result):
             lines += ["", *aligned(by_group)]
         lines.append(
             f"{self.cv_short} band in: the share of the held-out logs' measured probe samples inside the "
-            f"{BAND_LEVEL:.0%} band of the model fitted without them (about {BAND_LEVEL:.0%} when the band is honest)"
+            f"{_percent(BAND_LEVEL)} band of the model fitted without them (about {_percent(BAND_LEVEL)} when the band is honest)"
         )
         best = self.best
         by_aic = min(self.scores, key=lambda s: s.aic)
@@ -407,10 +407,10 @@ class ModelComparison(Result):
         bottom = ax
         if band_ax is not None:
             band_ax.axhline(100.0 * BAND_LEVEL, color="0.2", lw=1.0, ls="--")
-            band_ax.annotate(f"level {BAND_LEVEL:.0%}", (1.0, 100.0 * BAND_LEVEL), xycoords=("axes fraction", "data"),
+            band_ax.annotate(f"level {_percent(BAND_LEVEL)}", (1.0, 100.0 * BAND_LEVEL), xycoords=("axes fraction", "data"),
                              xytext=(3, 0), textcoords="offset points", va="center", fontsize=8)  # fmt: skip
             band_ax.set_ylim(0.0, 100.0)
-            band_ax.set_ylabel(f"inside the {BAND_LEVEL:.0%} band [%]")
+            band_ax.set_ylabel(f"inside the {_percent(BAND_LEVEL)} band [%]")
             band_ax.grid(axis="y", alpha=0.3)
             ax.tick_params(labelbottom=False)
             bottom = band_ax
