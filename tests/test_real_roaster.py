@@ -1,7 +1,6 @@
 """Fitting a real roaster whose logs lack Tgi and Gg (examples/skywalker), and the baseline."""
 
 import json
-import math
 from pathlib import Path
 
 import numpy as np
@@ -293,13 +292,20 @@ def test_bullet_example_fits_a_later_steeper_exotherm_than_the_papers(bullet_mod
     """The example frees eq. 14's rate law (A, Ha/R; Het held), and three nominal logs already ask for
     a steeper one than Schwartzberg's: about the paper's rate near 150 degC, more near 200 degC, less
     near 100 degC (docs/real-roaster.md, 'The beans' exotherm, fitted'). init keeps the paper's law."""
+    from roastlab.model.layout import N_PARAMS, P
     from roastlab.model.quantities import QUANTITIES
+    from roastlab.model.rhs import reaction_heat_rate_kW_kg
 
     doc = json.loads(bullet_model.read_text())
     p = {k: doc["parameters"][k]["value"] for k in ("A", "Ha_R")}
     assert {doc["parameters"][k]["how"] for k in p} == {"fitted"}
     paper = {k: QUANTITIES[k].default for k in p}
-    rate = lambda q, T_C: q["A"] * math.exp(-q["Ha_R"] / (T_C + 273.15))  # noqa: E731
+
+    def rate(q, T_C):  # the model's own eq. 14, at the start of the reaction (He = 0)
+        vector = np.zeros(N_PARAMS)
+        vector[P["A"]], vector[P["Ha_R"]], vector[P["Het"]] = q["A"], q["Ha_R"], QUANTITIES["Het"].default
+        return reaction_heat_rate_kW_kg(T_C, 0.0, vector)
+
     assert p["Ha_R"] > 1.3 * paper["Ha_R"]
     assert 0.5 < rate(p, 150.0) / rate(paper, 150.0) < 2.0
     assert rate(p, 200.0) > 1.5 * rate(paper, 200.0) and rate(p, 100.0) < 0.6 * rate(paper, 100.0)
