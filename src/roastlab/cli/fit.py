@@ -190,9 +190,9 @@ def cmd_compare_models(args) -> int:
 def _band_table(model, batches, level) -> tuple[dict, list]:
     """Print and return how often each batch's measured probe lies inside the model's band, and
     the bands (drawn by --plot)."""
-    from ..evaluate.bands import band_report
+    from ..evaluate.bands import band_report, stored_spread
 
-    if not (model.doc.get("fit") or {}).get("spread"):
+    if not stored_spread(model):
         print("note: the model file has no roast-to-roast spread (fitted on one log, or by an older roastlab): "
               "the band is the parameters' alone")  # fmt: skip
     report, bands = band_report(model, batches, level)

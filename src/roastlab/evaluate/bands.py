@@ -84,6 +84,12 @@ def roast_spread(time_s, errors_C, held_out: bool = True, batch_kg=None, units=N
     return out
 
 
+def stored_spread(model) -> dict | None:
+    """The roast-to-roast spread ``model``'s file stores (``fit.spread``, :func:`roast_spread`), or None
+    (fitted on one log, or by an older roastlab)."""
+    return (model.doc.get("fit") or {}).get("spread") or None
+
+
 def _note(*parts) -> str | None:
     """One sentence from the (why, what the band does not hold) parts that apply:
     ``why and why: the band holds neither ... nor ..., so expect fewer measured samples inside it``."""
@@ -111,7 +117,7 @@ def _sizes_outside(model, batch_kg) -> tuple[str, str] | None:
     """:func:`sizes_outside`'s (why, what the band does not hold), or None."""
     from .metrics import GROUP_STEP_SHARE, size_key
 
-    spread = (model.doc.get("fit") or {}).get("spread") or {}
+    spread = stored_spread(model) or {}
     rng = spread.get("batch_kg")
     if not rng:
         return None
@@ -145,7 +151,7 @@ def units_outside(model, units) -> str | None:
 
 def _units_outside(model, units) -> tuple[str, str] | None:
     """:func:`units_outside`'s (why, what the band does not hold), or None."""
-    fitted = ((model.doc.get("fit") or {}).get("spread") or {}).get("units")
+    fitted = (stored_spread(model) or {}).get("units")
     odd = sorted({str(u) for u in units if u} - set(fitted or ()))
     if not fitted or not odd:
         return None
@@ -168,7 +174,7 @@ def why_no_band(model) -> str | None:
     """None when ``model`` can carry a band (its file has the fit's parameter correlation or a
     roast-to-roast spread); else the reason, in words for the roaster."""
     fit = model.doc.get("fit") or {}
-    if (fit.get("correlation") or {}).get("names") or fit.get("spread"):
+    if (fit.get("correlation") or {}).get("names") or stored_spread(model):
         return None
     return "this model file has no parameter covariance or roast-to-roast spread: no band"
 
@@ -277,7 +283,7 @@ def prediction_bands(model, batches, level: float = BAND_LEVEL, plant=None, **ch
         all_names = base_names + extra
         _, g = output_sensitivities(applied.packed, all_names, values, [(all_names.index(n), -1) for n in names])["Ta"]
         sigma_p = np.sqrt(np.clip(np.einsum("btk,kl,btl->bt", g, C, g), 0.0, None))  # (nb, nmax), NaN-padded
-    spread = (model.doc.get("fit") or {}).get("spread")
+    spread = stored_spread(model)
     z_roasts = _new_roast_quantile(level, spread["logs"]) if spread else 0.0
     out = []
     for i, r in enumerate(center):

@@ -37,7 +37,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..errors import InputError, ParameterError
-from ..evaluate.bands import BAND_LEVEL, band_coverage, share_inside, why_no_band
+from ..evaluate.bands import BAND_LEVEL, band_coverage, share_inside, stored_spread, why_no_band
 from ..evaluate.metrics import size_labels
 from ..model.bed import LAWS, VARIANTS, BedLaws
 from ..model.limits import check_value
@@ -527,7 +527,7 @@ def compare_models(
                 rows = band_coverage(model, test)
                 band_rows += rows
                 band_by_group[g] = share_inside(rows)
-                if not (model.doc.get("fit") or {}).get("spread"):
+                if not stored_spread(model):
                     no_spread.append(g)
             else:
                 band_by_group[g] = math.nan
