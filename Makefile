@@ -74,8 +74,7 @@ BED_VARIANTS = paper probe=tumbling contact=wall probe=tumbling,probe_gas=mean c
 # the laws cross-validation chose, as the code holds them (roastlab.model.bed.CROSS_VALIDATED)
 BED_EXAMPLE = $(shell $(PY) -c "from roastlab.model.bed import CROSS_VALIDATED as b; print(b.name)")
 # the Bullet's logs of the fit's batch size (docs/real_roaster.py's NOMINAL_G)
-BULLET_NOMINAL = $(shell cd docs && ../$(PY) -c "from real_roaster import DATA, grams, nominal_size as n; \
-  print(' '.join(str(p) for p in sorted((DATA / 'bullet').glob('*.json')) if grams(p) and n(p)))")
+BULLET_NOMINAL = $(shell cd docs && ../$(PY) -c "from real_roaster import nominal_logs; print(*nominal_logs())")
 # the paper's exothermic rate law (Schwartzberg's A and Ha/R, the quantity table's defaults), held in the
 # rows that compare bed laws; the example fits it (examples/bullet/fit.toml)
 PAPER_EXOTHERM = $(shell $(PY) -c "from roastlab.model.quantities import QUANTITIES as q; print(f'A={q[\"A\"].default:g},Ha_R={q[\"Ha_R\"].default:g}')")

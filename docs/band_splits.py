@@ -21,7 +21,7 @@ import time
 import numpy as np
 
 # run as a script from docs/, whose folder Python puts first on the path
-from real_roaster import DATA, DOCS, NOMINAL, ROOT, grams, nominal_size
+from real_roaster import DATA, DOCS, NOMINAL, ROOT, nominal_logs
 
 import roastlab
 from roastlab.evaluate.bands import BAND_LEVEL, band_coverage, roast_spread, share_inside
@@ -49,7 +49,7 @@ def main() -> int:
         return 2
     example = ROOT / "examples" / "bullet"
     column_map = load_map(example / "map.toml")
-    nominal = [p for p in sorted((DATA / "bullet").glob("*.json")) if grams(p) is not None and nominal_size(p)]
+    nominal = nominal_logs()
     logs = [roastlab.load_log(p, column_map) for p in nominal]
     n = len(logs)
     rng = np.random.default_rng(SEED)

@@ -48,6 +48,16 @@ def nominal_size(path: Path) -> bool:
     return g is not None and NOMINAL_G[0] <= g <= NOMINAL_G[1]
 
 
+def bullet_logs() -> list[Path]:
+    """The weighed Bullet logs (a green weight in the name), sorted by name."""
+    return sorted(p for p in (DATA / "bullet").glob("*.json") if grams(p) is not None)
+
+
+def nominal_logs() -> list[Path]:
+    """The Bullet logs of the fit's batch size (:data:`NOMINAL_G`), sorted by name."""
+    return [p for p in bullet_logs() if nominal_size(p)]
+
+
 def unit(path: Path) -> str:
     """The roaster unit that recorded a RoasTime log (its serial number; roastime.read_roastime)."""
     from roastlab.io.importers.roastime import read_roastime
@@ -202,6 +212,7 @@ def scaling(model, column_map, paths, nominal_val, lines):
             f"| {row2['FIT']:.1f} | {row2['MPE']:+.2f} |"
         )
     same = [r for r, u in zip(v.rows, units) if u in fit_units]
+
     def span(masses):  # "200-470 g" over the batch masses of a group
         return f"{min(masses)} g" if min(masses) == max(masses) else f"{min(masses)}-{max(masses)} g"
 
@@ -311,7 +322,9 @@ def variants_and_bands(column_map, paths, lines):
     variants = {f"{name}, h_probe_m {FREE}": Variant(laws, (("h_probe_m", FREE),)) for name, laws in VARIANTS.items()}
     variants[f"example: {spec.bed.name}, h_probe_m {spec.fixed['h_probe_m']:g} m"] = Variant(spec.bed)
     for name, variant in variants.items():
-        model = roastlab.fit(fit_b, example / "plant.toml", variant.spec(spec), column_map=column_map, bed=variant.laws).model
+        model = roastlab.fit(
+            fit_b, example / "plant.toml", variant.spec(spec), column_map=column_map, bed=variant.laws
+        ).model
         v_val, v_oth = model.validate(val_b), model.validate(oth_b)
         cov_val, cov_oth = band_coverage(model, val_b), band_coverage(model, oth_b)
 
@@ -321,7 +334,10 @@ def variants_and_bands(column_map, paths, lines):
             f"| {v_oth.output_average('Tb2')['FIT']:.1f} | {share_inside(cov_val):.0%} | {share_inside(cov_oth):.0%} "
             f"| {share_inside([c for c, o in zip(cov_oth, own) if o]):.0%} | {width:.1f} |"
         )
-        print(f"variant {name}: held-out {v_val.average['FIT']:.1f} %, others {v_oth.average['FIT']:.1f} %", file=sys.stderr)
+        print(
+            f"variant {name}: held-out {v_val.average['FIT']:.1f} %, others {v_oth.average['FIT']:.1f} %",
+            file=sys.stderr,
+        )
     lines.append("")
 
 
@@ -344,7 +360,9 @@ def spread_against_refits(column_map, paths, lines):
     ]
     times, refit_errors = [], []
     for i, b in enumerate(fit_b):
-        model = roastlab.fit(fit_b[:i] + fit_b[i + 1 :], example / "plant.toml", example / "fit.toml", column_map=column_map).model
+        model = roastlab.fit(
+            fit_b[:i] + fit_b[i + 1 :], example / "plant.toml", example / "fit.toml", column_map=column_map
+        ).model
         v = model.validate([b])
         e = np.asarray(v.predicted[0]) - np.asarray(v.measured[0])
         own = np.asarray(own_v.predicted[i]) - np.asarray(own_v.measured[i])
@@ -401,8 +419,7 @@ def main() -> int:
     sky = sorted((DATA / "skywalker").glob("*.alog"))
     machine("Skywalker (heater and fan settings, shell loss)", ROOT / "examples" / "skywalker", sky, lines)
     skywalker_et(sky, lines)
-    bullet = sorted(p for p in (DATA / "bullet").glob("*.json") if grams(p) is not None)
-    nominal = [p for p in bullet if nominal_size(p)]
+    bullet, nominal = bullet_logs(), nominal_logs()
     model, column_map, val = machine(
         f"Aillio Bullet R1, {NOMINAL} batches", ROOT / "examples" / "bullet", nominal, lines
     )
