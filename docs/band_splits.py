@@ -32,14 +32,11 @@ SEED = 7
 SPLITS = 16
 
 
-def held_out_rms(model, batches) -> float:
+def held_out_rms(validation) -> float:
     """The held-out logs' error in the stored spread's own terms: the median over time of their root
-    mean square probe error (:func:`roastlab.evaluate.bands.roast_spread`, the rule the fit stores) [degC]."""
-    times, errors = [], []
-    for b, r in zip(batches, model.simulate(model.apply(batches))):
-        times.append(r.time_s)
-        errors.append(np.asarray(b.Ta_C, float)[: r.time_s.size] - r.Ta_C)
-    spread = roast_spread(times, errors)  # None for a single held-out log: no spread between roasts
+    mean square probe error (:func:`roastlab.evaluate.bands.roast_spread`, the rule the fit stores),
+    from their validation [degC]."""
+    spread = roast_spread(validation.time_s, validation.errors)  # None for a single held-out log
     return float(np.median(spread["rms_C"])) if spread else float("nan")
 
 
@@ -62,7 +59,7 @@ def main() -> int:
         fit_b = [logs[i] for i in fit_i]
         held = [b for i, b in enumerate(logs) if i not in fit_i]
         model = roastlab.fit(fit_b, example / "plant.toml", example / "fit.toml", column_map=column_map).model
-        cov = band_coverage(model, held)
+        cov, v = band_coverage(model, held), model.validate(held)
         rows.append(
             {
                 "split": k,
@@ -70,9 +67,9 @@ def main() -> int:
                 "inside": share_inside(cov),
                 "per_log": [r["inside"] for r in cov],
                 "width_C": float(np.median([r["median_width_C"] for r in cov])),
-                "FIT": model.validate(held).average["FIT"],
+                "FIT": v.average["FIT"],
                 "spread_C": float(np.median(model.doc["fit"]["spread"]["rms_C"])),
-                "held_rms_C": held_out_rms(model, held),
+                "held_rms_C": held_out_rms(v),
             }
         )
         r = rows[-1]
