@@ -65,7 +65,7 @@ def test_skywalker_fit_and_validate(cli, real_data, tmp_path):
     doc = json.loads(theta.read_text())
     for key in ("hgm", "hbm", "Pbm", "Gg_kg_s", "Kt", "Qe_gain_kW", "Tgi_gain_C", "tau_heater_s"):
         assert doc["parameters"][key]["how"] == "fitted", key
-    assert doc["initial"]["Tm0_C"] == {"how": "from log", "field": ["ET", "BT"]} and doc["map"]["Gg"] == {
+    assert doc["initial"]["Tm0_C"] == {"how": "from log", "field": "BT"} and doc["map"]["Gg"] == {
         "identify": True
     }
     assert doc["map"]["heater"] == {"column": "Burner", "unit": "percent", "step": 5.0}
@@ -96,7 +96,7 @@ def test_skywalker_fit_on_bt_alone_fails_on_its_states(cli, real_data, tmp_path)
     """Without ET the fit on these two logs heats the beans through the air with the drum metal below them: it is
     marked failed (exit 1, the model file says why, commands using it warn); the example's ET
     weight makes the same logs' fit physical (test above)."""
-    fit_logs = sorted(real_data.glob("*.alog"))[5:9:2]  # ET read as the drum's air on these (the map)
+    fit_logs = sorted(real_data.glob("*.alog"))[3:6:2]  # ET read as the drum's air on these (the map)
     theta = tmp_path / "bt-only.json"
     common = ["--plant", EXAMPLE / "plant.toml", "--map", EXAMPLE / "map.toml"]
     args = ("identify", *common, "--spec", EXAMPLE / "fit.toml", *fit_logs, "--out", theta, "--starts", "2")
@@ -188,24 +188,37 @@ def test_init_offers_the_room_temperature_the_logs_record_and_reads_its_unit(bul
     assert import_log(logs[2], load_map(on)).Tgi_C[0] == 22.0  # records none: the constant
 
 
-def test_init_and_the_bullet_example_use_the_cross_validated_bed(bullet_data, tmp_path):
-    """One fact: the laws leave-one-size-out chose (roastlab.model.bed.CROSS_VALIDATED) and the probe's
-    depth scale at the drum's diameter are the example's and what init writes for a roaster with a
-    second bean reading (there with its own estimated diameter)."""
+def test_init_and_both_examples_use_the_cross_validated_bed(real_data, bullet_data, tmp_path):
+    """One fact: the laws cross-validation chose (roastlab.model.bed.CROSS_VALIDATED) and the probe's
+    depth scale at the drum's diameter are both examples' and what init writes for either roaster
+    (there with its own estimated diameter); so is the drum at charge, each format's own
+    (the Bullet's preheat, the Skywalker's BT at CHARGE)."""
     from roastlab.io.fitspec import load_fit_spec
+    from roastlab.io.importers import artisan, roastime
+    from roastlab.io.importers.mapping import load_map
     from roastlab.io.plants import load_plant
     from roastlab.model.bed import CROSS_VALIDATED, PROBE_DEPTH_OVER_DIAMETER
     from roastlab.workflows.roaster import init_roaster
 
+    for folder, log, at_charge in (
+        (BULLET, bullet_data / "bullet_2020-07-31_0152_490g.json", roastime.DRUM_AT_CHARGE),
+        (EXAMPLE, sorted(real_data.glob("*.alog"))[5], artisan.DRUM_AT_CHARGE),
+    ):
+        example = load_fit_spec(folder / "fit.toml")
+        assert example.bed == CROSS_VALIDATED, folder
+        assert example.fixed["h_probe_m"] == pytest.approx(
+            PROBE_DEPTH_OVER_DIAMETER * load_plant(folder / "plant.toml").Dch_m
+        )
+        assert load_map(folder / "map.toml").initial["Tm0_C"] == at_charge
+        out = tmp_path / folder.name
+        summary = init_roaster([log], out)
+        spec = load_fit_spec(out / "fit.toml")
+        assert spec.bed == CROSS_VALIDATED and "h_probe_m" not in {f.name for f in spec.free}
+        assert spec.fixed["h_probe_m"] == pytest.approx(
+            PROBE_DEPTH_OVER_DIAMETER * summary["plant"]["Dch_m"], rel=1e-3
+        )
+        assert load_map(out / "map.toml").initial["Tm0_C"] == at_charge
     example = load_fit_spec(BULLET / "fit.toml")
-    assert example.bed == CROSS_VALIDATED
-    assert example.fixed["h_probe_m"] == pytest.approx(
-        PROBE_DEPTH_OVER_DIAMETER * load_plant(BULLET / "plant.toml").Dch_m
-    )
-    summary = init_roaster([bullet_data / "bullet_2020-07-31_0152_490g.json"], tmp_path / "cfg")
-    spec = load_fit_spec(tmp_path / "cfg" / "fit.toml")
-    assert spec.bed == CROSS_VALIDATED and "h_probe_m" not in {f.name for f in spec.free}
-    assert spec.fixed["h_probe_m"] == pytest.approx(PROBE_DEPTH_OVER_DIAMETER * summary["plant"]["Dch_m"], rel=1e-3)
     # the exotherm's rate law: the Bullet example fits it, init (a machine we have not seen) keeps the paper's
     exotherm = {"A", "Ha_R"}
     assert exotherm <= {f.name for f in example.free} and not exotherm & {f.name for f in spec.free}

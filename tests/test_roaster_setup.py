@@ -33,7 +33,8 @@ def test_init_detects_an_artisan_layout_and_writes_commented_files(cli, tmp_path
     text = {n: (tmp_path / "cfg" / f"{n}.toml").read_text() for n in ("map", "plant", "fit")}
     assert 'column = "Burner"' in text["map"] and 'column = "Air"' in text["map"] and 'unit = "percent"' in text["map"]
     assert "catalogue: Hottop" in text["plant"] and "Mm_kg = 0.75" in text["plant"]  # 3 kg per kg of 0.25 kg
-    assert "Qe_gain_kW" in text["fit"] and "Tgi_gain_C" in text["fit"] and "h_probe_m" not in text["fit"]
+    assert "Qe_gain_kW" in text["fit"] and "Tgi_gain_C" in text["fit"] and "\n[fixed]\nh_probe_m = " in text["fit"]
+    assert 'Tm0_C = "BT"' in text["map"]  # the drum at CHARGE: the probe soaked in the empty drum
     assert "Hottop" in out and [p.read_bytes() for p in logs] == before  # logs never modified
 
 
@@ -101,6 +102,22 @@ def test_init_and_fit_roaster_reach_the_hand_written_examples_on_the_shared_logs
     assert (tmp_path / "cfg" / "heldout.png").stat().st_size > 20_000
 
 
+def _truth_of_init(cfg: Path, **values):
+    """The model ``roastlab init``'s files describe (its plant, map, bed laws and held probe depth),
+    with chosen heater and flow values: the truth the SYNTHETIC logs below are drawn from, so that
+    the fit they test can reach it. The drum at CHARGE comes from the log, as the map reads it."""
+    import roastlab
+    from roastlab.io.fitspec import load_fit_spec
+    from roastlab.io.importers import load_map
+    from roastlab.workflows.model import FittedModel
+
+    spec = load_fit_spec(cfg / "fit.toml")
+    truth = FittedModel.paper(roastlab.load_plant(cfg / "plant.toml")).with_values(**spec.fixed, **values)
+    truth.bed = spec.bed
+    truth.doc["map"] = load_map(cfg / "map.toml").to_mapping()
+    return FittedModel(truth.doc)
+
+
 def _synthetic_hottop_logs(folder: Path, n_logs: int = 6, seed: int = 7) -> list[Path]:
     """SYNTHETIC Artisan logs of a machine no example describes: a Fahrenheit Hottop whose heater
     and fan are extra-device curves (%), 0.25 kg batches. The layout comes from
@@ -110,7 +127,6 @@ def _synthetic_hottop_logs(folder: Path, n_logs: int = 6, seed: int = 7) -> list
 
     import roastlab
     from roastlab.io.importers import load_map
-    from roastlab.workflows.model import FittedModel
 
     rng = np.random.default_rng(seed)
     n, dt = 145, 5.0  # 12 minutes, a sample every 5 s
@@ -127,9 +143,9 @@ def _synthetic_hottop_logs(folder: Path, n_logs: int = 6, seed: int = 7) -> list
              "timeindex": [0, 0, 0, 0, 0, 0, n - 1, 0]}  # fmt: skip
     f = lambda c: [float(v) * 9.0 / 5.0 + 32.0 for v in c]  # noqa: E731 - degC -> degF
     paths = []
-    for k, (heater, fan) in enumerate(layouts):  # first the layout alone, BT a placeholder
+    for k, (heater, fan) in enumerate(layouts):  # first the layout alone, BT at CHARGE the drum's
         p = folder / f"hottop_2026-0{1 + k // 3}-1{k % 3}.alog"
-        p.write_text(fake_alog("F", f([200.0] * n), f([220.0] * n), n, {**extra, "timex": t,
+        p.write_text(fake_alog("F", f([210.0] * n), f([220.0] * n), n, {**extra, "timex": t,
                      "extratemp1": [heater.tolist()], "extratemp2": [fan.tolist()]}))  # fmt: skip
         paths.append(p)
     cfg = folder / "truth"
@@ -137,18 +153,12 @@ def _synthetic_hottop_logs(folder: Path, n_logs: int = 6, seed: int = 7) -> list
 
     assert main(["init", *map(str, paths), "--out", str(cfg)]) == 0
     cmap = load_map(cfg / "map.toml")
-    truth = FittedModel.paper(roastlab.load_plant(cfg / "plant.toml")).with_values(
-        Qe_gain_kW=0.003, Tgi_gain_C=1.5, tau_heater_s=40.0, Gg_kg_s=0.004, Kt=0.03, Tm0_C=210.0
-    )
-    truth.doc["map"] = cmap.to_mapping()
-    truth = FittedModel(truth.doc)
+    truth = _truth_of_init(cfg, Qe_gain_kW=0.003, Tgi_gain_C=1.5, tau_heater_s=40.0, Gg_kg_s=0.004, Kt=0.03)
     for p, (heater, fan) in zip(paths, layouts):
         sim = truth.predict(roastlab.load_log(p, cmap))
         bt = sim.Ta_C + rng.normal(0.0, 0.3, n)
-        # ET: the drum's air (the outlet gas, as a fit weighs it); at CHARGE the empty preheated drum's
-        # air, which the map reads as the drum temperature
-        et = sim.Tgo_C + rng.normal(0.0, 0.3, n)
-        et[0] = sim.Tm_C[0]
+        bt[0] = sim.Ta_C[0]  # at CHARGE the probe soaked in the empty drum: the drum's temperature, as the map reads it
+        et = sim.Tgo_C + rng.normal(0.0, 0.3, n)  # ET: the drum's air (the outlet gas, as a fit weighs it)
         p.write_text(fake_alog("F", f(bt), f(et), n, {**extra, "timex": t,
                      "extratemp1": [heater.tolist()], "extratemp2": [fan.tolist()]}))  # fmt: skip
     shutil.rmtree(cfg)
@@ -182,7 +192,6 @@ def _synthetic_gas_drum_logs(folder: Path, n_logs: int = 6, seed: int = 11) -> l
 
     import roastlab
     from roastlab.io.importers import load_map
-    from roastlab.workflows.model import FittedModel
 
     rng = np.random.default_rng(seed)
     n, dt = 241, 3.0  # 12 minutes
@@ -201,23 +210,19 @@ def _synthetic_gas_drum_logs(folder: Path, n_logs: int = 6, seed: int = 11) -> l
     paths = []
     for k, events in enumerate(layouts):
         p = folder / f"gasdrum_2026-0{1 + k // 3}-2{k % 3}.alog"
-        p.write_text(fake_alog("C", [200.0] * n, [230.0] * n, n, {**extra, **events, "timex": t}))
+        p.write_text(fake_alog("C", [230.0] * n, [200.0] * n, n, {**extra, **events, "timex": t}))
         paths.append(p)
     cfg = folder / "truth"
     from roastlab.cli.main import main
 
     assert main(["init", *map(str, paths), "--out", str(cfg), "--batch-capacity-kg", "5"]) == 0
     cmap = load_map(cfg / "map.toml")
-    truth = FittedModel.paper(roastlab.load_plant(cfg / "plant.toml")).with_values(
-        Qe_gain_kW=0.05, Tgi_gain_C=3.0, tau_heater_s=25.0, Gg_kg_s=0.06, Kt=0.04, Tm0_C=230.0
-    )
-    truth.doc["map"] = cmap.to_mapping()
-    truth = FittedModel(truth.doc)
+    truth = _truth_of_init(cfg, Qe_gain_kW=0.05, Tgi_gain_C=3.0, tau_heater_s=25.0, Gg_kg_s=0.06, Kt=0.04)
     for p, events in zip(paths, layouts):
         sim = truth.predict(roastlab.load_log(p, cmap))  # on the map's resampled grid
         bt = np.interp(t, sim.time_s, sim.Ta_C) + rng.normal(0.0, 0.3, n)
-        et = np.interp(t, sim.time_s, sim.Tgo_C) + rng.normal(0.0, 0.3, n)  # ET: the drum's air (outlet gas),
-        et[0] = sim.Tm_C[0]  # at CHARGE the empty preheated drum's, read as the drum temperature
+        bt[0] = sim.Ta_C[0]  # at CHARGE the probe soaked in the empty drum: the drum's temperature, as the map reads it
+        et = np.interp(t, sim.time_s, sim.Tgo_C) + rng.normal(0.0, 0.3, n)  # ET: the drum's air (outlet gas)
         p.write_text(fake_alog("C", bt.tolist(), et.tolist(), n, {**extra, **events, "timex": t}))
     shutil.rmtree(cfg)
     return paths

@@ -39,6 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
+from ..io.importers.artisan import DRUM_AT_CHARGE as ARTISAN_DRUM_AT_CHARGE
 from ..io.importers.artisan import WEIGHT_UNITS, RoomReading, read_alog, read_artisan_csv
 from ..io.importers.mapping import bare_room_unit, detect_format
 from ..io.importers.roastime import DRUM_AT_CHARGE, read_roastime
@@ -420,17 +421,19 @@ def map_text(s: Survey) -> str:
     initial = []
     if s.format == "roastime":
         initial.append(f'Tm0_C = "{DRUM_AT_CHARGE}"   # the drum at charge: the preheat it was held at')
-    elif s.has_et and s.et_not_air:
-        lines += [
-            "[ET]",
-            'column = "ET"',
-            f"above_BT = true        # ET reads below BT through the roast on {len(s.et_not_air)} log(s), unlike the "
-            "others: not the drum's air there, dropped on such logs",
-            "",
-        ]
-        initial.append('Tm0_C = ["ET", "BT"]  # the drum at CHARGE: ET then, else BT (the probe in the empty drum)')
-    elif s.has_et:
-        initial.append('Tm0_C = "ET"          # ET at CHARGE as the drum temperature')
+    else:
+        if s.has_et and s.et_not_air:
+            lines += [
+                "[ET]",
+                'column = "ET"',
+                f"above_BT = true        # ET reads below BT through the roast on {len(s.et_not_air)} log(s), unlike "
+                "the others: not the drum's air there, dropped on such logs",
+                "",
+            ]
+        initial.append(
+            f'Tm0_C = "{ARTISAN_DRUM_AT_CHARGE}"          # the drum at CHARGE: the probe soaked in the empty preheated '
+            "drum, steadier than ET then"
+        )
     if initial:
         lines += ["[initial]", *initial, ""]
     return "\n".join(lines)
@@ -480,18 +483,17 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
         rows.append(line("Gg_fan_kg_s", 0.0, 0.01, 0.001, "air flow per fan step [kg/s]"))
     rows += ["", "[initial]", "Tb0_C = 22.0                          # green beans at room temperature",
              "X0 = 0.11                             # typical green-coffee moisture [kg/kg dry]"]  # fmt: skip
-    if s.second_bean:  # the probe's immersion in the bed: the laws and depth scale cross-validation chose
-        rows += [
-            "",
-            "# The probe's immersion in the bed (a second bean reading shows it): the laws chosen by",
-            "# leave-one-size-out cross-validation (roastlab.model.bed.CROSS_VALIDATED, docs/real-roaster.md)",
-            "[bed]",
-            *(f'{k} = "{v}"' for k, v in CROSS_VALIDATED.as_dict().items()),
-            "",
-            "[fixed]",
-            f"h_probe_m = {PROBE_DEPTH_OVER_DIAMETER * diameter_m:.4g}".ljust(38)
-            + "# bed depth that covers the probe [m]: the drum's diameter; only other batch sizes determine it",
-        ]
+    rows += [  # the probe's immersion in the bed: the laws and depth scale cross-validation chose
+        "",
+        "# The probe in a tumbling bed, its uncovered part in the bed's air: the laws chosen by",
+        "# cross-validation on both real roasters (roastlab.model.bed.CROSS_VALIDATED, docs/real-roaster.md)",
+        "[bed]",
+        *(f'{k} = "{v}"' for k, v in CROSS_VALIDATED.as_dict().items()),
+        "",
+        "[fixed]",
+        f"h_probe_m = {PROBE_DEPTH_OVER_DIAMETER * diameter_m:.4g}".ljust(38)
+        + "# bed depth that covers the probe [m]: the drum's diameter; only other batch sizes determine it",
+    ]
     weights = []
     if s.second_bean:
         weights.append("Tb2 = 1.0                             # the second bean reading vs the model's Tb")
