@@ -50,8 +50,10 @@ wheel-check:
 # Bullet (12 variants x 9 fits), then by roaster (3 variants x 6 fits): 77 min on 2 cores on 2026-11-25
 # (part of it beside a test run, with the example's exotherm bounds wider than now). Then the band's
 # calibration: the example leave-one-log-out on the 17 nominal logs (18 fits) and on 16 splits of
-# them into 9 fit and 8 held out (docs/band_splits.py): about 13 min more.
+# them into 9 fit and 8 held out (docs/band_splits.py): about 13 min more. Last, the Skywalker's
+# 16 logs one by one, the example's bed laws against the paper's probe (2 x 17 fits): about 3 min.
 BULLET = ../shared/data/real/bullet
+SKYWALKER = ../shared/data/real/skywalker
 real-roaster: $(STAMP)
 	$(PY) docs/real_roaster.py
 	$(VENV)/bin/roastlab compare-models --plant examples/bullet/plant.toml --map examples/bullet/map.toml \
@@ -69,6 +71,10 @@ real-roaster: $(STAMP)
 	  --spec examples/bullet/fit.toml $(BULLET_NOMINAL) --group-by log \
 	  --variant $(BED_EXAMPLE) --json docs/real-roaster-logs.json --plot docs/real-roaster-logs.png
 	$(PY) docs/band_splits.py
+	$(VENV)/bin/roastlab compare-models --plant examples/skywalker/plant.toml --map examples/skywalker/map.toml \
+	  --spec examples/skywalker/fit.toml $(SKYWALKER)/*.alog --group-by log \
+	  --variant $(BED_EXAMPLE) --variant paper,h_probe_m=0 \
+	  --json docs/real-roaster-skywalker.json --plot docs/real-roaster-skywalker.png
 # each bed law with the probe's depth scale fitted, then that scale's profile under the example's laws
 BED_VARIANTS = paper probe=tumbling contact=wall probe=tumbling,probe_gas=mean contact=wall,probe=tumbling,probe_gas=mean
 # the laws cross-validation chose, as the code holds them (roastlab.model.bed.CROSS_VALIDATED)

@@ -406,7 +406,48 @@ def skywalker_et(paths, lines):
         "",
         f"ET reads below BT through the roast on {below} of {len(medians)} logs and above it on the others: "
         "the channel does not measure the same thing on every log. The example's map (`[ET] above_BT = true`) "
-        "drops ET on the logs where it reads below BT, and takes their drum at charge from BT.",
+        "drops ET on the logs where it reads below BT.",
+        "",
+    ]
+    drum_at_charge(paths, lines)
+
+
+STEADY_C = 2.5  # a reading that moves less than this over the minute before CHARGE is steady [degC]
+
+
+def drum_at_charge(paths, lines, before_s: float = 60.0):
+    """How far BT and ET move over the last ``before_s`` before CHARGE on each Skywalker log (the
+    preheated empty drum): which reading at CHARGE can stand for the drum's temperature then
+    (roastlab.io.importers.artisan.DRUM_AT_CHARGE)."""
+    from roastlab.io.importers.artisan import DRUM_AT_CHARGE, read_alog
+
+    lines += [
+        f"### Skywalker: the drum at CHARGE (the map reads {DRUM_AT_CHARGE} then)",
+        "",
+        f"| log | BT at CHARGE [°C] | its range over the {before_s:g} s before [°C] | ET at CHARGE [°C] "
+        f"| its range over the {before_s:g} s before [°C] |",
+        "|---|---|---|---|---|",
+    ]
+    spans = {"BT": [], "ET": []}
+    for path in paths:
+        log = read_alog(path, align_charge=False)
+        t, c = log.time_s, log.charge_index
+        before = (t >= t[c] - before_s) & (t <= t[c])
+        row = [path.stem]
+        for name in ("BT", "ET"):
+            v = log.channels[name][before]
+            v = v[np.isfinite(v) & (v < 300.0)]  # a probe fault reads 300+ degC in an empty drum (R55's BT)
+            spans[name].append(float(np.ptp(v)) if len(v) else np.nan)
+            row += [f"{log.channels[name][c]:.1f}", f"{spans[name][-1]:.1f}"]
+        lines.append("| " + " | ".join(row) + " |")
+    bt, et = np.array(spans["BT"]), np.array(spans["ET"])
+    lines += [
+        "",
+        f"Over the {before_s:g} s before CHARGE, BT moves by a median {np.nanmedian(bt):.1f} °C (more than "
+        f"{STEADY_C:g} °C on {int(np.sum(bt > STEADY_C))} of {len(bt)} logs) and ET by a median "
+        f"{np.nanmedian(et):.1f} °C, up to {np.nanmax(et):.1f} °C: BT, the probe soaked in the empty preheated "
+        "drum, is steady when the beans go in, while ET's reading at CHARGE depends on the second the button "
+        "was pressed.",
         "",
     ]
 

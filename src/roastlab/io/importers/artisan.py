@@ -33,10 +33,10 @@ from ..files import read_input_text
 
 #: The channel whose reading at CHARGE is the drum's temperature then, for an Artisan log (a map's
 #: ``[initial] Tm0_C``; what ``roastlab init`` writes): BT, the probe that has soaked in the preheated
-#: empty drum, and the charge temperature roasters quote. Before the charge it is steady (within 2 °C
-#: over the last minute on 15 of the Skywalker's 16 logs), while ET swings by up to 24 °C in that
-#: minute as the drum is opened and charged, so ET's reading stamped at CHARGE depends on the second
-#: the button was pressed. Leave-one-log-out on the Skywalker's 16 logs: FIT 79.3 % with BT, 76.5 %
+#: empty drum, and the charge temperature roasters quote. Over the minute before the charge it moves
+#: by a median 1.1 °C on the Skywalker's 16 logs (more than 2.5 °C on one), while ET moves by a median
+#: 11 °C and up to 24 °C as the drum is opened and charged, so ET's reading stamped at CHARGE depends
+#: on the second the button was pressed. Leave-one-log-out on the Skywalker's 16 logs: FIT 79.3 % with BT, 76.5 %
 #: with ET (the paper's probe; 83.8 % and 77.3 % with the bed laws of
 #: :data:`roastlab.model.bed.CROSS_VALIDATED`; docs/real-roaster.md).
 DRUM_AT_CHARGE = "BT"
