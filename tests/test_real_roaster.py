@@ -65,9 +65,7 @@ def test_skywalker_fit_and_validate(cli, real_data, tmp_path):
     doc = json.loads(theta.read_text())
     for key in ("hgm", "hbm", "Pbm", "Gg_kg_s", "Kt", "Qe_gain_kW", "Tgi_gain_C", "tau_heater_s"):
         assert doc["parameters"][key]["how"] == "fitted", key
-    assert doc["initial"]["Tm0_C"] == {"how": "from log", "field": "BT"} and doc["map"]["Gg"] == {
-        "identify": True
-    }
+    assert doc["initial"]["Tm0_C"] == {"how": "from log", "field": "BT"} and doc["map"]["Gg"] == {"identify": True}
     assert doc["map"]["heater"] == {"column": "Burner", "unit": "percent", "step": 5.0}
     metrics = tmp_path / "m.json"
     code, out, err = cli("validate", *common, "--model", theta, *val_logs, "--json", metrics)
@@ -214,9 +212,7 @@ def test_init_and_both_examples_use_the_cross_validated_bed(real_data, bullet_da
         summary = init_roaster([log], out)
         spec = load_fit_spec(out / "fit.toml")
         assert spec.bed == CROSS_VALIDATED and "h_probe_m" not in {f.name for f in spec.free}
-        assert spec.fixed["h_probe_m"] == pytest.approx(
-            PROBE_DEPTH_OVER_DIAMETER * summary["plant"]["Dch_m"], rel=1e-3
-        )
+        assert spec.fixed["h_probe_m"] == pytest.approx(PROBE_DEPTH_OVER_DIAMETER * summary["plant"]["Dch_m"], rel=1e-3)
         assert load_map(out / "map.toml").initial["Tm0_C"] == at_charge
     example = load_fit_spec(BULLET / "fit.toml")
     # the exotherm's rate law: the Bullet example fits it, init (a machine we have not seen) keeps the paper's
