@@ -9,7 +9,8 @@ What :func:`survey` detects in the logs (and says in the files' comments):
   event type or an extra device), with their unit by value range (whole steps up to 20: a
   level; else percent);
 * a second bean reading (RoasTime's infrared ``drumTemperature``);
-* ET, and so the drum temperature at CHARGE;
+* ET (the drum temperature at CHARGE is BT's reading then,
+  :data:`roastlab.io.importers.artisan.DRUM_AT_CHARGE`; RoasTime's preheat for RoasTime logs);
 * each log's green batch (Artisan ``weight``, RoasTime ``weightGreen``, a file name's "230g").
 
 The plant (:func:`estimate_plant`) comes from the drum's dimensions when given, else from the
@@ -20,9 +21,9 @@ per kg of capacity. The fit spec (:func:`fit_spec_text`) frees what these logs c
 the paper's three coefficients and the probe constant always; the gas flow when none is
 logged; the heater's gains and lag when a heater is logged (into the drum metal, and into the
 air unless the machine heats the drum itself); the fan's share of the flow when a fan is
-logged; a shell loss when the inlet is room air; the probe's immersion (under the bed laws
-cross-validation chose, its depth scale held at the drum's diameter) and the second reading's
-weight when the log has a second bean reading; ET's weight (against the outlet gas) when ET is
+logged; a shell loss when the inlet is room air; the probe's immersion under the bed laws
+cross-validation chose, its depth scale held at the drum's diameter (for every roaster); the
+second reading's weight when the log has a second bean reading; ET's weight (against the outlet gas) when ET is
 logged beside a heater, because a fit on BT alone can heat the beans by a path the machine does
 not have, and such a fit fails (:attr:`roastlab.workflows.model.FittedModel.failed`). Bounds come
 from the quantity table.
