@@ -323,6 +323,23 @@ def test_et_below_bt_through_the_roast_is_dropped_when_the_map_asks(tmp_path):
     assert et_minus_bt_C(t[:5], et[:5], np.full(5, 120.0)) is None
 
 
+def test_the_drum_at_charge_of_an_artisan_log_is_bt_else_et(tmp_path):
+    """roastlab.io.importers.artisan.DRUM_AT_CHARGE, as init writes it: BT at CHARGE, and ET where a
+    log has no BT reading then (Artisan's -1) instead of refusing the log. Synthetic logs (fake_alog)."""
+    from roastlab.io.importers.artisan import DRUM_AT_CHARGE
+
+    sources = ", ".join(f'"{c}"' for c in DRUM_AT_CHARGE)
+    cmap = load_map(write_map(tmp_path, ROOM_AIR_MAP + f"[initial]\nTm0_C = [{sources}]\n"))
+    n = 120
+    bt = [130.0 - 0.2 * i if i < 30 else 124.0 + 0.5 * (i - 30) for i in range(n)]
+    et = [150.0 + 0.4 * i for i in range(n)]
+    whole, gap = tmp_path / "whole.alog", tmp_path / "gap.alog"
+    whole.write_text(fake_alog(bt=bt, et=et, n=n))
+    gap.write_text(fake_alog(bt=bt[:5] + [-1.0] + bt[6:], et=et, n=n))  # BT missing at CHARGE (index 5)
+    assert import_log(whole, cmap).initial["Tm0_C"] == pytest.approx(bt[5])
+    assert import_log(gap, cmap).initial["Tm0_C"] == pytest.approx(et[5])
+
+
 def test_the_skywalker_examples_drop_et_on_the_three_oldest_logs(real_data):
     """On the shared Skywalker logs the example's map drops ET where it reads below BT: the three
     September-October 2025 logs (docs/real-roaster.md), and keeps it on the 13 later ones."""

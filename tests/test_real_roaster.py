@@ -65,7 +65,9 @@ def test_skywalker_fit_and_validate(cli, real_data, tmp_path):
     doc = json.loads(theta.read_text())
     for key in ("hgm", "hbm", "Pbm", "Gg_kg_s", "Kt", "Qe_gain_kW", "Tgi_gain_C", "tau_heater_s"):
         assert doc["parameters"][key]["how"] == "fitted", key
-    assert doc["initial"]["Tm0_C"] == {"how": "from log", "field": "BT"} and doc["map"]["Gg"] == {"identify": True}
+    assert doc["initial"]["Tm0_C"] == {"how": "from log", "field": ["BT", "ET"]} and doc["map"]["Gg"] == {
+        "identify": True
+    }
     assert doc["map"]["heater"] == {"column": "Burner", "unit": "percent", "step": 5.0}
     metrics = tmp_path / "m.json"
     code, out, err = cli("validate", *common, "--model", theta, *val_logs, "--json", metrics)
@@ -200,7 +202,7 @@ def test_init_and_both_examples_use_the_cross_validated_bed(real_data, bullet_da
 
     for folder, log, at_charge in (
         (BULLET, bullet_data / "bullet_2020-07-31_0152_490g.json", roastime.DRUM_AT_CHARGE),
-        (EXAMPLE, sorted(real_data.glob("*.alog"))[5], artisan.DRUM_AT_CHARGE),
+        (EXAMPLE, sorted(real_data.glob("*.alog"))[5], list(artisan.DRUM_AT_CHARGE)),
     ):
         example = load_fit_spec(folder / "fit.toml")
         assert example.bed == CROSS_VALIDATED, folder

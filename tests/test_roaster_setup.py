@@ -34,7 +34,7 @@ def test_init_detects_an_artisan_layout_and_writes_commented_files(cli, tmp_path
     assert 'column = "Burner"' in text["map"] and 'column = "Air"' in text["map"] and 'unit = "percent"' in text["map"]
     assert "catalogue: Hottop" in text["plant"] and "Mm_kg = 0.75" in text["plant"]  # 3 kg per kg of 0.25 kg
     assert "Qe_gain_kW" in text["fit"] and "Tgi_gain_C" in text["fit"] and "\n[fixed]\nh_probe_m = " in text["fit"]
-    assert 'Tm0_C = "BT"' in text["map"]  # the drum at CHARGE: the probe soaked in the empty drum
+    assert 'Tm0_C = ["BT", "ET"]' in text["map"]  # the drum at CHARGE: the probe soaked in the empty drum
     assert "Hottop" in out and [p.read_bytes() for p in logs] == before  # logs never modified
 
 

@@ -431,9 +431,10 @@ def map_text(s: Survey) -> str:
                 "the others: not the drum's air there, dropped on such logs",
                 "",
             ]
+        sources = ", ".join(f'"{c}"' for c in ARTISAN_DRUM_AT_CHARGE)
         initial.append(
-            f'Tm0_C = "{ARTISAN_DRUM_AT_CHARGE}"          # the drum at CHARGE: the probe soaked in the empty preheated '
-            "drum, steadier than ET then"
+            f"Tm0_C = [{sources}]  # the drum at CHARGE: BT then, the probe soaked in the empty preheated drum "
+            "(steadier than ET), else ET"
         )
     if initial:
         lines += ["[initial]", *initial, ""]

@@ -38,8 +38,9 @@ from ..files import read_input_text
 #: 11 °C and up to 24 °C as the drum is opened and charged, so ET's reading stamped at CHARGE depends
 #: on the second the button was pressed. Leave-one-log-out on the Skywalker's 16 logs: FIT 79.3 % with BT, 76.5 %
 #: with ET (the paper's probe; 83.8 % and 77.3 % with the bed laws of
-#: :data:`roastlab.model.bed.CROSS_VALIDATED`; docs/real-roaster.md).
-DRUM_AT_CHARGE = "BT"
+#: :data:`roastlab.model.bed.CROSS_VALIDATED`; docs/real-roaster.md). ET stands in where a log has no BT
+#: reading at CHARGE (a map's ``[initial]`` sources are tried in order).
+DRUM_AT_CHARGE = ("BT", "ET")
 EVENT_NAMES = ("CHARGE", "DRY", "FCs", "FCe", "SCs", "SCe", "DROP", "COOL")
 WEIGHT_UNITS = {"g": 1e-3, "kg": 1.0, "lb": 0.45359237, "oz": 0.028349523125}
 
