@@ -91,8 +91,9 @@ def test_init_and_fit_roaster_reach_the_hand_written_examples_on_the_shared_logs
         width[cfg] = float(out.split("median width ")[1].split(" °C")[0])
     assert abs(held["cfg"] - held["example"]) <= 2.0 and held["cfg"] > base + 20, held
     # the 90 % band on the held-out logs: about its level and not uselessly wide (measured
-    # 2026-11-25: Skywalker 96 %, 34.5 °C, since 2026-11-26 92 %, 14.5 °C; Bullet 94 %, 19.0 °C; 100 % and 70 °C on the Skywalker
-    # while the band drew parameter sets instead of propagating the covariance)
+    # 2026-11-25: Skywalker 96 %, 34.5 °C, since 2026-11-26 92 %, 14.5 °C; Bullet 94 %, 19.0 °C;
+    # 100 % and 70 °C on the Skywalker while the band drew parameter sets instead of propagating
+    # the covariance)
     assert 85.0 <= inside["cfg"] <= 98.0 and width["cfg"] < 40.0, (inside, width)
     doc = json.loads((tmp_path / "cfg" / "model.json").read_text())
     assert doc["format"] == "roastlab-model/1"
