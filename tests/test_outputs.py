@@ -27,6 +27,7 @@ INPUTS = {"--model", "--theta", "--plant", "--inputs", "--map", "--spec", "--dat
 INPUTS |= {"--from", "--to", "--reference", "--scenario", "--scenarios", "--manifest", "--data-dir", "logs", "dir"}
 #: Options that take no path: numbers, names, choices and flags.
 VALUES = {
+    "--every-log",
     "--batch-capacity-kg",
     "--drum-diameter-m",
     "--drum-length-m",

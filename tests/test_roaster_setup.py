@@ -183,6 +183,29 @@ def test_an_unseen_fahrenheit_hottop_is_fitted_with_no_hand_edits(cli, tmp_path)
     assert held > 80.0 and held > base + 10.0, out
 
 
+@pytest.mark.slow
+def test_fit_roaster_every_log_holds_each_log_out_once(cli, tmp_path):
+    """--every-log: each SYNTHETIC log predicted by a fit on the others, with the fit spec's own
+    bed laws; the report gets a row per log and the overall figures, the terminal one line."""
+    logs = _synthetic_hottop_logs(tmp_path)
+    assert cli("init", *logs, "--out", tmp_path / "cfg")[0] == 0
+    code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs, "--every-log")
+    assert code == 0, err
+    line = out.split("each log held out once: FIT ")[1]
+    cv = float(line.split(" %")[0])
+    held = float(out.split("held out: FIT ")[1].split(" %")[0])
+    assert 80.0 < cv <= 100.0 and abs(cv - held) < 10.0, out
+    assert "inside the band of the fit without their log" in line
+    report = (tmp_path / "cfg" / "report.md").read_text()
+    section = report.split("## Every log held out once")[1]
+    rows = [r for r in section.splitlines() if r.startswith("| hottop_")]
+    assert len(rows) == len(logs) and f"FIT {cv:.1f} % on average" in section
+    # without the flag: no section, no line
+    code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
+    assert code == 0 and "each log held out once" not in out
+    assert "## Every log held out once" not in (tmp_path / "cfg" / "report.md").read_text()
+
+
 def _synthetic_gas_drum_logs(folder: Path, n_logs: int = 6, seed: int = 11) -> list[Path]:
     """SYNTHETIC Artisan logs of a gas drum no catalogue entry names: the burner is logged as
     special events only (Artisan's slider, German event names: Luft, Trommel, Klappe, Brenner),

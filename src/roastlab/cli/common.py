@@ -65,7 +65,9 @@ def progress(desc: str):
 
     def update(done: int, total: int, text: str = "") -> None:
         bar = state.get("bar")
-        if bar is None:
+        if bar is None or bar.total != total or done < bar.n:  # the first call, or the next stage of the work
+            if bar is not None:
+                bar.close()
             bar = state["bar"] = tqdm(total=total, desc=desc, file=sys.stderr, delay=2.0, disable=None, leave=False)
         bar.set_postfix_str(text[:60], refresh=False)
         bar.update(done - bar.n)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 
 from .common import failed_fit_status, float_arg, progress
@@ -38,7 +39,7 @@ def cmd_init(args) -> int:
 def cmd_fit_roaster(args) -> int:
     from ..workflows.roaster import band_sentence, fit_roaster
 
-    r = fit_roaster(args.dir, args.logs, progress=progress("fit-roaster"), seed=args.seed)
+    r = fit_roaster(args.dir, args.logs, progress=progress("fit-roaster"), seed=args.seed, every_log=args.every_log)
     f, h, b = r["fit"], r["held_out"], r["baseline_held_out"]
     print(f"fit set:  FIT {f['FIT']:.1f} %, MAE {f['MAE']:.2f} °C")
     print(
@@ -48,6 +49,15 @@ def cmd_fit_roaster(args) -> int:
         print(f"band:     {band_sentence(r['band'])}")
         if r["band"]["note"]:
             print(f"note: {r['band']['note']}")
+    e = r["every_log"]
+    if e:
+        band = (
+            f", {100 * e['band_inside']:.0f} % of the samples inside the band of the fit without their log "
+            f"(median width {e['band_median_width_C']:.1f} °C)"
+            if math.isfinite(e["band_inside"])
+            else ""
+        )
+        print(f"each log held out once: FIT {e['FIT']:.1f} % on average{band}")
     for w in r["warnings"]:
         print(f"warning: {w}", file=sys.stderr)
     print(f"wrote {r['model']}, {r['report']}")
@@ -84,9 +94,17 @@ def add_parsers(sub) -> None:
         "DIR/report.md and DIR/heldout.png. Exit status 1 when the fit failed (states the machine cannot have, "
         "such as drum metal below the beans; the files are written and say so), 2 on bad input.",
         formatter_class=argparse.RawDescriptionHelpFormatter,
-        epilog="example:\n  roastlab fit-roaster myroaster roasts/*.alog",
+        epilog="examples:\n  roastlab fit-roaster myroaster roasts/*.alog\n"
+        "  roastlab fit-roaster myroaster roasts/*.alog --every-log   each log also held out once (minutes)",
     )
     p.add_argument("dir", metavar="DIR", help="the folder 'roastlab init' wrote")
     p.add_argument("logs", nargs="+", metavar="LOG", help="the roaster's logs")
     p.add_argument("--seed", type=int, default=0, help="seed of the global search (default 0)")
+    p.add_argument(
+        "--every-log",
+        action="store_true",
+        help="also hold every log out once, predicted by a fit on all the others (leave-one-log-out: one fit "
+        "per log, plus one), and report each log's FIT and its share inside the 90 %% band: the figure to judge "
+        "the model by when one split of a few roasts is too few",
+    )
     p.set_defaults(func=cmd_fit_roaster)

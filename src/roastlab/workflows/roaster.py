@@ -553,7 +553,7 @@ def band_sentence(band: dict) -> str:
     )
 
 
-def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0) -> dict:
+def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: bool = False) -> dict:
     """Fit, validate and report a roaster set up by :func:`init_roaster`.
 
     The logs, sorted by when they were roasted (Artisan ``roastepoch``, RoasTime ``dateTime``;
@@ -561,6 +561,11 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0) -> dict:
     4th, ... are held out. Writes
     ``config_dir``/model.json, report.md and heldout.png (measured vs predicted BT of the
     held-out logs); returns the figures of the report.
+
+    ``every_log``: also hold every log out once, predicted by a fit on all the others
+    (leave-one-log-out, :func:`roastlab.workflows.compare.compare_models` with the fit spec's own
+    bed laws), and report each log's FIT and its share inside the 90 % band: one split of a few
+    roasts moves the held-out figure by points, this uses every roast (one fit per log, plus one).
     """
     from ..evaluate.metrics import average_metrics
     from ..fit.baseline import describe, fit_first_order, validate_first_order
@@ -643,6 +648,9 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0) -> dict:
         if band["by_size"]:
             lines += ["", "| batch size | held-out logs | inside the band |", "|---|---|---|"]
             lines += [f"| {g['size']} | {g['logs']} | {100 * g['inside']:.0f} % |" for g in band["by_size"]]
+    every = held_out_one_by_one(batches, d, cmap, seed, progress) if every_log else None
+    if every is not None:
+        lines += every_log_lines(every, len(batches))
     from ..report.figures import figure_bytes
 
     fig = v_val.plot()
@@ -655,8 +663,63 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0) -> dict:
         "held_out": {"FIT": v_val.average["FIT"], "MAE": v_val.average["MAE"]},
         "baseline_held_out": {"FIT": bv["FIT"], "MAE": bv["MAE"]},
         "band": band,
+        "every_log": every
+        and {
+            "FIT": every.cv_FIT,
+            "band_inside": every.cv_band_inside,
+            "band_median_width_C": every.cv_band_width_C,
+            "by_log": every.cv_by_group,
+        },
         "warnings": result.warnings,
         "failed": result.failed,
         "model": d / "model.json",
         "report": d / "report.md",
     }
+
+
+def held_out_one_by_one(batches, config_dir: Path, column_map, seed: int, progress=None):
+    """Each log predicted by a fit on all the others, with the fit spec as it is (its own bed laws):
+    the :class:`~roastlab.workflows.compare.VariantScore` of leave-one-log-out."""
+    from ..io.fitspec import load_fit_spec
+    from .compare import Variant, compare_models
+
+    spec = load_fit_spec(config_dir / "fit.toml")
+    return compare_models(
+        batches,
+        config_dir / "plant.toml",
+        spec,
+        [Variant(spec.bed)],
+        column_map=column_map,
+        group_by="log",
+        seed=seed,
+        progress=progress,
+    ).scores[0]
+
+
+def every_log_lines(score, n_logs: int) -> list[str]:
+    """The report's section on every log held out once (:func:`held_out_one_by_one`)."""
+    from ..evaluate.bands import BAND_LEVEL
+
+    level = f"{100 * BAND_LEVEL:.0f} %"
+    has_band = math.isfinite(score.cv_band_inside)
+    lines = [
+        "",
+        "## Every log held out once",
+        "",
+        f"Each of the {n_logs} logs predicted by a fit on the other {n_logs - 1} (leave-one-log-out): one split "
+        "of a few roasts moves the held-out figure by points; this uses every roast.",
+        "",
+        f"| log | FIT % |{f' inside the {level} band |' if has_band else ''}",
+        f"|---|---|{'---|' if has_band else ''}",
+    ]
+    for name, fit_pct in score.cv_by_group.items():
+        inside = score.cv_band_by_group.get(name, math.nan)
+        band = f" {100 * inside:.0f} % |" if has_band and math.isfinite(inside) else (" - |" if has_band else "")
+        lines.append(f"| {name} | {fit_pct:.1f} |{band}")
+    lines += ["", f"Every log held out once: FIT {score.cv_FIT:.1f} % on average."]
+    if has_band:
+        lines[-1] += (
+            f" {100 * score.cv_band_inside:.0f} % of the measured samples lie inside the {level} band of the fit "
+            f"without their log (median width {score.cv_band_width_C:.1f} °C; about {level} when the band is honest)."
+        )
+    return lines
