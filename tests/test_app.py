@@ -363,5 +363,13 @@ def test_a_model_is_fitted_on_the_page_in_the_background(client, data_dir):
     assert "error" not in st, st
     assert "held out" in st["report"] and st["held_out"]["FIT"] > 0
     assert st["model"] in client.get("/api/files", headers=H).json()["models"]
+    assert st["every_log"] is None and "Every log held out once" not in st["report"]
+    # the page's "also hold each log out once": fit-roaster --every-log behind it
+    assert client.post("/api/fit", json={"logs": logs, "name": "sky", "every_log": True}, headers=H).json()["started"]
+    deadline = time.monotonic() + 300
+    while (st := client.get("/api/fit-status", headers=H).json()).get("running") and time.monotonic() < deadline:
+        time.sleep(0.2)
+    assert "error" not in st, st
+    assert "## Every log held out once" in st["report"] and -100 < st["every_log"]["FIT"] <= 100
     one = client.post("/api/fit", json={"logs": logs[:1]}, headers=H)
     assert one.status_code == 400 and "at least two logs" in one.json()["error"]

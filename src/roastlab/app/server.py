@@ -13,7 +13,8 @@ repository); the page talks JSON to a handful of endpoints, each a thin call int
   (:func:`roastlab.workflows.transfer.transfer`, as ``roastlab transfer``)
 * ``POST /api/upload``    a log file into ``<data>/uploads/`` (size-limited, read as data)
 * ``POST /api/fit``       fit a model on chosen logs in the background (``roastlab init`` +
-  ``fit-roaster`` into ``<data>/roasters/<name>/``); ``GET /api/fit-status`` its progress and report
+  ``fit-roaster`` into ``<data>/roasters/<name>/``; ``every_log``: each log also held out once);
+  ``GET /api/fit-status`` its progress and report
 * ``GET  /downloads/...`` what a transfer wrote
 
 Safety: the server binds 127.0.0.1 unless told otherwise; every path a request names is
@@ -433,12 +434,13 @@ def create_app(data_dir: str | Path):
         def work():
             try:
                 init_roaster(paths, folder, batch_kg=body.get("batch_kg") or None)
-                r = fit_roaster(folder, paths, progress=progress)
+                r = fit_roaster(folder, paths, progress=progress, every_log=bool(body.get("every_log")))
                 session.fit.update(
                     running=False,
                     model=(folder / "model.json").relative_to(data).as_posix(),
                     report=(folder / "report.md").read_text(encoding="utf-8"),
                     held_out=r["held_out"],
+                    every_log=r["every_log"] and {"FIT": r["every_log"]["FIT"]},
                 )
             except RoastlabError as exc:
                 session.fit.update(running=False, error=str(exc))
