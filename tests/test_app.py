@@ -341,6 +341,21 @@ def test_a_bad_upload_shows_a_message_and_the_page_keeps_working(page, tmp_path)
     assert json.loads(page.evaluate("fetch('/api/files', {headers: {'X-Session': 'probe-12345'}}).then(r => r.text())"))
 
 
+def test_the_server_is_not_one_run(data_dir):
+    """`roastlab app` starts as a CLI command (which remembers every input it reads so no output can
+    replace one) and then serves for hours: create_app ends that run, or a roaster could not be
+    fitted again into the folder whose map the last fit read (seen on the page: 'map.toml is an
+    input of this run'). Each of the server's writes names its own inputs instead."""
+    from roastlab.app.server import create_app
+    from roastlab.io.files import begin_run, inputs_read, read_input_text
+
+    begin_run()  # as roastlab.cli.main does before the app command
+    read_input_text(next(p for p in data_dir.rglob("*") if p.is_file()))
+    assert inputs_read()
+    create_app(data_dir)
+    assert inputs_read() == []
+
+
 @pytest.mark.slow
 def test_a_model_is_fitted_on_the_page_in_the_background(client, data_dir):
     """roastlab init + fit-roaster behind the page: progress to poll, the report, a model listed."""

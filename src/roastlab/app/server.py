@@ -262,9 +262,12 @@ def create_app(data_dir: str | Path):
     from starlette.responses import FileResponse, HTMLResponse, JSONResponse, Response
     from starlette.routing import Route
 
+    from ..io.files import end_run
+
     data = Path(data_dir)
     if not data.is_dir():
         raise InputError("not a folder", data)
+    end_run()  # a server is not one run: each write below names its own inputs (roastlab.io.files.end_run)
     sessions = Sessions()
     assets = resources.files("roastlab.app")
 

@@ -56,6 +56,14 @@ def begin_run() -> None:
     _RUN["active"] = True
 
 
+def end_run() -> None:
+    """Stop remembering inputs. A long-running server is not one command: it reads and writes files
+    for many requests over its life (the page re-fits a roaster into the folder whose map it read
+    for the last fit), so each of its writes names its own inputs (``Outputs(inputs)``) instead."""
+    _READ.clear()
+    _RUN["active"] = False
+
+
 def as_path(value, what: str = "path") -> Path:
     """``value`` as a Path if it is one (a str or os.PathLike); else the project's own error."""
     if isinstance(value, Path):
