@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 
 from .common import failed_fit_status, float_arg, progress
@@ -37,7 +36,7 @@ def cmd_init(args) -> int:
 
 
 def cmd_fit_roaster(args) -> int:
-    from ..workflows.roaster import band_sentence, fit_roaster
+    from ..workflows.roaster import band_sentence, every_log_sentence, fit_roaster
 
     r = fit_roaster(args.dir, args.logs, progress=progress("fit-roaster"), seed=args.seed, every_log=args.every_log)
     f, h, b = r["fit"], r["held_out"], r["baseline_held_out"]
@@ -51,13 +50,7 @@ def cmd_fit_roaster(args) -> int:
             print(f"note: {r['band']['note']}")
     e = r["every_log"]
     if e:
-        band = (
-            f", {100 * e['band_inside']:.0f} % of the samples inside the band of the fit without their log "
-            f"(median width {e['band_median_width_C']:.1f} °C)"
-            if math.isfinite(e["band_inside"])
-            else ""
-        )
-        print(f"each log held out once: FIT {e['FIT']:.1f} % on average{band}")
+        print(f"each log held out once: {every_log_sentence(e['FIT'], e['band_inside'], e['band_median_width_C'])}")
     for w in r["warnings"]:
         print(f"warning: {w}", file=sys.stderr)
     print(f"wrote {r['model']}, {r['report']}")

@@ -196,7 +196,8 @@ def fit(
         if dropped:  # the map's [ET] above_BT dropped it on every log given (io.importers.mapping)
             message = (
                 f"the ET output has a weight, but the map dropped ET on all {dropped} log(s) given (it reads below BT "
-                "through the roast there): add logs whose ET is the drum's air, or pass --weight ET=0"
+                "through the roast there): add logs whose ET is the drum's air, or set ET = 0 under [weights] in the fit spec "
+                "(identify: --weight ET=0)"
             )
         raise InputError(message, "command line" if "ET" in given else spec_source)
     names_moved = {f.name for f in free} | set(fixed)

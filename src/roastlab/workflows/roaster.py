@@ -716,10 +716,20 @@ def every_log_lines(score, n_logs: int) -> list[str]:
         inside = score.cv_band_by_group.get(name, math.nan)
         band = f" {100 * inside:.0f} % |" if has_band and math.isfinite(inside) else (" - |" if has_band else "")
         lines.append(f"| {name} | {fit_pct:.1f} |{band}")
-    lines += ["", f"Every log held out once: FIT {score.cv_FIT:.1f} % on average."]
-    if has_band:
-        lines[-1] += (
-            f" {100 * score.cv_band_inside:.0f} % of the measured samples lie inside the {level} band of the fit "
-            f"without their log (median width {score.cv_band_width_C:.1f} °C; about {level} when the band is honest)."
-        )
+    lines += [
+        "",
+        f"Every log held out once: {every_log_sentence(score.cv_FIT, score.cv_band_inside, score.cv_band_width_C)}"
+        + (f"; an honest band holds about {level}." if has_band else "."),
+    ]
     return lines
+
+
+def every_log_sentence(fit_pct: float, band_inside: float, band_width_C: float) -> str:
+    """Every log held out once, in one clause: the report's and the terminal's (:func:`held_out_one_by_one`)."""
+    text = f"FIT {fit_pct:.1f} % on average"
+    if math.isfinite(band_inside):
+        text += (
+            f", {100 * band_inside:.0f} % of the samples inside the band of the fit without their log "
+            f"(median width {band_width_C:.1f} °C)"
+        )
+    return text
