@@ -413,6 +413,7 @@ def skywalker_et(paths, lines):
 
 
 STEADY_C = 2.5  # a reading that moves less than this over the minute before CHARGE is steady [degC]
+PROBE_FAULT_C = 300.0  # no empty preheated drum reads this; a probe fault does (R55's BT before CHARGE) [degC]
 
 
 def drum_at_charge(paths, lines, before_s: float = 60.0):
@@ -422,7 +423,7 @@ def drum_at_charge(paths, lines, before_s: float = 60.0):
     from roastlab.io.importers.artisan import DRUM_AT_CHARGE, read_alog
 
     lines += [
-        f"### Skywalker: the drum at CHARGE (the map reads {DRUM_AT_CHARGE} then)",
+        f"### Skywalker: the drum at CHARGE (the map reads {DRUM_AT_CHARGE[0]} then)",
         "",
         f"| log | BT at CHARGE [°C] | its range over the {before_s:g} s before [°C] | ET at CHARGE [°C] "
         f"| its range over the {before_s:g} s before [°C] |",
@@ -436,7 +437,7 @@ def drum_at_charge(paths, lines, before_s: float = 60.0):
         row = [path.stem]
         for name in ("BT", "ET"):
             v = log.channels[name][before]
-            v = v[np.isfinite(v) & (v < 300.0)]  # a probe fault reads 300+ degC in an empty drum (R55's BT)
+            v = v[np.isfinite(v) & (v < PROBE_FAULT_C)]
             spans[name].append(float(np.ptp(v)) if len(v) else np.nan)
             row += [f"{log.channels[name][c]:.1f}", f"{spans[name][-1]:.1f}"]
         lines.append("| " + " | ".join(row) + " |")

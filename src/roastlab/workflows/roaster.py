@@ -23,8 +23,8 @@ logged; the heater's gains and lag when a heater is logged (into the drum metal,
 air unless the machine heats the drum itself); the fan's share of the flow when a fan is
 logged; a shell loss when the inlet is room air; the probe's immersion under the bed laws
 cross-validation chose, its depth scale held at the drum's diameter (for every roaster); the
-second reading's weight when the log has a second bean reading; ET's weight (against the outlet gas) when ET is
-logged beside a heater, because a fit on BT alone can heat the beans by a path the machine does
+second reading's weight when the log has a second bean reading; ET's weight (against the outlet
+gas) when ET is logged beside a heater, because a fit on BT alone can heat the beans by a path the machine does
 not have, and such a fit fails (:attr:`roastlab.workflows.model.FittedModel.failed`). Bounds come
 from the quantity table.
 """
