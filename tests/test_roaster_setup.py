@@ -38,6 +38,35 @@ def test_init_detects_an_artisan_layout_and_writes_commented_files(cli, tmp_path
     assert "Hottop" in out and [p.read_bytes() for p in logs] == before  # logs never modified
 
 
+def test_init_without_et_lets_the_heater_heat_the_drum_alone(cli, tmp_path):
+    """SYNTHETIC logs with a burner but no ET: BT alone cannot tell the heater's two paths apart, so
+    the fit spec sends the heater into the drum metal only (no Tgi_gain_C) and says why; with ET the
+    fit may use both (the test above)."""
+    extra = {"specialevents": [10, 40], "specialeventstype": [3, 0], "specialeventsvalue": [8.0, 4.0],
+             "etypes": ["Air", "Drum", "Damper", "Burner", "--"]}  # fmt: skip
+    logs = []
+    for k in range(2):
+        logs.append(tmp_path / f"r{k}.alog")
+        logs[-1].write_text(fake_alog(et=[-1.0] * 120, extra=extra))
+    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
+    assert code == 0 and "ET: no" in out, err
+    fit = (tmp_path / "cfg" / "fit.toml").read_text()
+    assert "Qe_gain_kW" in fit and "Tgi_gain_C" not in fit and "heater heats the drum metal alone" in fit
+    assert "[weights]" not in fit
+
+
+def test_a_model_below_the_baseline_is_called_not_usable_with_what_the_logs_lack():
+    from roastlab.io.importers.mapping import ColumnMap
+
+    et_driven = ColumnMap(source="map.toml", Tgi={"column": "ET"})
+    heated = ColumnMap(source="map.toml", Tgi={"constant_C": 22.0}, heater={"column": "Burner"})
+    assert roaster.below_baseline(80.0, 33.0, et_driven) is None
+    text = roaster.below_baseline(13.8, 33.0, et_driven)
+    assert "13.8 % against 33.0 %" in text and "no heater setting is logged" in text and "logged ET" in text
+    text = roaster.below_baseline(20.0, 33.0, heated)
+    assert "worse than a first-order lag" in text and "heater" not in text
+
+
 @pytest.mark.parametrize(
     "case, words",
     [

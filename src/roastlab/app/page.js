@@ -343,6 +343,7 @@ async function runFit() {
       $("fit-report").textContent = st.report;
       $("fit_text").textContent = `held out: FIT ${st.held_out.FIT.toFixed(1)} %, MAE ${st.held_out.MAE.toFixed(2)} °C` +
         (st.every_log ? `; each log held out once: FIT ${st.every_log.FIT.toFixed(1)} %` : "");
+      if (st.verdict) say(`not usable: ${st.verdict}`);
       pickModel = st.model;
       await refreshFiles($("log").value);
       document.body.dataset.fitted = st.model;

@@ -443,6 +443,7 @@ def create_app(data_dir: str | Path):
                     model=(folder / "model.json").relative_to(data).as_posix(),
                     report=(folder / "report.md").read_text(encoding="utf-8"),
                     held_out=r["held_out"],
+                    verdict=r["below_baseline"],
                     every_log=r["every_log"] and {"FIT": r["every_log"]["FIT"]},
                 )
             except RoastlabError as exc:

@@ -44,6 +44,8 @@ def cmd_fit_roaster(args) -> int:
     print(
         f"held out: FIT {h['FIT']:.1f} %, MAE {h['MAE']:.2f} °C (first-order baseline: {b['FIT']:.1f} %, {b['MAE']:.2f} °C)"
     )
+    if r["below_baseline"]:
+        print(f"verdict:  {r['below_baseline']}")
     if r["band"] is not None:
         print(f"band:     {band_sentence(r['band'])}")
         if r["band"]["note"]:

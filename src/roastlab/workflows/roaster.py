@@ -20,7 +20,7 @@ the capacity at a 20 % fill, length 1.25 diameters, vanes D/8 high at 0.6 D pitc
 per kg of capacity. The fit spec (:func:`fit_spec_text`) frees what these logs can determine:
 the paper's three coefficients and the probe constant always; the gas flow when none is
 logged; the heater's gains and lag when a heater is logged (into the drum metal, and into the
-air unless the machine heats the drum itself); the fan's share of the flow when a fan is
+air unless the machine heats the drum itself or no ET is logged to tell the two paths apart); the fan's share of the flow when a fan is
 logged; a shell loss when the inlet is room air; the probe's immersion under the bed laws
 cross-validation chose, its depth scale held at the drum's diameter (for every roaster); the
 second reading's weight when the log has a second bean reading; ET's weight (against the outlet
@@ -459,7 +459,13 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
         line("Kt", 0.002, 0.2, 0.02, "bean-probe inverse time constant [1/s]"),
     ]
     entry = catalogue_entry(s.machine) if s.machine else None
-    path = entry[1] if entry else "both"
+    # BT alone cannot tell the heater's two paths apart (a fit free to use both can heat the beans
+    # through the air with the drum colder than they are, and fails): without ET to tell them
+    # apart, the heater heats the drum, the path of a drum roaster and the one the Skywalker's fit
+    # with ET chooses (docs/your-roaster.md, "No ET in the logs")
+    path = entry[1] if entry else ("both" if s.has_et else "drum")
+    if s.heater and path == "drum" and not entry:
+        rows.append("# no ET logged to tell the heater's paths apart: the heater heats the drum metal alone")
     if s.heater:
         span = _setting_span(s.heater_unit, s.heater_max)
         qe_hi = round(10.0 * capacity_kg / span, 4)  # ~10 kW per kg of capacity at full setting, generous
@@ -532,6 +538,24 @@ def init_roaster(paths, out_dir, *, batch_kg=None, capacity_kg=None, diameter_m=
     return {"survey": s, "plant": plant, "notes": notes}
 
 
+def below_baseline(model_fit_pct: float, baseline_fit_pct: float, column_map) -> str | None:
+    """The verdict when the model predicts the held-out logs worse than the first-order lag fed the
+    same inputs (its FIT on them below the baseline's), with what the logs may lack; None otherwise."""
+    if not model_fit_pct < baseline_fit_pct:
+        return None
+    text = (
+        f"the model predicts the held-out logs worse than a first-order lag fed the same inputs "
+        f"(FIT {model_fit_pct:.1f} % against {baseline_fit_pct:.1f} %): do not plan roasts with it"
+    )
+    if column_map.heater is None and column_map.Tgi.get("column"):
+        text += (
+            f"; no heater setting is logged, so the logged {column_map.Tgi['column']} drives the model as the "
+            "air entering the drum, which it is only where that probe sits in the inlet air: log the "
+            "burner or heater setting (an Artisan event or extra device) and run init again"
+        )
+    return text
+
+
 def held_out_band(model, batches) -> dict | None:
     """How well the model's 90 % prediction band holds logs it was not fitted on
     (:func:`roastlab.evaluate.bands.band_report`); None when the model file can carry no band
@@ -598,6 +622,7 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: b
     _, b_fit = validate_first_order(fit_b, base)
     _, b_val = validate_first_order(val_b, base)
     bf, bv = average_metrics(b_fit), average_metrics(b_val)
+    verdict = below_baseline(v_val.average["FIT"], bv["FIT"], cmap)
     lines = [
         f"# {model.plant.name if model.plant else 'roaster'}: fitted by roastlab fit-roaster",
         "",
@@ -606,6 +631,7 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: b
             if result.failed
             else []
         ),
+        *([f"**Not usable**: {verdict}.", ""] if verdict else []),
         f"{len(batches)} logs sorted by {by}, split alternately: {len(fit_b)} fit, {len(val_b)} held out "
         f"(the fit never saw them). Fit in {result.identification.wall_s:.1f} s.",
         "",
@@ -662,6 +688,7 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: b
         "fit": {"FIT": v_fit.average["FIT"], "MAE": v_fit.average["MAE"]},
         "held_out": {"FIT": v_val.average["FIT"], "MAE": v_val.average["MAE"]},
         "baseline_held_out": {"FIT": bv["FIT"], "MAE": bv["MAE"]},
+        "below_baseline": verdict,
         "band": band,
         "every_log": every
         and {
