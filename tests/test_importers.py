@@ -103,6 +103,12 @@ def test_fahrenheit_log_converted_but_not_non_temperature_extras(tmp_path):
     assert log.weight_in_kg == pytest.approx(0.2)
 
 
+def test_a_weight_in_pounds_reads_as_the_grams_it_was(tmp_path):
+    p = tmp_path / "lb.alog"
+    p.write_text(fake_alog(extra={"weight": [152.0 / 453.59237, 130.0 / 453.59237, "lb"]}))
+    assert read_alog(p).weight_in_kg == 0.152  # to a tenth of a gram, so messages print 0.152 kg
+
+
 def test_json_alog_and_missing_samples(tmp_path):
     n = 120
     bt = [130.0 - 0.2 * i if i < 30 else 124.0 + 0.5 * (i - 30) for i in range(n)]

@@ -237,14 +237,15 @@ def _numeric_list(data: dict, key: str, path: Path, required: bool = True):
 
 
 def _weight(value, factor: float, path: Path) -> float | None:
-    """A logged weight in kg, or None when absent (Artisan writes 0 for 'not weighed')."""
+    """A logged weight in kg to a tenth of a gram (finer than a roaster's scale reads; a weight in
+    pounds then prints as the grams it was), or None when absent (Artisan writes 0 for 'not weighed')."""
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
         return None
     try:
         kg = float(value) * factor
     except OverflowError:
         raise InputError("weight out of range", path, "key weight") from None
-    return kg if math.isfinite(kg) else None
+    return round(kg, 4) if math.isfinite(kg) else None
 
 
 def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: bool = True) -> ArtisanLog:
