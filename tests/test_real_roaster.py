@@ -138,6 +138,38 @@ def test_skywalker_logs_without_et_fit_with_the_heater_into_the_drum(cli, real_d
     assert held >= 80.0, out  # 83.3 % measured on 2026-11-26 (79.7 % with ET weighed, docs/real-roaster.md)
 
 
+@pytest.mark.slow
+def test_a_log_without_burner_events_is_left_out_and_a_non_physical_fit_refitted(cli, real_data, tmp_path):
+    """Six Skywalker logs (October-November 2025, rewritten in tmp_path), one with its Burner events
+    removed, as Artisan writes a roast whose burner never moved while it recorded: init sets up the
+    other five's layout and says so, fit-roaster leaves that log out; on the five, the fit with both
+    heater paths free puts the drum below the beans, and fit-roaster refits with the drum's path alone."""
+    import ast
+
+    logs = []
+    for p in sorted(real_data.glob("roast_25-1[01]-*.alog")):
+        doc = ast.literal_eval(p.read_text(encoding="utf-8"))  # a Python literal, as Artisan writes it
+        if p.name == "roast_25-10-25_1544.alog":
+            keep = [k for k, t in enumerate(doc["specialeventstype"]) if t != 3]  # 3: Burner (etypes)
+            for key in ("specialevents", "specialeventstype", "specialeventsvalue", "specialeventsStrings"):
+                doc[key] = [doc[key][k] for k in keep]
+        logs.append(tmp_path / p.name)
+        logs[-1].write_text(repr(doc), encoding="utf-8")
+    assert len(logs) == 6
+    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
+    assert code == 0 and "1 log(s) record no Burner (roast_25-10-25_1544.alog)" in out, err
+    code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
+    assert code == 0 and "failed" not in err, err
+    assert "left out: roast_25-10-25_1544.alog records no Burner" in out
+    assert "refitted: with the heater free to heat the air and the drum, the fit failed on non-physical" in out
+    held, base = out.split("held out: FIT ")[1].split(" %")[0], out.split("first-order baseline: ")[1].split(" %")[0]
+    assert float(held) > float(base) + 10, out  # 71.0 % against 44.4 % measured on 2026-11-26
+    report = (tmp_path / "cfg" / "report.md").read_text()
+    assert (
+        "5 logs sorted by date" in report and "Left out: roast_25-10-25_1544.alog" in report and "Refitted:" in report
+    )
+
+
 BULLET = Path(__file__).resolve().parents[1] / "examples" / "bullet"
 
 

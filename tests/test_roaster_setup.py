@@ -38,21 +38,38 @@ def test_init_detects_an_artisan_layout_and_writes_commented_files(cli, tmp_path
     assert "Hottop" in out and [p.read_bytes() for p in logs] == before  # logs never modified
 
 
+#: SYNTHETIC Burner (type 3) and Air (type 0) events in Artisan's encoding.
+_BURNER_AIR = {"specialevents": [10, 40], "specialeventstype": [3, 0], "specialeventsvalue": [8.0, 4.0],
+               "etypes": ["Air", "Drum", "Damper", "Burner", "--"]}  # fmt: skip
+
+
 def test_init_without_et_lets_the_heater_heat_the_drum_alone(cli, tmp_path):
     """SYNTHETIC logs with a burner but no ET: BT alone cannot tell the heater's two paths apart, so
     the fit spec sends the heater into the drum metal only (no Tgi_gain_C) and says why; with ET the
     fit may use both (the test above)."""
-    extra = {"specialevents": [10, 40], "specialeventstype": [3, 0], "specialeventsvalue": [8.0, 4.0],
-             "etypes": ["Air", "Drum", "Damper", "Burner", "--"]}  # fmt: skip
     logs = []
     for k in range(2):
         logs.append(tmp_path / f"r{k}.alog")
-        logs[-1].write_text(fake_alog(et=[-1.0] * 120, extra=extra))
+        logs[-1].write_text(fake_alog(et=[-1.0] * 120, extra=_BURNER_AIR))
     code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
     assert code == 0 and "ET: no" in out, err
     fit = (tmp_path / "cfg" / "fit.toml").read_text()
     assert "Qe_gain_kW" in fit and "Tgi_gain_C" not in fit and "heater heats the drum metal alone" in fit
     assert "[weights]" not in fit
+
+
+def test_a_log_that_records_no_burner_is_named_and_the_others_set_up(cli, tmp_path):
+    """SYNTHETIC: Artisan logs a setting only when it moves; a roast whose burner never moved has no
+    Burner events. init keeps the other logs' layout and names that log (fit-roaster leaves it out)."""
+    logs = [tmp_path / f"r{k}.alog" for k in range(3)]
+    for k, p in enumerate(logs):
+        p.write_text(fake_alog(extra=_BURNER_AIR if k < 2 else {}))
+    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
+    assert code == 0, err
+    assert (
+        "1 log(s) record no Burner (r2.alog)" in out
+        and 'column = "Burner"' in (tmp_path / "cfg" / "map.toml").read_text()
+    )
 
 
 def test_a_model_below_the_baseline_is_called_not_usable_with_what_the_logs_lack():
@@ -74,6 +91,7 @@ def test_a_model_below_the_baseline_is_called_not_usable_with_what_the_logs_lack
         ("mixed machines", "different roasters"),
         ("no BT", "bean temperature"),
         ("nothing drives the model", "neither a heater setting nor ET"),
+        ("one log records the heater", "only one log records the Burner setting"),
     ],
 )
 def test_init_bad_input_is_one_line_saying_what_to_pass(cli, tmp_path, case, words):
@@ -87,6 +105,9 @@ def test_init_bad_input_is_one_line_saying_what_to_pass(cli, tmp_path, case, wor
         b.write_text(fake_alog(extra={"roastertype": "Behmor"}))
     elif case == "no BT":
         a.write_text(fake_alog(extra={"temp2": [-1] * 120}))
+        b.write_text(fake_alog())
+    elif case == "one log records the heater":
+        a.write_text(fake_alog(extra=_BURNER_AIR))
         b.write_text(fake_alog())
     else:  # no heater events and no ET
         a.write_text(fake_alog(et=[-1.0] * 120))

@@ -40,6 +40,10 @@ def cmd_fit_roaster(args) -> int:
 
     r = fit_roaster(args.dir, args.logs, progress=progress("fit-roaster"), seed=args.seed, every_log=args.every_log)
     f, h, b = r["fit"], r["held_out"], r["baseline_held_out"]
+    for why in r["left_out"].values():
+        print(f"left out: {why}")
+    if r["refit"]:
+        print(f"refitted: {r['refit']}")
     print(f"fit set:  FIT {f['FIT']:.1f} %, MAE {f['MAE']:.2f} °C")
     print(
         f"held out: FIT {h['FIT']:.1f} %, MAE {h['MAE']:.2f} °C (first-order baseline: {b['FIT']:.1f} %, {b['MAE']:.2f} °C)"

@@ -251,14 +251,20 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
     infos = [inspect_log(p, batch_kg) for p in paths]
     first = infos[0]
     for key, what in (("format", "formats"), ("heater", "heater channels"), ("fan", "fan channels")):
-        kinds = {getattr(i, key) for i in infos}
+        kinds = {getattr(i, key) for i in infos} - ({None} if key != "format" else set())
         if len(kinds) > 1:
-            odd = next(i for i in infos if getattr(i, key) != getattr(first, key))
+            one = next(i for i in infos if getattr(i, key) is not None)
+            odd = next(i for i in infos if getattr(i, key) not in (None, getattr(one, key)))
             raise InputError(
-                f"the logs disagree on {what} ({', '.join(sorted(map(str, kinds)))}): {first.path.name} vs "
+                f"the logs disagree on {what} ({', '.join(sorted(map(str, kinds)))}): {one.path.name} vs "
                 f"{odd.path.name}. Set up one roaster (one layout) at a time",
                 odd.path,
             )
+    # a log without a control's events (the setting never moved while Artisan recorded) does not
+    # say what the setting was: the map keeps the channel the other logs name, fit-roaster leaves
+    # that log out (logs_without_controls)
+    heater = next((i.heater for i in infos if i.heater), None)
+    fan = next((i.fan for i in infos if i.fan), None)
     machines = {i.machine for i in infos if i.machine}
     if len(machines) > 1:
         raise InputError(f"the logs name different roasters ({', '.join(sorted(machines))}): one at a time", "init")
@@ -274,6 +280,17 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
     fan_units = {i.fan_unit for i in infos if i.fan}
     fan_unit = "percent" if "percent" in fan_units else (fan_units.pop() if fan_units else None)
     notes = []
+    for channel, what in ((heater, "heater"), (fan, "fan")):
+        lacking = [i.path.name for i in infos if channel and channel not in i.channels]
+        if lacking:
+            notes.append(
+                f"{len(lacking)} log(s) record no {channel} ({', '.join(lacking[:3])}{' ...' if len(lacking) > 3 else ''}): "
+                f"their {what} setting is unknown, so fit-roaster leaves them out"
+            )
+    if heater and len(infos) - sum(heater not in i.channels for i in infos) < 2:
+        raise InputError(
+            f"only one log records the {heater} setting: fit-roaster needs two (one to fit, one to hold out)", "init"
+        )
     serials = Counter(i.unit for i in infos if i.unit)
     if len(serials) > 1:
         notes.append(
@@ -292,9 +309,9 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
         infos,
         first.format,
         machines.pop() if machines else "",
-        first.heater,
+        heater,
         heater_unit,
-        first.fan,
+        fan,
         fan_unit,
         first.second_bean,
         all(i.has_et for i in infos),
@@ -538,6 +555,21 @@ def init_roaster(paths, out_dir, *, batch_kg=None, capacity_kg=None, diameter_m=
     return {"survey": s, "plant": plant, "notes": notes}
 
 
+def logs_without_controls(infos, column_map) -> dict[str, str]:
+    """The logs that do not record a setting the map drives the model with (a heater or fan channel
+    with no events: Artisan logs a setting only when it moves), each with why; ``{name: why}``."""
+    out = {}
+    for info in infos:
+        for what, spec in (("heater", column_map.heater), ("fan", column_map.fan)):
+            if spec and spec.get("column") and spec["column"] not in info.channels:
+                out[info.path.name] = (
+                    f"{info.path.name} records no {spec['column']} (its {what} setting is unknown: Artisan "
+                    "logs a setting only when it moves)"
+                )
+                break
+    return out
+
+
 def below_baseline(model_fit_pct: float, baseline_fit_pct: float, column_map) -> str | None:
     """The verdict when the model predicts the held-out logs worse than the first-order lag fed the
     same inputs (its FIT on them below the baseline's), with what the logs may lack; None otherwise."""
@@ -594,6 +626,7 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: b
     from ..evaluate.metrics import average_metrics
     from ..fit.baseline import describe, fit_first_order, validate_first_order
     from ..io.files import Outputs
+    from ..io.fitspec import load_fit_spec
     from ..io.importers.mapping import load_map
     from ..io.modelfile import model_document_text
     from .fitting import FAILED_HINT, fit
@@ -607,15 +640,36 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: b
     if len(paths) < 2:
         raise InputError("give at least two logs: one to fit, one to hold out", "fit-roaster")
     infos = [inspect_log(p, 1.0) for p in paths]
+    cmap = load_map(d / "map.toml")
+    left_out = logs_without_controls(infos, cmap)
+    if left_out:
+        keep = [k for k, i in enumerate(infos) if i.path.name not in left_out]
+        paths, infos = [paths[k] for k in keep], [infos[k] for k in keep]
+        if len(paths) < 2:
+            raise InputError(
+                f"fewer than two logs record the settings the map drives the model with ({'; '.join(left_out.values())})",
+                "fit-roaster",
+            )
     if all(i.started_epoch_s for i in infos):  # by when they were roasted, else by name
         order, by = sorted(range(len(paths)), key=lambda k: infos[k].started_epoch_s), "date"
     else:
         order, by = sorted(range(len(paths)), key=lambda k: paths[k].name), "name"
     paths = [paths[k] for k in order]
-    cmap = load_map(d / "map.toml")
     batches = [load_log(p, cmap) for p in paths]
     fit_b, val_b = batches[0::2], batches[1::2]
-    result = fit(fit_b, d / "plant.toml", d / "fit.toml", column_map=cmap, progress=progress, seed=seed)
+    spec = load_fit_spec(d / "fit.toml")
+    result = fit(fit_b, d / "plant.toml", spec, column_map=cmap, progress=progress, seed=seed)
+    refit = None
+    drum_only = drum_path_alone(spec) if result.failed else None
+    if drum_only is not None:  # both heater paths free and the drum below the beans: the drum's path alone
+        again = fit(fit_b, d / "plant.toml", drum_only, column_map=cmap, progress=progress, seed=seed)
+        if not again.failed:
+            refit = (
+                f"with the heater free to heat the air and the drum, the fit failed on {result.failed}; "
+                "refitted with the heater heating the drum alone (Tgi_gain_C held at 0), the path of a drum "
+                "roaster; to keep this, remove Tgi_gain_C from [free] in fit.toml"
+            )
+            result, spec = again, drum_only
     model = result.model
     v_fit, v_val = model.validate(fit_b), model.validate(val_b)
     base = fit_first_order(fit_b)
@@ -635,6 +689,8 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: b
         f"{len(batches)} logs sorted by {by}, split alternately: {len(fit_b)} fit, {len(val_b)} held out "
         f"(the fit never saw them). Fit in {result.identification.wall_s:.1f} s.",
         "",
+        *(line for why in left_out.values() for line in (f"Left out: {why}.", "")),
+        *([f"Refitted: {refit}.", ""] if refit else []),
         "| set | logs | model FIT % | model MAE °C | baseline FIT % | baseline MAE °C |",
         "|---|---|---|---|---|---|",
         f"| fit | {len(fit_b)} | {v_fit.average['FIT']:.1f} | {v_fit.average['MAE']:.2f} | {bf['FIT']:.1f} | {bf['MAE']:.2f} |",
@@ -674,7 +730,7 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: b
         if band["by_size"]:
             lines += ["", "| batch size | held-out logs | inside the band |", "|---|---|---|"]
             lines += [f"| {g['size']} | {g['logs']} | {100 * g['inside']:.0f} % |" for g in band["by_size"]]
-    every = held_out_one_by_one(batches, d, cmap, seed, progress) if every_log else None
+    every = held_out_one_by_one(batches, d, cmap, seed, progress, spec) if every_log else None
     if every is not None:
         lines += every_log_lines(every, len(batches))
     from ..report.figures import figure_bytes
@@ -689,6 +745,8 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: b
         "held_out": {"FIT": v_val.average["FIT"], "MAE": v_val.average["MAE"]},
         "baseline_held_out": {"FIT": bv["FIT"], "MAE": bv["MAE"]},
         "below_baseline": verdict,
+        "left_out": left_out,
+        "refit": refit,
         "band": band,
         "every_log": every
         and {
@@ -704,13 +762,29 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: b
     }
 
 
-def held_out_one_by_one(batches, config_dir: Path, column_map, seed: int, progress=None):
-    """Each log predicted by a fit on all the others, with the fit spec as it is (its own bed laws):
-    the :class:`~roastlab.workflows.compare.VariantScore` of leave-one-log-out."""
+def drum_path_alone(spec):
+    """``spec`` with the heater's path into the air held shut (Tgi_gain_C fixed at 0), where it frees
+    both of the heater's paths; None otherwise. BT alone cannot tell the two paths apart, and a fit
+    that sends the heat through the air with the drum below the beans has failed
+    (:attr:`roastlab.workflows.model.FittedModel.failed`); the drum is a drum roaster's path."""
+    import dataclasses
+
+    names = {p.name for p in spec.free}
+    if not {"Qe_gain_kW", "Tgi_gain_C"} <= names:
+        return None
+    return dataclasses.replace(
+        spec, free=[p for p in spec.free if p.name != "Tgi_gain_C"], fixed={**spec.fixed, "Tgi_gain_C": 0.0}
+    )
+
+
+def held_out_one_by_one(batches, config_dir: Path, column_map, seed: int, progress=None, spec=None):
+    """Each log predicted by a fit on all the others, with the fit spec as it is (its own bed laws;
+    ``spec``, default ``config_dir``/fit.toml): the :class:`~roastlab.workflows.compare.VariantScore`
+    of leave-one-log-out."""
     from ..io.fitspec import load_fit_spec
     from .compare import Variant, compare_models
 
-    spec = load_fit_spec(config_dir / "fit.toml")
+    spec = spec or load_fit_spec(config_dir / "fit.toml")
     return compare_models(
         batches,
         config_dir / "plant.toml",
