@@ -434,3 +434,27 @@ def test_the_room_temperature_a_log_records_sets_the_inlet_air_and_the_beans_at_
         load_map(write_map(tmp_path, SKY_MAP.replace('column = "ET"\n', 'column = "ET"\nroom = true\n', 1)))
     with pytest.raises(InputError, match="room_unit"):
         load_map(write_map(tmp_path, room_map.replace("room = true\n", 'room = true\nroom_unit = "K"\n')))
+
+
+@pytest.mark.parametrize("preheat", [230.0, 0, None])
+def test_roastime_drum_at_charge_is_the_preheat_else_the_ir_reading_then(tmp_path, preheat):
+    """SYNTHETIC RoasTime log: roastime.DRUM_AT_CHARGE (the map init writes) takes the preheat, and
+    the IR reading at charge where the log has none (absent, or RoasTime's 0 for "not set")."""
+    from roastlab.io.importers.roastime import DRUM_AT_CHARGE
+
+    d = {
+        "sampleRate": 1,
+        "weightGreen": 500,
+        "beanTemperature": [150.0 - 2 * i if i < 30 else 90 + i for i in range(200)],
+        "drumTemperature": [200.0] * 200,
+        "drumChargeTemperature": 221.5,
+        "actions": {"actionTimeList": [{"index": 0, "value": 6, "ctrlType": 0}]},
+    }
+    if preheat is not None:
+        d["preheatTemperature"] = preheat
+    p = tmp_path / "rt.json"
+    p.write_text(json.dumps(d))
+    sources = ", ".join(f'"{c}"' for c in DRUM_AT_CHARGE)
+    m = load_map(write_map(tmp_path, f'format = "roastime"\n[Ta]\ncolumn = "beanTemperature"\n[Tgi]\n'
+                                     f'constant_C = 22.0\n[Gg]\nconstant_kg_s = 0.01\n[initial]\nTm0_C = [{sources}]\n'))  # fmt: skip
+    assert import_log(p, m).initial["Tm0_C"] == (preheat or 221.5)

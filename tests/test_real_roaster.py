@@ -204,8 +204,8 @@ def test_drum_at_charge_is_the_preheat_where_the_log_starts_after_the_charge(bul
     ir = log.channels["drumTemperature"][:3]
     assert np.all(np.diff(ir) < -5)  # the beans are already falling past the IR sensor
     assert log.fields["drumChargeTemperature"] == pytest.approx(ir[0])
-    assert log.fields[DRUM_AT_CHARGE] - ir[0] > 40
-    assert import_log(path, load_map(BULLET / "map.toml")).initial["Tm0_C"] == log.fields[DRUM_AT_CHARGE]
+    assert log.fields[DRUM_AT_CHARGE[0]] - ir[0] > 40
+    assert import_log(path, load_map(BULLET / "map.toml")).initial["Tm0_C"] == log.fields[DRUM_AT_CHARGE[0]]
     assert log.unit == "2779"
 
 
@@ -255,7 +255,7 @@ def test_init_and_both_examples_use_the_cross_validated_bed(real_data, bullet_da
     from roastlab.workflows.roaster import init_roaster
 
     for folder, log, at_charge in (
-        (BULLET, bullet_data / "bullet_2020-07-31_0152_490g.json", roastime.DRUM_AT_CHARGE),
+        (BULLET, bullet_data / "bullet_2020-07-31_0152_490g.json", list(roastime.DRUM_AT_CHARGE)),
         (EXAMPLE, sorted(real_data.glob("*.alog"))[5], list(artisan.DRUM_AT_CHARGE)),
     ):
         example = load_fit_spec(folder / "fit.toml")

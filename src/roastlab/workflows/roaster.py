@@ -287,7 +287,8 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
                 f"{len(lacking)} log(s) record no {channel} ({', '.join(lacking[:3])}{' ...' if len(lacking) > 3 else ''}): "
                 f"their {what} setting is unknown, so fit-roaster leaves them out"
             )
-    if heater and len(infos) - sum(heater not in i.channels for i in infos) < 2:
+    without = sum(heater not in i.channels for i in infos) if heater else 0
+    if without and len(infos) - without < 2:
         raise InputError(
             f"only one log records the {heater} setting: fit-roaster needs two (one to fit, one to hold out)", "init"
         )
@@ -438,7 +439,10 @@ def map_text(s: Survey) -> str:
         lines += ["[Tb2]", f'column = "{s.second_bean}"   # a second bean reading (infrared)', "start_s = 10.0", ""]
     initial = []
     if s.format == "roastime":
-        initial.append(f'Tm0_C = "{DRUM_AT_CHARGE}"   # the drum at charge: the preheat it was held at')
+        sources = ", ".join(f'"{c}"' for c in DRUM_AT_CHARGE)
+        initial.append(
+            f"Tm0_C = [{sources}]   # the drum at charge: the preheat it was held at, else the IR reading then"
+        )
     else:
         if s.has_et and s.et_not_air:
             lines += [

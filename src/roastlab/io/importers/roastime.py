@@ -61,8 +61,10 @@ FIELDS = (
 #: ``bullet_2020-11-05_1536_500g`` the probe falls from the first sample and the IR reads 195, 183,
 #: 171 °C over the first 2 s against a preheat of 245 °C. Where the log starts before the charge
 #: the two agree within 3 °C on 26 of the 28 shared logs. docs/real-roaster.md measures the
-#: Bullet example with each.
-DRUM_AT_CHARGE = "preheatTemperature"
+#: Bullet example with each. A log without a preheat (none recorded, or 0: RoasTime's "not set",
+#: as for every field of :data:`FIELDS`) falls back on the IR reading at charge, the map's list
+#: tried in order.
+DRUM_AT_CHARGE = ("preheatTemperature", "drumChargeTemperature")
 #: Where RoasTime keeps the room temperature the owner typed (text, e.g. ``"72"`` or ``"64 F"``):
 #: ``ambientTemp`` in older files, ``ambient`` in later ones.
 ROOM_KEYS = ("ambientTemp", "ambient")
@@ -187,7 +189,8 @@ def read_roastime(path: str | Path, keep_after_drop: bool = False) -> ArtisanLog
             data.get("dateTime") / 1000.0 if isinstance(data.get("dateTime"), (int, float)) else None
         ),
     )
-    log.fields = {k: v for k in FIELDS if (v := _number(data, k, path, -100, 1000, required=False)) is not None}
+    # 0 is "not recorded" (no drum or bean is at 0 degC during a roast; Artisan writes 0 alike)
+    log.fields = {k: v for k in FIELDS if (v := _number(data, k, path, -100, 1000, required=False)) not in (None, 0.0)}
     # the room temperature the owner typed (older RoasTime: ambientTemp, later: ambient), as written
     log.room = room_from_text(next((data[k] for k in ROOM_KEYS if data.get(k) not in (None, "")), None))
     serial = data.get("serialNumber")
