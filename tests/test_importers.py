@@ -458,3 +458,27 @@ def test_roastime_drum_at_charge_is_the_preheat_else_the_ir_reading_then(tmp_pat
     m = load_map(write_map(tmp_path, f'format = "roastime"\n[Ta]\ncolumn = "beanTemperature"\n[Tgi]\n'
                                      f'constant_C = 22.0\n[Gg]\nconstant_kg_s = 0.01\n[initial]\nTm0_C = [{sources}]\n'))  # fmt: skip
     assert import_log(p, m).initial["Tm0_C"] == (preheat or 221.5)
+
+
+def test_an_unmarked_charge_and_drop_are_read_from_bt(tmp_path):
+    """SYNTHETIC BT: 30 s of preheated drum at 200 degC, the charge (a dip to a turning point near 90 degC),
+    a rise to 205 degC at 10:00 after CHARGE, then the discharge; no CHARGE or DROP marked (-1, 0)."""
+    t = np.arange(0.0, 720.0, 1.5)
+    after = t - 30.0
+    roast = (
+        90.0 + 110.0 * np.exp(-np.maximum(after, 0) / 25.0) + 115.0 * (1 - np.exp(-np.maximum(after, 0) / 400.0)) * 1.35
+    )
+    bt = np.where(after < 0, 200.0, roast)
+    bt = np.where(after > 600.0, bt[np.searchsorted(after, 600.0)] - 0.8 * (after - 600.0), bt)
+    p = tmp_path / "unmarked.alog"
+    p.write_text(fake_alog(bt=bt.tolist(), et=[220.0] * len(t), n=len(t),
+                           extra={"timex": t.tolist(), "timeindex": [-1, 0, 0, 0, 0, 0, 0, 0]}))  # fmt: skip
+    log = read_alog(p)
+    assert log.time_s[0] == 0.0 and abs(t[log.charge_index] - 30.0) <= 1.5
+    assert abs(log.time_s[-1] - 600.0) <= 3.0 and log.events["DROP"] == log.time_s[-1]
+    assert [n.split(":")[0] for n in log.notes] == ["no CHARGE marked", "no DROP marked"]
+    # marked logs are read as marked, with no note
+    p.write_text(fake_alog(bt=bt.tolist(), et=[220.0] * len(t), n=len(t),
+                           extra={"timex": t.tolist(), "timeindex": [10, 0, 0, 0, 0, 0, 400, 0]}))  # fmt: skip
+    log = read_alog(p)
+    assert log.charge_index == 10 and log.time_s[-1] == t[400] - t[10] and not log.notes

@@ -170,6 +170,44 @@ def test_a_log_without_burner_events_is_left_out_and_a_non_physical_fit_refitted
     )
 
 
+def test_an_unmarked_charge_and_drop_are_found_where_the_roaster_marked_them(real_data):
+    """roastlab.io.importers.artisan.charge_from_bt / drop_from_bt on the Skywalker's 16 logs, their
+    marks ignored: CHARGE within 3 s of the marked one, DROP within 10 s after it (where the probe held
+    to DROP: one log's probe fails before it, and the import cuts that log at the fault)."""
+    import ast
+
+    from roastlab.io.importers.artisan import BT_FALL_C, BT_FALL_WINDOW_S, charge_from_bt, drop_from_bt
+
+    for p in sorted(real_data.glob("*.alog")):
+        doc = ast.literal_eval(p.read_text(encoding="utf-8"))
+        t, bt = np.array(doc["timex"]), np.array(doc["temp2"], dtype=float)
+        bt[bt == -1] = np.nan
+        charge, drop = doc["timeindex"][0], doc["timeindex"][6]
+        found = charge_from_bt(t, bt)
+        assert abs(t[found] - t[charge]) <= 3.0, p.name
+        after = bt[drop : np.searchsorted(t, t[drop] + BT_FALL_WINDOW_S)]
+        if bt[drop] - np.nanmin(after) >= BT_FALL_C:  # the probe still read the beans at DROP
+            assert 0.0 <= t[drop_from_bt(t, bt, found)] - t[drop] <= 10.0, p.name
+
+
+def test_an_alog_without_charge_or_drop_marks_is_cut_where_bt_says_and_says_so(real_data, tmp_path):
+    from roastlab.io.importers.artisan import read_alog
+
+    src = sorted(real_data.glob("*.alog"))[1]
+    marked = read_alog(src)
+    text = src.read_text(encoding="utf-8")
+    import ast
+
+    doc = ast.literal_eval(text)
+    doc["timeindex"][0], doc["timeindex"][6] = -1, 0  # Artisan's "not marked"
+    bare = tmp_path / src.name
+    bare.write_text(repr(doc), encoding="utf-8")
+    log = read_alog(bare)
+    assert abs(log.time_s[-1] - marked.time_s[-1]) <= 10.0 and len(log.notes) == 2
+    assert log.notes[0].startswith("no CHARGE marked: taken at") and log.notes[1].startswith("no DROP marked")
+    assert abs(len(log.time_s) - len(marked.time_s)) <= 8
+
+
 BULLET = Path(__file__).resolve().parents[1] / "examples" / "bullet"
 
 

@@ -622,6 +622,12 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: b
     ``config_dir``/model.json, report.md and heldout.png (measured vs predicted BT of the
     held-out logs); returns the figures of the report.
 
+    Logs that do not record a setting the map drives the model with are left out
+    (:func:`logs_without_controls`). A fit that fails on its states with both of the heater's paths
+    free is refitted with the drum's path alone (:func:`drum_path_alone`), said in ``refit``; a model
+    that predicts the held-out logs worse than the first-order baseline is called so
+    (:func:`below_baseline`).
+
     ``every_log``: also hold every log out once, predicted by a fit on all the others
     (leave-one-log-out, :func:`roastlab.workflows.compare.compare_models` with the fit spec's own
     bed laws), and report each log's FIT and its share inside the 90 % band: one split of a few

@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from ...errors import InputError
+from ...metrics.profile import mmss
 from ..files import read_input_text
 
 #: The channel whose reading at CHARGE is the drum's temperature then, for an Artisan log (a map's
@@ -42,6 +43,17 @@ from ..files import read_input_text
 #: reading at CHARGE (a map's ``[initial]`` sources are tried in order).
 DRUM_AT_CHARGE = ("BT", "ET")
 EVENT_NAMES = ("CHARGE", "DRY", "FCs", "FCe", "SCs", "SCe", "DROP", "COOL")
+#: A log with no CHARGE or DROP marked: they are where the bean probe bends into a fall of BT_FALL_C
+#: or more within BT_FALL_WINDOW_S, at the charge (cold beans on the probe) and at the discharge (the
+#: probe left in the emptied drum). On the Skywalker's 16 logs BT falls 14-36 degC in the 30 s after
+#: each marked CHARGE and 11-34 degC after each DROP (one log's probe failed before its DROP), and at
+#: most 0.2 degC within any 30 s between the turning point and the last 30 s before DROP. Found so
+#: with the marks ignored: CHARGE within 3 s of the marked one on all 16, DROP 1.5-7.5 s after it on
+#: the 15 whose probe held (tests/test_real_roaster.py).
+BT_FALL_C = 10.0
+BT_FALL_WINDOW_S = 30.0
+#: The turning point is sought this long after CHARGE [s], the discharge after it.
+TURNING_POINT_WITHIN_S = 300.0
 WEIGHT_UNITS = {"g": 1e-3, "kg": 1.0, "lb": 0.45359237, "oz": 0.028349523125}
 
 
@@ -128,6 +140,84 @@ class ArtisanLog:
     started_epoch_s: float | None = None  # when the roast started (Artisan roastepoch, RoasTime dateTime)
     unit: str = ""  # which roaster of that make (RoasTime serialNumber); empty when the log does not say
     room: RoomReading | None = None  # the room temperature the log records, as written; None if it does not
+    notes: list[str] = field(default_factory=list)  # what the reader inferred (an unmarked CHARGE or DROP)
+
+
+def bt_falls_from(time_s: np.ndarray, bt: np.ndarray, start: int) -> int | None:
+    """The first sample from ``start`` on from which BT falls by :data:`BT_FALL_C` or more within
+    :data:`BT_FALL_WINDOW_S` (the beans' arrival at CHARGE, their departure at DROP), or None."""
+    ends = np.searchsorted(time_s, time_s + BT_FALL_WINDOW_S, side="right")
+    for k in range(start, len(bt)):
+        if np.isfinite(bt[k]) and bt[k] - np.nanmin(bt[k : ends[k]]) >= BT_FALL_C:
+            return k
+    return None
+
+
+def _running_median3(x: np.ndarray) -> np.ndarray:
+    """Each sample replaced by the median of it and its two neighbours (one glitch cannot look like
+    a fall); the ends by the median of the three nearest."""
+    if len(x) < 3:
+        return x.copy()
+    y = np.nanmedian(np.stack([x[:-2], x[1:-1], x[2:]]), axis=0)
+    return np.concatenate([y[:1], y, y[-1:]])
+
+
+def _bend_of_fall(time_s: np.ndarray, bt: np.ndarray, start: int) -> int | None:
+    """Where BT bends into the first fall of :func:`bt_falls_from` after ``start``: over the span from
+    :data:`BT_FALL_WINDOW_S` before the fall begins to where it has fallen :data:`BT_FALL_C`, the
+    sample furthest above the chord joining the span's ends (a slow drift before the fall, or a
+    rise, is not the event; the knee where the fall steepens is)."""
+    k0 = bt_falls_from(time_s, bt, start)
+    if k0 is None:
+        return None
+    fallen = np.flatnonzero(bt[k0:] <= bt[k0] - BT_FALL_C)
+    k1 = k0 + int(fallen[0])
+    a = max(start, int(np.searchsorted(time_s, time_s[k0] - BT_FALL_WINDOW_S)))
+    t, b = time_s[a : k1 + 1], bt[a : k1 + 1]
+    chord = b[0] + (b[-1] - b[0]) * (t - t[0]) / (t[-1] - t[0])
+    return a + int(np.nanargmax(b - chord))
+
+
+def marks_or_bt(time_s, bt, charge: int | None, drop: int | None, keep_after_drop: bool = False):
+    """A log's CHARGE and DROP sample indices, each as marked or, where unmarked (None), found in BT
+    (:func:`charge_from_bt`, :func:`drop_from_bt`); returns ``(charge, drop or None, notes)``, a note
+    for each mark found so. No CHARGE in BT: the first sample; no DROP: the log's end."""
+    notes = []
+    if charge is None:
+        charge = charge_from_bt(time_s, bt)
+        notes.append(
+            f"no CHARGE marked: taken at {time_s[charge] - time_s[0]:.0f} s into the recording, where BT bends "
+            f"into a fall of {BT_FALL_C:g} degC or more within {BT_FALL_WINDOW_S:g} s"
+            if charge is not None
+            else "no CHARGE marked and BT shows no charge: the log is read from its first sample"
+        )
+        charge = charge or 0
+    if drop is None and not keep_after_drop:
+        drop = drop_from_bt(time_s, bt, charge)
+        if drop is not None:
+            notes.append(
+                f"no DROP marked: taken at {mmss(time_s[drop] - time_s[charge])} after CHARGE, where BT bends "
+                f"into a fall of {BT_FALL_C:g} degC or more within {BT_FALL_WINDOW_S:g} s after its peak"
+            )
+    return charge, drop, notes
+
+
+def charge_from_bt(time_s: np.ndarray, bt: np.ndarray) -> int | None:
+    """An unmarked CHARGE: where BT bends into its first fall (:func:`_bend_of_fall`), or None."""
+    return _bend_of_fall(time_s, _running_median3(bt), 0)
+
+
+def drop_from_bt(time_s: np.ndarray, bt: np.ndarray, charge: int) -> int | None:
+    """An unmarked DROP: where BT bends into its first fall after its peak past the turning point
+    (the lowest BT within :data:`TURNING_POINT_WITHIN_S` of CHARGE); None when BT never falls so
+    (the log is then read to its end)."""
+    b = _running_median3(bt)
+    within = int(np.searchsorted(time_s, time_s[charge] + TURNING_POINT_WITHIN_S))
+    if not np.isfinite(b[charge:]).any():
+        return None
+    tp = charge + int(np.nanargmin(b[charge : max(within, charge + 1)]))
+    peak = tp + int(np.nanargmax(b[tp:]))
+    return _bend_of_fall(time_s, b, peak)
 
 
 # Tokens of a Python literal that JSON spells differently. Strings come first so that words,
@@ -330,8 +420,14 @@ def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: boo
     if not isinstance(ti, list) or not all(isinstance(q, int) and not isinstance(q, bool) for q in ti):
         raise InputError("timeindex must be a list of integers", path, "key timeindex")
     ti = (ti + [0] * 8)[:8]
-    charge = ti[0] if 0 <= ti[0] < n else 0
-    drop = ti[6] if 0 < ti[6] < n else None
+    charge, drop, notes = marks_or_bt(
+        timex,
+        channels["BT"],
+        ti[0] if 0 <= ti[0] < n else None,  # CHARGE unmarked: Artisan's -1
+        ti[6] if 0 < ti[6] < n else None,  # DROP unmarked: 0
+        keep_after_drop,
+    )
+    ti[0], ti[6] = charge, drop or 0
     events = {}
     for name, k in zip(EVENT_NAMES, ti):
         if (k > 0 or name == "CHARGE") and k < n:
@@ -363,6 +459,7 @@ def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: boo
         machine=str(data.get("roastertype", "") or "")[:100],
         started_epoch_s=epoch_or_none(data.get("roastepoch")),
         room=_alog_room(data.get("ambientTemp"), mode),
+        notes=notes,
     )
 
 
@@ -456,8 +553,6 @@ def read_artisan_csv(path: str | Path, keep_after_drop: bool = False) -> Artisan
     if mode == "F":
         et, bt = f_to_c(et), f_to_c(bt)
     charged = np.flatnonzero(np.isfinite(t2))
-    charge = int(charged[0]) if charged.size else 0
-    time_s = t1 - t1[charge]
     drop = None
     if meta.get("DROP"):
         # the meta line's event times are clock times on the Time1 axis, like CHARGE's
@@ -465,9 +560,13 @@ def read_artisan_csv(path: str | Path, keep_after_drop: bool = False) -> Artisan
             drop = int(np.argmin(np.abs(t1 - _mmss(meta["DROP"]))))
         except ValueError:
             raise InputError(f"DROP time {meta['DROP'][:20]!r} is not mm:ss", path, "line 1") from None
+    charge, drop, notes = marks_or_bt(t1, bt, int(charged[0]) if charged.size else None, drop, keep_after_drop)
+    time_s = t1 - t1[charge]
     end = len(time_s) if (keep_after_drop or drop is None) else drop + 1
     sl = slice(charge, end)
     events = {"CHARGE": 0.0}
     if drop is not None:
         events["DROP"] = float(time_s[drop])
-    return ArtisanLog(str(path), time_s[sl], {"ET": et[sl], "BT": bt[sl]}, {"ET", "BT"}, mode, charge, drop, events)
+    return ArtisanLog(
+        str(path), time_s[sl], {"ET": et[sl], "BT": bt[sl]}, {"ET", "BT"}, mode, charge, drop, events, notes=notes
+    )

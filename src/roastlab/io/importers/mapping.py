@@ -511,6 +511,7 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
             log = read_artisan_csv(path, cmap.keep_after_drop)
         time_s = log.time_s
         available = log.channels
+        default_notes.extend(log.notes)
 
         def channel(spec: dict, what: str) -> np.ndarray:
             col = spec["column"]
