@@ -146,11 +146,17 @@ class ArtisanLog:
 def bt_falls_from(time_s: np.ndarray, bt: np.ndarray, start: int) -> int | None:
     """The first sample from ``start`` on from which BT falls by :data:`BT_FALL_C` or more within
     :data:`BT_FALL_WINDOW_S` (the beans' arrival at CHARGE, their departure at DROP), or None."""
-    ends = np.searchsorted(time_s, time_s + BT_FALL_WINDOW_S, side="right")
-    for k in range(start, len(bt)):
-        if np.isfinite(bt[k]) and bt[k] - np.nanmin(bt[k : ends[k]]) >= BT_FALL_C:
-            return k
-    return None
+    from scipy.ndimage import minimum_filter1d
+
+    if len(bt) - start < 2:
+        return None
+    # the window in samples at the log's median sampling interval (Artisan and RoasTime sample evenly);
+    # a forward running minimum, so a long log costs one pass, not one slice per sample
+    width = max(2, int(round(BT_FALL_WINDOW_S / float(np.median(np.diff(time_s))))) + 1)
+    x = np.where(np.isfinite(bt), bt, np.inf)[start:]
+    ahead = minimum_filter1d(x, size=width, origin=-(width // 2), mode="nearest")
+    hits = np.flatnonzero(np.isfinite(x) & (x - ahead >= BT_FALL_C))
+    return start + int(hits[0]) if hits.size else None
 
 
 def _running_median3(x: np.ndarray) -> np.ndarray:
