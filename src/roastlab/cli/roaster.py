@@ -90,7 +90,10 @@ def add_parsers(sub) -> None:
         description="With DIR from 'roastlab init': sort LOG... by when they were roasted (by name when a log has no date) and split them alternately (1st, 3rd, ... fit; "
         "2nd, 4th, ... held out), identify the model, validate it on the held-out logs, fit the first-order "
         "baseline on the same inputs, and write DIR/model.json (MODEL.json for every other command), "
-        "DIR/report.md and DIR/heldout.png. Exit status 1 when the fit failed (states the machine cannot have, "
+        "DIR/report.md and DIR/heldout.png. A log that records no setting the map drives the model with is left "
+        "out; a fit whose drum runs below the beans with the heater free to heat the air is refitted with the "
+        "heater heating the drum alone; a model worse than the baseline on the held-out logs is called not "
+        "usable; each is said. Exit status 1 when the fit failed (states the machine cannot have, "
         "such as drum metal below the beans; the files are written and say so), 2 on bad input.",
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog="examples:\n  roastlab fit-roaster myroaster roasts/*.alog\n"
