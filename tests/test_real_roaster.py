@@ -146,8 +146,12 @@ def test_a_log_without_burner_events_is_left_out_and_a_non_physical_fit_refitted
     heater paths free puts the drum below the beans, and fit-roaster refits with the drum's path alone."""
     import ast
 
+    names = ["roast_25-10-04_1155", "roast_25-10-04_1229", "roast_25-10-25_1544", "roast_25-10-25_1609",
+             "roast_25-11-16_1235", "roast_25-11-16_1259"]  # fmt: skip
+    if not all((real_data / f"{n}.alog").is_file() for n in names):
+        pytest.skip("the six Skywalker logs of October-November 2025 are absent")
     logs = []
-    for p in sorted(real_data.glob("roast_25-1[01]-*.alog")):
+    for p in (real_data / f"{n}.alog" for n in names):
         doc = ast.literal_eval(p.read_text(encoding="utf-8"))  # a Python literal, as Artisan writes it
         if p.name == "roast_25-10-25_1544.alog":
             keep = [k for k, t in enumerate(doc["specialeventstype"]) if t != 3]  # 3: Burner (etypes)
@@ -155,7 +159,6 @@ def test_a_log_without_burner_events_is_left_out_and_a_non_physical_fit_refitted
                 doc[key] = [doc[key][k] for k in keep]
         logs.append(tmp_path / p.name)
         logs[-1].write_text(repr(doc), encoding="utf-8")
-    assert len(logs) == 6
     code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
     assert code == 0 and "1 log(s) record no Burner (roast_25-10-25_1544.alog)" in out, err
     code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
