@@ -11,6 +11,28 @@ SHARED = REPO.parent / "shared"
 REAL_DATA = SHARED / "data" / "real"
 
 
+#: Artisan's special-event lists (one entry per event).
+EVENT_KEYS = ("specialevents", "specialeventstype", "specialeventsvalue", "specialeventsStrings")
+
+
+def rewritten_alog(src: Path, dst: Path, edit) -> Path:
+    """``src`` (an Artisan profile: a Python literal) with ``edit(doc)`` applied, written to ``dst``:
+    a shared log changed into the case a test needs, the shared file untouched."""
+    import ast
+
+    doc = ast.literal_eval(src.read_text(encoding="utf-8"))
+    edit(doc)
+    dst.write_text(repr(doc), encoding="utf-8")
+    return dst
+
+
+def drop_events(doc: dict, event_type: int | None = None) -> None:
+    """Remove ``doc``'s special events of ``event_type`` (an index into ``etypes``), or all of them."""
+    keep = [k for k, t in enumerate(doc["specialeventstype"]) if event_type is not None and t != event_type]
+    for key in EVENT_KEYS:
+        doc[key] = [doc[key][k] for k in keep]
+
+
 @pytest.fixture
 def real_data():
     folder = REAL_DATA / "skywalker"

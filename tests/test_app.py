@@ -4,7 +4,6 @@ itself in a real browser (Playwright driving Debian's chromium; skipped with a m
 
 from __future__ import annotations
 
-import ast
 import json
 import shutil
 import socket
@@ -18,7 +17,7 @@ import pytest
 
 pytest.importorskip("starlette", reason="the page needs the app extra: pip install 'roastlab[app]'")
 
-from conftest import REAL_DATA  # noqa: E402
+from conftest import REAL_DATA, drop_events, rewritten_alog  # noqa: E402
 from roastlab.app.server import create_app  # noqa: E402
 from roastlab.workflows.model import FittedModel  # noqa: E402
 
@@ -392,10 +391,7 @@ def test_a_model_is_fitted_on_the_page_in_the_background(client, data_dir):
     (data_dir / "bare").mkdir(exist_ok=True)
     bare = []
     for p in sorted(sky.glob("*.alog"))[:6]:
-        doc = ast.literal_eval(p.read_text(encoding="utf-8"))
-        for key in ("specialevents", "specialeventstype", "specialeventsvalue", "specialeventsStrings"):
-            doc[key] = []
-        (data_dir / "bare" / p.name).write_text(repr(doc), encoding="utf-8")
+        rewritten_alog(p, data_dir / "bare" / p.name, drop_events)
         bare.append(f"bare/{p.name}")
     assert client.post("/api/fit", json={"logs": bare, "name": "bare"}, headers=H).json()["started"]
     deadline = time.monotonic() + 180

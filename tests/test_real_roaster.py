@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import REAL_DATA
+from conftest import REAL_DATA, drop_events, rewritten_alog
 from roastlab.fit.baseline import first_order_response, fit_first_order
 from roastlab.io.batch import Batch
 
@@ -121,14 +121,11 @@ def test_skywalker_logs_without_et_fit_with_the_heater_into_the_drum(cli, real_d
     """The Skywalker's 16 logs with their ET removed (rewritten in tmp_path; the shared logs untouched),
     as a roaster that logs BT and the settings only: init sends the heater into the drum alone, and the
     fit is physical and predicts the held-out half (free to use both paths, it failed on its states)."""
-    import ast
 
-    logs = []
-    for p in sorted(real_data.glob("*.alog")):
-        doc = ast.literal_eval(p.read_text(encoding="utf-8"))  # a Python literal, as Artisan writes it
-        doc["temp1"] = [-1.0] * len(doc["temp1"])
-        logs.append(tmp_path / p.name)
-        logs[-1].write_text(repr(doc), encoding="utf-8")
+    def no_et(doc):
+        doc["temp1"] = [-1.0] * len(doc["temp1"])  # Artisan's "no sample"
+
+    logs = [rewritten_alog(p, tmp_path / p.name, no_et) for p in sorted(real_data.glob("*.alog"))]
     code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
     assert code == 0 and "ET: no" in out, err
     assert "Tgi_gain_C" not in (tmp_path / "cfg" / "fit.toml").read_text()
@@ -144,21 +141,18 @@ def test_a_log_without_burner_events_is_left_out_and_a_non_physical_fit_refitted
     removed, as Artisan writes a roast whose burner never moved while it recorded: init sets up the
     other five's layout and says so, fit-roaster leaves that log out; on the five, the fit with both
     heater paths free puts the drum below the beans, and fit-roaster refits with the drum's path alone."""
-    import ast
-
     names = ["roast_25-10-04_1155", "roast_25-10-04_1229", "roast_25-10-25_1544", "roast_25-10-25_1609",
              "roast_25-11-16_1235", "roast_25-11-16_1259"]  # fmt: skip
     if not all((real_data / f"{n}.alog").is_file() for n in names):
         pytest.skip("the six Skywalker logs of October-November 2025 are absent")
-    logs = []
-    for p in (real_data / f"{n}.alog" for n in names):
-        doc = ast.literal_eval(p.read_text(encoding="utf-8"))  # a Python literal, as Artisan writes it
-        if p.name == "roast_25-10-25_1544.alog":
-            keep = [k for k, t in enumerate(doc["specialeventstype"]) if t != 3]  # 3: Burner (etypes)
-            for key in ("specialevents", "specialeventstype", "specialeventsvalue", "specialeventsStrings"):
-                doc[key] = [doc[key][k] for k in keep]
-        logs.append(tmp_path / p.name)
-        logs[-1].write_text(repr(doc), encoding="utf-8")
+    logs = [
+        rewritten_alog(
+            real_data / f"{n}.alog",
+            tmp_path / f"{n}.alog",
+            (lambda doc: drop_events(doc, 3)) if n == "roast_25-10-25_1544" else (lambda doc: None),  # 3: Burner
+        )
+        for n in names
+    ]
     code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
     assert code == 0 and "1 log(s) record no Burner (roast_25-10-25_1544.alog)" in out, err
     code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
@@ -198,14 +192,11 @@ def test_an_alog_without_charge_or_drop_marks_is_cut_where_bt_says_and_says_so(r
 
     src = sorted(real_data.glob("*.alog"))[1]
     marked = read_alog(src)
-    text = src.read_text(encoding="utf-8")
-    import ast
 
-    doc = ast.literal_eval(text)
-    doc["timeindex"][0], doc["timeindex"][6] = -1, 0  # Artisan's "not marked"
-    bare = tmp_path / src.name
-    bare.write_text(repr(doc), encoding="utf-8")
-    log = read_alog(bare)
+    def unmarked(doc):
+        doc["timeindex"][0], doc["timeindex"][6] = -1, 0  # Artisan's "not marked"
+
+    log = read_alog(rewritten_alog(src, tmp_path / src.name, unmarked))
     assert abs(log.time_s[-1] - marked.time_s[-1]) <= 10.0 and len(log.notes) == 2
     assert log.notes[0].startswith("no CHARGE marked: taken at") and log.notes[1].startswith("no DROP marked")
     assert abs(len(log.time_s) - len(marked.time_s)) <= 8
