@@ -251,7 +251,7 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
     infos = [inspect_log(p, batch_kg) for p in paths]
     first = infos[0]
     for key, what in (("format", "formats"), ("heater", "heater channels"), ("fan", "fan channels")):
-        kinds = {getattr(i, key) for i in infos} - ({None} if key != "format" else set())
+        kinds = {getattr(i, key) for i in infos} - {None}  # a log without a control: below
         if len(kinds) > 1:
             one = next(i for i in infos if getattr(i, key) is not None)
             odd = next(i for i in infos if getattr(i, key) not in (None, getattr(one, key)))
