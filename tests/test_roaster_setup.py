@@ -58,6 +58,28 @@ def test_init_without_et_lets_the_heater_heat_the_drum_alone(cli, tmp_path):
     assert "[weights]" not in fit
 
 
+def test_a_heater_logged_in_watts_is_read_as_a_power(cli, tmp_path):
+    """SYNTHETIC logs whose heater is an extra device reading 450-900 (a power readout, not a
+    percent): the map says W with the logs' top, the fit spec bounds the drum's share of it at all of
+    it (roastlab.workflows.roaster.KW_PER_W), and a program labels it in W."""
+    from roastlab.io.importers.mapping import load_map
+    from roastlab.workflows.roaster import KW_PER_W
+
+    n = 120
+    power = [450.0 if i < 60 else 900.0 for i in range(n)]
+    extra = {"extratimex": [[1.5 * i for i in range(n)]], "extraname1": ["Heater W"], "extraname2": ["Fan"],
+             "extratemp1": [power], "extratemp2": [[40.0] * n], "extraNoneTempHint1": [True],
+             "extraNoneTempHint2": [True]}  # fmt: skip
+    logs = [tmp_path / f"w{k}.alog" for k in range(2)]
+    for p in logs:
+        p.write_text(fake_alog(extra=extra))
+    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
+    assert code == 0 and "heater: Heater W (W)" in out, err
+    heater = load_map(tmp_path / "cfg" / "map.toml").actuator("heater")
+    assert (heater.unit, heater.high, heater.step, heater.label(900)) == ("W", 900.0, None, "900 W")
+    assert f"Qe_gain_kW = [0, {KW_PER_W:g}," in (tmp_path / "cfg" / "fit.toml").read_text()
+
+
 def test_a_log_that_records_no_burner_is_named_and_the_others_set_up(cli, tmp_path):
     """SYNTHETIC: Artisan logs a setting only when it moves; a roast whose burner never moved has no
     Burner events. init keeps the other logs' layout and names that log (fit-roaster leaves it out)."""

@@ -27,6 +27,7 @@ UNIT_DEFAULTS: dict[str, tuple[float, float, float | None, float]] = {
     "percent": (0.0, 100.0, 5.0, 60.0),
     "level": (0.0, 20.0, 1.0, 12.0),
     "kW": (0.0, 1e4, None, 1e4),
+    "W": (0.0, 1e5, None, 1e5),  # a heater's power readout in watts (an Artisan extra device)
 }
 #: How a setting's value reads to a roaster, per control and unit ("P7", "F3", "35 %").
 _PREFIX = {("heater", "level"): "P", ("fan", "level"): "F"}
@@ -41,7 +42,7 @@ MIN_HOLD_S = 30.0
 @dataclass(frozen=True)
 class Actuator:
     """One control of a roaster: ``name`` ("heater" or "fan"), its ``unit`` ("percent",
-    "level", "kW"), the range ``low``..``high`` in that unit, the ``step`` between settings the
+    "level", "kW", "W"), the range ``low``..``high`` in that unit, the ``step`` between settings the
     machine offers (None: continuous) and the fastest change ``rate_per_min`` [unit/min]."""
 
     name: str

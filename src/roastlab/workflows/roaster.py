@@ -7,7 +7,7 @@ What :func:`survey` detects in the logs (and says in the files' comments):
 * the format (Artisan ``.alog``/CSV, RoasTime JSON) and the bean probe (BT);
 * which channels are the heater/burner and the fan/air, by name in Artisan's languages (an
   event type or an extra device), with their unit by value range (whole steps up to 20: a
-  level; else percent);
+  level; up to 100: percent; above 100: a heater's power in W);
 * a second bean reading (RoasTime's infrared ``drumTemperature``);
 * ET (the drum temperature at CHARGE is BT's reading then,
   :data:`roastlab.io.importers.artisan.DRUM_AT_CHARGE`; RoasTime's preheat for RoasTime logs);
@@ -172,11 +172,23 @@ class Survey:
     room_unit: str | None = None  # the unit of their bare numbers (mapping.bare_room_unit); None if none is bare
 
 
+#: A heater logged in watts heats the drum by at most its electric power [kW per W].
+KW_PER_W = 1e-3
+
+
 def _unit_of(values: np.ndarray) -> str:
+    """A logged setting's unit by its values: whole steps up to 20 a level; up to 100 a percent;
+    above 100 a power in watts (a heater's power readout; a fan so logged is not used)."""
     v = values[np.isfinite(values)]
     if v.size and np.all(np.abs(v - np.round(v)) < 1e-9) and v.max() <= 20:
         return "level"
-    return "percent"
+    return "W" if v.size and v.max() > 100.0 else "percent"
+
+
+def _common_unit(units: set) -> str | None:
+    """One unit for a control whose logs read as different units: the widest range (W over
+    percent over level: a log that never passes 20 does not make the channel a level)."""
+    return next((u for u in ("W", "percent", "level") if u in units), None)
 
 
 def _find(names, candidates) -> str | None:
@@ -275,11 +287,14 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
             "and none in the file name: pass --batch-kg",
             "init",
         )
-    units = {i.heater_unit for i in infos if i.heater} | set()
-    heater_unit = "percent" if "percent" in units else (units.pop() if units else None)
-    fan_units = {i.fan_unit for i in infos if i.fan}
-    fan_unit = "percent" if "percent" in fan_units else (fan_units.pop() if fan_units else None)
+    heater_unit = _common_unit({i.heater_unit for i in infos if i.heater})
+    fan_unit = _common_unit({i.fan_unit for i in infos if i.fan})
     notes = []
+    if fan_unit == "W":  # above 100: not a percent or a level (a speed in rpm?); the model's flow law cannot read it
+        notes.append(
+            f"the {fan} channel reads above 100, neither a percent nor a level: not used (set its unit in the map)"
+        )
+        fan = fan_unit = None
     for channel, what in ((heater, "heater"), (fan, "fan")):
         lacking = [i.path.name for i in infos if channel and channel not in i.channels]
         if lacking:
@@ -424,15 +439,19 @@ def map_text(s: Survey) -> str:
         ("fan", s.fan, s.fan_unit, s.fan_max),
     ):
         if col:
-            step = "step = 1" if unit == "level" else "step = 5              # Artisan's slider in 5 % steps"
+            why = {"level": "whole steps", "percent": "percent", "W": "above 100: a power in watts"}[unit]
             lines += [
                 f"[{name}]",
                 f'column = "{col}"      # detected by name',
-                f'unit = "{unit}"       # by the logged values ({"whole steps" if unit == "level" else "percent"})',
+                f'unit = "{unit}"       # by the logged values ({why})',
             ]
-            if unit == "level":
+            if unit in ("level", "W"):
                 lines += ["min = 0", f"max = {top:g}                # the highest setting the logs use"]
-            lines += [step, ""]
+            if unit == "level":
+                lines.append("step = 1")
+            elif unit == "percent":
+                lines.append("step = 5              # Artisan's slider in 5 % steps")
+            lines.append("")
     for what, ch in s.unused.items():
         lines.insert(2, f"# logged but not used by the model: {what} ({ch!r})")
     if s.second_bean:
@@ -490,6 +509,8 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
     if s.heater:
         span = _setting_span(s.heater_unit, s.heater_max)
         qe_hi = round(10.0 * capacity_kg / span, 4)  # ~10 kW per kg of capacity at full setting, generous
+        if s.heater_unit == "W":  # a power readout: the drum gets at most all of it
+            qe_hi = KW_PER_W
         if path in ("drum", "both"):
             rows.append(
                 line(
