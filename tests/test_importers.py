@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from roastlab.io.importers import gas_flow_pitot_kg_s, import_log, load_map
-from roastlab.io.importers.artisan import events_internal_to_external, read_alog
+from roastlab.io.importers.artisan import events_internal_to_external, read_alog, read_artisan_csv
 
 SPOT = ["roast_25-09-27_1236_R14.alog", "roast_25-11-16_1235.alog", "roast_26-05-10_1438_R58_brazil_250.alog"]
 
@@ -142,6 +142,21 @@ def test_artisan_csv_export(tmp_path):
     b = import_log(p, load_map(write_map(tmp_path, SKY_MAP)))
     assert b.time_s[0] == 0 and b.time_s[-1] == pytest.approx(174.0)
     assert b.Ta_C[0] == pytest.approx(121.8)
+
+
+def test_an_artisan_csv_export_with_repeated_whole_seconds_is_averaged(tmp_path):
+    """SYNTHETIC export sampled every 0.5 s: the export's whole seconds repeat each time twice; the rows
+    sharing a time are averaged (it was refused: time not strictly increasing)."""
+    rows = ["Date:01.01.2026\tUnit:C\tCHARGE:00:00\tDROP:02:00", "Time1\tTime2\tET\tBT\tEvent"]
+    for k in range(0, 242):
+        s = k // 2  # 0.5 s apart, written as whole seconds
+        rows.append(f"{s // 60:02d}:{s % 60:02d}\t{s // 60:02d}:{s % 60:02d}\t{200 + k * 0.1:.2f}\t{120 + k:.1f}\t")
+    p = tmp_path / "fast.csv"
+    p.write_text("\n".join(rows) + "\n")
+    log = read_artisan_csv(p)
+    assert np.all(np.diff(log.time_s) == 1.0) and log.time_s[-1] == 120.0
+    assert log.channels["BT"][:2].tolist() == [120.5, 122.5]  # each second the mean of its two rows
+    assert log.notes[0].startswith("121 time stamp(s) repeat")
 
 
 def test_generic_csv_with_units_and_pitot(tmp_path):

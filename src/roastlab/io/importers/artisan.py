@@ -506,6 +506,24 @@ def _mmss(text: str) -> float:
         raise ValueError(text) from None
 
 
+def _merge_repeated_times(time_s: np.ndarray, columns):
+    """Rows that share a time stamp merged into one, each column the mean of its readings there
+    (NaN where none): Artisan's CSV export writes whole seconds, so a log sampled faster than once a
+    second, or with jitter, repeats times. Returns ``(times, columns, how many times repeat)``;
+    times that go backwards are left for the batch check to refuse."""
+    if time_s.size < 2 or not np.any(np.diff(time_s) == 0) or np.any(np.diff(time_s) < 0):
+        return time_s, columns, 0
+    times, inverse, counts = np.unique(time_s, return_inverse=True, return_counts=True)
+
+    def mean(x):
+        ok = np.isfinite(x)
+        n = np.bincount(inverse, weights=ok.astype(float), minlength=times.size)
+        total = np.bincount(inverse, weights=np.where(ok, x, 0.0), minlength=times.size)
+        return np.divide(total, n, out=np.full(times.size, np.nan), where=n > 0)
+
+    return times, tuple(mean(c) for c in columns), int(np.sum(counts > 1))
+
+
 def read_artisan_csv(path: str | Path, keep_after_drop: bool = False) -> ArtisanLog:
     """Parse Artisan's CSV export: a first line with ``Unit:C``/``Unit:F`` and the event clock
     times (CHARGE, DROP, ... on the Time1 axis), a header ``Time1, Time2, ET, BT, Event`` (tab-
@@ -558,6 +576,7 @@ def read_artisan_csv(path: str | Path, keep_after_drop: bool = False) -> Artisan
     et, bt = np.array(et), np.array(bt)
     if mode == "F":
         et, bt = f_to_c(et), f_to_c(bt)
+    t1, (t2, et, bt), repeats = _merge_repeated_times(t1, (t2, et, bt))
     charged = np.flatnonzero(np.isfinite(t2))
     drop = None
     if meta.get("DROP"):
@@ -567,6 +586,8 @@ def read_artisan_csv(path: str | Path, keep_after_drop: bool = False) -> Artisan
         except ValueError:
             raise InputError(f"DROP time {meta['DROP'][:20]!r} is not mm:ss", path, "line 1") from None
     charge, drop, notes = marks_or_bt(t1, bt, int(charged[0]) if charged.size else None, drop, keep_after_drop)
+    if repeats:
+        notes.insert(0, f"{repeats} time stamp(s) repeat (the export writes whole seconds): their rows averaged")
     time_s = t1 - t1[charge]
     end = len(time_s) if (keep_after_drop or drop is None) else drop + 1
     sl = slice(charge, end)
