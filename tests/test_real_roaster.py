@@ -161,7 +161,9 @@ def test_a_log_without_burner_events_is_left_out_and_a_non_physical_fit_refitted
     assert "refitted: with the heater free to heat the air and the drum, the fit failed on non-physical" in out
     held, base = out.split("held out: FIT ")[1].split(" %")[0], out.split("first-order baseline: ")[1].split(" %")[0]
     assert float(held) > float(base) + 10, out  # 71.0 % against 44.4 % measured on 2026-11-26
+    assert "note: roast_25-10-25_1609.alog: bean temperature jumps" in err  # what the import did, said
     report = (tmp_path / "cfg" / "report.md").read_text()
+    assert "Read from the logs:" in report and "- roast_25-10-25_1609.alog: bean temperature jumps" in report
     assert (
         "5 logs sorted by date" in report and "Left out: roast_25-10-25_1544.alog" in report and "Refitted:" in report
     )

@@ -40,6 +40,9 @@ def cmd_fit_roaster(args) -> int:
 
     r = fit_roaster(args.dir, args.logs, progress=progress("fit-roaster"), seed=args.seed, every_log=args.every_log)
     f, h, b = r["fit"], r["held_out"], r["baseline_held_out"]
+    for name, notes in r["notes"].items():
+        for note in notes:
+            print(f"note: {name}: {note}", file=sys.stderr)
     for why in r["left_out"].values():
         print(f"left out: {why}")
     if r["refit"]:

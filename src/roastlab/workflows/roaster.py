@@ -722,6 +722,11 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: b
         "",
         *(line for why in left_out.values() for line in (f"Left out: {why}.", "")),
         *([f"Refitted: {refit}.", ""] if refit else []),
+        *(
+            ["Read from the logs:", "", *(f"- {p.name}: {n}" for p, b in zip(paths, batches) for n in b.notes), ""]
+            if any(b.notes for b in batches)
+            else []
+        ),  # fmt: skip
         "| set | logs | model FIT % | model MAE °C | baseline FIT % | baseline MAE °C |",
         "|---|---|---|---|---|---|",
         f"| fit | {len(fit_b)} | {v_fit.average['FIT']:.1f} | {v_fit.average['MAE']:.2f} | {bf['FIT']:.1f} | {bf['MAE']:.2f} |",
@@ -778,6 +783,7 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: b
         "below_baseline": verdict,
         "left_out": left_out,
         "refit": refit,
+        "notes": {p.name: list(b.notes) for p, b in zip(paths, batches) if b.notes},
         "band": band,
         "every_log": every
         and {
