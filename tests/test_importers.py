@@ -497,3 +497,15 @@ def test_an_unmarked_charge_and_drop_are_read_from_bt(tmp_path):
                            extra={"timex": t.tolist(), "timeindex": [10, 0, 0, 0, 0, 0, 400, 0]}))  # fmt: skip
     log = read_alog(p)
     assert log.charge_index == 10 and log.time_s[-1] == t[400] - t[10] and not log.notes
+
+
+def test_a_green_weight_in_the_file_name_is_the_batchs_when_the_log_has_none(tmp_path):
+    """SYNTHETIC: init reads a weight from a file name ("..._230g.alog"); the import does too, so the
+    fit sees each log's own batch, not the plant's nominal one (the log's own weight wins)."""
+    unweighed = tmp_path / "kenya_230g.alog"
+    unweighed.write_text(fake_alog(extra={"weight": [0, 0, "g"]}))
+    b = import_log(unweighed, load_map(write_map(tmp_path, SKY_MAP)))
+    assert b.Mb_kg == 0.23 and any("from the file name's '230g'" in n for n in b.notes)
+    weighed = tmp_path / "kenya_230g_weighed.alog"
+    weighed.write_text(fake_alog())  # weight [200, 170, "g"]
+    assert import_log(weighed, load_map(write_map(tmp_path, SKY_MAP))).Mb_kg == 0.2

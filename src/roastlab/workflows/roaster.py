@@ -42,7 +42,7 @@ import numpy as np
 from ..errors import InputError
 from ..io.importers.artisan import DRUM_AT_CHARGE as ARTISAN_DRUM_AT_CHARGE
 from ..io.importers.artisan import WEIGHT_UNITS, RoomReading, read_alog, read_artisan_csv
-from ..io.importers.mapping import bare_room_unit, detect_format
+from ..io.importers.mapping import bare_room_unit, detect_format, grams_in_name
 from ..io.importers.roastime import DRUM_AT_CHARGE, read_roastime
 from ..metrics.profile import et_minus_bt_C, et_not_drum_air
 from ..model.bed import CROSS_VALIDATED, PROBE_DEPTH_OVER_DIAMETER
@@ -122,7 +122,6 @@ GAS_FLOW_MAX_FLOOR_KG_S = 0.05
 #: order below the quantity table's fit bounds (made for the paper's industrial drums), inside
 #: its plausible range (the Bullet's gas-metal coefficient ends near it).
 SMALL_COEFF_FLOOR = 0.001
-_GRAMS = re.compile(r"(?<![0-9])(\d{2,5})\s?g(?![a-z])", re.I)
 
 
 @dataclass
@@ -221,8 +220,8 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
         mass, source = batch_kg, "--batch-kg"
     elif log.weight_in_kg:
         mass, source = log.weight_in_kg, "the log's green weight"
-    elif m := _GRAMS.search(path.stem):
-        mass, source = int(m.group(1)) / 1000.0, f"the file name's '{m.group(0)}'"
+    elif named := grams_in_name(path):
+        mass, source = named[0], f"the file name's '{named[1]}'"
     else:
         mass, source = None, ""
     return LogInfo(

@@ -63,6 +63,7 @@ map or log file and the key.
 from __future__ import annotations
 
 import io
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -377,6 +378,16 @@ def to_celsius(values: np.ndarray, unit: str) -> np.ndarray:
     return values
 
 
+#: A green weight written in a log's file name: "..._230g.alog", "kenya 250 g.csv".
+_GRAMS = re.compile(r"(?<![0-9])(\d{2,5})\s?g(?![a-z])", re.I)
+
+
+def grams_in_name(path: Path) -> tuple[float, str] | None:
+    """The green batch [kg] a log's file name states, with the text it was read from, or None."""
+    m = _GRAMS.search(Path(path).stem)
+    return (int(m.group(1)) / 1000.0, m.group(0)) if m else None
+
+
 def detect_format(path: Path, fmt: str = "auto") -> str:
     """The log format of ``path``: ``fmt`` unless "auto", else by suffix and content."""
     if fmt != "auto":
@@ -600,10 +611,30 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
                 to_celsius(v, spec.get("unit", "C")) + (spec.get("offset_C") or 0.0) if k in ("Tb2", "ET") else v
             )
         drop_known = True
-        if cmap.initial:
-            raise InputError("[initial] from the log needs a roast log (alog, artisan-csv, roastime)", cmap.source)
+        # the first row is the charge: an initial state from the log is one of the map's temperature
+        # columns read there (in its unit), the first of a list that has a reading
+        temps = {cmap.Ta["column"]: Ta}
+        if "column" in cmap.Tgi:
+            temps[cmap.Tgi["column"]] = Tgi
+        temps.update({settings[k]["column"]: series[k] for k in ("Tb2", "ET") if k in series})
+        for state, sources in cmap.initial.items():
+            names = [sources] if isinstance(sources, str) else sources
+            unknown = [n for n in names if n not in temps]
+            if unknown:
+                raise InputError(
+                    f"initial.{state}: {', '.join(map(repr, unknown))} is not one of this map's temperature "
+                    f"columns ({', '.join(temps)}), which a CSV's initial states are read from",
+                    cmap.source,
+                )
+            found = next((temps[n][0] for n in names if np.isfinite(temps[n][0])), None)
+            if found is None:
+                raise InputError(f"initial.{state}: no reading of {', '.join(names)} in the first row", path)
+            initial[state] = float(found)
     if Mb is None and cmap.batch_kg is not None:
         Mb = cmap.batch_kg
+    if Mb is None and (named := grams_in_name(path)):  # the log records none; its name does
+        Mb = named[0]
+        default_notes.append(f"green weight {named[0]:g} kg from the file name's '{named[1]}'")
     if Mb is None and fmt == "roastime":
         raise InputError(
             "the log has no green weight (weightGreen 0): set batch_kg = ... in the map, or pass --batch-kg", path
