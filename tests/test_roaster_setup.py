@@ -80,6 +80,31 @@ def test_a_heater_logged_in_watts_is_read_as_a_power(cli, tmp_path):
     assert f"Qe_gain_kW = [0, {KW_PER_W:g}," in (tmp_path / "cfg" / "fit.toml").read_text()
 
 
+def test_init_reads_a_plain_csv_by_its_column_names(cli, tmp_path):
+    """SYNTHETIC plain CSV logs (a header row, numbers, the first row the charge; degF by the names):
+    init finds time, BT, ET, the burner and the fan by name, writes them with their units, reads the
+    drum at charge from BT's first row and the batch from the file name; the import reads it so."""
+    from roastlab.io.importers.mapping import import_log, load_map
+
+    logs = []
+    for k, grams in enumerate((230, 250)):
+        rows = ["time (s),Bean Temp (F),ET (F),Burner %,Fan %,Inlet temp (F),BT RoR"]
+        for i in range(120):
+            bt_f = 300.0 - 2.0 * i if i < 30 else 240.0 + 1.2 * (i - 30)
+            rows.append(f"{2.0 * i},{bt_f:.1f},{bt_f + 40:.1f},{60 + 10 * (i > 60)},{30 + k},572.0,0")
+        logs.append(tmp_path / f"roast{k}_{grams}g.csv")
+        logs[-1].write_text("\n".join(rows) + "\n")
+    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
+    assert code == 0, err
+    assert "format csv" in out and "heater: Burner % (percent); fan: Fan % (percent)" in out
+    assert "CSV: time 'time (s)' [s], BT 'Bean Temp (F)', ET 'ET (F)' [degF]" in out
+    cmap = load_map(tmp_path / "cfg" / "map.toml")
+    assert (cmap.Ta["column"], cmap.Ta["unit"], cmap.ET["unit"]) == ("Bean Temp (F)", "F", "F")
+    b = import_log(logs[1], cmap)
+    assert b.initial["Tm0_C"] == pytest.approx((300.0 - 32) * 5 / 9) and b.Mb_kg == 0.25
+    assert b.Ta_C[0] == pytest.approx((300.0 - 32) * 5 / 9) and b.heater[-1] == 70.0
+
+
 def test_a_log_that_records_no_burner_is_named_and_the_others_set_up(cli, tmp_path):
     """SYNTHETIC: Artisan logs a setting only when it moves; a roast whose burner never moved has no
     Burner events. init keeps the other logs' layout and names that log (fit-roaster leaves it out)."""

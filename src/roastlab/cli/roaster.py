@@ -71,7 +71,8 @@ def add_parsers(sub) -> None:
     p = sub.add_parser(
         "init",
         help="read a roaster's logs and write its column map, plant and fit spec",
-        description="Inspect LOG... (Artisan .alog/.csv or RoasTime .json of one roaster) and write DIR/map.toml "
+        description="Inspect LOG... (Artisan .alog/.csv, RoasTime .json, or plain CSV with a header naming time, BT and "
+        "ET, its first row the charge, of one roaster) and write DIR/map.toml "
         "(which channel is BT, the heater, the fan, a second bean reading, ET), DIR/plant.toml (the drum, from its "
         "dimensions, a catalogue entry or the batch capacity, each estimate stated) and DIR/fit.toml (what these "
         "logs can determine), each commented with what was detected and what was guessed. Logs are never modified. "

@@ -4,7 +4,8 @@ with the first-order baseline and writes the model and a report.
 
 What :func:`survey` detects in the logs (and says in the files' comments):
 
-* the format (Artisan ``.alog``/CSV, RoasTime JSON) and the bean probe (BT);
+* the format (Artisan ``.alog``/CSV, RoasTime JSON, a plain CSV whose columns are found by name,
+  :func:`plain_csv_columns`) and the bean probe (BT);
 * which channels are the heater/burner and the fan/air, by name in Artisan's languages (an
   event type or an extra device), with their unit by value range (whole steps up to 20: a
   level; up to 100: percent; above 100: a heater's power in W);
@@ -31,6 +32,7 @@ from the quantity table.
 
 from __future__ import annotations
 
+import io
 import math
 import re
 from collections import Counter
@@ -147,6 +149,7 @@ class LogInfo:
     unit: str = ""  # the roaster unit the log names (RoasTime serialNumber), else empty
     et_minus_bt_C: float | None = None  # median ET - BT through the roast (metrics.profile.et_minus_bt_C)
     room: RoomReading | None = None  # the room temperature the log records, as written
+    columns: dict | None = None  # a plain CSV's own names and units (plain_csv_columns)
 
 
 @dataclass
@@ -169,6 +172,7 @@ class Survey:
     et_not_air: list[str] = field(default_factory=list)  # logs whose ET is not the drum's air
     rooms: int = 0  # logs that record the room temperature
     room_unit: str | None = None  # the unit of their bare numbers (mapping.bare_room_unit); None if none is bare
+    columns: dict | None = None  # a plain CSV's own names and units (plain_csv_columns)
 
 
 #: A heater logged in watts heats the drum by at most its electric power [kW per W].
@@ -198,22 +202,100 @@ def _find(names, candidates) -> str | None:
     return None
 
 
+#: A plain CSV's columns by name: the first word of a header, lower case ("BT (F)" -> "bt").
+CSV_TIME_WORDS = ("time", "t", "sec", "secs", "seconds", "elapsed")
+CSV_BT_WORDS = ("bt", "bean", "beans", "beantemp")
+CSV_ET_WORDS = ("et", "env", "environment", "exhaust", "exit")
+#: Words that make a column a rate or a difference, not a reading ("BT RoR", "delta BT").
+CSV_NOT_A_READING = ("ror", "delta", "rate", "dbt", "det")
+
+
+def plain_csv_columns(header: list[str]) -> dict:
+    """The time, BT and ET columns of a plain CSV log by their names (:data:`CSV_TIME_WORDS` ...),
+    with their units: minutes or milliseconds where the time's name says so, else seconds; degF
+    where a temperature's name says F (``BT (F)``, ``bean_temp_degF``, ``°F``), else degC."""
+
+    def words(name):
+        return re.findall(r"[a-z]+", name.lower().replace("°", " deg"))
+
+    def first(candidates, taken=()):
+        for name in header:
+            w = words(name)
+            if w and w[0] in candidates and name not in taken and not set(w) & set(CSV_NOT_A_READING):
+                return name
+        return None
+
+    def temp_unit(name):
+        w = words(name)
+        return "F" if name and ({"f", "degf", "fahrenheit"} & set(w) or name.strip().lower().endswith("_f")) else "C"
+
+    time, bt = first(CSV_TIME_WORDS), first(CSV_BT_WORDS)
+    et = first(CSV_ET_WORDS, (bt,))
+    tw = set(words(time or ""))
+    return {
+        "time": time,
+        "time_unit": "min" if tw & {"min", "mins", "minutes"} else ("ms" if "ms" in tw else "s"),
+        "BT": bt,
+        "ET": et,
+        "temp_unit": temp_unit(bt or ""),
+    }
+
+
+def read_plain_csv(path: Path):
+    """A plain CSV log (a header row, numbers below; its first row the charge) read as an
+    :class:`~roastlab.io.importers.artisan.ArtisanLog` whose BT and ET are in degC under those
+    names, and its columns (:func:`plain_csv_columns`): what :func:`inspect_log` needs."""
+    import csv as _csv
+
+    from ..io.batch import read_table
+    from ..io.files import read_input_text
+    from ..io.importers.artisan import ArtisanLog
+    from ..io.importers.mapping import TIME_UNITS, to_celsius
+
+    text = read_input_text(path, "a CSV log")
+    header = next(
+        (row for row in _csv.reader(ln for ln in io.StringIO(text) if not ln.lstrip().startswith("#")) if row), []
+    )
+    header = [h.strip() for h in header]
+    cols = plain_csv_columns(header)
+    if cols["time"] is None or cols["BT"] is None:
+        raise InputError(
+            f"a CSV log needs a time column and a bean-temperature column by name (a header like time,BT,ET; "
+            f"found: {', '.join(header[:8])})",
+            path,
+        )
+    others = tuple(h for h in header if h not in (cols["time"], cols["BT"], cols["ET"]) and h)
+    data = read_table(path, (cols["time"], cols["BT"]), (*((cols["ET"],) if cols["ET"] else ()), *others), text=text)
+    time_s = data[cols["time"]] * TIME_UNITS[cols["time_unit"]]
+    channels = {"BT": to_celsius(data[cols["BT"]], cols["temp_unit"])}
+    if cols["ET"]:
+        channels["ET"] = to_celsius(data[cols["ET"]], cols["temp_unit"])
+    channels.update({h: data[h] for h in others if h in data})
+    log = ArtisanLog(str(path), time_s - time_s[0], channels, {"BT", "ET"}, cols["temp_unit"], 0, None, {"CHARGE": 0.0})
+    return log, cols
+
+
 def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
     """One log's layout (format, channels, heater/fan, second bean reading, batch)."""
     path = Path(path)
     fmt = detect_format(path, "auto")
+    columns = None
     if fmt == "alog":
         log = read_alog(path)
     elif fmt == "artisan-csv":
         log = read_artisan_csv(path)
     elif fmt == "roastime":
         log = read_roastime(path)
+    elif fmt == "csv":
+        log, columns = read_plain_csv(path)
     else:
-        raise InputError("not a roast log roastlab can set up from (Artisan .alog/.csv, RoasTime .json)", path)
+        raise InputError("not a roast log roastlab can set up from (Artisan .alog/.csv, RoasTime .json, CSV)", path)
     names = list(log.channels)
     if "BT" not in log.channels or not np.isfinite(log.channels["BT"]).any():
         raise InputError("no bean temperature (BT) in this log: roastlab needs the bean probe", path)
     others = [n for n in names if n not in ("BT", "ET", "beanTemperature", "drumTemperature", "exitTemperature")]
+    if fmt == "csv":  # a CSV's other temperatures ("inlet temp", "air temp") are not settings
+        others = [n for n in others if "temp" not in n.lower() and "°" not in n]
     heater = "heater" if fmt == "roastime" and "heater" in names else _find(others, HEATER_NAMES)
     fan = "fan" if fmt == "roastime" and "fan" in names else _find([n for n in others if n != heater], FAN_NAMES)
     if batch_kg is not None:
@@ -250,6 +332,7 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
         if "ET" in names
         else None,
         log.room,
+        columns,
     )
 
 
@@ -276,6 +359,12 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
     # that log out (logs_without_controls)
     heater = next((i.heater for i in infos if i.heater), None)
     fan = next((i.fan for i in infos if i.fan), None)
+    if first.columns is not None and any(i.columns != first.columns for i in infos):
+        odd = next(i for i in infos if i.columns != first.columns)
+        raise InputError(
+            f"the CSV logs name their columns differently ({first.path.name} vs {odd.path.name}): one layout at a time",
+            odd.path,
+        )
     machines = {i.machine for i in infos if i.machine}
     if len(machines) > 1:
         raise InputError(f"the logs name different roasters ({', '.join(sorted(machines))}): one at a time", "init")
@@ -305,6 +394,13 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
     if without and len(infos) - without < 2:
         raise InputError(
             f"only one log records the {heater} setting: fit-roaster needs two (one to fit, one to hold out)", "init"
+        )
+    if first.columns is not None:
+        c = first.columns
+        notes.append(
+            f"CSV: time {c['time']!r} [{c['time_unit']}], BT {c['BT']!r}"
+            + (f", ET {c['ET']!r}" if c["ET"] else ", no ET")
+            + f" [deg{c['temp_unit']}], by their names; each log's first row is taken as CHARGE"
         )
     serials = Counter(i.unit for i in infos if i.unit)
     if len(serials) > 1:
@@ -337,6 +433,7 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
         odd,
         sum(i.room is not None for i in infos),
         bare_room_unit(i.room for i in infos),
+        first.columns,
     )
 
 
@@ -409,10 +506,13 @@ def map_text(s: Survey) -> str:
         f'format = "{s.format}"',
         "resample_s = 5.0      # fits fast and loses nothing at roasting time scales",
         "",
-        "[Ta]",
-        'column = "BT"         # the bean probe',
-        "",
     ]
+    cols = s.columns  # a plain CSV names its own columns and units; Artisan's are BT and ET in degC
+    if cols:
+        lines += ["[time]", f'column = "{cols["time"]}"', f'unit = "{cols["time_unit"]}"', ""]
+    lines += ["[Ta]", f'column = "{cols["BT"] if cols else "BT"}"         # the bean probe']
+    lines += [f'unit = "{cols["temp_unit"]}"', ""] if cols else [""]
+    et, et_unit = (cols["ET"], f'\nunit = "{cols["temp_unit"]}"') if cols else ("ET", "")
     room_air = bool(s.heater)
     if room_air:
         lines += ["[Tgi]", "constant_C = 22.0     # room air drawn into the drum: the heat comes from the heater"]
@@ -429,7 +529,7 @@ def map_text(s: Survey) -> str:
                 )
         lines.append("")
     elif s.has_et:
-        lines += ["[Tgi]", 'column = "ET"         # no heater logged: ET taken as the inlet gas', ""]
+        lines += ["[Tgi]", f'column = "{et}"         # no heater logged: ET taken as the inlet gas{et_unit}', ""]
     else:
         raise InputError("the logs have neither a heater setting nor ET: nothing drives the model", s.logs[0].path)
     lines += ["[Gg]", "identify = true       # the gas flow is not logged: a constant the fit identifies", ""]
@@ -448,7 +548,7 @@ def map_text(s: Survey) -> str:
                 lines += ["min = 0", f"max = {top:g}                # the highest setting the logs use"]
             if unit == "level":
                 lines.append("step = 1")
-            elif unit == "percent":
+            elif unit == "percent" and not cols:
                 lines.append("step = 5              # Artisan's slider in 5 % steps")
             lines.append("")
     for what, ch in s.unused.items():
@@ -460,6 +560,18 @@ def map_text(s: Survey) -> str:
         sources = ", ".join(f'"{c}"' for c in DRUM_AT_CHARGE)
         initial.append(
             f"Tm0_C = [{sources}]   # the drum at charge: the preheat it was held at, else the IR reading then"
+        )
+    elif cols:  # the first row is the charge: BT there, else ET (as for Artisan, ARTISAN_DRUM_AT_CHARGE)
+        if s.has_et and s.heater:
+            lines += ["[ET]", f'column = "{et}"       # the roaster\'s ET, weighed against the outlet gas{et_unit}']
+            if s.et_not_air:
+                lines.append(
+                    f"above_BT = true        # ET reads below BT through the roast on {len(s.et_not_air)} log(s)"
+                )
+            lines.append("")
+        sources = ", ".join(f'"{cols[k]}"' for k in ARTISAN_DRUM_AT_CHARGE if cols[k])
+        initial.append(
+            f"Tm0_C = [{sources}]  # the drum at CHARGE: BT in the first row, the probe soaked in the empty drum"
         )
     else:
         if s.has_et and s.et_not_air:

@@ -485,6 +485,25 @@ def _resample(time_s: np.ndarray, columns: dict[str, np.ndarray], step: float, p
     return grid, {k: np.interp(grid, time_s, v) for k, v in columns.items()}
 
 
+def _drop_et_not_drum_air(time_s, Ta, drop_s, settings: dict, series: dict, notes: list) -> set:
+    """Where the map asks (``[ET] above_BT``) and ET reads below BT through the roast, ET is not the
+    drum's air on this log (:func:`roastlab.metrics.profile.et_minus_bt_C`): it is removed from
+    ``settings`` and ``series`` with a note; returns the channels so rejected (no initial state
+    is read from them)."""
+    spec = settings.get("ET")
+    if spec is None or not spec.get("above_BT"):
+        return set()
+    gap = et_minus_bt_C(time_s, series["ET"], Ta, drop_s)
+    if gap is None or gap >= 0:
+        return set()
+    notes.append(
+        f"ET reads {-gap:.0f} degC below BT through the roast (median from {ET_CHECK_FROM_S:g} s): "
+        f"{ET_NOT_DRUM_AIR}, so it is neither fitted nor scored"
+    )
+    del settings["ET"], series["ET"]
+    return {spec["column"]}
+
+
 def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None) -> Batch:
     """Read any supported log with a column map into a validated canonical :class:`Batch`."""
     path = as_path(path, "path")
@@ -551,14 +570,8 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
         if et_spec is not None:
             settings["ET"] = et_spec
             series["ET"] = channel(et_spec, "ET") + (et_spec.get("offset_C") or 0.0)
-            gap = et_minus_bt_C(time_s, series["ET"], Ta, log.events.get("DROP")) if et_spec.get("above_BT") else None
-            if gap is not None and gap < 0:  # not the drum's air on this log (metrics.profile.et_minus_bt_C)
-                default_notes.append(
-                    f"ET reads {-gap:.0f} degC below BT through the roast (median from "
-                    f"{ET_CHECK_FROM_S:g} s): {ET_NOT_DRUM_AIR}, so it is neither fitted nor scored"
-                )
-                del settings["ET"], series["ET"]
-                et_spec, rejected = None, {cmap.ET["column"]}
+            rejected = _drop_et_not_drum_air(time_s, Ta, log.events.get("DROP"), settings, series, default_notes)
+            et_spec = settings.get("ET")
         Mb = log.weight_in_kg
         unit = log.unit
         drop_known = log.drop_index is not None
@@ -611,12 +624,15 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
                 to_celsius(v, spec.get("unit", "C")) + (spec.get("offset_C") or 0.0) if k in ("Tb2", "ET") else v
             )
         drop_known = True
+        rejected = _drop_et_not_drum_air(time_s, Ta, None, settings, series, default_notes)
         # the first row is the charge: an initial state from the log is one of the map's temperature
         # columns read there (in its unit), the first of a list that has a reading
         temps = {cmap.Ta["column"]: Ta}
         if "column" in cmap.Tgi:
             temps[cmap.Tgi["column"]] = Tgi
-        temps.update({settings[k]["column"]: series[k] for k in ("Tb2", "ET") if k in series})
+        for k in ("Tb2", "ET"):  # a reading the check above dropped on this log gives no state
+            if getattr(cmap, k):
+                temps[getattr(cmap, k)["column"]] = series.get(k, np.full(len(time_s), np.nan))
         for state, sources in cmap.initial.items():
             names = [sources] if isinstance(sources, str) else sources
             unknown = [n for n in names if n not in temps]
@@ -626,7 +642,7 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
                     f"columns ({', '.join(temps)}), which a CSV's initial states are read from",
                     cmap.source,
                 )
-            found = next((temps[n][0] for n in names if np.isfinite(temps[n][0])), None)
+            found = next((temps[n][0] for n in names if n not in rejected and np.isfinite(temps[n][0])), None)
             if found is None:
                 raise InputError(f"initial.{state}: no reading of {', '.join(names)} in the first row", path)
             initial[state] = float(found)
