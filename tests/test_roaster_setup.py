@@ -88,16 +88,18 @@ def test_init_reads_a_plain_csv_by_its_column_names(cli, tmp_path):
 
     logs = []
     for k, grams in enumerate((230, 250)):
-        rows = ["time (s),Bean Temp (F),ET (F),Burner %,Fan %,Inlet temp (F),BT RoR"]
+        rows = ["time (s),Bean Temp (F),ET (F),Burner %,Fan %,Inlet temp (F),BT RoR,Event"]
         for i in range(120):
             bt_f = 300.0 - 2.0 * i if i < 30 else 240.0 + 1.2 * (i - 30)
-            rows.append(f"{2.0 * i},{bt_f:.1f},{bt_f + 40:.1f},{60 + 10 * (i > 60)},{30 + k},572.0,0")
+            event = "Charge" if i == 0 else ""  # words and gaps: not a reading, left unread
+            rows.append(f"{2.0 * i},{bt_f:.1f},{bt_f + 40:.1f},{60 + 10 * (i > 60)},{30 + k},572.0,0,{event}")
         logs.append(tmp_path / f"roast{k}_{grams}g.csv")
         logs[-1].write_text("\n".join(rows) + "\n")
     code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
     assert code == 0, err
     assert "format csv" in out and "heater: Burner % (percent); fan: Fan % (percent)" in out
     assert "CSV: time 'time (s)' [s], BT 'Bean Temp (F)', ET 'ET (F)' [degF]" in out
+    assert "not read (words or empty cells): Event" in out
     cmap = load_map(tmp_path / "cfg" / "map.toml")
     assert (cmap.Ta["column"], cmap.Ta["unit"], cmap.ET["unit"]) == ("Bean Temp (F)", "F", "F")
     b = import_log(logs[1], cmap)

@@ -264,8 +264,14 @@ def read_plain_csv(path: Path):
             f"found: {', '.join(header[:8])})",
             path,
         )
-    others = tuple(h for h in header if h not in (cols["time"], cols["BT"], cols["ET"]) and h)
-    data = read_table(path, (cols["time"], cols["BT"]), (*((cols["ET"],) if cols["ET"] else ()), *others), text=text)
+    data = read_table(path, (cols["time"], cols["BT"]), text=text)
+    for h in (cols["ET"], *(h for h in header if h and h not in (cols["time"], cols["BT"], cols["ET"]))):
+        try:  # a column of words (events, notes) or with gaps is not a reading the model can use
+            data.update(read_table(path, (h,), text=text) if h else {})
+        except InputError:
+            cols["ET"] = None if h == cols["ET"] else cols["ET"]
+            cols["not read"] = [*cols.get("not read", []), h]
+    others = tuple(h for h in header if h in data and h not in (cols["time"], cols["BT"], cols["ET"]))
     time_s = data[cols["time"]] * TIME_UNITS[cols["time_unit"]]
     channels = {"BT": to_celsius(data[cols["BT"]], cols["temp_unit"])}
     if cols["ET"]:
@@ -359,8 +365,11 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
     # that log out (logs_without_controls)
     heater = next((i.heater for i in infos if i.heater), None)
     fan = next((i.fan for i in infos if i.fan), None)
-    if first.columns is not None and any(i.columns != first.columns for i in infos):
-        odd = next(i for i in infos if i.columns != first.columns)
+    layout = ("time", "time_unit", "BT", "temp_unit")  # ET may be unreadable on some logs (has_et says)
+    if first.columns is not None and any(
+        [i.columns[k] for k in layout] != [first.columns[k] for k in layout] for i in infos
+    ):
+        odd = next(i for i in infos if [i.columns[k] for k in layout] != [first.columns[k] for k in layout])
         raise InputError(
             f"the CSV logs name their columns differently ({first.path.name} vs {odd.path.name}): one layout at a time",
             odd.path,
@@ -401,6 +410,7 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
             f"CSV: time {c['time']!r} [{c['time_unit']}], BT {c['BT']!r}"
             + (f", ET {c['ET']!r}" if c["ET"] else ", no ET")
             + f" [deg{c['temp_unit']}], by their names; each log's first row is taken as CHARGE"
+            + (f"; not read (words or empty cells): {', '.join(c['not read'])}" if c.get("not read") else "")
         )
     serials = Counter(i.unit for i in infos if i.unit)
     if len(serials) > 1:
