@@ -403,3 +403,18 @@ def test_init_states_a_capacity_read_from_the_catalogue(cli, tmp_path):
     assert code == 0, err
     plant = (tmp_path / "cfg" / "plant.toml").read_text()
     assert "batch capacity 6 kg: the catalogue: Giesen" in plant and "Mm_kg = 18" in plant  # 3 kg per kg
+
+
+@pytest.mark.parametrize(
+    "header, want",
+    [
+        (["time", "BT_F", "ET_F"], ("time", "s", "BT_F", "ET_F", "F")),
+        (["Time (min)", "bean temp °F", "exhaust"], ("Time (min)", "min", "bean temp °F", "exhaust", "F")),
+        (["t", "BT RoR", "BT", "ET"], ("t", "s", "BT", "ET", "C")),  # a rate is not the reading
+        (["seconds", "Bean", "Env (C)", "Burner"], ("seconds", "s", "Bean", "Env (C)", "C")),
+        (["elapsed ms", "bt"], ("elapsed ms", "ms", "bt", None, "C")),
+    ],
+)
+def test_a_plain_csvs_columns_are_found_by_name(header, want):
+    c = roaster.plain_csv_columns(header)
+    assert (c["time"], c["time_unit"], c["BT"], c["ET"], c["temp_unit"]) == want

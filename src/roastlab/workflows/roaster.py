@@ -226,8 +226,7 @@ def plain_csv_columns(header: list[str]) -> dict:
         return None
 
     def temp_unit(name):
-        w = words(name)
-        return "F" if name and ({"f", "degf", "fahrenheit"} & set(w) or name.strip().lower().endswith("_f")) else "C"
+        return "F" if {"f", "degf", "fahrenheit"} & set(words(name)) else "C"
 
     time, bt = first(CSV_TIME_WORDS), first(CSV_BT_WORDS)
     et = first(CSV_ET_WORDS, (bt,))
@@ -276,7 +275,7 @@ def read_plain_csv(path: Path):
     channels = {"BT": to_celsius(data[cols["BT"]], cols["temp_unit"])}
     if cols["ET"]:
         channels["ET"] = to_celsius(data[cols["ET"]], cols["temp_unit"])
-    channels.update({h: data[h] for h in others if h in data})
+    channels.update({h: data[h] for h in others})
     log = ArtisanLog(str(path), time_s - time_s[0], channels, {"BT", "ET"}, cols["temp_unit"], 0, None, {"CHARGE": 0.0})
     return log, cols
 
