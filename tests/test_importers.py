@@ -187,6 +187,15 @@ def test_flow_units(tmp_path):
     assert b.Gg_kg_s[0] == pytest.approx(0.4)
 
 
+def test_a_raw_csv_logs_empty_cell_is_a_sample_not_taken(tmp_path):
+    """A raw log read through a map: an empty cell drops its row with a note (as an Artisan -1 does);
+    a batch CSV stays strict (tests/test_bad_input.py)."""
+    p = tmp_path / "gaps.csv"
+    p.write_text("time_s,Ta_C,Tgi_C,flow\n0,30,450,1440\n30,,450,1440\n60,50,450,1440\n")
+    b = import_log(p, load_map(write_map(tmp_path, '[Gg]\ncolumn = "flow"\nunit = "kg/h"\n')))
+    assert b.time_s.tolist() == [0.0, 60.0] and any("dropped 1 incomplete sample" in n for n in b.notes)
+
+
 def test_pitot_formula_eq16():
     # Gg = S sqrt(2 rho0 dp 273.15 / (T + 273.15)); at T = 0 degC: S sqrt(2 rho0 dp)
     assert gas_flow_pitot_kg_s(100.0, 0.0, 0.05) == pytest.approx(0.05 * np.sqrt(2 * 1.275 * 100.0))

@@ -6,6 +6,7 @@ import json
 import shutil
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from conftest import REAL_DATA
@@ -91,20 +92,22 @@ def test_init_reads_a_plain_csv_by_its_column_names(cli, tmp_path):
         rows = ["time (s),Bean Temp (F),ET (F),Burner %,Fan %,Inlet temp (F),BT RoR,Event"]
         for i in range(120):
             bt_f = 300.0 - 2.0 * i if i < 30 else 240.0 + 1.2 * (i - 30)
-            event = "Charge" if i == 0 else ""  # words and gaps: not a reading, left unread
-            rows.append(f"{2.0 * i},{bt_f:.1f},{bt_f + 40:.1f},{60 + 10 * (i > 60)},{30 + k},572.0,0,{event}")
+            event = "Charge" if i == 0 else ""  # words: not a reading, left unread
+            et_f = "" if i == 50 else f"{bt_f + 40:.1f}"  # a reading not taken: a gap in ET, not an error
+            rows.append(f"{2.0 * i},{bt_f:.1f},{et_f},{60 + 10 * (i > 60)},{30 + k},572.0,0,{event}")
         logs.append(tmp_path / f"roast{k}_{grams}g.csv")
         logs[-1].write_text("\n".join(rows) + "\n")
     code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
     assert code == 0, err
     assert "format csv" in out and "heater: Burner % (percent); fan: Fan % (percent)" in out
     assert "CSV: time 'time (s)' [s], BT 'Bean Temp (F)', ET 'ET (F)' [degF]" in out
-    assert "not read (words or empty cells): Event" in out
+    assert "not read (not numbers): Event" in out
     cmap = load_map(tmp_path / "cfg" / "map.toml")
     assert (cmap.Ta["column"], cmap.Ta["unit"], cmap.ET["unit"]) == ("Bean Temp (F)", "F", "F")
     b = import_log(logs[1], cmap)
     assert b.initial["Tm0_C"] == pytest.approx((300.0 - 32) * 5 / 9) and b.Mb_kg == 0.25
     assert b.Ta_C[0] == pytest.approx((300.0 - 32) * 5 / 9) and b.heater[-1] == 70.0
+    assert b.ET_C is not None and 0.9 < np.isfinite(b.ET_C).mean() < 1.0
 
 
 def test_a_log_that_records_no_burner_is_named_and_the_others_set_up(cli, tmp_path):

@@ -140,12 +140,18 @@ def parse_number(cell: str, path, line: int, column: str) -> float:
 
 
 def read_table(
-    path: str | Path, required: tuple[str, ...], optional: tuple[str, ...] = (), text: str | None = None
+    path: str | Path,
+    required: tuple[str, ...],
+    optional: tuple[str, ...] = (),
+    text: str | None = None,
+    sparse: tuple[str, ...] = SPARSE_COLUMNS,
 ) -> dict[str, np.ndarray]:
     """Read named numeric columns from a CSV with a header row, strictly.
 
     Lines starting with ``#`` are comments. Returns ``{column: array}`` for the required
-    columns and those optional ones present.
+    columns and those optional ones present. An empty cell is an error except in the ``sparse``
+    columns, where it is NaN (a reading not taken: a batch CSV's second bean reading and ET; every
+    column of a raw log read through a map, whose incomplete samples the import drops).
     """
     path = as_path(path, "path")
     text = read_text(path) if text is None else text  # callers that already read it pass it
@@ -182,7 +188,7 @@ def read_table(
                     raise InputError(
                         f"row has {len(row)} cells, column {c} missing (truncated file?)", path, f"line {line_no}"
                     )
-                if c in SPARSE_COLUMNS and not row[j].strip():
+                if c in sparse and not row[j].strip():
                     values[c].append(math.nan)  # a reading not taken at this sample
                 else:
                     values[c].append(parse_number(row[j], path, line_no, c))

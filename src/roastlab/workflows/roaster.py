@@ -263,14 +263,18 @@ def read_plain_csv(path: Path):
             f"found: {', '.join(header[:8])})",
             path,
         )
-    data = read_table(path, (cols["time"], cols["BT"]), text=text)
+    data = read_table(path, (cols["time"], cols["BT"]), text=text, sparse=(cols["time"], cols["BT"]))
     for h in (cols["ET"], *(h for h in header if h and h not in (cols["time"], cols["BT"], cols["ET"]))):
-        try:  # a column of words (events, notes) or with gaps is not a reading the model can use
-            data.update(read_table(path, (h,), text=text) if h else {})
+        try:  # a column of words (events, notes) is not a reading the model can use; a gap is a sample not taken
+            data.update(read_table(path, (h,), text=text, sparse=(h,)) if h else {})
         except InputError:
             cols["ET"] = None if h == cols["ET"] else cols["ET"]
             cols["not read"] = [*cols.get("not read", []), h]
     others = tuple(h for h in header if h in data and h not in (cols["time"], cols["BT"], cols["ET"]))
+    kept = np.isfinite(data[cols["time"]]) & np.isfinite(data[cols["BT"]])  # rows with a time and a BT
+    if kept.sum() < 2:
+        raise InputError(f"fewer than 2 rows with both {cols['time']!r} and {cols['BT']!r}", path)
+    data = {k: v[kept] for k, v in data.items()}
     time_s = data[cols["time"]] * TIME_UNITS[cols["time_unit"]]
     channels = {"BT": to_celsius(data[cols["BT"]], cols["temp_unit"])}
     if cols["ET"]:
@@ -409,7 +413,7 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
             f"CSV: time {c['time']!r} [{c['time_unit']}], BT {c['BT']!r}"
             + (f", ET {c['ET']!r}" if c["ET"] else ", no ET")
             + f" [deg{c['temp_unit']}], by their names; each log's first row is taken as CHARGE"
-            + (f"; not read (words or empty cells): {', '.join(c['not read'])}" if c.get("not read") else "")
+            + (f"; not read (not numbers): {', '.join(c['not read'])}" if c.get("not read") else "")
         )
     serials = Counter(i.unit for i in infos if i.unit)
     if len(serials) > 1:

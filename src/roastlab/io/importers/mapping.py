@@ -603,7 +603,10 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
             settings["ET"] = et_spec
         needed += [spec["column"] for spec in settings.values()]
         needed = list(dict.fromkeys(needed))
-        cols = _read_parquet(path, needed) if fmt == "parquet" else read_table(path, tuple(needed))
+        # an empty cell is a sample not taken: NaN here, its row dropped below with a note
+        cols = (
+            _read_parquet(path, needed) if fmt == "parquet" else read_table(path, tuple(needed), sparse=tuple(needed))
+        )
         time_s = cols[cmap.time["column"]] * TIME_UNITS[cmap.time["unit"]]
         Ta = to_celsius(cols[cmap.Ta["column"]], cmap.Ta["unit"]) + (cmap.Ta.get("offset_C") or 0.0)
         Tgi = _constant_or(
