@@ -46,7 +46,8 @@ A map is a TOML file::
     [ET]                       # the roaster's ET, drawn beside the model (default: an Artisan
     column = "ET"              # log's ET channel); never an input
     above_BT = true            # drop it on a log where it reads below BT through the roast
-    [initial]                  # initial states from the log: a scalar field or a channel at CHARGE,
+    [initial]                  # initial states from the log: a scalar field or a channel at CHARGE
+                               # (a CSV or Parquet log: one of the map's temperature columns, first row),
     Tm0_C = "preheatTemperature"  # or a list tried in order: ["ET", "BT"]
     Tb0_C = "Tgi"              # "Tgi": the inlet gas at CHARGE (with room = true, the room's)
 
