@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from ...errors import InputError
-from ...metrics.profile import mmss
+from ...metrics.profile import mmss, turning_point
 from ..files import read_input_text
 
 #: The channel whose reading at CHARGE is the drum's temperature then, for an Artisan log (a map's
@@ -52,8 +52,6 @@ EVENT_NAMES = ("CHARGE", "DRY", "FCs", "FCe", "SCs", "SCe", "DROP", "COOL")
 #: the 15 whose probe held (tests/test_real_roaster.py).
 BT_FALL_C = 10.0
 BT_FALL_WINDOW_S = 30.0
-#: The turning point is sought this long after CHARGE [s], the discharge after it.
-TURNING_POINT_WITHIN_S = 300.0
 WEIGHT_UNITS = {"g": 1e-3, "kg": 1.0, "lb": 0.45359237, "oz": 0.028349523125}
 
 
@@ -215,13 +213,13 @@ def charge_from_bt(time_s: np.ndarray, bt: np.ndarray) -> int | None:
 
 def drop_from_bt(time_s: np.ndarray, bt: np.ndarray, charge: int) -> int | None:
     """An unmarked DROP: where BT bends into its first fall after its peak past the turning point
-    (the lowest BT within :data:`TURNING_POINT_WITHIN_S` of CHARGE); None when BT never falls so
-    (the log is then read to its end)."""
+    (:func:`roastlab.metrics.profile.turning_point` of the curve from CHARGE); None when BT never
+    falls so (the log is then read to its end)."""
     b = _running_median3(bt)
-    within = int(np.searchsorted(time_s, time_s[charge] + TURNING_POINT_WITHIN_S))
-    if not np.isfinite(b[charge:]).any():
+    tp_s, _ = turning_point(time_s[charge:], b[charge:])
+    if tp_s is None:
         return None
-    tp = charge + int(np.nanargmin(b[charge : max(within, charge + 1)]))
+    tp = int(np.searchsorted(time_s, tp_s))
     peak = tp + int(np.nanargmax(b[tp:]))
     return _bend_of_fall(time_s, b, peak)
 
