@@ -395,15 +395,14 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
             f"the {fan} channel reads above 100, neither a percent nor a level: not used (set its unit in the map)"
         )
         fan = fan_unit = None
-    for channel, what in ((heater, "heater"), (fan, "fan")):
-        lacking = [i.path.name for i in infos if channel and channel not in i.channels]
-        if lacking:
+    lacking = {what: list(logs_without_controls(infos, {what: ch})) for what, ch in (("heater", heater), ("fan", fan))}
+    for (what, names), channel in zip(lacking.items(), (heater, fan)):
+        if names:
             notes.append(
-                f"{len(lacking)} log(s) record no {channel} ({', '.join(lacking[:3])}{' ...' if len(lacking) > 3 else ''}): "
+                f"{len(names)} log(s) record no {channel} ({', '.join(names[:3])}{' ...' if len(names) > 3 else ''}): "
                 f"their {what} setting is unknown, so fit-roaster leaves them out"
             )
-    without = sum(heater not in i.channels for i in infos) if heater else 0
-    if without and len(infos) - without < 2:
+    if lacking["heater"] and len(infos) - len(lacking["heater"]) < 2:
         raise InputError(
             f"only one log records the {heater} setting: fit-roaster needs two (one to fit, one to hold out)", "init"
         )
@@ -704,15 +703,16 @@ def init_roaster(paths, out_dir, *, batch_kg=None, capacity_kg=None, diameter_m=
     return {"survey": s, "plant": plant, "notes": notes}
 
 
-def logs_without_controls(infos, column_map) -> dict[str, str]:
-    """The logs that do not record a setting the map drives the model with (a heater or fan channel
-    with no events: Artisan logs a setting only when it moves), each with why; ``{name: why}``."""
+def logs_without_controls(infos, controls: dict[str, str | None]) -> dict[str, str]:
+    """The logs that do not record a setting the model is driven with (``controls``: ``{"heater":
+    channel, "fan": channel}``, None for none; a channel with no events: Artisan logs a setting only
+    when it moves), each with why; ``{name: why}``. ``init`` names them, ``fit-roaster`` leaves them out."""
     out = {}
     for info in infos:
-        for what, spec in (("heater", column_map.heater), ("fan", column_map.fan)):
-            if spec and spec.get("column") and spec["column"] not in info.channels:
+        for what, channel in controls.items():
+            if channel and channel not in info.channels:
                 out[info.path.name] = (
-                    f"{info.path.name} records no {spec['column']} (its {what} setting is unknown: Artisan "
+                    f"{info.path.name} records no {channel} (its {what} setting is unknown: Artisan "
                     "logs a setting only when it moves)"
                 )
                 break
@@ -796,7 +796,7 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: b
         raise InputError("give at least two logs: one to fit, one to hold out", "fit-roaster")
     infos = [inspect_log(p, 1.0) for p in paths]
     cmap = load_map(d / "map.toml")
-    left_out = logs_without_controls(infos, cmap)
+    left_out = logs_without_controls(infos, {k: (getattr(cmap, k) or {}).get("column") for k in ("heater", "fan")})
     if left_out:
         keep = [k for k, i in enumerate(infos) if i.path.name not in left_out]
         paths, infos = [paths[k] for k in keep], [infos[k] for k in keep]
