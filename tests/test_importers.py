@@ -103,6 +103,53 @@ def test_fahrenheit_log_converted_but_not_non_temperature_extras(tmp_path):
     assert log.weight_in_kg == pytest.approx(0.2)
 
 
+#: SYNTHETIC extra devices laid out as Artisan's Aillio R1 setup writes them: ``{3}``/``{0}`` are the
+#: heater and fan readouts named after the event types, beside a fan speed in rpm.
+AILLIO_LIKE_EXTRAS = {
+    "etypes": ["Fan", "Drum", "Damper", "Heater", "--"],
+    "extraname1": ["{3}", "Voltage"],
+    "extraname2": ["{0}", "Fan RPM"],
+    "extraNoneTempHint1": [True, True],
+    "extraNoneTempHint2": [True, True],
+}
+
+
+def _aillio_like(n: int, events: bool) -> dict:
+    extra = dict(AILLIO_LIKE_EXTRAS)
+    extra["extratimex"] = [[1.5 * i for i in range(n)]] * 2
+    extra["extratemp1"] = [[6.0] * n, [230.0] * n]
+    extra["extratemp2"] = [[3.0] * n, [2400.0] * n]
+    if events:  # Heater 70 %, Fan 20 % in Artisan's encoding
+        extra.update(specialevents=[5, 5], specialeventstype=[3, 0], specialeventsvalue=[8.0, 3.0])
+    return extra
+
+
+@pytest.mark.parametrize("events", [True, False])
+def test_extra_device_names_are_filled_from_the_event_types(tmp_path, events):
+    """Artisan shows ``{3}`` as the fourth event type's name; a readout whose name is an event type
+    with events in the log is kept apart from those events (the events are the setting made)."""
+    n = 120
+    p = tmp_path / "a.alog"
+    p.write_text(fake_alog(n=n, extra=_aillio_like(n, events)))
+    log = read_alog(p)
+    assert "{3}" not in log.channels and "Voltage" in log.channels and "Fan RPM" in log.channels
+    if events:
+        assert log.channels["Heater"][0] == 70.0 and log.channels["Fan"][0] == 20.0
+        assert log.channels["Heater readout"][0] == 6.0 and log.channels["Fan readout"][0] == 3.0
+    else:
+        assert log.channels["Heater"][0] == 6.0 and log.channels["Fan"][0] == 3.0
+        assert "Heater readout" not in log.channels
+
+
+def test_a_name_field_outside_the_event_types_is_left_as_written(tmp_path):
+    n = 120
+    extra = _aillio_like(n, False)
+    extra["etypes"] = ["Fan", "Drum"]
+    p = tmp_path / "a.alog"
+    p.write_text(fake_alog(n=n, extra=extra))
+    assert "{3}" in read_alog(p).channels and "Fan" in read_alog(p).channels
+
+
 def test_a_weight_in_pounds_reads_as_the_grams_it_was(tmp_path):
     p = tmp_path / "lb.alog"
     p.write_text(fake_alog(extra={"weight": [152.0 / 453.59237, 130.0 / 453.59237, "lb"]}))

@@ -39,6 +39,25 @@ def test_init_detects_an_artisan_layout_and_writes_commented_files(cli, tmp_path
     assert "Hottop" in out and [p.read_bytes() for p in logs] == before  # logs never modified
 
 
+@pytest.mark.parametrize("events", [True, False])
+def test_init_takes_the_event_types_before_a_device_named_like_them(cli, tmp_path, events):
+    """SYNTHETIC logs with Artisan's Aillio R1 extra devices: the Fan events (or, without events,
+    the ``{0}`` readout) are the fan, not the "Fan RPM" speed; likewise the heater."""
+    from test_importers import _aillio_like
+
+    n = 120
+    logs = []
+    for k in range(2):
+        logs.append(tmp_path / f"r{k}.alog")
+        logs[-1].write_text(fake_alog(n=n, extra=_aillio_like(n, events) | {"roastertype": "Aillio Bullet R1 IBTS"}))
+    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
+    assert code == 0, err
+    assert "heater: Heater (" in out and "fan: Fan (" in out and "RPM" not in out
+    unit = "percent" if events else "level"
+    heater = (tmp_path / "cfg" / "map.toml").read_text().split("[heater]")[1].split("[")[0]
+    assert 'column = "Heater"' in heater and f'unit = "{unit}"' in heater
+
+
 #: SYNTHETIC Burner (type 3) and Air (type 0) events in Artisan's encoding.
 _BURNER_AIR = {"specialevents": [10, 40], "specialeventstype": [3, 0], "specialeventsvalue": [8.0, 4.0],
                "etypes": ["Air", "Drum", "Damper", "Burner", "--"]}  # fmt: skip

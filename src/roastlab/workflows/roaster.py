@@ -195,10 +195,13 @@ def _common_unit(units: set) -> str | None:
 
 
 def _find(names, candidates) -> str | None:
-    for name in names:
-        low = name.lower()
-        if any(c in low for c in candidates):
-            return name
+    """The first of ``names`` that is one of ``candidates`` (lower case), else the first that
+    contains one: an event type "Fan" before a device's "Fan RPM", "Heater" before "Heater readout"."""
+    lows = [name.lower().strip() for name in names]
+    for test in (lambda low, c: low == c, lambda low, c: c in low):
+        for name, low in zip(names, lows):
+            if any(test(low, c) for c in candidates):
+                return name
     return None
 
 

@@ -342,6 +342,38 @@ def _weight(value, factor: float, path: Path) -> float | None:
     return round(kg, 4) if math.isfinite(kg) else None
 
 
+#: An extra device's name as Artisan shows it: ``{0}``-``{3}`` stand for the event types' names
+#: (``etypes``), as Artisan's own machine setups name their heater and fan readouts (the Aillio R1's
+#: ``{3}`` and ``{0}`` read "Heater" and "Fan").
+EXTRA_NAME_FIELD = re.compile(r"\{([0-3])\}")
+#: What a readout is called when its name is an event type's and the log has that type's events too:
+#: the events are the setting the roaster made (the map's default), the readout what the machine reports.
+READOUT_SUFFIX = " readout"
+
+
+def extra_name(name: str, etypes: list, with_events: set[str]) -> str:
+    """``name`` of an extra device with Artisan's ``{n}`` fields filled from ``etypes`` (no
+    :meth:`str.format` on a file's text), and :data:`READOUT_SUFFIX` added when an event type of
+    that name has events in the log (else the events would be written over the readout)."""
+    filled = EXTRA_NAME_FIELD.sub(
+        lambda m: str(etypes[int(m.group(1))]) if int(m.group(1)) < len(etypes) else m.group(0), name
+    )
+    return filled + READOUT_SUFFIX if filled in with_events else filled
+
+
+def _types_with_events(data: dict, etypes: list) -> set[str]:
+    """The names of the event types the log has special events of (nothing checked here: the
+    events' own reading below refuses malformed ones)."""
+    types = data.get("specialeventstype", [])
+    if not isinstance(types, list):
+        return set()
+    return {
+        str(etypes[int(t)])
+        for t in types
+        if isinstance(t, (int, float)) and not isinstance(t, bool) and 0 <= t < len(etypes)
+    }
+
+
 def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: bool = True) -> ArtisanLog:
     """Parse an Artisan ``.alog`` file into an :class:`ArtisanLog` (see module docstring)."""
     path = Path(path)
@@ -364,8 +396,10 @@ def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: boo
 
     channels = {"ET": et.copy(), "BT": bt.copy()}
     temps = {"ET", "BT"}
+    etypes = _as_list(data.get("etypes")) or ["Air", "Drum", "Damper", "Burner", "--"]
     # extra devices: each has a time base and two channels with names
     extratimex = _as_list(data.get("extratimex"))
+    with_events = _types_with_events(data, etypes)
     if extratimex:
         for d, tx in enumerate(extratimex):
             for k in (1, 2):
@@ -375,7 +409,10 @@ def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: boo
                 if d >= len(names) or d >= len(values):
                     continue
                 name = names[d]
-                if not isinstance(name, str) or not name or name in channels:
+                if not isinstance(name, str) or not name:
+                    continue
+                name = extra_name(name, etypes, with_events)
+                if name in channels:
                     continue
                 arr = _numeric_list({"v": values[d]}, "v", path)
                 txa = _numeric_list({"v": tx}, "v", path)
@@ -395,7 +432,6 @@ def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: boo
             channels[name] = f_to_c(channels[name])
 
     # special events -> step signals in external units, one per event type
-    etypes = _as_list(data.get("etypes")) or ["Air", "Drum", "Damper", "Burner", "--"]
     idx, types, vals = (data.get(k, []) for k in ("specialevents", "specialeventstype", "specialeventsvalue"))
     if not (isinstance(idx, list) and isinstance(types, list) and isinstance(vals, list)):
         raise InputError("special events must be lists", path, "key specialevents")
