@@ -428,6 +428,27 @@ def test_init_states_a_capacity_read_from_the_catalogue(cli, tmp_path):
 
 
 @pytest.mark.parametrize(
+    ("roastersize", "words"),
+    [
+        (12.0, "batch capacity 12 kg: the capacity 2 of 2 log(s) state"),  # before the catalogue's 6 kg
+        (0.0, "batch capacity 6 kg: the catalogue: Giesen"),  # Artisan's "not set"
+        (2.0, "batch capacity 6 kg: the catalogue: Giesen"),  # below the 3 kg logged: not a capacity
+        ("12", "batch capacity 6 kg: the catalogue: Giesen"),  # not a number
+    ],
+)
+def test_init_takes_the_capacity_the_logs_state(cli, tmp_path, roastersize, words):
+    """SYNTHETIC logs whose Roast Properties state the machine's capacity (Artisan's roastersize, kg)."""
+    extra = {"roastertype": "Giesen W6A", "weight": [3000.0, 0.0, "g"], "roastersize": roastersize}
+    logs = []
+    for k in range(2):
+        logs.append(tmp_path / f"g{k}.alog")
+        logs[-1].write_text(fake_alog(extra=extra))
+    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
+    assert code == 0, err
+    assert words in (tmp_path / "cfg" / "plant.toml").read_text()
+
+
+@pytest.mark.parametrize(
     "header, want",
     [
         (["time", "BT_F", "ET_F"], ("time", "s", "BT_F", "ET_F", "F")),

@@ -150,6 +150,7 @@ class LogInfo:
     et_minus_bt_C: float | None = None  # median ET - BT through the roast (metrics.profile.et_minus_bt_C)
     room: RoomReading | None = None  # the room temperature the log records, as written
     columns: dict | None = None  # a plain CSV's own names and units (plain_csv_columns)
+    capacity_kg: float | None = None  # the batch capacity the log states (Artisan's roastersize)
 
 
 @dataclass
@@ -345,6 +346,7 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
         else None,
         log.room,
         columns,
+        log.capacity_kg,
     )
 
 
@@ -463,16 +465,20 @@ def catalogue_entry(machine: str) -> tuple[float, str, str] | None:
 
 
 def batch_capacity(s: Survey, capacity_kg=None) -> tuple[float, str]:
-    """The roaster's rated green batch [kg] and where it comes from: given, the catalogue entry of
-    the logs' machine, or ESTIMATED as twice the largest logged batch."""
+    """The roaster's rated green batch [kg] and where it comes from: given, the capacity the logs
+    state (Artisan's Roast Properties; the most common when they differ; none below a logged batch),
+    the catalogue entry of the logs' machine, or ESTIMATED as twice the largest logged batch."""
     entry = catalogue_entry(s.machine) if s.machine else None
     if capacity_kg is not None:
         return capacity_kg, "--batch-capacity-kg"
+    largest = max(i.batch_kg for i in s.logs)
+    stated = Counter(i.capacity_kg for i in s.logs if i.capacity_kg and i.capacity_kg >= largest)
+    if stated:
+        cap, k = stated.most_common(1)[0]
+        return cap, f"the capacity {k} of {len(s.logs)} log(s) state (Artisan's Roast Properties)"
     if entry is not None:
         return entry[0], f"the catalogue: {entry[2]}"
-    return 2.0 * max(
-        i.batch_kg for i in s.logs
-    ), "ESTIMATED as twice the largest logged batch (pass --batch-capacity-kg)"
+    return 2.0 * largest, "ESTIMATED as twice the largest logged batch (pass --batch-capacity-kg)"
 
 
 def estimate_plant(s: Survey, capacity_kg=None, diameter_m=None, length_m=None) -> tuple[dict, list[str]]:

@@ -139,6 +139,7 @@ class ArtisanLog:
     unit: str = ""  # which roaster of that make (RoasTime serialNumber); empty when the log does not say
     room: RoomReading | None = None  # the room temperature the log records, as written; None if it does not
     notes: list[str] = field(default_factory=list)  # what the reader inferred (an unmarked CHARGE or DROP)
+    capacity_kg: float | None = None  # the roaster's batch capacity the log states (Artisan's roastersize)
 
 
 def bt_falls_from(time_s: np.ndarray, bt: np.ndarray, start: int) -> int | None:
@@ -500,7 +501,21 @@ def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: boo
         started_epoch_s=epoch_or_none(data.get("roastepoch")),
         room=_alog_room(data.get("ambientTemp"), mode),
         notes=notes,
+        capacity_kg=stated_capacity_kg(data.get("roastersize")),
     )
+
+
+#: Artisan's ``roastersize`` (Roast Properties, the machine's "Capacity") is in kg, 0 when not set; Artisan
+#: keeps it within 0-999.
+ROASTERSIZE_MAX_KG = 999.0
+
+
+def stated_capacity_kg(value) -> float | None:
+    """The batch capacity [kg] a log states (Artisan's ``roastersize``), or None when it is not set
+    (0), not a number or out of Artisan's range."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return None
+    return float(value) if 0.0 < value <= ROASTERSIZE_MAX_KG else None
 
 
 def _alog_room(value, mode: str) -> RoomReading | None:
