@@ -197,3 +197,26 @@ def test_a_band_says_when_a_log_comes_from_another_roaster_of_the_make():
     assert "holds neither the error of a batch-size change nor the difference between two drums" in both
     assert band_note(model, [batch], batch_kg=0.5).startswith("unit 2054")  # a what-if's weight replaces the log's
     assert band_note(model, [SimpleNamespace(Mb_kg=0.49, unit="2779")]) is None
+
+
+def test_a_band_of_a_model_fitted_on_one_log_says_it_holds_no_spread(fitted):
+    """One log says nothing about the spread between roasts: the band is the parameters' alone and
+    its note says so (fit-roaster on two logs held 4 % of the held-out log's samples before it did),
+    joined with the other notes; a model with a spread gets none of it."""
+    from types import SimpleNamespace
+
+    from roastlab.evaluate.bands import band_note, band_report
+
+    model, batches, _ = fitted
+    one = roastlab.fit(batches[:1], "120kg", bed="contact=wall", starts=2).model
+    report = band_report(one, batches[3:4])[0]
+    from roastlab.workflows.roaster import band_sentence
+
+    assert not report["spread"] and report["note"].startswith("the model was fitted on one log")
+    assert "(parameters only;" in band_sentence(report)
+    assert "does not hold the spread between roasts" in report["note"]
+    assert band_report(model, batches[3:4])[0]["spread"] and band_report(model, batches[3:4])[0]["note"] is None
+    three = band_note(
+        SimpleNamespace(doc={"fit": {}}, plant=None), [SimpleNamespace(Mb_kg=0.2, unit="2054")]
+    )  # no spread, so no sizes or units to compare either
+    assert three.startswith("the model was fitted on one log") and "nor" not in three

@@ -97,7 +97,11 @@ def _note(*parts) -> str | None:
     if not parts:
         return None
     whys, missing = [p[0] for p in parts], [p[1] for p in parts]
-    holds = f"does not hold {missing[0]}" if len(missing) == 1 else f"holds neither {missing[0]} nor {missing[1]}"
+    holds = (
+        f"does not hold {missing[0]}"
+        if len(missing) == 1
+        else f"holds neither {', '.join(missing[:-1])} nor {missing[-1]}"
+    )
     return f"{' and '.join(whys)}: the band {holds}, so expect fewer measured samples inside it"
 
 
@@ -162,12 +166,21 @@ def _units_outside(model, units) -> tuple[str, str] | None:
     )
 
 
+def _no_spread(model) -> tuple[str, str] | None:
+    """(why, what the band does not hold) when ``model`` stores no roast-to-roast spread (fitted on
+    one log: :func:`roast_spread`), so its band is the parameters' alone; else None."""
+    if stored_spread(model) is not None:
+        return None
+    return "the model was fitted on one log, which says nothing about how roasts differ", "the spread between roasts"
+
+
 def band_note(model, batches, batch_kg=None) -> str | None:
-    """Why a band of ``model`` may hold fewer samples of ``batches`` than its level: their sizes
-    (:func:`sizes_outside`; ``batch_kg`` replaces each batch's weight, as a what-if does) and their
-    roasters (:func:`units_outside`), in one sentence; None when neither applies."""
+    """Why a band of ``model`` may hold fewer samples of ``batches`` than its level: no spread
+    between roasts in the model (:func:`_no_spread`), their sizes (:func:`sizes_outside`;
+    ``batch_kg`` replaces each batch's weight, as a what-if does) and their roasters
+    (:func:`units_outside`), in one sentence; None when none applies."""
     masses = [batch_kg or b.Mb_kg for b in batches]
-    return _note(_sizes_outside(model, masses), _units_outside(model, [b.unit for b in batches]))
+    return _note(_no_spread(model), _sizes_outside(model, masses), _units_outside(model, [b.unit for b in batches]))
 
 
 def why_no_band(model) -> str | None:
@@ -332,7 +345,7 @@ def band_report(model, batches, level: float = BAND_LEVEL) -> tuple[dict, list[B
     """How the level-``level`` band of ``model`` holds the measured probe of ``batches``, and the
     bands: ``({"level", "inside_all" (share of all samples inside), "median_width_C" (median over the
     batches), "batches" (:func:`band_coverage` rows), "by_size" (:func:`inside_by_size`), "note"
-    (:func:`band_note` or None)}, [Band, ...])``."""
+    (:func:`band_note` or None), "spread" (whether the band holds a roast-to-roast spread)}, [Band, ...])``."""
     batches = list(batches)
     bands = prediction_bands(model, batches, level)
     rows = coverage(batches, bands)
@@ -344,6 +357,7 @@ def band_report(model, batches, level: float = BAND_LEVEL) -> tuple[dict, list[B
         "batches": rows,
         "by_size": inside_by_size(rows),
         "note": band_note(model, batches),
+        "spread": stored_spread(model) is not None,
     }
     return doc, bands
 

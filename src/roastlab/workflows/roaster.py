@@ -762,7 +762,8 @@ def band_sentence(band: dict) -> str:
     level = f"{100 * band['level']:.0f} %"
     return (
         f"{100 * band['inside_all']:.0f} % of the held-out logs' probe samples lie inside the {level} prediction "
-        f"band (parameters and spread between roasts; a calibrated band holds about {level}), median width "
+        f"band ({'parameters and spread between roasts' if band.get('spread', True) else 'parameters only'}; "
+        f"a calibrated band holds about {level}), median width "
         f"{band['median_width_C']:.1f} °C"
     )
 
