@@ -63,3 +63,38 @@ def test_implausible_states_only_where_the_heat_must_come_through_the_drum():
     hot_metal = SimpleNamespace(time_s=t, Ta_C=ta, Tb_C=beans, Tm_C=beans + 40.0, Tgi_C=np.full(t.size, 22.0))
     assert "colder than the beans" in implausible_states(room)[0]
     assert implausible_states(gas) == [] and implausible_states(hot_metal) == []
+
+
+@pytest.mark.parametrize("seconds", [0.0, 5.0, 59.0, 60.0, 457.0, 3599.0, 3725.0, -5.0, -65.0])
+def test_clock_s_reads_what_mmss_writes(seconds):
+    from roastlab.metrics.profile import clock_s, mmss
+
+    assert clock_s(mmss(seconds)) == seconds
+
+
+@pytest.mark.parametrize(
+    ("text", "seconds"), [("07:37.5", 457.5), ("1:02:05", 3725.0), (" 240 ", 240.0), ("0:00", 0.0), ("+1:00", 60.0)]
+)
+def test_clock_s_reads_a_clock_or_seconds(text, seconds):
+    from roastlab.metrics.profile import clock_s
+
+    assert clock_s(text) == seconds
+
+
+@pytest.mark.parametrize(
+    "text", ["", "1:60", "1:-5", "1::5", "1:2:3:4", "1.5:30", "a:30", "1:nan", "1e999", "inf", ":30", "1e999:30"]
+)
+def test_clock_s_refuses_what_is_not_a_clock(text):
+    from roastlab.metrics.profile import clock_s
+
+    with pytest.raises(ValueError, match="not a time"):
+        clock_s(text)
+
+
+def test_a_whatif_time_is_read_by_the_same_clock():
+    from roastlab.errors import ParameterError
+    from roastlab.workflows.whatif import parse_setting_change
+
+    assert parse_setting_change("heater", "+1@4:30").from_s == 270.0
+    with pytest.raises(ParameterError, match="not a time"):
+        parse_setting_change("heater", "+1@4:75")  # was read as 5:15

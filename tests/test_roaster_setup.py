@@ -129,6 +129,39 @@ def test_init_reads_a_plain_csv_by_its_column_names(cli, tmp_path):
     assert b.ET_C is not None and 0.9 < np.isfinite(b.ET_C).mean() < 1.0
 
 
+def test_init_reads_a_plain_csv_whose_time_is_a_clock(cli, tmp_path):
+    """SYNTHETIC plain CSV logs with the time written m:ss (and h:mm:ss past an hour, as a clock
+    does) and "nan" where a setting was not logged yet: the map says unit "m:ss", the import reads
+    seconds, and a bad clock cell is one line naming the file, the line and the column."""
+    from roastlab.io.importers.mapping import import_log, load_map
+
+    logs = []
+    for k, grams in enumerate((230, 250)):
+        rows = ["Time,BT,ET,Burner,Fan"]
+        for i in range(120):
+            t = 30.0 * i  # to 59:30; the last rows past an hour
+            clock = f"{int(t // 60):02d}:{t % 60:04.1f}" if t < 3600 else f"1:{int(t // 60) - 60:02d}:{t % 60:02.0f}"
+            bt = 150.0 - 1.0 * i if i < 30 else 120.0 + 0.6 * (i - 30)
+            burner = "nan" if i < 3 else f"{60 + 10 * (i > 60)}"
+            rows.append(f"{clock},{bt:.1f},{bt + 30:.1f},{burner},{40 + k}")
+        logs.append(tmp_path / f"roast{k}_{grams}g.csv")
+        logs[-1].write_text("\n".join(rows + ["1:00:00,160,190,70,40", "1:00:30,161,191,70,40"]) + "\n")
+    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
+    assert code == 0, err
+    assert "CSV: time 'Time' [m:ss]" in out and "heater: Burner (percent)" in out and "not read" not in out
+    cmap = load_map(tmp_path / "cfg" / "map.toml")
+    assert cmap.time == {"column": "Time", "unit": "m:ss"}
+    b = import_log(logs[0], cmap)
+    assert b.time_s[-1] == pytest.approx(3630.0)  # 1:00:30 after the first row
+    assert b.time_s[0] == pytest.approx(90.0) and any("incomplete" in n for n in b.notes)  # "nan": not logged yet
+    assert np.interp(600.0, b.time_s, b.Ta_C) == pytest.approx(130.0)  # 10:00.0 is the 21st row
+    bad = tmp_path / "bad_230g.csv"
+    bad.write_text(logs[0].read_text().replace("00:30.0,", "00:75.0,", 1))
+    code, out, err = cli("init", bad, logs[1], "--out", tmp_path / "cfg2")
+    assert code == 2 and "bad_230g.csv" in err and "line 3, column Time" in err and "'00:75.0'" in err
+    assert len(err.strip().splitlines()) == 1
+
+
 def test_a_log_that_records_no_burner_is_named_and_the_others_set_up(cli, tmp_path):
     """SYNTHETIC: Artisan logs a setting only when it moves; a roast whose burner never moved has no
     Burner events. init keeps the other logs' layout and names that log (fit-roaster leaves it out)."""

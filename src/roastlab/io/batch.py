@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError, ParameterError
+from ..metrics.profile import clock_s
 from ..model.limits import check_array, check_value
 from .files import as_path, atomic_write_text, read_input_text, read_toml
 
@@ -139,19 +140,38 @@ def parse_number(cell: str, path, line: int, column: str) -> float:
     return value
 
 
+#: What a ``sparse`` column's cell says when no reading was taken: empty, or NaN as NumPy and
+#: spreadsheets write it.
+MISSING_CELLS = ("", "nan")
+
+
+def parse_clock(cell: str, path, line: int, column: str) -> float:
+    """A time cell written m:ss, h:mm:ss or in seconds -> [s]; one-line error naming the cell."""
+    if not cell.strip():
+        raise InputError("empty cell", path, f"line {line}, column {column}")
+    try:
+        return clock_s(cell)
+    except ValueError as exc:
+        raise InputError(str(exc), path, f"line {line}, column {column}") from None
+
+
 def read_table(
     path: str | Path,
     required: tuple[str, ...],
     optional: tuple[str, ...] = (),
     text: str | None = None,
     sparse: tuple[str, ...] = SPARSE_COLUMNS,
+    clock: tuple[str, ...] = (),
 ) -> dict[str, np.ndarray]:
     """Read named numeric columns from a CSV with a header row, strictly.
 
     Lines starting with ``#`` are comments. Returns ``{column: array}`` for the required
     columns and those optional ones present. An empty cell is an error except in the ``sparse``
     columns, where it is NaN (a reading not taken: a batch CSV's second bean reading and ET; every
-    column of a raw log read through a map, whose incomplete samples the import drops).
+    column of a raw log read through a map, whose incomplete samples the import drops; "nan" reads
+    so too, :data:`MISSING_CELLS`). The
+    ``clock`` columns are times written m:ss or h:mm:ss, read as seconds
+    (:func:`roastlab.metrics.profile.clock_s`).
     """
     path = as_path(path, "path")
     text = read_text(path) if text is None else text  # callers that already read it pass it
@@ -188,8 +208,10 @@ def read_table(
                     raise InputError(
                         f"row has {len(row)} cells, column {c} missing (truncated file?)", path, f"line {line_no}"
                     )
-                if c in sparse and not row[j].strip():
+                if c in sparse and row[j].strip().lower() in MISSING_CELLS:
                     values[c].append(math.nan)  # a reading not taken at this sample
+                elif c in clock:
+                    values[c].append(parse_clock(row[j], path, line_no, c))
                 else:
                     values[c].append(parse_number(row[j], path, line_no, c))
     except csv.Error as exc:

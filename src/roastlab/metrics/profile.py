@@ -59,6 +59,33 @@ def mmss(seconds: float | None) -> str:
     return f"{'-' if seconds < 0 else ''}{s // 60}:{s % 60:02d}"
 
 
+def clock_s(text: str) -> float:
+    """A time written as the roaster's clock, m:ss or h:mm:ss (``"7:37"``, ``"07:37.5"``,
+    ``"1:02:05"``, ``"-0:05"``), or as plain seconds (``"457.4"``) -> [s]: the inverse of
+    :func:`mmss`. :class:`ValueError` for anything else.
+
+    >>> clock_s("7:37"), clock_s("-0:05"), clock_s("1:02:05"), clock_s("240")
+    (457.0, -5.0, 3725.0, 240.0)
+    """
+    text = text.strip()
+    sign = -1.0 if text.startswith("-") else 1.0
+    parts = text.lstrip("+-").split(":")
+    if len(parts) > 3 or any(not p.strip() for p in parts) or (len(parts) > 1 and "-" in text[1:]):
+        raise ValueError(f"not a time (m:ss or seconds): {text[:40]!r}")
+    try:
+        whole = [float(p) for p in parts]
+    except ValueError:
+        raise ValueError(f"not a time (m:ss or seconds): {text[:40]!r}") from None
+    if not all(np.isfinite(whole)) or (
+        len(whole) > 1 and (any(not 0 <= v < 60 for v in whole[1:]) or any(v != int(v) for v in whole[:-1]))
+    ):
+        raise ValueError(f"not a time (m:ss or seconds): {text[:40]!r}")
+    seconds = 0.0
+    for v in whole:
+        seconds = 60.0 * seconds + v
+    return sign * seconds
+
+
 def ror_operator(time_s, span_s: float = ROR_SPAN_S) -> tuple[sparse.csr_matrix, np.ndarray]:
     """(D, valid) of :func:`_ror_operator`, remembered per time grid (a what-if, a page update
     or an optimiser asks for the same grid again and again)."""

@@ -244,6 +244,21 @@ def plain_csv_columns(header: list[str]) -> dict:
     }
 
 
+def _clock_column(text: str, header: list[str], column: str | None) -> bool:
+    """Whether ``column``'s first filled cell is written as a clock (m:ss: it has a colon)."""
+    import csv as _csv
+
+    if column is None:
+        return False
+    j = header.index(column)
+    rows = (row for row in _csv.reader(ln for ln in io.StringIO(text) if not ln.lstrip().startswith("#")) if row)
+    next(rows, None)  # the header
+    for row in rows:
+        if j < len(row) and row[j].strip():
+            return ":" in row[j]
+    return False
+
+
 def read_plain_csv(path: Path):
     """A plain CSV log (a header row, numbers below; its first row the charge) read as an
     :class:`~roastlab.io.importers.artisan.ArtisanLog` whose BT and ET are in degC under those
@@ -267,7 +282,10 @@ def read_plain_csv(path: Path):
             f"found: {', '.join(header[:8])})",
             path,
         )
-    data = read_table(path, (cols["time"], cols["BT"]), text=text, sparse=(cols["time"], cols["BT"]))
+    if _clock_column(text, header, cols["time"]):
+        cols["time_unit"] = "m:ss"
+    clock = (cols["time"],) if cols["time_unit"] == "m:ss" else ()
+    data = read_table(path, (cols["time"], cols["BT"]), text=text, sparse=(cols["time"], cols["BT"]), clock=clock)
     for h in (cols["ET"], *(h for h in header if h and h not in (cols["time"], cols["BT"], cols["ET"]))):
         try:  # a column of words (events, notes) is not a reading the model can use; a gap is a sample not taken
             data.update(read_table(path, (h,), text=text, sparse=(h,)) if h else {})

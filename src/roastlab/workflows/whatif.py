@@ -20,6 +20,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..io.batch import Batch
 from ..metrics.profile import (  # noqa: F401  (re-exported)
+    clock_s,
     crossing_or_projected_s,
     crossing_time_s,
     display_temp,
@@ -100,10 +101,10 @@ def parse_time_s(text: str | None) -> float:
     """A time after CHARGE as seconds (``"240"``) or the roaster's m:ss (``"4:00"``) -> [s]."""
     if not text:
         return 0.0
-    if ":" in text:
-        m, sec = text.split(":", 1)
-        return 60.0 * float(m) + float(sec)
-    return float(text)
+    try:
+        return clock_s(text)
+    except ValueError as exc:
+        raise ParameterError(str(exc)) from None
 
 
 def parse_setting_change(setting: str, text: str, unit: str = "") -> SettingChange:

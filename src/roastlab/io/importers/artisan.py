@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from ...errors import InputError
-from ...metrics.profile import mmss, turning_point
+from ...metrics.profile import clock_s, mmss, turning_point
 from ..files import read_input_text
 
 #: The channel whose reading at CHARGE is the drum's temperature then, for an Artisan log (a map's
@@ -543,16 +543,8 @@ def epoch_or_none(value) -> float | None:
 
 
 def _mmss(text: str) -> float:
-    text = text.strip()
-    if not text:
-        return float("nan")
-    parts = text.split(":")
-    try:
-        if len(parts) == 2:
-            return int(parts[0]) * 60 + float(parts[1])
-        return float(text)
-    except ValueError:
-        raise ValueError(text) from None
+    """An Artisan CSV time cell (m:ss) [s]; NaN when empty (:func:`roastlab.metrics.profile.clock_s`)."""
+    return clock_s(text) if text.strip() else float("nan")
 
 
 def _merge_repeated_times(time_s: np.ndarray, columns):

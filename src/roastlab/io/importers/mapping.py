@@ -85,7 +85,8 @@ FORMATS = ("auto", "alog", "artisan-csv", "roastime", "csv", "parquet")
 SETTING_UNITS = {unit: (lo, hi) for unit, (lo, hi, _, _) in UNIT_DEFAULTS.items()}
 #: Initial states a map may take from the log.
 INITIAL_FROM_LOG = ("Tm0_C", "Tb0_C", "X0")
-TIME_UNITS = {"s": 1.0, "min": 60.0, "ms": 1e-3}
+#: A time column's units [s per unit]; "m:ss" is a clock (``7:37``, ``1:02:05``) read as seconds.
+TIME_UNITS = {"s": 1.0, "min": 60.0, "ms": 1e-3, "m:ss": 1.0}
 TEMP_UNITS = ("C", "F", "K")
 FLOW_UNITS = {"kg/s": 1.0, "kg/h": 1.0 / 3600.0, "g/s": 1e-3, "m3/h": None}
 DROP_BT_LIMIT_C = 300.0
@@ -606,7 +607,14 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
         needed = list(dict.fromkeys(needed))
         # an empty cell is a sample not taken: NaN here, its row dropped below with a note
         cols = (
-            _read_parquet(path, needed) if fmt == "parquet" else read_table(path, tuple(needed), sparse=tuple(needed))
+            _read_parquet(path, needed)
+            if fmt == "parquet"
+            else read_table(
+                path,
+                tuple(needed),
+                sparse=tuple(needed),
+                clock=(cmap.time["column"],) if cmap.time["unit"] == "m:ss" else (),
+            )
         )
         time_s = cols[cmap.time["column"]] * TIME_UNITS[cmap.time["unit"]]
         Ta = to_celsius(cols[cmap.Ta["column"]], cmap.Ta["unit"]) + (cmap.Ta.get("offset_C") or 0.0)
