@@ -8,7 +8,7 @@ A map is a TOML file::
 
     [time]                     # generic tables only; Artisan time is aligned to CHARGE
     column = "time"
-    unit = "s"                 # s | min | ms
+    unit = "s"                 # s | min | ms | m:ss (a clock: 07:37, 1:02:05)
 
     [Ta]                       # the measured bean probe
     column = "BT"
