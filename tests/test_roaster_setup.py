@@ -58,6 +58,29 @@ def test_init_takes_the_event_types_before_a_device_named_like_them(cli, tmp_pat
     assert 'column = "Heater"' in heater and f'unit = "{unit}"' in heater
 
 
+def test_init_takes_the_damper_as_the_fan_when_no_fan_is_logged(cli, tmp_path):
+    """SYNTHETIC logs with Burner and Damper events and no Air: on a drum with one fixed-speed
+    exhaust fan the damper sets the air flow, so it stands for the fan, and init says so; with an
+    Air channel too, the damper stays unused."""
+    damper = {"specialevents": [10, 40], "specialeventstype": [3, 2], "specialeventsvalue": [8.0, 4.0],
+              "etypes": ["Air", "Drum", "Damper", "Burner", "--"]}  # fmt: skip
+    logs = [tmp_path / f"r{k}.alog" for k in range(2)]
+    for p in logs:
+        p.write_text(fake_alog(extra=damper))
+    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
+    assert code == 0, err
+    assert "fan: Damper (percent)" in out and "no fan channel: the Damper sets the air flow" in out
+    fan = (tmp_path / "cfg" / "map.toml").read_text().split("[fan]")[1].split("[")[0]
+    assert 'column = "Damper"' in fan
+    both = dict(damper, specialevents=[10, 40, 50], specialeventstype=[3, 2, 0], specialeventsvalue=[8.0, 4.0, 3.0])
+    for p in logs:
+        p.write_text(fake_alog(extra=both))
+    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg2")
+    assert code == 0, err
+    assert "fan: Air (" in out and "no fan channel" not in out
+    assert "logged but not used by the model: damper ('Damper')" in (tmp_path / "cfg2" / "map.toml").read_text()
+
+
 #: SYNTHETIC Burner (type 3) and Air (type 0) events in Artisan's encoding.
 _BURNER_AIR = {"specialevents": [10, 40], "specialeventstype": [3, 0], "specialeventsvalue": [8.0, 4.0],
                "etypes": ["Air", "Drum", "Damper", "Burner", "--"]}  # fmt: skip

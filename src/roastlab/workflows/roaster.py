@@ -329,6 +329,8 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
         others = [n for n in others if "temp" not in n.lower() and "°" not in n]
     heater = "heater" if fmt == "roastime" and "heater" in names else _find(others, HEATER_NAMES)
     fan = "fan" if fmt == "roastime" and "fan" in names else _find([n for n in others if n != heater], FAN_NAMES)
+    if fan is None:  # no fan channel: a damper sets the air flow through the drum (one fixed-speed exhaust fan)
+        fan = _find([n for n in others if n != heater], OTHER_NAMES["damper"])
     if batch_kg is not None:
         mass, source = batch_kg, "--batch-kg"
     elif log.weight_in_kg:
@@ -418,6 +420,11 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
             f"the {fan} channel reads above 100, neither a percent nor a level: not used (set its unit in the map)"
         )
         fan = fan_unit = None
+    if fan and _find([fan], OTHER_NAMES["damper"]):
+        notes.append(
+            f"no fan channel: the {fan} sets the air flow through the drum, so the map takes it as the fan "
+            "(the model's flow rises with it)"
+        )
     lacking = {what: list(logs_without_controls(infos, {what: ch})) for what, ch in (("heater", heater), ("fan", fan))}
     for (what, names), channel in zip(lacking.items(), (heater, fan)):
         if names:
