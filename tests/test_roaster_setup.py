@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from conftest import REAL_DATA
+from roastlab.errors import InputError
 from roastlab.workflows import roaster
 from test_importers import fake_alog
 
@@ -183,6 +184,10 @@ def test_init_reads_a_plain_csv_whose_time_is_a_clock(cli, tmp_path):
     code, out, err = cli("init", bad, logs[1], "--out", tmp_path / "cfg2")
     assert code == 2 and "bad_230g.csv" in err and "line 3, column Time" in err and "'00:75.0'" in err
     assert len(err.strip().splitlines()) == 1
+    seconds_map = (tmp_path / "cfg" / "map.toml").read_text().replace('unit = "m:ss"', 'unit = "s"')
+    (tmp_path / "seconds.toml").write_text(seconds_map)
+    with pytest.raises(InputError, match=r"line 2, column Time: not a number: '00:00.0' \(a time written as a clock"):
+        import_log(logs[0], load_map(tmp_path / "seconds.toml"))
 
 
 def test_a_log_that_records_no_burner_is_named_and_the_others_set_up(cli, tmp_path):

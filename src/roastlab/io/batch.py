@@ -134,7 +134,8 @@ def parse_number(cell: str, path, line: int, column: str) -> float:
     try:
         value = float(text)
     except ValueError:
-        raise InputError(f"not a number: {text[:40]!r}", path, f"line {line}, column {column}") from None
+        clock = ' (a time written as a clock: a map\'s [time] unit "m:ss" reads it)' if ":" in text else ""
+        raise InputError(f"not a number: {text[:40]!r}{clock}", path, f"line {line}, column {column}") from None
     if not math.isfinite(value):
         raise InputError(f"non-finite value {text!r} (NaN or inf)", path, f"line {line}, column {column}")
     return value
