@@ -224,6 +224,7 @@ def test_a_model_below_the_baseline_is_called_not_usable_with_what_the_logs_lack
         ("no BT", "bean temperature"),
         ("nothing drives the model", "neither a heater setting nor ET"),
         ("one log records the heater", "only one log records the Burner setting"),
+        ("degF declared as degC", "°F data declared as °C?"),
     ],
 )
 def test_init_bad_input_is_one_line_saying_what_to_pass(cli, tmp_path, case, words):
@@ -240,6 +241,9 @@ def test_init_bad_input_is_one_line_saying_what_to_pass(cli, tmp_path, case, wor
         b.write_text(fake_alog())
     elif case == "one log records the heater":
         a.write_text(fake_alog(extra=_BURNER_AIR))
+        b.write_text(fake_alog())
+    elif case == "degF declared as degC":  # BT 400 degF at DROP in a log whose mode says C
+        a.write_text(fake_alog(bt=[266.0 + 1.2 * i for i in range(120)]))
         b.write_text(fake_alog())
     else:  # no heater events and no ET
         a.write_text(fake_alog(et=[-1.0] * 120))

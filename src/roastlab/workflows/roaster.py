@@ -44,7 +44,7 @@ import numpy as np
 from ..errors import InputError
 from ..io.importers.artisan import DRUM_AT_CHARGE as ARTISAN_DRUM_AT_CHARGE
 from ..io.importers.artisan import WEIGHT_UNITS, RoomReading, read_alog, read_artisan_csv
-from ..io.importers.mapping import bare_room_unit, detect_format, grams_in_name
+from ..io.importers.mapping import bare_room_unit, detect_format, grams_in_name, hot_drop
 from ..io.importers.roastime import DRUM_AT_CHARGE, read_roastime
 from ..metrics.profile import et_minus_bt_C, et_not_drum_air
 from ..model.bed import CROSS_VALIDATED, PROBE_DEPTH_OVER_DIAMETER
@@ -324,6 +324,8 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
     names = list(log.channels)
     if "BT" not in log.channels or not np.isfinite(log.channels["BT"]).any():
         raise InputError("no bean temperature (BT) in this log: roastlab needs the bean probe", path)
+    if log.drop_index is not None and (why := hot_drop(float(np.nanmedian(log.channels["BT"][-5:])))):
+        raise InputError(why, path)  # the import refuses it too; say it before the files are written
     others = [n for n in names if n not in ("BT", "ET", "beanTemperature", "drumTemperature", "exitTemperature")]
     if fmt == "csv":  # a CSV's other temperatures ("inlet temp", "air temp") are not settings
         others = [n for n in others if "temp" not in n.lower() and "°" not in n]

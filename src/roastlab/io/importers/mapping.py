@@ -90,6 +90,16 @@ TIME_UNITS = {"s": 1.0, "min": 60.0, "ms": 1e-3, "m:ss": 1.0}
 TEMP_UNITS = ("C", "F", "K")
 FLOW_UNITS = {"kg/s": 1.0, "kg/h": 1.0 / 3600.0, "g/s": 1e-3, "m3/h": None}
 DROP_BT_LIMIT_C = 300.0
+
+
+def hot_drop(bt_at_drop_C: float) -> str | None:
+    """Why a bean temperature at DROP above :data:`DROP_BT_LIMIT_C` is not a roast in degC (a log in
+    degF declared as degC), else None."""
+    if not bt_at_drop_C > DROP_BT_LIMIT_C:
+        return None
+    return f"bean temperature {bt_at_drop_C:.0f} degC at DROP is above {DROP_BT_LIMIT_C:.0f}: °F data declared as °C?"
+
+
 #: Smallest resampling step [s] and most samples a log may have after resampling.
 MIN_RESAMPLE_S = 0.1
 MAX_SAMPLES = 1_000_000
@@ -723,10 +733,8 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
         )
         time_s, Ta, Tgi, Gg = time_s[: j + 1], Ta[: j + 1], Tgi[: j + 1], Gg[: j + 1]
         series = {k: v[: j + 1] for k, v in series.items()}
-    if drop_known and Ta[-1] > DROP_BT_LIMIT_C:
-        raise InputError(
-            f"bean temperature {Ta[-1]:.0f} degC at DROP is above {DROP_BT_LIMIT_C:.0f}: °F data declared as °C?", path
-        )
+    if drop_known and (why := hot_drop(Ta[-1])):
+        raise InputError(why, path)
     if cmap.resample_s > 0:
         if np.any(np.diff(time_s) <= 0):
             raise InputError("time not strictly increasing", path)
