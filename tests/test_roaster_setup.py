@@ -253,6 +253,18 @@ def test_init_bad_input_is_one_line_saying_what_to_pass(cli, tmp_path, case, wor
     assert not (tmp_path / "cfg").exists()
 
 
+def test_init_takes_a_probe_fault_before_drop_for_what_it_is(cli, tmp_path):
+    """SYNTHETIC: a probe that jumps to 349 degC before DROP (as one Skywalker log's does) is a fault
+    the import cuts, not a log in degF: init sets it up."""
+    bt = [130.0 - 0.2 * i if i < 30 else 124.0 + 0.5 * (i - 30) for i in range(120)]
+    bt[100:] = [349.0] * 20
+    logs = [tmp_path / "a.alog", tmp_path / "b.alog"]
+    logs[0].write_text(fake_alog(bt=bt, extra=_BURNER_AIR))
+    logs[1].write_text(fake_alog(extra=_BURNER_AIR))
+    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
+    assert code == 0, err
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("machine, pattern", [("skywalker", "*.alog"), ("bullet", "*_49[0]g.json *_500g.json")])
 def test_init_and_fit_roaster_reach_the_hand_written_examples_on_the_shared_logs(cli, tmp_path, machine, pattern):

@@ -44,7 +44,7 @@ import numpy as np
 from ..errors import InputError
 from ..io.importers.artisan import DRUM_AT_CHARGE as ARTISAN_DRUM_AT_CHARGE
 from ..io.importers.artisan import WEIGHT_UNITS, RoomReading, read_alog, read_artisan_csv
-from ..io.importers.mapping import bare_room_unit, detect_format, grams_in_name, hot_drop
+from ..io.importers.mapping import bare_room_unit, detect_format, grams_in_name, hot_drop, probe_fault
 from ..io.importers.roastime import DRUM_AT_CHARGE, read_roastime
 from ..metrics.profile import et_minus_bt_C, et_not_drum_air
 from ..model.bed import CROSS_VALIDATED, PROBE_DEPTH_OVER_DIAMETER
@@ -324,7 +324,9 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
     names = list(log.channels)
     if "BT" not in log.channels or not np.isfinite(log.channels["BT"]).any():
         raise InputError("no bean temperature (BT) in this log: roastlab needs the bean probe", path)
-    if log.drop_index is not None and (why := hot_drop(float(np.nanmedian(log.channels["BT"][-5:])))):
+    bt = log.channels["BT"][np.isfinite(log.channels["BT"])]
+    bt = bt[: fault + 1] if (fault := probe_fault(bt)) is not None else bt  # the import cuts a probe fault so
+    if log.drop_index is not None and (why := hot_drop(float(bt[-1]))):
         raise InputError(why, path)  # the import refuses it too; say it before the files are written
     others = [n for n in names if n not in ("BT", "ET", "beanTemperature", "drumTemperature", "exitTemperature")]
     if fmt == "csv":  # a CSV's other temperatures ("inlet temp", "air temp") are not settings

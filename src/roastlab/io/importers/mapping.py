@@ -92,6 +92,13 @@ FLOW_UNITS = {"kg/s": 1.0, "kg/h": 1.0 / 3600.0, "g/s": 1e-3, "m3/h": None}
 DROP_BT_LIMIT_C = 300.0
 
 
+def probe_fault(bt_C: np.ndarray) -> int | None:
+    """The last sample before the bean probe's first step larger than :data:`MAX_JUMP_C` between
+    two samples (a sensor fault), or None when it makes none."""
+    jumps = np.flatnonzero(np.abs(np.diff(bt_C)) > MAX_JUMP_C)
+    return int(jumps[0]) if jumps.size else None
+
+
 def hot_drop(bt_at_drop_C: float) -> str | None:
     """Why a bean temperature at DROP above :data:`DROP_BT_LIMIT_C` is not a roast in degC (a log in
     degF declared as degC), else None."""
@@ -719,10 +726,8 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
     notes = list(default_notes)
     if ok.sum() < ok.size:
         notes.append(f"dropped {ok.size - ok.sum()} incomplete sample(s) (missing values)")
-    jumps = np.flatnonzero(np.abs(np.diff(Ta)) > MAX_JUMP_C)
-    if jumps.size:
+    if (j := probe_fault(Ta)) is not None:
         # a probe fault: keep what came before it rather than fit a physically impossible step
-        j = int(jumps[0])
         if j + 1 < max(2, 0.5 * len(Ta)):
             raise InputError(
                 f"bean temperature jumps {Ta[j]:.0f} -> {Ta[j + 1]:.0f} degC at t = {time_s[j + 1]:.0f} s, early in the log: sensor fault?",
