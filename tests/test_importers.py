@@ -555,6 +555,25 @@ def test_an_unmarked_charge_and_drop_are_read_from_bt(tmp_path):
     assert log.charge_index == 10 and log.time_s[-1] == t[400] - t[10] and not log.notes
 
 
+@pytest.mark.parametrize("drop_marked", [True, False])
+def test_a_recording_begun_after_the_charge_is_read_from_its_first_sample(tmp_path, drop_marked):
+    """SYNTHETIC BT as above, the recording begun 45 s after the charge (BT already past its fall):
+    the only fall left is the discharge's, which no roast follows, so it is not taken for the
+    charge (it was: the log was then cut to one sample and refused as having no BT)."""
+    t = np.arange(0.0, 720.0, 1.5)
+    roast = 90.0 + 110.0 * np.exp(-t / 25.0) + 115.0 * (1 - np.exp(-t / 400.0)) * 1.35
+    bt = np.where(t > 600.0, roast[np.searchsorted(t, 600.0)] - 0.8 * (t - 600.0), roast)
+    late = t >= 45.0
+    drop = int(np.searchsorted(t[late] - 45.0, 555.0))
+    p = tmp_path / "late.alog"
+    p.write_text(fake_alog(bt=bt[late].tolist(), et=[220.0] * int(late.sum()), n=int(late.sum()),
+                           extra={"timex": (t[late] - 45.0).tolist(),
+                                  "timeindex": [-1, 0, 0, 0, 0, 0, drop if drop_marked else 0, 0]}))  # fmt: skip
+    log = read_alog(p)
+    assert log.charge_index == 0 and log.notes[0].startswith("no CHARGE marked and BT shows no charge")
+    assert abs(log.time_s[-1] - 555.0) <= 3.0  # to the DROP, marked or found in BT
+
+
 def test_a_green_weight_in_the_file_name_is_the_batchs_when_the_log_has_none(tmp_path):
     """SYNTHETIC: init reads a weight from a file name ("..._230g.alog"); the import does too, so the
     fit sees each log's own batch, not the plant's nominal one (the log's own weight wins)."""

@@ -52,6 +52,10 @@ EVENT_NAMES = ("CHARGE", "DRY", "FCs", "FCe", "SCs", "SCe", "DROP", "COOL")
 #: the 15 whose probe held (tests/test_real_roaster.py).
 BT_FALL_C = 10.0
 BT_FALL_WINDOW_S = 30.0
+#: A fall is the charge only if BT then climbs this much above its turning point (a roast follows):
+#: the Skywalker's 16 logs climb 65-100 degC from the turning point to DROP; after the discharge's
+#: fall BT does not climb again.
+ROAST_RISE_C = 40.0
 WEIGHT_UNITS = {"g": 1e-3, "kg": 1.0, "lb": 0.45359237, "oz": 0.028349523125}
 
 
@@ -189,12 +193,13 @@ def marks_or_bt(time_s, bt, charge: int | None, drop: int | None, keep_after_dro
     for each mark found so. No CHARGE in BT: the first sample; no DROP: the log's end."""
     notes = []
     if charge is None:
-        charge = charge_from_bt(time_s, bt)
+        charge = charge_from_bt(time_s, bt, drop)
         notes.append(
             f"no CHARGE marked: taken at {time_s[charge] - time_s[0]:.0f} s into the recording, where BT bends "
             f"into a fall of {BT_FALL_C:g} degC or more within {BT_FALL_WINDOW_S:g} s"
             if charge is not None
-            else "no CHARGE marked and BT shows no charge: the log is read from its first sample"
+            else "no CHARGE marked and BT shows no charge: the log is read from its first sample (a recording "
+            "begun after the beans went in holds no drum temperature at charge; mark CHARGE or record from the preheat)"
         )
         charge = charge or 0
     if drop is None and not keep_after_drop:
@@ -207,9 +212,30 @@ def marks_or_bt(time_s, bt, charge: int | None, drop: int | None, keep_after_dro
     return charge, drop, notes
 
 
-def charge_from_bt(time_s: np.ndarray, bt: np.ndarray) -> int | None:
-    """An unmarked CHARGE: where BT bends into its first fall (:func:`_bend_of_fall`), or None."""
-    return _bend_of_fall(time_s, _running_median3(bt), 0)
+def charge_from_bt(time_s: np.ndarray, bt: np.ndarray, before: int | None = None) -> int | None:
+    """An unmarked CHARGE: where BT bends into its first fall (:func:`_bend_of_fall`) that a roast
+    follows (:func:`_roast_follows`: a recording begun after the charge shows the discharge's fall,
+    not the charge's), before sample ``before`` (a marked DROP) if given; or None."""
+    b = _running_median3(bt)
+    end = len(b) if before is None else max(0, min(int(before), len(b)))
+    t, b = time_s[:end], b[:end]
+    start = 0
+    while (k0 := bt_falls_from(t, b, start)) is not None:
+        knee = _bend_of_fall(t, b, start)
+        if _roast_follows(t[knee:], b[knee:]):
+            return knee
+        start = k0 + int(np.flatnonzero(b[k0:] <= b[k0] - BT_FALL_C)[0]) + 1  # past this fall
+    return None
+
+
+def _roast_follows(time_s: np.ndarray, bt: np.ndarray) -> bool:
+    """Whether BT climbs :data:`ROAST_RISE_C` or more above its turning point
+    (:func:`roastlab.metrics.profile.turning_point`) after a fall: a charge, not a discharge."""
+    tp_s, tp_C = turning_point(time_s, bt)
+    if tp_s is None:
+        return False
+    after = bt[int(np.searchsorted(time_s, tp_s)) :]
+    return bool(np.any(np.isfinite(after)) and np.nanmax(after) - tp_C >= ROAST_RISE_C)
 
 
 def drop_from_bt(time_s: np.ndarray, bt: np.ndarray, charge: int) -> int | None:
