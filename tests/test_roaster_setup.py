@@ -190,6 +190,22 @@ def test_init_reads_a_plain_csv_whose_time_is_a_clock(cli, tmp_path):
         import_log(logs[0], load_map(tmp_path / "seconds.toml"))
 
 
+def test_fit_roaster_on_one_log_says_how_to_fit_it_without_a_check(cli, tmp_path):
+    """SYNTHETIC: one log leaves nothing to hold out; the refusal gives the identify command that
+    fits it anyway from init's files, and that command runs."""
+    log = tmp_path / "r0.alog"
+    log.write_text(fake_alog(extra=_BURNER_AIR))
+    assert cli("init", log, "--out", tmp_path / "cfg")[0] == 0
+    code, _, err = cli("fit-roaster", tmp_path / "cfg", log)
+    assert code == 2 and err.count("\n") == 1 and "roastlab identify --plant" in err
+    command, d = err.split("fitted, unchecked, by ")[1].rsplit(" (D = ", 1)
+    command = command.replace("D/", d.strip().rstrip(")") + "/").split()
+    assert command[:2] == ["roastlab", "identify"] and command[-1] == "LOG"
+    code, _, err = cli(*command[1:-1], "--starts", "1", log)
+    assert code == 0, err
+    assert (tmp_path / "cfg" / "model.json").is_file()
+
+
 def test_a_log_that_records_no_burner_is_named_and_the_others_set_up(cli, tmp_path):
     """SYNTHETIC: Artisan logs a setting only when it moves; a roast whose burner never moved has no
     Burner events. init keeps the other logs' layout and names that log (fit-roaster leaves it out)."""

@@ -832,7 +832,11 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: b
             raise InputError(f"no {name} here: run 'roastlab init LOG... --out {d}' first", d)
     paths = [Path(p) for p in paths]
     if len(paths) < 2:
-        raise InputError("give at least two logs: one to fit, one to hold out", "fit-roaster")
+        raise InputError(
+            "give at least two logs: one to fit, one to hold out; one log alone is fitted, unchecked, by "
+            f"roastlab identify --plant D/plant.toml --map D/map.toml --spec D/fit.toml --out D/model.json LOG (D = {d})",
+            "fit-roaster",
+        )
     infos = [inspect_log(p, 1.0) for p in paths]
     cmap = load_map(d / "map.toml")
     left_out = logs_without_controls(infos, {k: (getattr(cmap, k) or {}).get("column") for k in ("heater", "fan")})
