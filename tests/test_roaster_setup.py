@@ -554,3 +554,22 @@ def test_init_takes_the_capacity_the_logs_state(cli, tmp_path, roastersize, word
 def test_a_plain_csvs_columns_are_found_by_name(header, want):
     c = roaster.plain_csv_columns(header)
     assert (c["time"], c["time_unit"], c["BT"], c["ET"], c["temp_unit"]) == want
+
+
+def test_notes_said_alike_on_many_logs_are_one_line_with_the_range():
+    notes = {
+        "a.alog": ["dropped 4 incomplete sample(s) (missing values)", "ET reads 32 degC below BT (median from 60 s)"],
+        "b.alog": ["dropped 1 incomplete sample(s) (missing values)"],
+        "c.alog": ["dropped 6 incomplete sample(s) (missing values)", "bean temperature jumps 176 -> 349 degC"],
+        "d.alog": ["dropped 1 incomplete sample(s) (missing values)"],
+        "e.alog": ["dropped 2 incomplete sample(s) (missing values)", "ET reads -3.5 degC below BT (median from 60 s)"],
+    }
+    lines = roaster.grouped_notes(notes)
+    assert lines[0] == "5 logs: dropped 1-6 incomplete sample(s) (missing values)"  # more than NAMED_UP_TO: counted
+    assert "a.alog: ET reads 32 degC below BT (median from 60 s)" in lines  # said on two logs: each as said
+    assert "c.alog: bean temperature jumps 176 -> 349 degC" in lines and len(lines) == 4
+    notes["f.alog"] = ["ET reads 40 degC below BT (median from 60 s)"]
+    assert (
+        "3 logs (a.alog, e.alog, f.alog): ET reads -3.5 to 40 degC below BT (median from 60 s)"
+        in roaster.grouped_notes(notes)
+    )

@@ -36,13 +36,12 @@ def cmd_init(args) -> int:
 
 
 def cmd_fit_roaster(args) -> int:
-    from ..workflows.roaster import band_sentence, every_log_sentence, fit_roaster
+    from ..workflows.roaster import band_sentence, every_log_sentence, fit_roaster, grouped_notes
 
     r = fit_roaster(args.dir, args.logs, progress=progress("fit-roaster"), seed=args.seed, every_log=args.every_log)
     f, h, b = r["fit"], r["held_out"], r["baseline_held_out"]
-    for name, notes in r["notes"].items():
-        for note in notes:
-            print(f"note: {name}: {note}", file=sys.stderr)
+    for line in grouped_notes(r["notes"]):
+        print(f"note: {line}", file=sys.stderr)
     for why in r["left_out"].values():
         print(f"left out: {why}")
     if r["refit"]:

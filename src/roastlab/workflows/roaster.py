@@ -741,6 +741,38 @@ def init_roaster(paths, out_dir, *, batch_kg=None, capacity_kg=None, diameter_m=
     return {"survey": s, "plant": plant, "notes": notes}
 
 
+_NUMBER = re.compile(r"-?\d+(?:\.\d+)?")
+#: A note said alike on this many logs or fewer names them; on more, it counts them.
+NAMED_UP_TO = 4
+
+
+def grouped_notes(notes: dict[str, list[str]], at_least: int = 3) -> list[str]:
+    """The import's notes of each log (``{log name: [note, ...]}``) as lines to read: ``"name: note"``,
+    except that a note said alike on ``at_least`` logs or more (the same words, other numbers) is one
+    line, ``"16 logs: dropped 1-6 incomplete sample(s) (missing values)"``, each number the range over
+    those logs (their names too, up to :data:`NAMED_UP_TO` of them)."""
+    groups: dict[tuple, list[tuple[str, str, list[str]]]] = {}
+    for name, said in notes.items():
+        for note in said:
+            groups.setdefault(tuple(_NUMBER.split(note)), []).append((name, note, _NUMBER.findall(note)))
+    lines = []
+    for words, rows in groups.items():
+        if len(rows) < at_least:
+            lines += [f"{name}: {note}" for name, note, _ in rows]
+            continue
+        spans = []
+        for k in range(len(words) - 1):
+            by_value = sorted((float(r[2][k]), r[2][k]) for r in rows)
+            lo, hi = by_value[0][1], by_value[-1][1]
+            spans.append(
+                lo if by_value[0][0] == by_value[-1][0] else f"{lo} to {hi}" if lo.startswith("-") else f"{lo}-{hi}"
+            )
+        text = "".join(w + (spans[k] if k < len(spans) else "") for k, w in enumerate(words))
+        names = f" ({', '.join(r[0] for r in rows)})" if len(rows) <= NAMED_UP_TO else ""
+        lines.append(f"{len(rows)} logs{names}: {text}")
+    return lines
+
+
 def logs_without_controls(infos, controls: dict[str, str | None]) -> dict[str, str]:
     """The logs that do not record a setting the model is driven with (``controls``: ``{"heater":
     channel, "fan": channel}``, None for none; a channel with no events: Artisan logs a setting only
@@ -890,7 +922,12 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: b
         *(line for why in left_out.values() for line in (f"Left out: {why}.", "")),
         *([f"Refitted: {refit}.", ""] if refit else []),
         *(
-            ["Read from the logs:", "", *(f"- {p.name}: {n}" for p, b in zip(paths, batches) for n in b.notes), ""]
+            [
+                "Read from the logs:",
+                "",
+                *(f"- {line}" for line in grouped_notes({p.name: b.notes for p, b in zip(paths, batches)})),
+                "",
+            ]
             if any(b.notes for b in batches)
             else []
         ),  # fmt: skip
