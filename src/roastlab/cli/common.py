@@ -330,9 +330,10 @@ def load_batches(args, model=None):
             batches, dataset_plant = expand_batch_args(args.batches, require_Ta=True)
         else:
             batches, dataset_plant = [load_log(p, cmap) for p in args.batches], None
-        for b in batches:
-            for note in b.notes:
-                print(f"warning: {b.source}: {note}", file=sys.stderr)
+        from ..workflows.roaster import grouped_notes
+
+        for line in grouped_notes({b.source: b.notes for b in batches}):  # one line for a note said alike on many
+            print(f"warning: {line}", file=sys.stderr)
     else:
         batches, dataset_plant = expand_batch_args(args.batches, require_Ta=True)
     return batches, args.plant or dataset_plant
