@@ -206,6 +206,20 @@ def test_fit_roaster_on_one_log_says_how_to_fit_it_without_a_check(cli, tmp_path
     assert (tmp_path / "cfg" / "model.json").is_file()
 
 
+def test_a_log_with_no_green_weight_is_named_and_left_out(cli, tmp_path):
+    """SYNTHETIC: one log of three records no green weight (as one shared Bullet log): init sets up
+    the others and names it (it refused all three), fit-roaster leaves it out and says so."""
+    logs = [tmp_path / f"r{k}.alog" for k in range(3)]
+    for k, p in enumerate(logs):
+        p.write_text(fake_alog(extra=dict(_BURNER_AIR, **({"weight": [0, 0, "g"]} if k == 1 else {}))))
+    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
+    assert code == 0, err
+    assert "1 log(s) record no green weight, nor one in the file name (r1.alog): fit-roaster leaves them out" in out
+    code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
+    assert code == 0, err
+    assert "left out: r1.alog records no green weight" in out
+
+
 def test_a_log_that_records_no_burner_is_named_and_the_others_set_up(cli, tmp_path):
     """SYNTHETIC: Artisan logs a setting only when it moves; a roast whose burner never moved has no
     Burner events. init keeps the other logs' layout and names that log (fit-roaster leaves it out)."""

@@ -409,16 +409,24 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
     machines = {i.machine for i in infos if i.machine}
     if len(machines) > 1:
         raise InputError(f"the logs name different roasters ({', '.join(sorted(machines))}): one at a time", "init")
-    missing = [i.path.name for i in infos if i.batch_kg is None]
-    if missing:
+    unweighed = logs_without_weight(infos)
+    if len(infos) - len(unweighed) < 2:
+        missing = list(unweighed)
         raise InputError(
             f"no green weight in {len(missing)} log(s) ({', '.join(missing[:3])}{' ...' if len(missing) > 3 else ''}) "
             "and none in the file name: pass --batch-kg",
             "init",
         )
+    infos = [i for i in infos if i.path.name not in unweighed]  # the set-up reads the weighed logs
     heater_unit = _common_unit({i.heater_unit for i in infos if i.heater})
     fan_unit = _common_unit({i.fan_unit for i in infos if i.fan})
     notes = []
+    if unweighed:
+        names = list(unweighed)
+        notes.append(
+            f"{len(names)} log(s) record no green weight, nor one in the file name ({', '.join(names[:3])}"
+            f"{' ...' if len(names) > 3 else ''}): fit-roaster leaves them out (--batch-kg gives every log one weight)"
+        )
     if fan_unit == "W":  # above 100: not a percent or a level (a speed in rpm?); the model's flow law cannot read it
         notes.append(
             f"the {fan} channel reads above 100, neither a percent nor a level: not used (set its unit in the map)"
@@ -773,6 +781,17 @@ def grouped_notes(notes: dict[str, list[str]], at_least: int = 3) -> list[str]:
     return lines
 
 
+def logs_without_weight(infos) -> dict[str, str]:
+    """The logs whose green weight is unknown (none in the log, its file name or ``--batch-kg``),
+    each with why; ``{name: why}``. The model scales with the batch, so a log of unknown batch cannot
+    be fitted or scored: ``init`` names them, ``fit-roaster`` leaves them out."""
+    return {
+        i.path.name: f"{i.path.name} records no green weight, nor one in its file name (its batch is unknown)"
+        for i in infos
+        if i.batch_kg is None
+    }
+
+
 def logs_without_controls(infos, controls: dict[str, str | None]) -> dict[str, str]:
     """The logs that do not record a setting the model is driven with (``controls``: ``{"heater":
     channel, "fan": channel}``, None for none; a channel with no events: Artisan logs a setting only
@@ -838,8 +857,8 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: b
     ``config_dir``/model.json, report.md and heldout.png (measured vs predicted BT of the
     held-out logs); returns the figures of the report.
 
-    Logs that do not record a setting the map drives the model with are left out
-    (:func:`logs_without_controls`). A fit that fails on its states with both of the heater's paths
+    Logs that do not record a setting the map drives the model with, or their green weight, are
+    left out (:func:`logs_without_controls`, :func:`logs_without_weight`). A fit that fails on its states with both of the heater's paths
     free is refitted with the drum's path alone (:func:`drum_path_alone`), said in ``refit``; a model
     that predicts the held-out logs worse than the first-order baseline is called so
     (:func:`below_baseline`).
@@ -869,15 +888,19 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: b
             f"roastlab identify --plant D/plant.toml --map D/map.toml --spec D/fit.toml --out D/model.json LOG (D = {d})",
             "fit-roaster",
         )
-    infos = [inspect_log(p, 1.0) for p in paths]
+    infos = [inspect_log(p) for p in paths]
     cmap = load_map(d / "map.toml")
-    left_out = logs_without_controls(infos, {k: (getattr(cmap, k) or {}).get("column") for k in ("heater", "fan")})
+    left_out = {
+        **logs_without_weight(infos),
+        **logs_without_controls(infos, {k: (getattr(cmap, k) or {}).get("column") for k in ("heater", "fan")}),
+    }
     if left_out:
         keep = [k for k, i in enumerate(infos) if i.path.name not in left_out]
         paths, infos = [paths[k] for k in keep], [infos[k] for k in keep]
         if len(paths) < 2:
             raise InputError(
-                f"fewer than two logs record the settings the map drives the model with ({'; '.join(left_out.values())})",
+                f"fewer than two logs record their green weight and the settings the map drives the model with "
+                f"({'; '.join(left_out.values())})",
                 "fit-roaster",
             )
     if all(i.started_epoch_s for i in infos):  # by when they were roasted, else by name
