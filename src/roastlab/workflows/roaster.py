@@ -410,7 +410,7 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
     if len(machines) > 1:
         raise InputError(f"the logs name different roasters ({', '.join(sorted(machines))}): one at a time", "init")
     unweighed = logs_without_weight(infos)
-    if len(infos) - len(unweighed) < 2:
+    if unweighed and len(infos) - len(unweighed) < 2:
         missing = list(unweighed)
         raise InputError(
             f"no green weight in {len(missing)} log(s) ({', '.join(missing[:3])}{' ...' if len(missing) > 3 else ''}) "
