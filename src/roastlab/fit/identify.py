@@ -395,8 +395,11 @@ POLISH_OVERFLOW = "its polish met values where the model's sensitivities overflo
 def _polish(obj: Objective, z0: np.ndarray):
     scale = obj.upper - obj.lower
     # far out along a parameter spanning decades (A) SciPy's products overflow; the start is then
-    # given up (identify catches the ValueError) or the step rejected, so no warning is printed
-    with np.errstate(over="ignore", invalid="ignore"):
+    # given up (identify catches the ValueError) or the step rejected, so no warning is printed. Its
+    # trust-region solver divides by a zero derivative of the step's secular equation on a flat
+    # direction (phi / phi_prime, scipy.optimize._lsq.common.solve_lsq_trust_region) and recovers
+    # alike (a parameter held by the data to none of its range: exotherm freed on the Skywalker)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         res = least_squares(
             obj.residuals,
             z0,
