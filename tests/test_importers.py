@@ -584,3 +584,9 @@ def test_a_green_weight_in_the_file_name_is_the_batchs_when_the_log_has_none(tmp
     weighed = tmp_path / "kenya_230g_weighed.alog"
     weighed.write_text(fake_alog())  # weight [200, 170, "g"]
     assert import_log(weighed, load_map(write_map(tmp_path, SKY_MAP))).Mb_kg == 0.2
+    # the map's batch_kg is the weight of a log that records none, nor in its file name
+    default = load_map(write_map(tmp_path, "batch_kg = 0.3\n" + SKY_MAP))
+    assert import_log(unweighed, default).Mb_kg == 0.23 and import_log(weighed, default).Mb_kg == 0.2
+    plain = tmp_path / "kenya.alog"
+    plain.write_text(fake_alog(extra={"weight": [0, 0, "g"]}))
+    assert import_log(plain, default).Mb_kg == 0.3

@@ -218,6 +218,13 @@ def test_a_log_with_no_green_weight_is_named_and_left_out(cli, tmp_path):
     code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
     assert code == 0, err
     assert "left out: r1.alog records no green weight" in out
+    # --batch-kg is the weight of a log that records none (the others keep theirs), kept in the map
+    # for every command's import: nothing is left out then
+    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg2", "--batch-kg", "0.3")
+    assert code == 0 and "green batches: 200 g, 300 g" in out, (out, err)
+    assert "\nbatch_kg = 0.3 " in (tmp_path / "cfg2" / "map.toml").read_text()
+    code, out, err = cli("fit-roaster", tmp_path / "cfg2", *logs)
+    assert code == 0 and "left out" not in out, err
 
 
 def test_a_log_that_records_no_burner_is_named_and_the_others_set_up(cli, tmp_path):

@@ -74,14 +74,20 @@ def add_parsers(sub) -> None:
         "ET, its first row the charge, of one roaster) and write DIR/map.toml "
         "(which channel is BT, the heater, the fan, a second bean reading, ET), DIR/plant.toml (the drum, from its "
         "dimensions, a catalogue entry or the batch capacity, each estimate stated) and DIR/fit.toml (what these "
-        "logs can determine), each commented with what was detected and what was guessed. Logs are never modified. "
+        "logs can determine), each commented with what was detected and what was guessed. A log that records no "
+        "green weight (nor one in its file name) or no setting the others record is named, and fit-roaster leaves "
+        "it out. Logs are never modified. "
         "Then 'roastlab fit-roaster DIR LOG...' fits the model (MODEL.json) and writes a report.",
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog="example:\n  roastlab init roasts/*.alog --out myroaster\n  roastlab fit-roaster myroaster roasts/*.alog",
     )
     p.add_argument("logs", nargs="+", metavar="LOG", help="roast logs of one roaster")
     p.add_argument("--out", required=True, metavar="DIR", help="folder for map.toml, plant.toml, fit.toml")
-    p.add_argument("--batch-kg", type=float_arg("--batch-kg"), help="green batch [kg] for logs that record none")
+    p.add_argument(
+        "--batch-kg",
+        type=float_arg("--batch-kg"),
+        help="green batch [kg] of every log (else each log's own, or the grams in its file name)",
+    )
     p.add_argument("--batch-capacity-kg", type=float_arg("--batch-capacity-kg"), help="the roaster's rated batch [kg]")
     p.add_argument("--drum-diameter-m", type=float_arg("--drum-diameter-m"), help="inner drum diameter [m]")
     p.add_argument("--drum-length-m", type=float_arg("--drum-length-m"), help="inner drum length [m]")
@@ -93,8 +99,8 @@ def add_parsers(sub) -> None:
         description="With DIR from 'roastlab init': sort LOG... by when they were roasted (by name when a log has no date) and split them alternately (1st, 3rd, ... fit; "
         "2nd, 4th, ... held out), identify the model, validate it on the held-out logs, fit the first-order "
         "baseline on the same inputs, and write DIR/model.json (MODEL.json for every other command), "
-        "DIR/report.md and DIR/heldout.png. A log that records no setting the map drives the model with is left "
-        "out; a fit whose drum runs below the beans with the heater free to heat the air is refitted with the "
+        "DIR/report.md and DIR/heldout.png. A log that records no green weight or no setting the map drives the "
+        "model with is left out; a fit whose drum runs below the beans with the heater free to heat the air is refitted with the "
         "heater heating the drum alone; a model worse than the baseline on the held-out logs is called not "
         "usable; each is said. Exit status 1 when the fit failed (states the machine cannot have, "
         "such as drum metal below the beans; the files are written and say so), 2 on bad input.",

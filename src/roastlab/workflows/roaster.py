@@ -174,6 +174,7 @@ class Survey:
     rooms: int = 0  # logs that record the room temperature
     room_unit: str | None = None  # the unit of their bare numbers (mapping.bare_room_unit); None if none is bare
     columns: dict | None = None  # a plain CSV's own names and units (plain_csv_columns)
+    batch_kg: float | None = None  # --batch-kg: the green weight of a log that records none (the map's batch_kg)
 
 
 #: A heater logged in watts heats the drum by at most its electric power [kW per W].
@@ -335,12 +336,12 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
     fan = "fan" if fmt == "roastime" and "fan" in names else _find([n for n in others if n != heater], FAN_NAMES)
     if fan is None:  # no fan channel: a damper sets the air flow through the drum (one fixed-speed exhaust fan)
         fan = _find([n for n in others if n != heater], OTHER_NAMES["damper"])
-    if batch_kg is not None:
-        mass, source = batch_kg, "--batch-kg"
-    elif log.weight_in_kg:
+    if log.weight_in_kg:  # the import's order (mapping.import_log): the log, its file name, the map's batch_kg
         mass, source = log.weight_in_kg, "the log's green weight"
     elif named := grams_in_name(path):
         mass, source = named[0], f"the file name's '{named[1]}'"
+    elif batch_kg is not None:
+        mass, source = batch_kg, "--batch-kg"
     else:
         mass, source = None, ""
     return LogInfo(
@@ -488,6 +489,7 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
         sum(i.room is not None for i in infos),
         bare_room_unit(i.room for i in infos),
         first.columns,
+        batch_kg,
     )
 
 
@@ -563,6 +565,11 @@ def map_text(s: Survey) -> str:
         f"# format: {s.format}; roaster: {s.machine or '(not named in the logs)'}",
         f'format = "{s.format}"',
         "resample_s = 5.0      # fits fast and loses nothing at roasting time scales",
+        *(
+            [f"batch_kg = {s.batch_kg:g}        # --batch-kg: the green weight of a log that records none"]
+            if s.batch_kg
+            else []
+        ),
         "",
     ]
     cols = s.columns  # a plain CSV names its own columns and units; Artisan's are BT and ET in degC
@@ -888,8 +895,8 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: b
             f"roastlab identify --plant D/plant.toml --map D/map.toml --spec D/fit.toml --out D/model.json LOG (D = {d})",
             "fit-roaster",
         )
-    infos = [inspect_log(p) for p in paths]
     cmap = load_map(d / "map.toml")
+    infos = [inspect_log(p, cmap.batch_kg) for p in paths]
     left_out = {
         **logs_without_weight(infos),
         **logs_without_controls(infos, {k: (getattr(cmap, k) or {}).get("column") for k in ("heater", "fan")}),

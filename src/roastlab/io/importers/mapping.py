@@ -34,7 +34,7 @@ A map is a TOML file::
     # dp_column = "dp_Pa"; T_column = "T_pitot_C"; section_m2 = 0.03; rho0_kg_m3 = 1.275
 
     # --- the actuator extension (optional; the paper's model uses none of these) ---
-    batch_kg = 0.5             # green weight when the log has none [kg]
+    batch_kg = 0.5             # green weight of a log that records none, nor in its file name [kg]
     [heater]                   # a logged heater/burner setting, held between changes
     column = "Burner"          # Artisan event type, RoasTime "heater" (P1-P9), or a CSV column
     unit = "percent"           # percent | level | kW | W
@@ -675,11 +675,12 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
             if found is None:
                 raise InputError(f"initial.{state}: no reading of {', '.join(names)} in the first row", path)
             initial[state] = float(found)
-    if Mb is None and cmap.batch_kg is not None:
-        Mb = cmap.batch_kg
+    # the log's own weight, else its file name's, else the map's batch_kg (roastlab init reads them in this order)
     if Mb is None and (named := grams_in_name(path)):  # the log records none; its name does
         Mb = named[0]
         default_notes.append(f"green weight {named[0]:g} kg from the file name's '{named[1]}'")
+    if Mb is None and cmap.batch_kg is not None:
+        Mb = cmap.batch_kg
     if Mb is None and fmt == "roastime":
         raise InputError(
             "the log has no green weight (weightGreen 0): set batch_kg = ... in the map, or pass --batch-kg", path
