@@ -426,7 +426,7 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
         names = list(unweighed)
         notes.append(
             f"{len(names)} log(s) record no green weight, nor one in the file name ({', '.join(names[:3])}"
-            f"{' ...' if len(names) > 3 else ''}): fit-roaster leaves them out (--batch-kg gives every log one weight)"
+            f"{' ...' if len(names) > 3 else ''}): fit-roaster leaves them out (--batch-kg gives them one)"
         )
     if fan_unit == "W":  # above 100: not a percent or a level (a speed in rpm?); the model's flow law cannot read it
         notes.append(
