@@ -227,6 +227,39 @@ def test_a_log_with_no_green_weight_is_named_and_left_out(cli, tmp_path):
     assert code == 0 and "left out" not in out, err
 
 
+def test_a_csv_of_a_european_spreadsheet_reads_as_any_other():
+    from roastlab.io.batch import as_comma_separated
+
+    assert as_comma_separated("time,BT\n0,131.7\n") == "time,BT\n0,131.7\n"  # comma-separated: as it is
+    eu = "# Röster 1\nZeit;BT (°C);Ereignis\n00:00,0;131,7;Charge, 200 g\n00:01,5;-1,5;\n"
+    assert as_comma_separated(eu) == '# Röster 1\nZeit,BT (°C),Ereignis\n00:00.0,131.7,"Charge, 200 g"\n00:01.5,-1.5,\n'
+    assert as_comma_separated("t\tBT\n1,5\t131,7\n") == "t,BT\n1.5,131.7\n"  # tab-separated too
+
+
+def test_init_reads_a_semicolon_csv_with_decimal_commas(cli, tmp_path):
+    """SYNTHETIC: a log as a German spreadsheet exports it (Zeit;BT;ET;Brenner;Luft, decimal commas):
+    set up and imported as the comma-separated log with decimal points is."""
+    from roastlab.io.importers.mapping import import_log, load_map
+
+    logs = {}
+    for sep, dec in ((";", ","), (",", ".")):
+        folder = tmp_path / ("eu" if sep == ";" else "us")
+        folder.mkdir()
+        for k, grams in enumerate((230, 250)):
+            rows = [sep.join(["Zeit", "BT", "ET", "Brenner", "Luft"])]
+            for i in range(120):
+                bt = 150.0 - 1.0 * i if i < 30 else 120.0 + 0.6 * (i - 30)
+                cells = [f"{2.5 * i:.1f}", f"{bt:.1f}", f"{bt + 30:.1f}", f"{60 + 10 * (i > 60)}", f"{40 + k}"]
+                rows.append(sep.join(c.replace(".", dec) for c in cells))
+            (folder / f"roast{k}_{grams}g.csv").write_text("\n".join(rows) + "\n")
+        logs[sep] = sorted(folder.glob("*.csv"))
+        code, out, err = cli("init", *logs[sep], "--out", folder / "cfg")
+        assert code == 0 and "heater: Brenner (percent); fan: Luft (percent)" in out, err
+    a = import_log(logs[";"][0], load_map(tmp_path / "eu" / "cfg" / "map.toml"))
+    b = import_log(logs[","][0], load_map(tmp_path / "us" / "cfg" / "map.toml"))
+    assert np.array_equal(a.time_s, b.time_s) and np.array_equal(a.Ta_C, b.Ta_C) and a.Ta_C[10] != a.Ta_C[0]
+
+
 def test_a_log_that_records_no_burner_is_named_and_the_others_set_up(cli, tmp_path):
     """SYNTHETIC: Artisan logs a setting only when it moves; a roast whose burner never moved has no
     Burner events. init keeps the other logs' layout and names that log (fit-roaster leaves it out)."""

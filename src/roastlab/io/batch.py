@@ -12,6 +12,7 @@ import csv
 import io
 import math
 import os
+import re
 from array import array
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -139,6 +140,31 @@ def parse_number(cell: str, path, line: int, column: str) -> float:
     if not math.isfinite(value):
         raise InputError(f"non-finite value {text!r} (NaN or inf)", path, f"line {line}, column {column}")
     return value
+
+
+#: A cell that is a number or a clock time written with a decimal comma ("131,7", "07:37,5"), as
+#: spreadsheets in much of Europe export it (with ";" or a tab between the cells).
+_DECIMAL_COMMA = re.compile(r"^\s*-?(?:\d+:)*\d+,\d+\s*$")
+
+
+def as_comma_separated(text: str) -> str:
+    """A raw log's CSV text with its cells separated by commas and decimal points: a file whose
+    header row holds more ``;`` or tabs than commas (a European spreadsheet's export: ``Zeit;BT;ET``,
+    ``131,7``) is rewritten so (its decimal commas become points); any other text is returned as it
+    is. Comment lines (``#``) stay as they are."""
+    head = next((ln for ln in io.StringIO(text) if ln.strip() and not ln.lstrip().startswith("#")), "")
+    sep = max((";", "\t"), key=head.count)
+    if head.count(sep) <= head.count(","):
+        return text
+    out = io.StringIO()
+    writer = csv.writer(out, lineterminator="\n")
+    for line in io.StringIO(text):
+        if line.lstrip().startswith("#") or not line.strip():
+            out.write(line if line.endswith("\n") else line + "\n")
+            continue
+        for row in csv.reader([line], delimiter=sep):
+            writer.writerow([c.replace(",", ".") if _DECIMAL_COMMA.match(c) else c for c in row])
+    return out.getvalue()
 
 
 #: What a ``sparse`` column's cell says when no reading was taken: empty, or NaN as NumPy and

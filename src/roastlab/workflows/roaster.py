@@ -208,7 +208,7 @@ def _find(names, candidates) -> str | None:
 
 
 #: A plain CSV's columns by name: the first word of a header, lower case ("BT (F)" -> "bt").
-CSV_TIME_WORDS = ("time", "t", "sec", "secs", "seconds", "elapsed")
+CSV_TIME_WORDS = ("time", "t", "sec", "secs", "seconds", "elapsed", "zeit", "temps", "tiempo", "tempo")
 CSV_BT_WORDS = ("bt", "bean", "beans", "beantemp")
 CSV_ET_WORDS = ("et", "env", "environment", "exhaust", "exit")
 #: Words that make a column a rate or a difference, not a reading ("BT RoR", "delta BT").
@@ -266,12 +266,12 @@ def read_plain_csv(path: Path):
     names, and its columns (:func:`plain_csv_columns`): what :func:`inspect_log` needs."""
     import csv as _csv
 
-    from ..io.batch import read_table
+    from ..io.batch import as_comma_separated, read_table
     from ..io.files import read_input_text
     from ..io.importers.artisan import ArtisanLog
     from ..io.importers.mapping import TIME_UNITS, to_celsius
 
-    text = read_input_text(path, "a CSV log")
+    text = as_comma_separated(read_input_text(path, "a CSV log"))
     header = next(
         (row for row in _csv.reader(ln for ln in io.StringIO(text) if not ln.lstrip().startswith("#")) if row), []
     )
