@@ -158,12 +158,15 @@ def as_comma_separated(text: str) -> str:
         return text
     out = io.StringIO()
     writer = csv.writer(out, lineterminator="\n")
-    for line in io.StringIO(text):
-        if line.lstrip().startswith("#") or not line.strip():
-            out.write(line if line.endswith("\n") else line + "\n")
-            continue
-        for row in csv.reader([line], delimiter=sep):
-            writer.writerow([c.replace(",", ".") if _DECIMAL_COMMA.match(c) else c for c in row])
+    try:
+        for line in io.StringIO(text):
+            if line.lstrip().startswith("#") or not line.strip():
+                out.write(line if line.endswith("\n") else line + "\n")
+                continue
+            for row in csv.reader([line], delimiter=sep):
+                writer.writerow([c.replace(",", ".") if _DECIMAL_COMMA.match(c) else c for c in row])
+    except csv.Error:  # not a table (a NUL byte, a broken quote): the strict reader says where
+        return text
     return out.getvalue()
 
 
