@@ -215,6 +215,7 @@ def test_a_log_with_no_green_weight_is_named_and_left_out(cli, tmp_path):
     code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
     assert code == 0, err
     assert "1 log(s) record no green weight, nor one in the file name (r1.alog): fit-roaster leaves them out" in out
+    assert out.startswith("2 log(s) (and 1 without a green weight, below)")
     code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
     assert code == 0, err
     assert "left out: r1.alog records no green weight" in out

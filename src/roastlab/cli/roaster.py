@@ -20,7 +20,8 @@ def cmd_init(args) -> int:
         length_m=args.drum_length_m,
     )
     s = r["survey"]
-    print(f"{len(s.logs)} log(s), format {s.format}, roaster {s.machine or '(not named)'}")
+    aside = f" (and {len(s.unweighed)} without a green weight, below)" if s.unweighed else ""
+    print(f"{len(s.logs)} log(s){aside}, format {s.format}, roaster {s.machine or '(not named)'}")
     print(
         f"  bean probe BT; heater: {s.heater or 'none'} ({s.heater_unit or '-'}); fan: {s.fan or 'none'} ({s.fan_unit or '-'})"
     )

@@ -175,6 +175,7 @@ class Survey:
     room_unit: str | None = None  # the unit of their bare numbers (mapping.bare_room_unit); None if none is bare
     columns: dict | None = None  # a plain CSV's own names and units (plain_csv_columns)
     batch_kg: float | None = None  # --batch-kg: the green weight of a log that records none (the map's batch_kg)
+    unweighed: list[str] = field(default_factory=list)  # logs set aside: no green weight (logs_without_weight)
 
 
 #: A heater logged in watts heats the drum by at most its electric power [kW per W].
@@ -490,6 +491,7 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
         bare_room_unit(i.room for i in infos),
         first.columns,
         batch_kg,
+        list(unweighed),
     )
 
 
