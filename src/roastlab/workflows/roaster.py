@@ -246,21 +246,6 @@ def plain_csv_columns(header: list[str]) -> dict:
     }
 
 
-def _clock_column(text: str, header: list[str], column: str | None) -> bool:
-    """Whether ``column``'s first filled cell is written as a clock (m:ss: it has a colon)."""
-    import csv as _csv
-
-    if column is None:
-        return False
-    j = header.index(column)
-    rows = (row for row in _csv.reader(ln for ln in io.StringIO(text) if not ln.lstrip().startswith("#")) if row)
-    next(rows, None)  # the header
-    for row in rows:
-        if j < len(row) and row[j].strip():
-            return ":" in row[j]
-    return False
-
-
 def read_plain_csv(path: Path):
     """A plain CSV log (a header row, numbers below; its first row the charge) read as an
     :class:`~roastlab.io.importers.artisan.ArtisanLog` whose BT and ET are in degC under those
@@ -273,10 +258,8 @@ def read_plain_csv(path: Path):
     from ..io.importers.mapping import TIME_UNITS, to_celsius
 
     text = as_comma_separated(read_input_text(path, "a CSV log"))
-    header = next(
-        (row for row in _csv.reader(ln for ln in io.StringIO(text) if not ln.lstrip().startswith("#")) if row), []
-    )
-    header = [h.strip() for h in header]
+    rows = (row for row in _csv.reader(ln for ln in io.StringIO(text) if not ln.lstrip().startswith("#")) if row)
+    header = [h.strip() for h in next(rows, [])]
     cols = plain_csv_columns(header)
     if cols["time"] is None or cols["BT"] is None:
         raise InputError(
@@ -284,7 +267,9 @@ def read_plain_csv(path: Path):
             f"found: {', '.join(header[:8])})",
             path,
         )
-    if _clock_column(text, header, cols["time"]):
+    at = header.index(cols["time"])
+    first_time = next((row[at] for row in rows if at < len(row) and row[at].strip()), "")
+    if ":" in first_time:  # the time written as a clock (m:ss): its first filled cell says so
         cols["time_unit"] = "m:ss"
     clock = (cols["time"],) if cols["time_unit"] == "m:ss" else ()
     data = read_table(path, (cols["time"], cols["BT"]), text=text, sparse=(cols["time"], cols["BT"]), clock=clock)
