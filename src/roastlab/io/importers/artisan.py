@@ -388,17 +388,30 @@ def extra_name(name: str, etypes: list, with_events: set[str]) -> str:
     return filled + READOUT_SUFFIX if filled in with_events else filled
 
 
-def _types_with_events(data: dict, etypes: list) -> set[str]:
-    """The names of the event types the log has special events of (nothing checked here: the
-    events' own reading below refuses malformed ones)."""
-    types = data.get("specialeventstype", [])
-    if not isinstance(types, list):
-        return set()
-    return {
-        str(etypes[int(t)])
-        for t in types
-        if isinstance(t, (int, float)) and not isinstance(t, bool) and 0 <= t < len(etypes)
-    }
+def _special_events(data: dict, etypes: list, n: int, path) -> list[tuple[int, str, float]]:
+    """The log's special events as ``(sample index, event type's name, value in external units)``,
+    checked (malformed ones refused); events of an unknown type, of type ``--`` or outside the
+    log's samples are skipped."""
+    idx, types, vals = (data.get(k, []) for k in ("specialevents", "specialeventstype", "specialeventsvalue"))
+    if not (isinstance(idx, list) and isinstance(types, list) and isinstance(vals, list)):
+        raise InputError("special events must be lists", path, "key specialevents")
+    if not (len(idx) == len(types) == len(vals)):
+        raise InputError(
+            f"specialevents/type/value lengths differ ({len(idx)}, {len(types)}, {len(vals)})",
+            path,
+            "key specialevents",
+        )
+    out = []
+    for i, ty, v in zip(idx, types, vals):
+        if not all(isinstance(q, (int, float)) and not isinstance(q, bool) for q in (i, ty, v)):
+            raise InputError("special events must be numbers", path, "key specialevents")
+        if not all(abs(q) <= 1e9 for q in (i, ty, v)):  # also False for NaN; exact for huge ints
+            raise InputError("special event index, type or value out of range", path, "key specialevents")
+        ty, i = int(ty), int(i)
+        if not 0 <= ty < len(etypes) or not 0 <= i < n or str(etypes[ty]) == "--":
+            continue
+        out.append((i, str(etypes[ty]), events_internal_to_external(float(v))))
+    return out
 
 
 def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: bool = True) -> ArtisanLog:
@@ -424,9 +437,10 @@ def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: boo
     channels = {"ET": et.copy(), "BT": bt.copy()}
     temps = {"ET", "BT"}
     etypes = _as_list(data.get("etypes")) or ["Air", "Drum", "Damper", "Burner", "--"]
+    events = _special_events(data, etypes, n, path)
+    with_events = {name for _, name, _ in events}
     # extra devices: each has a time base and two channels with names
     extratimex = _as_list(data.get("extratimex"))
-    with_events = _types_with_events(data, etypes)
     if extratimex:
         for d, tx in enumerate(extratimex):
             for k in (1, 2):
@@ -459,28 +473,8 @@ def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: boo
             channels[name] = f_to_c(channels[name])
 
     # special events -> step signals in external units, one per event type
-    idx, types, vals = (data.get(k, []) for k in ("specialevents", "specialeventstype", "specialeventsvalue"))
-    if not (isinstance(idx, list) and isinstance(types, list) and isinstance(vals, list)):
-        raise InputError("special events must be lists", path, "key specialevents")
-    if not (len(idx) == len(types) == len(vals)):
-        raise InputError(
-            f"specialevents/type/value lengths differ ({len(idx)}, {len(types)}, {len(vals)})",
-            path,
-            "key specialevents",
-        )
-    for i, ty, v in zip(idx, types, vals):
-        if not all(isinstance(q, (int, float)) and not isinstance(q, bool) for q in (i, ty, v)):
-            raise InputError("special events must be numbers", path, "key specialevents")
-        if not all(abs(q) <= 1e9 for q in (i, ty, v)):  # also False for NaN; exact for huge ints
-            raise InputError("special event index, type or value out of range", path, "key specialevents")
-        ty, i = int(ty), int(i)
-        if not 0 <= ty < len(etypes) or not 0 <= i < n:
-            continue
-        name = str(etypes[ty])
-        if name == "--":
-            continue
-        sig = channels.setdefault(name, np.full(n, np.nan))
-        sig[i:] = events_internal_to_external(float(v))
+    for i, name, value in events:
+        channels.setdefault(name, np.full(n, np.nan))[i:] = value
 
     # CHARGE alignment and DROP cut
     ti = data.get("timeindex", [0] * 8)
