@@ -172,19 +172,24 @@ def _running_median3(x: np.ndarray) -> np.ndarray:
 
 
 def _bend_of_fall(time_s: np.ndarray, bt: np.ndarray, start: int) -> int | None:
-    """Where BT bends into the first fall of :func:`bt_falls_from` after ``start``: over the span from
-    :data:`BT_FALL_WINDOW_S` before the fall begins to where it has fallen :data:`BT_FALL_C`, the
-    sample furthest above the chord joining the span's ends (a slow drift before the fall, or a
-    rise, is not the event; the knee where the fall steepens is)."""
+    """Where BT bends into the first fall of :func:`bt_falls_from` after ``start`` (:func:`_fall`)."""
+    fall = _fall(time_s, bt, start)
+    return None if fall is None else fall[0]
+
+
+def _fall(time_s: np.ndarray, bt: np.ndarray, start: int) -> tuple[int, int] | None:
+    """``(knee, end)`` of the first fall of :func:`bt_falls_from` after ``start``, or None: ``end`` is
+    where BT has fallen :data:`BT_FALL_C`; ``knee``, over the span from :data:`BT_FALL_WINDOW_S`
+    before the fall begins to ``end``, the sample furthest above the chord joining the span's ends
+    (a slow drift before the fall, or a rise, is not the event; the knee where the fall steepens is)."""
     k0 = bt_falls_from(time_s, bt, start)
     if k0 is None:
         return None
-    fallen = np.flatnonzero(bt[k0:] <= bt[k0] - BT_FALL_C)
-    k1 = k0 + int(fallen[0])
+    k1 = k0 + int(np.flatnonzero(bt[k0:] <= bt[k0] - BT_FALL_C)[0])
     a = max(start, int(np.searchsorted(time_s, time_s[k0] - BT_FALL_WINDOW_S)))
     t, b = time_s[a : k1 + 1], bt[a : k1 + 1]
     chord = b[0] + (b[-1] - b[0]) * (t - t[0]) / (t[-1] - t[0])
-    return a + int(np.nanargmax(b - chord))
+    return a + int(np.nanargmax(b - chord)), k1
 
 
 def marks_or_bt(time_s, bt, charge: int | None, drop: int | None, keep_after_drop: bool = False):
@@ -220,11 +225,11 @@ def charge_from_bt(time_s: np.ndarray, bt: np.ndarray, before: int | None = None
     end = len(b) if before is None else max(0, min(int(before), len(b)))
     t, b = time_s[:end], b[:end]
     start = 0
-    while (k0 := bt_falls_from(t, b, start)) is not None:
-        knee = _bend_of_fall(t, b, start)
+    while (fall := _fall(t, b, start)) is not None:
+        knee, end_of_fall = fall
         if _roast_follows(t[knee:], b[knee:]):
             return knee
-        start = k0 + int(np.flatnonzero(b[k0:] <= b[k0] - BT_FALL_C)[0]) + 1  # past this fall
+        start = end_of_fall + 1  # past this fall
     return None
 
 
