@@ -170,6 +170,12 @@ def as_comma_separated(text: str) -> str:
     return out.getvalue()
 
 
+def csv_log_text(path) -> str:
+    """A raw CSV log's text through the input guard, comma-separated (:func:`as_comma_separated`):
+    what ``roastlab init`` and a map's import both read."""
+    return as_comma_separated(read_input_text(path, "a CSV log"))
+
+
 #: What a ``sparse`` column's cell says when no reading was taken: empty, or NaN as NumPy and
 #: spreadsheets write it.
 MISSING_CELLS = ("", "nan")

@@ -252,12 +252,11 @@ def read_plain_csv(path: Path):
     names, and its columns (:func:`plain_csv_columns`): what :func:`inspect_log` needs."""
     import csv as _csv
 
-    from ..io.batch import as_comma_separated, read_table
-    from ..io.files import read_input_text
+    from ..io.batch import csv_log_text, read_table
     from ..io.importers.artisan import ArtisanLog
     from ..io.importers.mapping import TIME_UNITS, to_celsius
 
-    text = as_comma_separated(read_input_text(path, "a CSV log"))
+    text = csv_log_text(path)
     rows = (row for row in _csv.reader(ln for ln in io.StringIO(text) if not ln.lstrip().startswith("#")) if row)
     header = [h.strip() for h in next(rows, [])]
     cols = plain_csv_columns(header)

@@ -75,8 +75,8 @@ from ...metrics.profile import ET_CHECK_FROM_S, et_minus_bt_C
 from ...model.actuators import UNIT_DEFAULTS, Actuator
 from ...model.limits import check_value
 from ...model.pitot import gas_flow_pitot_kg_s
-from ..batch import Batch, as_comma_separated, read_table
-from ..files import as_path, finite_number, read_input_bytes, read_input_text, read_toml
+from ..batch import Batch, csv_log_text, read_table
+from ..files import as_path, finite_number, read_input_bytes, read_toml
 from .artisan import f_to_c, read_alog, read_artisan_csv
 from .roastime import read_roastime
 
@@ -629,7 +629,7 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
             else read_table(
                 path,
                 tuple(needed),
-                text=as_comma_separated(read_input_text(path, "a CSV log")),
+                text=csv_log_text(path),
                 sparse=tuple(needed),
                 clock=(cmap.time["column"],) if cmap.time["unit"] == "m:ss" else (),
             )
