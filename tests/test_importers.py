@@ -436,6 +436,41 @@ def test_init_flags_an_et_that_reads_below_bt_unlike_the_machines_other_logs():
     assert et_not_drum_air([-30.0, None, 20.0]) == [False] * 3  # two known logs say nothing about a spread
 
 
+def test_an_et_that_falls_to_the_green_beans_at_charge_reads_the_beans():
+    """SYNTHETIC readings: an infrared bean sensor logged as ET reads the green beans as they land
+    (25 degC) while the probe cools only to its turning point (100 degC); a drum-air ET dips to about
+    the probe's low, or (roastlab's model of a big batch in a gas drum) 0.4 of the way from the room
+    to it. Undecided without both readings in the first minute, or with a probe at the room's."""
+    from roastlab.metrics.profile import BEANS_IN_VIEW_S, et_reads_beans
+
+    t = np.arange(0.0, 300.0, 2.0)
+    bt = np.where(t < 60, 150.0 - 50.0 * t / 60, 100.0 + 0.4 * (t - 60))
+    ir = 25.0 + 0.6 * t
+    assert et_reads_beans(t, ir, bt, 22.0) is True
+    assert et_reads_beans(t, bt - 10.0, bt, 22.0) is False  # the Skywalker's air: 91 degC against 99 at most
+    assert et_reads_beans(t, np.where(t < 40, 40.0, bt), bt, 22.0) is False  # (40-22) > 0.2 (100-22)
+    assert et_reads_beans(t, np.where(t < 40, 36.0, bt), bt, 22.0) is True
+    late = t > BEANS_IN_VIEW_S
+    assert et_reads_beans(t, np.where(late, ir, np.nan), bt, 22.0) is None
+    assert et_reads_beans(t, ir, np.full(t.size, 20.0), 22.0) is None
+
+
+def test_the_shared_logs_et_reads_the_beans_on_the_bullet_only():
+    """The Bullet's IR reading (RoasTime's drumTemperature, what Artisan's IBTS device logs as ET)
+    reads the beans on all 28 logs; the Skywalker's ET, the drum's air, on none of its 16."""
+    from conftest import REAL_DATA
+    from roastlab.io.importers.roastime import read_roastime
+    from roastlab.metrics.profile import et_reads_beans
+
+    if not (REAL_DATA / "bullet").is_dir() or not (REAL_DATA / "skywalker").is_dir():
+        pytest.skip("../shared/data/real is absent")
+    bullet = [read_roastime(p) for p in sorted((REAL_DATA / "bullet").glob("*.json"))]
+    sky = [read_alog(p) for p in sorted((REAL_DATA / "skywalker").glob("*.alog"))]
+    assert len(bullet) >= 28 and len(sky) >= 16
+    assert all(et_reads_beans(g.time_s, g.channels["drumTemperature"], g.channels["BT"], 22.0) for g in bullet)
+    assert not any(et_reads_beans(g.time_s, g.channels["ET"], g.channels["BT"], 22.0) for g in sky)
+
+
 def test_the_room_temperature_a_log_records_sets_the_inlet_air_and_the_beans_at_charge(tmp_path):
     """[Tgi] room = true: the inlet air is the room temperature the log records (Artisan's
     ambientTemp in the profile's mode, RoasTime's typed text with the map's room_unit for a bare

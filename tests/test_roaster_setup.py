@@ -59,6 +59,44 @@ def test_init_takes_the_event_types_before_a_device_named_like_them(cli, tmp_pat
     assert 'column = "Heater"' in heater and f'unit = "{unit}"' in heater
 
 
+def _ir_as_et(n: int = 120, charge: int = 5) -> dict:
+    """SYNTHETIC: an ET that reads the beans, as Artisan's Aillio Bullet R1 IBTS device logs its
+    infrared sensor: the empty preheated drum (240 degC) before CHARGE, the green beans (25 degC)
+    as they land, then above the probe (fake_alog's BT: 130 degC falling to 124, then rising)."""
+    et = [240.0] * charge + [25.0 + 2.0 * i for i in range(n - charge)]
+    return {"temp1": et, "specialevents": [charge, charge], "specialeventstype": [3, 0],
+            "specialeventsvalue": [8.0, 4.0], "etypes": ["Fan", "Drum", "Damper", "Heater", "--"],
+            "roastertype": "Aillio Bullet R1 IBTS"}  # fmt: skip
+
+
+def test_init_reads_an_et_that_falls_to_the_green_beans_as_a_second_bean_reading(cli, tmp_path):
+    """SYNTHETIC logs whose ET falls to the green beans at CHARGE (:func:`_ir_as_et`): init maps it as
+    the second bean reading ([Tb2]), not the drum's air, starts the drum at ET's reading before
+    CHARGE, and weighs it against the model's beans; the import does not draw it as ET. A drum-air
+    ET (fake_alog's) stays ET."""
+    from roastlab.io.importers.mapping import import_log, load_map
+
+    logs = [tmp_path / f"r{k}.alog" for k in range(2)]
+    for p in logs:
+        p.write_text(fake_alog(extra=_ir_as_et()))
+    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
+    assert code == 0, err
+    assert "ET: a bean reading, not the drum's air" in out and "ET falls to the green beans' temperature" in out
+    text = {n: (tmp_path / "cfg" / f"{n}.toml").read_text() for n in ("map", "fit")}
+    assert '[Tb2]\ncolumn = "ET"' in text["map"] and "[ET]" not in text["map"]
+    assert 'Tm0_C = ["ET before CHARGE", "BT"]' in text["map"]
+    assert "Tb2 = 1.0" in text["fit"] and "\nET = " not in text["fit"]
+    batch = import_log(logs[0], load_map(tmp_path / "cfg" / "map.toml"))
+    assert batch.initial["Tm0_C"] == 240.0  # the drum, not BT (130) nor the beans (25)
+    assert batch.Tb2_C is not None and batch.ET_C is None
+    air = tmp_path / "air.alog"
+    air.write_text(fake_alog(extra=_ir_as_et() | {"temp1": [150.0 + 0.4 * i for i in range(120)]}))
+    code, out, err = cli("init", logs[0], air, "--out", tmp_path / "cfg2")
+    assert code == 0 and "ET: yes" in out, err
+    assert "ET falls to the green beans' temperature at CHARGE on 1 log(s) (r0.alog), unlike the others" in out
+    assert "[Tb2]" not in (tmp_path / "cfg2" / "map.toml").read_text()
+
+
 def test_init_takes_the_damper_as_the_fan_when_no_fan_is_logged(cli, tmp_path):
     """SYNTHETIC logs with Burner and Damper events and no Air: on a drum with one fixed-speed
     exhaust fan the damper sets the air flow, so it stands for the fan, and init says so; with an
@@ -530,7 +568,9 @@ def test_an_unseen_gas_drum_with_burner_events_is_fitted_with_no_hand_edits(cli,
     code, out, err = cli("init", *logs, "--out", tmp_path / "cfg", "--batch-capacity-kg", "5")
     assert code == 0, err
     text = (tmp_path / "cfg" / "map.toml").read_text()
-    assert 'column = "Brenner"' in text, text
+    assert 'column = "Brenner"' in text and "ET: yes" in out, (
+        text
+    )  # its outlet gas falls far at CHARGE, not to the beans
     code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
     assert code == 0, err
     held = float(out.split("held out: FIT ")[1].split(" %")[0])

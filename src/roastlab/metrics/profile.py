@@ -317,6 +317,38 @@ def et_not_drum_air(differences_C) -> list[bool]:
     return [bool(ok[i] and d[i] < min(0.0, med - 3.0 * sd)) for i in range(len(d))]
 
 
+#: The first part of a roast in which an ET that reads the beans shows it [s after CHARGE].
+BEANS_IN_VIEW_S = 60.0
+#: ET's lowest reading in :data:`BEANS_IN_VIEW_S`, as a share of the way from the room to the
+#: probe's lowest then, below which ET reads the beans (:func:`et_reads_beans`).
+BEANS_SHARE = 0.2
+
+
+def et_reads_beans(time_s, et_C, bt_C, room_C: float) -> bool | None:
+    """True where a log's ET reads the beans, not the drum's air: an infrared bean sensor logged
+    as ET (Artisan's "Aillio Bullet R1 IBTS" device logs the Bullet's IR bean reading as ET). Such
+    a sensor reads the green beans the moment they land, at about the room's temperature, while the
+    probe in the bed cools only to its turning point and the air leaving the bed stays warmer. The
+    test: ET's lowest reading in the first :data:`BEANS_IN_VIEW_S` after CHARGE lies less than
+    :data:`BEANS_SHARE` of the way from the room (``room_C``) to the probe's lowest then. On the
+    shared logs: the Bullet's IR reading (RoasTime's ``drumTemperature``) falls to 25 °C on all 28,
+    0.06 of the way or less to the probe's 74-108 °C; the Skywalker's ET, the drum's air, to
+    91-159 °C, 0.83 of the way or more to its probe's 99-136 °C. The steepest fall of an air reading
+    we know is roastlab's own model of a 3 kg batch charged into a 5 kg gas drum, whose outlet gas
+    falls 0.4 of the way (tests/test_roaster_setup.py's synthetic gas drum). None when either
+    reading is missing in that window, or the probe's lowest is not above the room."""
+    t = np.asarray(time_s, dtype=float)
+    et, bt = np.asarray(et_C, dtype=float), np.asarray(bt_C, dtype=float)
+    w = (t >= 0.0) & (t <= BEANS_IN_VIEW_S)
+    ok_et, ok_bt = w & np.isfinite(et) & (et > -1.0 + 1e-9), w & np.isfinite(bt) & (bt > -1.0 + 1e-9)
+    if not ok_et.any() or not ok_bt.any():
+        return None
+    bt_low = float(bt[ok_bt].min())
+    if bt_low <= room_C:
+        return None  # the probe itself at the room's temperature: nothing to tell them apart by
+    return bool(float(et[ok_et].min()) - room_C < BEANS_SHARE * (bt_low - room_C))
+
+
 def implausible_states(result) -> list[str]:
     """What a simulation's states say that the machine cannot do (empty when nothing).
 

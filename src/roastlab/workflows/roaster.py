@@ -9,7 +9,10 @@ What :func:`survey` detects in the logs (and says in the files' comments):
 * which channels are the heater/burner and the fan/air, by name in Artisan's languages (an
   event type or an extra device), with their unit by value range (whole steps up to 20: a
   level; up to 100: percent; above 100: a heater's power in W);
-* a second bean reading (RoasTime's infrared ``drumTemperature``);
+* a second bean reading (RoasTime's infrared ``drumTemperature``, or an ET that falls to the
+  green beans at CHARGE, :func:`roastlab.metrics.profile.et_reads_beans`: an infrared bean sensor
+  as Artisan's Aillio Bullet R1 IBTS device logs it, the drum at CHARGE then ET's reading before it,
+  :data:`roastlab.io.importers.artisan.ET_BEFORE_CHARGE`);
 * ET (the drum temperature at CHARGE is BT's reading then,
   :data:`roastlab.io.importers.artisan.DRUM_AT_CHARGE`; RoasTime's preheat for RoasTime logs);
 * each log's green batch (Artisan ``weight``, RoasTime ``weightGreen``, a file name's "230g").
@@ -43,12 +46,13 @@ import numpy as np
 
 from ..errors import InputError
 from ..io.importers.artisan import DRUM_AT_CHARGE as ARTISAN_DRUM_AT_CHARGE
-from ..io.importers.artisan import WEIGHT_UNITS, RoomReading, read_alog, read_artisan_csv
+from ..io.importers.artisan import ET_BEFORE_CHARGE, WEIGHT_UNITS, RoomReading, read_alog, read_artisan_csv
 from ..io.importers.mapping import bare_room_unit, detect_format, grams_in_name, hot_drop, probe_fault
 from ..io.importers.roastime import DRUM_AT_CHARGE, read_roastime
-from ..metrics.profile import et_minus_bt_C, et_not_drum_air
+from ..metrics.profile import et_minus_bt_C, et_not_drum_air, et_reads_beans
 from ..model.bed import CROSS_VALIDATED, PROBE_DEPTH_OVER_DIAMETER
 from ..model.constants import GREEN_BULK_DENSITY_KG_M3
+from ..model.quantities import default
 
 #: Names of a heater/burner and a fan/air channel in Artisan's languages (lower case, substrings).
 HEATER_NAMES = ("burner", "heater", "power", "heat", "gas", "brûleur", "bruleur", "brenner", "quemador",
@@ -151,6 +155,8 @@ class LogInfo:
     room: RoomReading | None = None  # the room temperature the log records, as written
     columns: dict | None = None  # a plain CSV's own names and units (plain_csv_columns)
     capacity_kg: float | None = None  # the batch capacity the log states (Artisan's roastersize)
+    et_reads_beans: bool | None = None  # ET falls to the green beans at CHARGE (metrics.profile.et_reads_beans)
+    et_before_charge: bool = False  # the log has ET's reading before CHARGE (artisan.ET_BEFORE_CHARGE)
 
 
 @dataclass
@@ -176,6 +182,7 @@ class Survey:
     columns: dict | None = None  # a plain CSV's own names and units (plain_csv_columns)
     batch_kg: float | None = None  # --batch-kg: the green weight of a log that records none (the map's batch_kg)
     unweighed: list[str] = field(default_factory=list)  # logs set aside: no green weight (logs_without_weight)
+    et_is_bean: bool = False  # ET is a bean reading (the second one, an infrared sensor), not the drum's air
 
 
 #: A heater logged in watts heats the drum by at most its electric power [kW per W].
@@ -329,7 +336,7 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
         mass, source = batch_kg, "--batch-kg"
     else:
         mass, source = None, ""
-    return LogInfo(
+    info = LogInfo(
         path,
         fmt,
         log.machine,
@@ -358,6 +365,10 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
         columns,
         log.capacity_kg,
     )
+    if fmt != "roastime" and info.has_et:  # RoasTime names its IR reading (drumTemperature) itself
+        info.et_reads_beans = et_reads_beans(log.time_s, log.channels["ET"], log.channels["BT"], default("T_room_C"))
+        info.et_before_charge = ET_BEFORE_CHARGE in log.fields
+    return info
 
 
 def survey(paths, batch_kg: float | None = None) -> Survey:
@@ -450,7 +461,26 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
             + "): one fit treats them as one drum, so the differences between units count as its error; "
             "fit one unit's logs for that unit's model"
         )
-    odd = [i.path.name for i, bad in zip(infos, et_not_drum_air([i.et_minus_bt_C for i in infos])) if bad]
+    told = [i for i in infos if i.et_reads_beans is not None]  # logs whose ET can tell beans from air
+    beans = [i.path.name for i in told if i.et_reads_beans]
+    et_is_bean = bool(told) and len(beans) == len(told)
+    if et_is_bean:
+        notes.append(
+            f"ET falls to the green beans' temperature at CHARGE on {'every log' if len(told) > 1 else 'the log'}: "
+            "it reads the beans (an infrared bean sensor, as Artisan's Aillio Bullet R1 IBTS device logs ET), "
+            "not the drum's air, so the map fits it as a second bean reading ([Tb2]) against the model's beans"
+        )
+    elif beans:
+        notes.append(
+            f"ET falls to the green beans' temperature at CHARGE on {len(beans)} log(s) ({', '.join(beans[:3])}"
+            f"{' ...' if len(beans) > 3 else ''}), unlike the others: a bean sensor there, not the drum's air; "
+            "set up those logs apart"
+        )
+    odd = (
+        []
+        if et_is_bean
+        else [i.path.name for i, bad in zip(infos, et_not_drum_air([i.et_minus_bt_C for i in infos])) if bad]
+    )
     if odd:
         notes.append(
             f"ET reads below BT through the roast on {len(odd)} log(s) ({', '.join(odd[:3])}{' ...' if len(odd) > 3 else ''}), "
@@ -464,8 +494,8 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
         heater_unit,
         fan,
         fan_unit,
-        first.second_bean,
-        all(i.has_et for i in infos),
+        first.second_bean or (((first.columns or {}).get("ET") or "ET") if et_is_bean else None),
+        all(i.has_et for i in infos) and not et_is_bean,
         max(i.heater_max for i in infos),
         max(i.fan_max for i in infos),
         {k: v for i in infos for k, v in i.unused.items()},
@@ -476,6 +506,7 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
         first.columns,
         batch_kg,
         list(unweighed),
+        et_is_bean,
     )
 
 
@@ -604,7 +635,15 @@ def map_text(s: Survey) -> str:
             lines.append("")
     for what, ch in s.unused.items():
         lines.insert(2, f"# logged but not used by the model: {what} ({ch!r})")
-    if s.second_bean:
+    if s.et_is_bean:
+        lines += [
+            "[Tb2]",
+            f'column = "{s.second_bean}"   # ET reads the beans: it falls to the green beans at CHARGE (infrared)'
+            + et_unit,
+            "start_s = 10.0",
+            "",
+        ]
+    elif s.second_bean:
         lines += ["[Tb2]", f'column = "{s.second_bean}"   # a second bean reading (infrared)', "start_s = 10.0", ""]
     initial = []
     if s.format == "roastime":
@@ -620,9 +659,19 @@ def map_text(s: Survey) -> str:
                     f"above_BT = true        # ET reads below BT through the roast on {len(s.et_not_air)} log(s)"
                 )
             lines.append("")
-        sources = ", ".join(f'"{cols[k]}"' for k in ARTISAN_DRUM_AT_CHARGE if cols[k])
+        sources = ", ".join(
+            f'"{cols[k]}"' for k in ARTISAN_DRUM_AT_CHARGE if cols[k] and not (s.et_is_bean and k == "ET")
+        )
         initial.append(
             f"Tm0_C = [{sources}]  # the drum at CHARGE: BT in the first row, the probe soaked in the empty drum"
+        )
+    elif s.et_is_bean:  # ET read the empty preheated drum before the beans came (as RoasTime's preheat)
+        before = [ET_BEFORE_CHARGE] if any(i.et_before_charge for i in s.logs) else []
+        sources = ", ".join(f'"{c}"' for c in (*before, "BT"))
+        initial.append(
+            f"Tm0_C = [{sources}]  # the drum at CHARGE: "
+            + ("ET before it, the infrared sensor on the empty preheated drum, else " if before else "")
+            + "BT then, the probe soaked in the drum"
         )
     else:
         if s.has_et and s.et_not_air:

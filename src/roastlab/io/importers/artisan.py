@@ -42,6 +42,12 @@ from ..files import read_input_text
 #: :data:`roastlab.model.bed.CROSS_VALIDATED`; docs/real-roaster.md). ET stands in where a log has no BT
 #: reading at CHARGE (a map's ``[initial]`` sources are tried in order).
 DRUM_AT_CHARGE = ("BT", "ET")
+#: The field (``ArtisanLog.fields``) with ET's reading before CHARGE: the median over the
+#: :data:`BT_FALL_WINDOW_S` before the CHARGE sample, where the log recorded the preheated drum. Where
+#: ET is an infrared bean sensor (:func:`roastlab.metrics.profile.et_reads_beans`), it then looks at
+#: the empty drum, as RoasTime's ``preheatTemperature`` does, while at CHARGE it already reads the
+#: beans; ``roastlab init`` takes it as the drum's temperature at charge for such logs.
+ET_BEFORE_CHARGE = "ET before CHARGE"
 EVENT_NAMES = ("CHARGE", "DRY", "FCs", "FCe", "SCs", "SCe", "DROP", "COOL")
 #: A log with no CHARGE or DROP marked: they are where the bean probe bends into a fall of BT_FALL_C
 #: or more within BT_FALL_WINDOW_S, at the charge (cold beans on the probe) and at the discharge (the
@@ -190,6 +196,15 @@ def _fall(time_s: np.ndarray, bt: np.ndarray, start: int) -> tuple[int, int] | N
     t, b = time_s[a : k1 + 1], bt[a : k1 + 1]
     chord = b[0] + (b[-1] - b[0]) * (t - t[0]) / (t[-1] - t[0])
     return a + int(np.nanargmax(b - chord)), k1
+
+
+def before_charge(time_s, values, charge: int) -> dict:
+    """``{ET_BEFORE_CHARGE: reading}`` from a channel's samples in the :data:`BT_FALL_WINDOW_S`
+    before sample ``charge`` (their median; Artisan's -1 and NaN skipped), or ``{}`` when the
+    log holds none there (recording began at the charge)."""
+    t, v = np.asarray(time_s, dtype=float), np.asarray(values, dtype=float)
+    w = (t < t[charge]) & (t >= t[charge] - BT_FALL_WINDOW_S) & np.isfinite(v) & (v != -1.0)
+    return {ET_BEFORE_CHARGE: float(np.median(v[w]))} if w.any() else {}
 
 
 def marks_or_bt(time_s, bt, charge: int | None, drop: int | None, keep_after_drop: bool = False):
@@ -498,6 +513,7 @@ def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: boo
     for name, k in zip(EVENT_NAMES, ti):
         if (k > 0 or name == "CHARGE") and k < n:
             events[name] = float(timex[k] - timex[charge])
+    pre_charge = before_charge(timex, channels["ET"], charge)  # before the slice below drops those samples
     t0 = timex[charge] if align_charge else 0.0
     end = n if (keep_after_drop or drop is None) else drop + 1
     start = charge if align_charge else 0
@@ -522,6 +538,7 @@ def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: boo
         weight_in,
         weight_out,
         str(data.get("title", "")),
+        fields=pre_charge,
         machine=str(data.get("roastertype", "") or "")[:100],
         started_epoch_s=epoch_or_none(data.get("roastepoch")),
         room=_alog_room(data.get("ambientTemp"), mode),
@@ -661,5 +678,14 @@ def read_artisan_csv(path: str | Path, keep_after_drop: bool = False) -> Artisan
     if drop is not None:
         events["DROP"] = float(time_s[drop])
     return ArtisanLog(
-        str(path), time_s[sl], {"ET": et[sl], "BT": bt[sl]}, {"ET", "BT"}, mode, charge, drop, events, notes=notes
+        str(path),
+        time_s[sl],
+        {"ET": et[sl], "BT": bt[sl]},
+        {"ET", "BT"},
+        mode,
+        charge,
+        drop,
+        events,
+        fields=before_charge(t1, et, charge),
+        notes=notes,
     )

@@ -583,8 +583,9 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
             extra["dp"] = channel({"column": gg["pitot"]["dp_column"]}, "Gg.pitot.dp_column")
             extra["Tp"] = channel({"column": gg["pitot"]["T_column"]}, "Gg.pitot.T_column")
         series = {k: channel(spec, k) + (spec.get("offset_C") or 0.0) for k, spec in settings.items()}
-        if et_spec is None and fmt != "roastime" and "ET" in available:
-            et_spec = {"column": "ET"}  # Artisan's ET (temp1): drawn beside the model, never an input
+        # Artisan's ET (temp1): drawn beside the model, never an input; unless the map reads it as the beans
+        if et_spec is None and fmt != "roastime" and "ET" in available and (cmap.Tb2 or {}).get("column") != "ET":
+            et_spec = {"column": "ET"}
         rejected = set()  # channels that do not read what the map says (no initial state from them)
         if et_spec is not None:
             settings["ET"] = et_spec
