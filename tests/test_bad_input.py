@@ -490,7 +490,7 @@ ROASTIME = {
     "map with an unknown setting unit": (
         lambda d: import_with(d, "r.json", RT, RT_MAP.replace('unit = "level"', 'unit = "watts"')),
         "map.toml",
-        "must be one of percent, level, kW",
+        "must be one of percent, level, tens, kW",
     ),
     "map Tgi with both a column and a constant": (
         lambda d: import_with(d, "r.json", RT, RT_MAP.replace("constant_C = 22", 'constant_C = 22\ncolumn = "x"')),

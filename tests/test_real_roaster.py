@@ -380,8 +380,8 @@ def bullet_as_artisan(src: Path, dst: Path) -> Path:
     """A RoasTime log (``src``) written to ``dst`` as Artisan's "Aillio Bullet R1 IBTS" device records
     a roast: ET (temp1) the IR reading, BT (temp2) the probe, 1 s samples with 20 s of the preheated
     drum before CHARGE (ET at the preheat, BT at its charge reading), the settings as Fan/Drum/Heater
-    events (heater and drum in tens, as Artisan shows them; the fan in levels) and their readouts
-    as extra devices. A rewriting of the shared data; the shared file untouched."""
+    events in tens, as Artisan's Aillio setup shows them (fan 10-120 for F1-F12, heater 0-90), and
+    their readouts as extra devices. A rewriting of the shared data; the shared file untouched."""
     from roastlab.io.importers.roastime import read_roastime
 
     doc, log = json.loads(src.read_text()), read_roastime(src)
@@ -392,7 +392,7 @@ def bullet_as_artisan(src: Path, dst: Path) -> Path:
     timex = [float(k) for k in range(n0 + pre)]
     drum = float(doc.get("preheatTemperature") or doc["drumChargeTemperature"])
     events = []  # (sample, event type, Artisan's internal value: 1 + shown / 10)
-    for kind, name, shown in ((0, "fan", 1.0), (1, "drum", 10.0), (3, "heater", 10.0)):
+    for kind, name, shown in ((0, "fan", 10.0), (1, "drum", 10.0), (3, "heater", 10.0)):
         steps = ch.get(name, np.zeros(n0))
         for k in [0, *np.flatnonzero(np.diff(steps)) + 1]:
             events.append((pre + int(k), kind, 1.0 + float(steps[k]) * shown / 10.0))
@@ -406,7 +406,7 @@ def bullet_as_artisan(src: Path, dst: Path) -> Path:
     for name, pos in (("DRY", 1), ("FCs", 2)):
         if name in log.events:
             ti[pos] = pre + round(log.events[name])
-    fan = readout("fan", 1.0)
+    fan = readout("fan", 10.0)
     dst.write_text(repr({
         "mode": "C", "timeindex": ti, "timex": timex, "roastertype": "Aillio Bullet R1 IBTS", "roastersize": 1.0,
         "temp1": [drum] * pre + [float(x) for x in ir],
@@ -418,7 +418,7 @@ def bullet_as_artisan(src: Path, dst: Path) -> Path:
         "extradevices": [84, 85, 86], "extraname1": ["{3}", "BT RoR", "Voltage"],
         "extraname2": ["{0}", "{1}", "Fan RPM"], "extratimex": [timex] * 3,
         "extratemp1": [readout("heater", 10.0), [0.0] * len(timex), [205.0] * len(timex)],
-        "extratemp2": [fan, readout("drum", 10.0), [700.0 + 100.0 * f for f in fan]],
+        "extratemp2": [fan, readout("drum", 10.0), [700.0 + 10.0 * f for f in fan]],
         "extraNoneTempHint1": [True, False, True], "extraNoneTempHint2": [True, False, True],
     }))  # fmt: skip
     return dst
@@ -433,7 +433,7 @@ def test_bullet_logs_recorded_through_artisan_fit_as_the_roastime_logs_do(cli, b
     with that ET weighed as the drum's air and the drum at BT's charge reading)."""
     logs = [bullet_as_artisan(p, tmp_path / f"{p.stem}.alog") for p in sorted(bullet_data.glob("*.json"))]
     code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
-    assert code == 0 and "ET: a bean reading, not the drum's air" in out, err
+    assert code == 0 and "ET: a bean reading, not the drum's air" in out and "fan: Fan (tens)" in out, err
     assert 'Tm0_C = ["ET before CHARGE", "BT"]' in (tmp_path / "cfg" / "map.toml").read_text()
     code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
     assert code == 0, err

@@ -162,6 +162,31 @@ def test_a_heater_logged_in_watts_is_read_as_a_power(cli, tmp_path):
     assert f"Qe_gain_kW = [0, {KW_PER_W:g}," in (tmp_path / "cfg" / "fit.toml").read_text()
 
 
+def test_a_fan_logged_in_tens_above_100_is_the_machines_levels(cli, tmp_path):
+    """SYNTHETIC logs whose Fan events run 10-120 in tens, as Artisan's Aillio setup shows the
+    Bullet's F1-F12 (a log that never passes F2 beside one that reaches F12): one unit for the
+    channel from every log's values, "tens", not a power to drop; a program labels it F1-F12 and
+    the fit's flow per logged unit is bounded a tenth of a step's. A heater in W stays W."""
+    from roastlab.io.importers.mapping import load_map
+    from roastlab.workflows.roaster import _unit_of
+
+    assert _unit_of(np.array([10.0, 20.0, 70.0, 120.0])) == "tens"
+    assert _unit_of(np.array([10.0, 20.0, 70.0])) == "percent"  # within Artisan's 0-100: a percent
+    assert _unit_of(np.array([900.0, 1350.0])) == "W" and _unit_of(np.array([15.0, 125.0])) == "W"
+    assert _unit_of(np.array([0.0, 5.0, 9.0])) == "level"
+    logs = []
+    for k, top in enumerate((20.0, 120.0)):  # Artisan's internal values: 1 + shown / 10
+        extra = {"specialevents": [5, 40], "specialeventstype": [3, 0], "specialeventsvalue": [8.0, 1.0 + top / 10],
+                 "etypes": ["Fan", "Drum", "Damper", "Heater", "--"]}  # fmt: skip
+        logs.append(tmp_path / f"r{k}.alog")
+        logs[-1].write_text(fake_alog(extra=extra))
+    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
+    assert code == 0 and "fan: Fan (tens)" in out, err
+    fan = load_map(tmp_path / "cfg" / "map.toml").actuator("fan")
+    assert (fan.unit, fan.high, fan.step, fan.label(120), fan.label(70)) == ("tens", 120.0, 10.0, "F12", "F7")
+    assert "Gg_fan_kg_s = [0, 0.001, 0.0001]" in (tmp_path / "cfg" / "fit.toml").read_text()
+
+
 def test_init_reads_a_plain_csv_by_its_column_names(cli, tmp_path):
     """SYNTHETIC plain CSV logs (a header row, numbers, the first row the charge; degF by the names):
     init finds time, BT, ET, the burner and the fan by name, writes them with their units, reads the
@@ -568,9 +593,8 @@ def test_an_unseen_gas_drum_with_burner_events_is_fitted_with_no_hand_edits(cli,
     code, out, err = cli("init", *logs, "--out", tmp_path / "cfg", "--batch-capacity-kg", "5")
     assert code == 0, err
     text = (tmp_path / "cfg" / "map.toml").read_text()
-    assert 'column = "Brenner"' in text and "ET: yes" in out, (
-        text
-    )  # its outlet gas falls far at CHARGE, not to the beans
+    # its outlet gas falls far at CHARGE (0.4 of the way from the room to the probe), not to the beans
+    assert 'column = "Brenner"' in text and "ET: yes" in out, text
     code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
     assert code == 0, err
     held = float(out.split("held out: FIT ")[1].split(" %")[0])

@@ -26,11 +26,16 @@ import numpy as np
 UNIT_DEFAULTS: dict[str, tuple[float, float, float | None, float]] = {
     "percent": (0.0, 100.0, 5.0, 60.0),
     "level": (0.0, 20.0, 1.0, 12.0),
+    # a machine's levels as Artisan's sliders show them, in tens: its Aillio Bullet setup logs the
+    # fan F1-F12 as 10-120 and the power P0-P9 as 0-90 (Artisan's machine setup "Bullet R1 IBTS")
+    "tens": (0.0, 200.0, 10.0, 120.0),
     "kW": (0.0, 1e4, None, 1e4),
     "W": (0.0, 1e5, None, 1e5),  # a heater's power readout in watts (an Artisan extra device)
 }
 #: How a setting's value reads to a roaster, per control and unit ("P7", "F3", "35 %").
-_PREFIX = {("heater", "level"): "P", ("fan", "level"): "F"}
+_PREFIX = {("heater", "level"): "P", ("fan", "level"): "F", ("heater", "tens"): "P", ("fan", "tens"): "F"}
+#: What a logged value is worth in the machine's own steps, per unit (a level in tens: a tenth).
+_STEPS_PER_UNIT = {"tens": 0.1}
 #: The inlet gas temperature as a decided input (the paper's gas roaster): lowest and highest
 #: [degC] and fastest change [degC/min] a program may use unless told otherwise.
 TGI_LIMITS = (150.0, 550.0, 120.0)
@@ -42,7 +47,7 @@ MIN_HOLD_S = 30.0
 @dataclass(frozen=True)
 class Actuator:
     """One control of a roaster: ``name`` ("heater" or "fan"), its ``unit`` ("percent",
-    "level", "kW", "W"), the range ``low``..``high`` in that unit, the ``step`` between settings the
+    "level", "tens", "kW", "W"), the range ``low``..``high`` in that unit, the ``step`` between settings the
     machine offers (None: continuous) and the fastest change ``rate_per_min`` [unit/min]."""
 
     name: str
@@ -79,10 +84,10 @@ class Actuator:
         return np.clip(self.low + np.round((v - self.low) / self.step) * self.step, self.low, self.high)
 
     def label(self, value: float) -> str:
-        """The setting as a roaster reads it: "P7", "F3", "35 %", "2.5 kW"."""
+        """The setting as a roaster reads it: "P7", "F3" (also logged in tens: 70, 30), "35 %", "2.5 kW"."""
         prefix = _PREFIX.get((self.name, self.unit))
         if prefix:
-            return f"{prefix}{value:g}"
+            return f"{prefix}{value * _STEPS_PER_UNIT.get(self.unit, 1.0):g}"
         return f"{value:g} %" if self.unit == "percent" else f"{value:g} {self.unit}"
 
     def describe(self) -> str:

@@ -7,8 +7,9 @@ What :func:`survey` detects in the logs (and says in the files' comments):
 * the format (Artisan ``.alog``/CSV, RoasTime JSON, a plain CSV whose columns are found by name,
   :func:`plain_csv_columns`) and the bean probe (BT);
 * which channels are the heater/burner and the fan/air, by name in Artisan's languages (an
-  event type or an extra device), with their unit by value range (whole steps up to 20: a
-  level; up to 100: percent; above 100: a heater's power in W);
+  event type or an extra device), with their unit by value range over every log (whole steps up
+  to 20: a level; whole tens above 100 up to :data:`TENS_MAX`: levels shown in tens; up to 100:
+  percent; above 100 otherwise: a heater's power in W);
 * a second bean reading (RoasTime's infrared ``drumTemperature``, or an ET that falls to the
   green beans at CHARGE, :func:`roastlab.metrics.profile.et_reads_beans`: an infrared bean sensor
   as Artisan's Aillio Bullet R1 IBTS device logs it, the drum at CHARGE then ET's reading before it,
@@ -50,6 +51,7 @@ from ..io.importers.artisan import ET_BEFORE_CHARGE, WEIGHT_UNITS, RoomReading, 
 from ..io.importers.mapping import bare_room_unit, detect_format, grams_in_name, hot_drop, probe_fault
 from ..io.importers.roastime import DRUM_AT_CHARGE, read_roastime
 from ..metrics.profile import et_minus_bt_C, et_not_drum_air, et_reads_beans
+from ..model.actuators import UNIT_DEFAULTS
 from ..model.bed import CROSS_VALIDATED, PROBE_DEPTH_OVER_DIAMETER
 from ..model.constants import GREEN_BULK_DENSITY_KG_M3
 from ..model.quantities import default
@@ -157,6 +159,7 @@ class LogInfo:
     capacity_kg: float | None = None  # the batch capacity the log states (Artisan's roastersize)
     et_reads_beans: bool | None = None  # ET falls to the green beans at CHARGE (metrics.profile.et_reads_beans)
     et_before_charge: bool = False  # the log has ET's reading before CHARGE (artisan.ET_BEFORE_CHARGE)
+    seen: dict = field(default_factory=dict)  # the heater's and the fan's distinct logged values
 
 
 @dataclass
@@ -189,19 +192,25 @@ class Survey:
 KW_PER_W = 1e-3
 
 
+#: The highest setting read as a machine's levels shown in tens (:func:`_unit_of`, the unit "tens"
+#: of :data:`roastlab.model.actuators.UNIT_DEFAULTS`): Artisan's sliders for the Aillio Bullet show
+#: its fan F1-F12 as 10-120 (its machine setup "Bullet R1 IBTS": fan 10-120, heater 0-90, drum
+#: 10-90), and a heater's power in W lies far above it.
+TENS_MAX = UNIT_DEFAULTS["tens"][1]
+
+
 def _unit_of(values: np.ndarray) -> str:
-    """A logged setting's unit by its values: whole steps up to 20 a level; up to 100 a percent;
-    above 100 a power in watts (a heater's power readout; a fan so logged is not used)."""
+    """A logged setting's unit by its values (every log's, pooled: one unit for the channel): whole
+    steps up to 20 a level; whole tens above 100 and up to :data:`TENS_MAX` levels shown in tens
+    ("tens"); up to 100 a percent; above 100 otherwise a power in watts (a heater's power readout;
+    a fan so logged is not used)."""
     v = values[np.isfinite(values)]
-    if v.size and np.all(np.abs(v - np.round(v)) < 1e-9) and v.max() <= 20:
+    whole = bool(v.size) and bool(np.all(np.abs(v - np.round(v)) < 1e-9))
+    if whole and v.max() <= 20:
         return "level"
+    if whole and 100.0 < v.max() <= TENS_MAX and np.all(np.round(v) % 10 == 0):
+        return "tens"
     return "W" if v.size and v.max() > 100.0 else "percent"
-
-
-def _common_unit(units: set) -> str | None:
-    """One unit for a control whose logs read as different units: the widest range (W over
-    percent over level: a log that never passes 20 does not make the channel a level)."""
-    return next((u for u in ("W", "percent", "level") if u in units), None)
 
 
 def _find(names, candidates) -> str | None:
@@ -368,6 +377,10 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
     if fmt != "roastime" and info.has_et:  # RoasTime names its IR reading (drumTemperature) itself
         info.et_reads_beans = et_reads_beans(log.time_s, log.channels["ET"], log.channels["BT"], default("T_room_C"))
         info.et_before_charge = ET_BEFORE_CHARGE in log.fields
+    for what, channel in (("heater", heater), ("fan", fan)):
+        if channel:
+            values = log.channels[channel]
+            info.seen[what] = np.unique(values[np.isfinite(values)])
     return info
 
 
@@ -415,8 +428,10 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
             "init",
         )
     infos = [i for i in infos if i.path.name not in unweighed]  # the set-up reads the weighed logs
-    heater_unit = _common_unit({i.heater_unit for i in infos if i.heater})
-    fan_unit = _common_unit({i.fan_unit for i in infos if i.fan})
+    heater_unit, fan_unit = (  # every log's values pooled: one unit for the channel
+        _unit_of(np.concatenate(seen)) if (seen := [i.seen[what] for i in infos if what in i.seen]) else None
+        for what in ("heater", "fan")
+    )
     notes = []
     if unweighed:
         names = list(unweighed)
@@ -570,7 +585,7 @@ def estimate_plant(s: Survey, capacity_kg=None, diameter_m=None, length_m=None) 
 
 def _setting_span(unit: str, top: float) -> float:
     """The range of a logged setting: 0..100 for percent, 0..the highest logged level."""
-    return 100.0 if unit == "percent" else max(top, 1.0)
+    return 100.0 if unit == "percent" else max(top, 1.0)  # levels (also in tens) and W: the highest logged
 
 
 def map_text(s: Survey) -> str:
@@ -620,16 +635,21 @@ def map_text(s: Survey) -> str:
         ("fan", s.fan, s.fan_unit, s.fan_max),
     ):
         if col:
-            why = {"level": "whole steps", "percent": "percent", "W": "above 100: a power in watts"}[unit]
+            why = {
+                "level": "whole steps",
+                "tens": "whole tens above 100: levels shown in tens, as Artisan's Aillio setup shows them",
+                "percent": "percent",
+                "W": "above 100: a power in watts",
+            }[unit]
             lines += [
                 f"[{name}]",
                 f'column = "{col}"      # detected by name',
                 f'unit = "{unit}"       # by the logged values ({why})',
             ]
-            if unit in ("level", "W"):
+            if unit in ("level", "tens", "W"):
                 lines += ["min = 0", f"max = {top:g}                # the highest setting the logs use"]
-            if unit == "level":
-                lines.append("step = 1")
+            if unit in ("level", "tens"):
+                lines.append(f"step = {UNIT_DEFAULTS[unit][2]:g}")
             elif unit == "percent" and not cols:
                 lines.append("step = 5              # Artisan's slider in 5 % steps")
             lines.append("")
@@ -740,8 +760,12 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
             )
         rows.append(line("tau_heater_s", 1.0, 300.0, 30.0, "lag of the heater's effect [s]"))
         rows.append(line("U_shell_kW_m2K", 0.0, 0.1, 0.01, "drum shell heat loss to the room [kW/(m2 K)]"))
-    if s.fan and s.fan_unit == "level":
-        rows.append(line("Gg_fan_kg_s", 0.0, 0.01, 0.001, "air flow per fan step [kg/s]"))
+    if s.fan and s.fan_unit in ("level", "tens"):
+        step = UNIT_DEFAULTS[s.fan_unit][2]  # per unit of the logged value: a level shown in tens is ten of them
+        why = (
+            "air flow per fan step [kg/s]" if step == 1 else f"air flow per logged fan unit [kg/s] (a step is {step:g})"
+        )
+        rows.append(line("Gg_fan_kg_s", 0.0, 0.01 / step, 0.001 / step, why))
     rows += ["", "[initial]", "Tb0_C = 22.0                          # green beans at room temperature",
              "X0 = 0.11                             # typical green-coffee moisture [kg/kg dry]"]  # fmt: skip
     rows += [  # the probe's immersion in the bed: the laws and depth scale cross-validation chose

@@ -171,7 +171,7 @@ class TransferResult(Result):
                     v = float(act.quantise(v))
                 if last_v is not None and (v == last_v or (thin and t[i] - last_t < MIN_HOLD_S)):
                     continue
-                out.append((i, etype, v, act.label(v) if act.unit == "level" else f"{etype} {v:g}"))
+                out.append((i, etype, v, act.label(v) if act.unit in ("level", "tens") else f"{etype} {v:g}"))
                 last_v, last_t = v, t[i]
         return sorted(out, key=lambda e: e[0])
 
