@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from roastlab.io.importers import gas_flow_pitot_kg_s, import_log, load_map
-from roastlab.io.importers.artisan import events_internal_to_external, read_alog, read_artisan_csv
+from roastlab.io.importers.artisan import ET_BEFORE_CHARGE, events_internal_to_external, read_alog, read_artisan_csv
 
 SPOT = ["roast_25-09-27_1236_R14.alog", "roast_25-11-16_1235.alog", "roast_26-05-10_1438_R58_brazil_250.alog"]
 
@@ -189,6 +189,8 @@ def test_artisan_csv_export(tmp_path):
     b = import_log(p, load_map(write_map(tmp_path, SKY_MAP)))
     assert b.time_s[0] == 0 and b.time_s[-1] == pytest.approx(174.0)
     assert b.Ta_C[0] == pytest.approx(121.8)
+    # ET's median over the rows before CHARGE (0, 2, 4 s: 150.0, 150.4, 150.8), kept for an ET that reads beans
+    assert read_artisan_csv(p).fields == {ET_BEFORE_CHARGE: pytest.approx(150.4)}
 
 
 def test_an_artisan_csv_export_with_repeated_whole_seconds_is_averaged(tmp_path):

@@ -143,9 +143,7 @@ class LogInfo:
     batch_kg: float | None
     batch_from: str
     heater: str | None = None
-    heater_unit: str | None = None
     fan: str | None = None
-    fan_unit: str | None = None
     second_bean: str | None = None
     has_et: bool = False
     heater_max: float = 0.0
@@ -159,7 +157,7 @@ class LogInfo:
     capacity_kg: float | None = None  # the batch capacity the log states (Artisan's roastersize)
     et_reads_beans: bool | None = None  # ET falls to the green beans at CHARGE (metrics.profile.et_reads_beans)
     et_before_charge: bool = False  # the log has ET's reading before CHARGE (artisan.ET_BEFORE_CHARGE)
-    seen: dict = field(default_factory=dict)  # the heater's and the fan's distinct logged values
+    seen: dict = field(default_factory=dict)  # the heater's and the fan's distinct logged values (their unit: survey)
 
 
 @dataclass
@@ -353,9 +351,7 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
         mass,
         source,
         heater,
-        _unit_of(log.channels[heater]) if heater else None,
         fan,
-        _unit_of(log.channels[fan]) if fan else None,
         "drumTemperature" if fmt == "roastime" and "drumTemperature" in names else None,
         "ET" in names and np.isfinite(log.channels["ET"]).any(),
         float(np.nanmax(log.channels[heater])) if heater else 0.0,

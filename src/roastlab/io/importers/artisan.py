@@ -198,11 +198,11 @@ def _fall(time_s: np.ndarray, bt: np.ndarray, start: int) -> tuple[int, int] | N
     return a + int(np.nanargmax(b - chord)), k1
 
 
-def before_charge(time_s, values, charge: int) -> dict:
-    """``{ET_BEFORE_CHARGE: reading}`` from a channel's samples in the :data:`BT_FALL_WINDOW_S`
-    before sample ``charge`` (their median; Artisan's -1 and NaN skipped), or ``{}`` when the
-    log holds none there (recording began at the charge)."""
-    t, v = np.asarray(time_s, dtype=float), np.asarray(values, dtype=float)
+def et_before_charge(time_s, et, charge: int) -> dict:
+    """``{ET_BEFORE_CHARGE: reading}`` from ET's samples in the :data:`BT_FALL_WINDOW_S` before
+    sample ``charge`` (their median; Artisan's -1 and NaN skipped), or ``{}`` when the log holds
+    none there (recording began at the charge)."""
+    t, v = np.asarray(time_s, dtype=float), np.asarray(et, dtype=float)
     w = (t < t[charge]) & (t >= t[charge] - BT_FALL_WINDOW_S) & np.isfinite(v) & (v != -1.0)
     return {ET_BEFORE_CHARGE: float(np.median(v[w]))} if w.any() else {}
 
@@ -513,7 +513,7 @@ def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: boo
     for name, k in zip(EVENT_NAMES, ti):
         if (k > 0 or name == "CHARGE") and k < n:
             events[name] = float(timex[k] - timex[charge])
-    pre_charge = before_charge(timex, channels["ET"], charge)  # before the slice below drops those samples
+    pre_charge = et_before_charge(timex, channels["ET"], charge)  # before the slice below drops those samples
     t0 = timex[charge] if align_charge else 0.0
     end = n if (keep_after_drop or drop is None) else drop + 1
     start = charge if align_charge else 0
@@ -686,6 +686,6 @@ def read_artisan_csv(path: str | Path, keep_after_drop: bool = False) -> Artisan
         charge,
         drop,
         events,
-        fields=before_charge(t1, et, charge),
+        fields=et_before_charge(t1, et, charge),
         notes=notes,
     )
