@@ -166,7 +166,8 @@ def test_a_fan_logged_in_tens_above_100_is_the_machines_levels(cli, tmp_path):
     """SYNTHETIC logs whose Fan events run 10-120 in tens, as Artisan's Aillio setup shows the
     Bullet's F1-F12 (a log that never passes F2 beside one that reaches F12): one unit for the
     channel from every log's values, "tens", not a power to drop; a program labels it F1-F12 and
-    the fit's flow per logged unit is bounded a tenth of a step's. A heater in W stays W."""
+    the fit's flow per logged unit is bounded a tenth of a step's. A heater in W stays W; a
+    percent setting every log moves in whole tens gets 10 % steps (Artisan's slider: 5)."""
     from roastlab.io.importers.mapping import load_map
     from roastlab.workflows.roaster import _unit_of
 
@@ -184,6 +185,8 @@ def test_a_fan_logged_in_tens_above_100_is_the_machines_levels(cli, tmp_path):
     assert code == 0 and "fan: Fan (tens)" in out, err
     fan = load_map(tmp_path / "cfg" / "map.toml").actuator("fan")
     assert (fan.unit, fan.high, fan.step, fan.label(120), fan.label(70)) == ("tens", 120.0, 10.0, "F12", "F7")
+    heater = load_map(tmp_path / "cfg" / "map.toml").actuator("heater")  # 70 % on both logs: moved in 10 % steps
+    assert (heater.unit, heater.high, heater.step) == ("percent", 70.0, 10.0)
     assert "Gg_fan_kg_s = [0, 0.001, 0.0001]" in (tmp_path / "cfg" / "fit.toml").read_text()
 
 

@@ -184,6 +184,7 @@ class Survey:
     batch_kg: float | None = None  # --batch-kg: the green weight of a log that records none (the map's batch_kg)
     unweighed: list[str] = field(default_factory=list)  # logs set aside: no green weight (logs_without_weight)
     et_is_bean: bool = False  # ET is a bean reading (the second one, an infrared sensor), not the drum's air
+    in_tens: dict = field(default_factory=dict)  # {"heater": True, ...}: every logged value a whole ten
 
 
 #: A heater logged in watts heats the drum by at most its electric power [kW per W].
@@ -424,10 +425,12 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
             "init",
         )
     infos = [i for i in infos if i.path.name not in unweighed]  # the set-up reads the weighed logs
-    heater_unit, fan_unit = (  # every log's values pooled: one unit for the channel
-        _unit_of(np.concatenate(seen)) if (seen := [i.seen[what] for i in infos if what in i.seen]) else None
+    pooled = {
+        what: np.concatenate(seen)
         for what in ("heater", "fan")
-    )
+        if (seen := [i.seen[what] for i in infos if what in i.seen])
+    }
+    heater_unit, fan_unit = (_unit_of(pooled[what]) if what in pooled else None for what in ("heater", "fan"))
     notes = []
     if unweighed:
         names = list(unweighed)
@@ -518,6 +521,10 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
         batch_kg,
         list(unweighed),
         et_is_bean,
+        {
+            what: bool(np.all(np.round(v) % 10 == 0) and np.all(np.abs(v - np.round(v)) < 1e-9))
+            for what, v in pooled.items()
+        },
     )
 
 
@@ -647,7 +654,11 @@ def map_text(s: Survey) -> str:
             if unit in ("level", "tens"):
                 lines.append(f"step = {UNIT_DEFAULTS[unit][2]:g}")
             elif unit == "percent" and not cols:
-                lines.append("step = 5              # Artisan's slider in 5 % steps")
+                if s.in_tens.get(name):  # levels in tens under a percent's name (the Bullet in Artisan: P0-P9 as 0-90)
+                    lines += [f"max = {top:g}                # the highest setting the logs use",
+                              "step = 10             # every log moves it in 10 % steps"]  # fmt: skip
+                else:
+                    lines.append("step = 5              # Artisan's slider in 5 % steps")
             lines.append("")
     for what, ch in s.unused.items():
         lines.insert(2, f"# logged but not used by the model: {what} ({ch!r})")
