@@ -185,7 +185,7 @@ function draw() {
 
 function unitName(name) {
   const a = (state.open && state.open.actuators || {})[name];
-  return a ? ({ level: "steps", percent: "%" }[a.unit] || a.unit) : "as logged";
+  return a ? ({ level: "steps", tens: "steps ×10", percent: "%" }[a.unit] || a.unit) : "as logged";
 }
 
 function drawTable() {
