@@ -89,12 +89,16 @@ def test_init_reads_an_et_that_falls_to_the_green_beans_as_a_second_bean_reading
     batch = import_log(logs[0], load_map(tmp_path / "cfg" / "map.toml"))
     assert batch.initial["Tm0_C"] == 240.0  # the drum, not BT (130) nor the beans (25)
     assert batch.Tb2_C is not None and batch.ET_C is None
+    from roastlab.workflows.transfer import et_source  # a background's ET then lies over the roaster's ET: beans
+
+    assert et_source(load_map(tmp_path / "cfg" / "map.toml")) == "Tb"
     air = tmp_path / "air.alog"
     air.write_text(fake_alog(extra=_ir_as_et() | {"temp1": [150.0 + 0.4 * i for i in range(120)]}))
     code, out, err = cli("init", logs[0], air, "--out", tmp_path / "cfg2")
     assert code == 0 and "ET: yes" in out, err
     assert "ET falls to the green beans' temperature at CHARGE on 1 log(s) (r0.alog), unlike the others" in out
     assert "[Tb2]" not in (tmp_path / "cfg2" / "map.toml").read_text()
+    assert et_source(load_map(tmp_path / "cfg2" / "map.toml")) == "Tm"  # the drum, as for the Skywalker
 
 
 def test_init_takes_the_damper_as_the_fan_when_no_fan_is_logged(cli, tmp_path):

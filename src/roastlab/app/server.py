@@ -136,7 +136,7 @@ def _series(values) -> list | None:
 
 def curves(batch, result, et: str = "Tm") -> dict:
     """The page's view of one prediction: times, BT and beans, the model's ET (``et``: "Tm" the
-    drum, "Tgi" the inlet gas the model sees, as :func:`roastlab.workflows.transfer.et_source`
+    drum, "Tgi" the inlet gas the model sees, "Tb" the beans where ET is a bean reading, as :func:`roastlab.workflows.transfer.et_source`
     reads the machine's map), the settings and the rate of rise [degC/min] (the one RoR of
     :mod:`roastlab.metrics.profile`); with ``batch`` the measured BT, ET and a second bean
     reading too."""
@@ -145,7 +145,7 @@ def curves(batch, result, et: str = "Tm") -> dict:
         "time_s": _series(t),
         "BT_model": _series(result.Ta_C),
         "beans_model": _series(result.Tb_C),
-        "ET_model": _series(result.Tm_C if et == "Tm" else result.gas_seen()[1]),
+        "ET_model": _series(result.Tm_C if et == "Tm" else result.Tb_C if et == "Tb" else result.gas_seen()[1]),
         "RoR_model": _series(rate_of_rise_C_per_min(t, result.Ta_C)),
         "heater": _series(result.heater),
         "fan": _series(result.fan),
@@ -161,7 +161,7 @@ def curves(batch, result, et: str = "Tm") -> dict:
 
 
 #: What the model's ET curve is, per :func:`roastlab.workflows.transfer.et_source`.
-ET_NAMES = {"Tm": "drum metal (model Tm)", "Tgi": "inlet gas the model sees (Tgi)"}
+ET_NAMES = {"Tm": "drum metal (model Tm)", "Tgi": "inlet gas the model sees (Tgi)", "Tb": "the beans (model Tb)"}
 
 
 def band(model, batch) -> dict:

@@ -31,7 +31,7 @@ from ..fit.program import (
 from ..io.batch import Batch
 from ..metrics.profile import DRY_END_C, FIRST_CRACK_C, crossing_or_projected_s, crossing_time_s, mmss
 from ..model.actuators import MIN_HOLD_S
-from ..model.layout import I_QEG, I_TGIG, S_TM
+from ..model.layout import I_QEG, I_TGIG, S_TB, S_TM
 from ..model.limits import check_value
 from ..model.plant import Plant
 from ..model.quantities import QUANTITIES
@@ -194,7 +194,7 @@ class TransferResult(Result):
             if at is not None and t[0] <= at <= t[-1] and name != "CHARGE":
                 timeindex[k] = int(np.argmin(np.abs(t - at)))
         timeindex[EVENT_NAMES.index("DROP")] = n - 1
-        et = pr.states[:, S_TM] if self.et_source == "Tm" else pr.Tgi_C
+        et = {"Tm": pr.states[:, S_TM], "Tb": pr.states[:, S_TB]}.get(self.et_source, pr.Tgi_C)
         now = _dt.datetime.now(_dt.UTC)
         decided = (
             lim.actuator.describe()
@@ -215,7 +215,7 @@ class TransferResult(Result):
             "roastingnotes": (
                 f"Computed by roastlab transfer from {self.reference} ({self.plant_from} -> {self.plant_to}, "
                 f"{self.batch_kg:g} kg). BT is the model's prediction, ET the model's "
-                f"{'drum temperature' if self.et_source == 'Tm' else 'inlet gas temperature'}; "
+                f"{ET_CURVE[self.et_source]}; "
                 f"Burner events = the decided {decided}."
             ),
             "roastdate": now.strftime("%a %b %d %Y"),
@@ -282,12 +282,20 @@ def default_limits(model, plant_from=None, plant_to=None) -> ProgramLimits:
     return ProgramLimits.for_model(getattr(model, "column_map", None))
 
 
+#: The model quantity a background's ET curve carries, per :func:`et_source`, as its notes name it.
+ET_CURVE = {"Tm": "drum temperature", "Tgi": "inlet gas temperature", "Tb": "bean temperature"}
+
+
 def et_source(cmap) -> str:
     """What ET is on this machine, for the background's ET curve: the inlet gas where the map
-    reads ET as the inlet (``[Tgi] column = "ET"``), else the drum (the Skywalker's and the
-    Bullet's ET is the drum's temperature, as their maps' [initial] Tm0_C says)."""
+    reads ET as the inlet (``[Tgi] column = "ET"``); the beans where it reads ET as a bean reading
+    (``[Tb2] column = "ET"``: an infrared bean sensor, as Artisan's Aillio Bullet R1 IBTS device
+    logs ET), so the background's ET lies over the roaster's own ET curve; else the drum (the
+    Skywalker's and the Bullet's ET is the drum's temperature, as their maps' [initial] Tm0_C says)."""
     if cmap is not None and cmap.Tgi.get("column") == "ET":
         return "Tgi"
+    if cmap is not None and (cmap.Tb2 or {}).get("column") == "ET":
+        return "Tb"
     return "Tm" if cmap is not None and cmap.inlet_is_constant else "Tgi"
 
 
