@@ -545,12 +545,14 @@ def test_fit_roaster_every_log_holds_each_log_out_once(cli, tmp_path):
     assert "## Every log held out once" not in (tmp_path / "cfg" / "report.md").read_text()
 
 
-def _synthetic_gas_drum_logs(folder: Path, n_logs: int = 6, seed: int = 11) -> list[Path]:
+def _synthetic_gas_drum_logs(folder: Path, n_logs: int = 6, seed: int = 11, inlet: bool = False) -> list[Path]:
     """SYNTHETIC Artisan logs of a gas drum no catalogue entry names: the burner is logged as
     special events only (Artisan's slider, German event names: Luft, Trommel, Klappe, Brenner),
     no extra devices, 3 kg batches on a 5 kg machine, a sample every 3 s. BT and ET come from
     roastlab's own model of the plant ``roastlab init`` estimates from the capacity (with chosen
-    gains), plus seeded noise: a check of the pipeline on this layout, not of the physics."""
+    gains), plus seeded noise: a check of the pipeline on this layout, not of the physics.
+    ``inlet``: a shop roaster that logs temperatures only, the burner heating the air alone: no
+    burner events, an extra device "Zuluft" (inlet air) with the model's inlet gas instead."""
     import numpy as np
 
     import roastlab
@@ -580,12 +582,19 @@ def _synthetic_gas_drum_logs(folder: Path, n_logs: int = 6, seed: int = 11) -> l
 
     assert main(["init", *map(str, paths), "--out", str(cfg), "--batch-capacity-kg", "5"]) == 0
     cmap = load_map(cfg / "map.toml")
-    truth = _truth_of_init(cfg, Qe_gain_kW=0.05, Tgi_gain_C=3.0, tau_heater_s=25.0, Gg_kg_s=0.06, Kt=0.04)
+    truth = _truth_of_init(
+        cfg, Qe_gain_kW=0.0 if inlet else 0.05, Tgi_gain_C=3.0, tau_heater_s=25.0, Gg_kg_s=0.06, Kt=0.04
+    )
     for p, events in zip(paths, layouts):
         sim = truth.predict(roastlab.load_log(p, cmap))  # on the map's resampled grid
         bt = np.interp(t, sim.time_s, sim.Ta_C) + rng.normal(0.0, 0.3, n)
         bt[0] = sim.Ta_C[0]  # at CHARGE the probe soaked in the empty drum: the drum's temperature, as the map reads it
         et = np.interp(t, sim.time_s, sim.Tgo_C) + rng.normal(0.0, 0.3, n)  # ET: the drum's air (outlet gas)
+        if inlet:
+            tgi = np.interp(t, sim.time_s, sim.gas_seen()[1]) + rng.normal(0.0, 0.3, n)  # the air the burner heats
+            events = {"extradevices": [25], "extraname1": ["Zuluft"], "extraname2": ["Abluft"], "extratimex": [t],
+                      "extratemp1": [tgi.tolist()], "extratemp2": [(et - 20.0).tolist()],
+                      "extraNoneTempHint1": [False], "extraNoneTempHint2": [False]}  # fmt: skip
         p.write_text(fake_alog("C", bt.tolist(), et.tolist(), n, {**extra, **events, "timex": t}))
     shutil.rmtree(cfg)
     return paths
@@ -607,6 +616,41 @@ def test_an_unseen_gas_drum_with_burner_events_is_fitted_with_no_hand_edits(cli,
     held = float(out.split("held out: FIT ")[1].split(" %")[0])
     base = float(out.split("baseline: ")[1].split(" %")[0])
     assert held > 80.0 and held > base + 10.0, out
+
+
+def test_an_inlet_air_logged_beside_a_burner_is_offered_and_is_not_the_fan(cli, tmp_path):
+    """SYNTHETIC logs with Burner and Air events and an extra device "Inlet Air" (a temperature): the
+    Air events are the fan, not the inlet's reading; the heater stays the input and the map offers
+    the inlet, commented, with what else to change."""
+    n = 120
+    extra = {"specialevents": [5, 40], "specialeventstype": [3, 0], "specialeventsvalue": [8.0, 4.0],
+             "etypes": ["Air", "Drum", "Damper", "Burner", "--"], "extratimex": [[1.5 * i for i in range(n)]],
+             "extraname1": ["Inlet Air"], "extraname2": ["Exhaust"], "extratemp1": [[300.0] * n],
+             "extratemp2": [[150.0] * n], "extraNoneTempHint1": [False], "extraNoneTempHint2": [False]}  # fmt: skip
+    logs = [tmp_path / f"r{k}.alog" for k in range(2)]
+    for p in logs:
+        p.write_text(fake_alog(extra=extra))
+    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
+    assert code == 0 and "fan: Air (percent)" in out and "inlet air: Inlet Air (offered in the map)" in out, err
+    text = (tmp_path / "cfg" / "map.toml").read_text()
+    assert "constant_C = 22.0" in text and '# column = "Inlet Air"' in text and "remove Tgi_gain_C" in text
+
+
+@pytest.mark.slow
+def test_an_unseen_gas_drum_that_logs_its_inlet_air_and_no_burner_is_driven_by_the_inlet(cli, tmp_path):
+    """init + fit-roaster on SYNTHETIC logs of a shop roaster that logs temperatures only: BT, ET and
+    an extra device "Zuluft" (the inlet air, German), no burner. init takes the inlet as the
+    model's input (the paper's Tgi) and ET as a reading against the outlet gas; before, ET itself
+    drove the model as the inlet."""
+    logs = _synthetic_gas_drum_logs(tmp_path, inlet=True)
+    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg", "--batch-capacity-kg", "5")
+    assert code == 0 and "heater: none" in out and "inlet air: Zuluft (the model's input)" in out, err
+    text = {n: (tmp_path / "cfg" / f"{n}.toml").read_text() for n in ("map", "fit")}
+    assert '[Tgi]\ncolumn = "Zuluft"' in text["map"] and "ET = 1.0" in text["fit"], text
+    code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
+    assert code == 0, err
+    held = float(out.split("held out: FIT ")[1].split(" %")[0])
+    assert held > 90.0, out
 
 
 @pytest.mark.parametrize(

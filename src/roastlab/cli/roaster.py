@@ -26,7 +26,9 @@ def cmd_init(args) -> int:
         f"  bean probe BT; heater: {s.heater or 'none'} ({s.heater_unit or '-'}); fan: {s.fan or 'none'} ({s.fan_unit or '-'})"
     )
     et = "yes" if s.has_et else ("a bean reading, not the drum's air" if s.et_is_bean else "no")
-    print(f"  second bean reading: {s.second_bean or 'none'}; ET: {et}")
+    role = "offered in the map" if s.heater else "the model's input"
+    inlet = f"; inlet air: {s.inlet} ({role})" if s.inlet else ""
+    print(f"  second bean reading: {s.second_bean or 'none'}; ET: {et}{inlet}")
     masses = sorted({round(i.batch_kg * 1000) for i in s.logs})  # to the gram; a big drum's in kg
     print(f"  green batches: {', '.join(f'{g} g' if g < 1000 else f'{g / 1000:g} kg' for g in masses)}")
     for note in s.notes:

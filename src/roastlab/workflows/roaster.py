@@ -14,6 +14,8 @@ What :func:`survey` detects in the logs (and says in the files' comments):
   green beans at CHARGE, :func:`roastlab.metrics.profile.et_reads_beans`: an infrared bean sensor
   as Artisan's Aillio Bullet R1 IBTS device logs it, the drum at CHARGE then ET's reading before it,
   :data:`roastlab.io.importers.artisan.ET_BEFORE_CHARGE`);
+* an inlet-air temperature (:data:`INLET_NAMES`): the paper's input Tgi where no heater is logged
+  (offered, commented, where one is);
 * ET (the drum temperature at CHARGE is BT's reading then,
   :data:`roastlab.io.importers.artisan.DRUM_AT_CHARGE`; RoasTime's preheat for RoasTime logs);
 * each log's green batch (Artisan ``weight``, RoasTime ``weightGreen``, a file name's "230g").
@@ -65,6 +67,9 @@ OTHER_NAMES = {
     "drum speed": ("drum", "trommel", "tambour", "tambor"),
 }
 FAN_NAMES = ("air", "fan", "airflow", "ventilateur", "lüfter", "luefter", "luft", "ventilador", "aria", "風", "风")
+#: Names of a temperature channel that logs the air entering the drum, the paper's inlet gas Tgi
+#: (lower case, substrings): an extra device many shop roasters log beside BT and ET.
+INLET_NAMES = ("inlet", "intake", "zuluft", "eintritt", "entrée", "entree", "entrada", "ingresso")
 
 
 @dataclass(frozen=True)
@@ -158,6 +163,7 @@ class LogInfo:
     et_reads_beans: bool | None = None  # ET falls to the green beans at CHARGE (metrics.profile.et_reads_beans)
     et_before_charge: bool = False  # the log has ET's reading before CHARGE (artisan.ET_BEFORE_CHARGE)
     seen: dict = field(default_factory=dict)  # the heater's and the fan's distinct logged values (their unit: survey)
+    inlet: str | None = None  # a temperature channel named as the inlet air (INLET_NAMES)
 
 
 @dataclass
@@ -185,6 +191,7 @@ class Survey:
     unweighed: list[str] = field(default_factory=list)  # logs set aside: no green weight (logs_without_weight)
     et_is_bean: bool = False  # ET is a bean reading (the second one, an infrared sensor), not the drum's air
     in_tens: dict = field(default_factory=dict)  # {"heater": True, ...}: every logged value a whole ten
+    inlet: str | None = None  # the inlet-air channel every log records (INLET_NAMES), else None
 
 
 #: A heater logged in watts heats the drum by at most its electric power [kW per W].
@@ -330,8 +337,11 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
     if log.drop_index is not None and (why := hot_drop(float(bt[-1]))):
         raise InputError(why, path)  # the import refuses it too; say it before the files are written
     others = [n for n in names if n not in ("BT", "ET", "beanTemperature", "drumTemperature", "exitTemperature")]
+    temps = [n for n in others if ("temp" in n.lower() or "°" in n if fmt == "csv" else n in log.temperature_channels)]
+    inlet = _find([n for n in temps if np.isfinite(log.channels[n]).any()], INLET_NAMES)
     if fmt == "csv":  # a CSV's other temperatures ("inlet temp", "air temp") are not settings
-        others = [n for n in others if "temp" not in n.lower() and "°" not in n]
+        others = [n for n in others if n not in temps]
+    others = [n for n in others if n != inlet]  # the inlet air is no setting ("Inlet Air" is not the fan)
     heater = "heater" if fmt == "roastime" and "heater" in names else _find(others, HEATER_NAMES)
     fan = "fan" if fmt == "roastime" and "fan" in names else _find([n for n in others if n != heater], FAN_NAMES)
     if fan is None:  # no fan channel: a damper sets the air flow through the drum (one fixed-speed exhaust fan)
@@ -374,6 +384,7 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
     if fmt != "roastime" and info.has_et:  # RoasTime names its IR reading (drumTemperature) itself
         info.et_reads_beans = et_reads_beans(log.time_s, log.channels["ET"], log.channels["BT"], default("T_room_C"))
         info.et_before_charge = ET_BEFORE_CHARGE in log.fields
+    info.inlet = inlet
     for what, channel in (("heater", heater), ("fan", fan)):
         if channel:
             values = log.channels[channel]
@@ -475,6 +486,13 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
             + "): one fit treats them as one drum, so the differences between units count as its error; "
             "fit one unit's logs for that unit's model"
         )
+    inlets = {i.inlet for i in infos}
+    inlet = inlets.pop() if len(inlets) == 1 else None  # every log records it, under one name
+    if inlet is None and inlets - {None}:
+        notes.append(
+            f"{sum(i.inlet is not None for i in infos)} of {len(infos)} log(s) record the inlet air "
+            f"({', '.join(sorted(inlets - {None}))}): not used, as the others do not"
+        )
     told = [i for i in infos if i.et_reads_beans is not None]  # logs whose ET can tell beans from air
     beans = [i.path.name for i in told if i.et_reads_beans]
     et_is_bean = bool(told) and len(beans) == len(told)
@@ -525,6 +543,7 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
             what: bool(np.all(np.round(v) % 10 == 0) and np.all(np.abs(v - np.round(v)) < 1e-9))
             for what, v in pooled.items()
         },
+        inlet,
     )
 
 
@@ -614,8 +633,16 @@ def map_text(s: Survey) -> str:
     lines += [f'unit = "{cols["temp_unit"]}"', ""] if cols else [""]
     et, et_unit = (cols["ET"], f'\nunit = "{cols["temp_unit"]}"') if cols else ("ET", "")
     room_air = bool(s.heater)
+    inlet_unit = f'\nunit = "{cols["temp_unit"]}"' if cols else ""
     if room_air:
         lines += ["[Tgi]", "constant_C = 22.0     # room air drawn into the drum: the heat comes from the heater"]
+        if s.inlet:  # an option: the heater is what a program decides
+            lines += [
+                f"# the logs also record the inlet air ({s.inlet!r}); to take it as the paper's input in place of "
+                "the room air and the heater's air path, replace the line above with the one below and remove "
+                "Tgi_gain_C from fit.toml's [free]:",
+                f'# column = "{s.inlet}"',
+            ]
         if s.rooms:  # an option, not the default: on the shared logs it helps one machine and not the other
             lines += [
                 f"# {s.rooms} of {len(s.logs)} logs record the room temperature; to take the inlet air from it "
@@ -628,6 +655,12 @@ def map_text(s: Survey) -> str:
                     + (" (some read as degC are no room's)" if s.room_unit == "F" else "")
                 )
         lines.append("")
+    elif s.inlet:
+        lines += [
+            "[Tgi]",
+            f'column = "{s.inlet}"         # the logged inlet air, the paper\'s input (no heater logged){inlet_unit}',
+            "",
+        ]
     elif s.has_et:
         lines += ["[Tgi]", f'column = "{et}"         # no heater logged: ET taken as the inlet gas{et_unit}', ""]
     else:
@@ -679,7 +712,7 @@ def map_text(s: Survey) -> str:
             f"Tm0_C = [{sources}]   # the drum at charge: the preheat it was held at, else the IR reading then"
         )
     elif cols:  # the first row is the charge: BT there, else ET (as for Artisan, ARTISAN_DRUM_AT_CHARGE)
-        if s.has_et and s.heater:
+        if s.has_et and (s.heater or s.inlet):  # ET a reading, not the inlet
             lines += ["[ET]", f'column = "{et}"       # the roaster\'s ET, weighed against the outlet gas{et_unit}']
             if s.et_not_air:
                 lines.append(
@@ -789,9 +822,10 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
     weights = []
     if s.second_bean:
         weights.append("Tb2 = 1.0                             # the second bean reading vs the model's Tb")
-    if s.has_et and s.heater:
+    if s.has_et and (s.heater or s.inlet):
         # ET is then a reading, not the inlet (map_text): fitted against the outlet gas, it tells the
-        # heater's paths (into the air, into the drum) apart, which BT alone cannot
+        # heater's paths (into the air, into the drum) apart, which BT alone cannot, and pins the
+        # air's heat to the beans where the inlet is logged
         weights.append("ET = 1.0                              # the logged ET vs the model's outlet gas Tgo")
     if weights:
         rows += ["", "[weights]", "Ta = 1.0", *weights]
@@ -894,7 +928,8 @@ def below_baseline(model_fit_pct: float, baseline_fit_pct: float, column_map) ->
         text += (
             f"; no heater setting is logged, so the logged {column_map.Tgi['column']} drives the model as the "
             "air entering the drum, which it is only where that probe sits in the inlet air: log the "
-            "burner or heater setting (an Artisan event or extra device) and run init again"
+            "burner or heater setting (an Artisan event or extra device) or the inlet air's temperature "
+            "(an extra device named Inlet) and run init again"
         )
     return text
 
