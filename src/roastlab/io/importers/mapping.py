@@ -37,7 +37,7 @@ A map is a TOML file::
     batch_kg = 0.5             # green weight of a log that records none, nor in its file name [kg]
     [heater]                   # a logged heater/burner setting, held between changes
     column = "Burner"          # Artisan event type, RoasTime "heater" (P1-P9), or a CSV column
-    unit = "percent"           # percent | level | kW | W
+    unit = "percent"           # percent | level | tens (levels shown x10) | kW | W
     [fan]                      # a logged fan/air setting
     column = "Air"             # Artisan event type, RoasTime "fan" (F0-F12), or a CSV column
     unit = "percent"
