@@ -355,6 +355,8 @@ def test_a_model_below_the_baseline_is_called_not_usable_with_what_the_logs_lack
     assert "13.8 % against 33.0 %" in text and "no heater setting is logged" in text and "logged ET" in text
     text = roaster.below_baseline(20.0, 33.0, heated)
     assert "worse than a first-order lag" in text and "heater" not in text
+    inlet = ColumnMap(source="map.toml", Tgi={"column": "Zuluft"})  # a logged inlet drives it: nothing to add
+    assert "no heater setting" not in roaster.below_baseline(20.0, 33.0, inlet)
 
 
 @pytest.mark.parametrize(

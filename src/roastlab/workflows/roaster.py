@@ -924,9 +924,10 @@ def below_baseline(model_fit_pct: float, baseline_fit_pct: float, column_map) ->
         f"the model predicts the held-out logs worse than a first-order lag fed the same inputs "
         f"(FIT {model_fit_pct:.1f} % against {baseline_fit_pct:.1f} %): do not plan roasts with it"
     )
-    if column_map.heater is None and column_map.Tgi.get("column"):
+    inlet = column_map.Tgi.get("column")
+    if column_map.heater is None and inlet and not _find([inlet], INLET_NAMES):  # a logged inlet is the inlet
         text += (
-            f"; no heater setting is logged, so the logged {column_map.Tgi['column']} drives the model as the "
+            f"; no heater setting is logged, so the logged {inlet} drives the model as the "
             "air entering the drum, which it is only where that probe sits in the inlet air: log the "
             "burner or heater setting (an Artisan event or extra device) or the inlet air's temperature "
             "(an extra device named Inlet) and run init again"
