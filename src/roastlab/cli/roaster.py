@@ -76,7 +76,7 @@ def add_parsers(sub) -> None:
         help="read a roaster's logs and write its column map, plant and fit spec",
         description="Inspect LOG... (Artisan .alog/.csv, RoasTime .json, or plain CSV with a header naming time, BT and "
         "ET, its first row the charge, of one roaster) and write DIR/map.toml "
-        "(which channel is BT, the heater, the fan, a second bean reading, ET), DIR/plant.toml (the drum, from its "
+        "(which channel is BT, the heater, the fan, a second bean reading, ET, the inlet air), DIR/plant.toml (the drum, from its "
         "dimensions, a catalogue entry or the batch capacity, each estimate stated) and DIR/fit.toml (what these "
         "logs can determine), each commented with what was detected and what was guessed. A log that records no "
         "green weight (nor one in its file name) or no setting the others record is named, and fit-roaster leaves "
@@ -90,7 +90,8 @@ def add_parsers(sub) -> None:
     p.add_argument(
         "--batch-kg",
         type=float_arg("--batch-kg"),
-        help="green batch [kg] of every log (else each log's own, or the grams in its file name)",
+        help="green batch [kg] of a log that records none (a log's own weight, else the grams in its file name, "
+        "come first)",
     )
     p.add_argument("--batch-capacity-kg", type=float_arg("--batch-capacity-kg"), help="the roaster's rated batch [kg]")
     p.add_argument("--drum-diameter-m", type=float_arg("--drum-diameter-m"), help="inner drum diameter [m]")
