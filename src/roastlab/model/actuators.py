@@ -26,8 +26,9 @@ import numpy as np
 UNIT_DEFAULTS: dict[str, tuple[float, float, float | None, float]] = {
     "percent": (0.0, 100.0, 5.0, 60.0),
     "level": (0.0, 20.0, 1.0, 12.0),
-    # a machine's levels as Artisan's sliders show them, in tens: its Aillio Bullet setup logs the
-    # fan F1-F12 as 10-120 and the power P0-P9 as 0-90 (Artisan's machine setup "Bullet R1 IBTS")
+    # a machine's levels as Artisan's sliders show them, in tens: its Aillio Bullet setups log the
+    # fan F1-F12 as 10-120 and the power P0-P9 as 0-90 (machine setup "Bullet R1 IBTS"), the R2's
+    # power P0-P14 as 0-140 ("Bullet R2")
     "tens": (0.0, 200.0, 10.0, 120.0),
     "kW": (0.0, 1e4, None, 1e4),
     "W": (0.0, 1e5, None, 1e5),  # a heater's power readout in watts (an Artisan extra device)
