@@ -454,6 +454,9 @@ def test_an_et_that_falls_to_the_green_beans_at_charge_reads_the_beans():
     assert et_reads_beans(t, np.where(t < 40, 36.0, bt), bt, 22.0) is True
     late = t > BEANS_IN_VIEW_S
     assert et_reads_beans(t, np.where(late, ir, np.nan), bt, 22.0) is None
+    assert et_reads_beans(t, np.zeros(t.size), bt, 22.0) is False  # an unconnected channel reading 0
+    assert et_reads_beans(t, np.full(t.size, -52.2), bt, 22.0) is None  # below -1 degC: no reading (Aillio's "Exhaust")
+    assert et_reads_beans(t, np.full(t.size, 5.0), bt, 22.0) is False  # below the room and flat: reads nothing
     assert et_reads_beans(t, ir, np.full(t.size, 20.0), 22.0) is None
 
 

@@ -69,6 +69,17 @@ def _ir_as_et(n: int = 120, charge: int = 5) -> dict:
             "roastertype": "Aillio Bullet R1 IBTS"}  # fmt: skip
 
 
+def test_init_takes_an_et_that_never_reads_above_the_room_for_no_et(cli, tmp_path):
+    """SYNTHETIC logs whose ET channel is unconnected (0 throughout, as some devices write it): no
+    ET for init (nothing to weigh against the outlet gas, nor a bean reading), the heater drives."""
+    logs = [tmp_path / f"r{k}.alog" for k in range(2)]
+    for p in logs:
+        p.write_text(fake_alog(et=[0.0] * 120, extra=_ir_as_et() | {"temp1": [0.0] * 120}))
+    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
+    assert code == 0 and "second bean reading: none; ET: no" in out, err
+    assert "\nET = " not in (tmp_path / "cfg" / "fit.toml").read_text()
+
+
 def test_init_reads_an_et_that_falls_to_the_green_beans_as_a_second_bean_reading(cli, tmp_path):
     """SYNTHETIC logs whose ET falls to the green beans at CHARGE (:func:`_ir_as_et`): init maps it as
     the second bean reading ([Tb2]), not the drum's air, starts the drum at ET's reading before

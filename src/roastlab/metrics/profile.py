@@ -335,8 +335,10 @@ def et_reads_beans(time_s, et_C, bt_C, room_C: float) -> bool | None:
     0.06 of the way or less to the probe's 74-108 °C; the Skywalker's ET, the drum's air, to
     91-159 °C, 0.83 of the way or more to its probe's 99-136 °C. The steepest fall of an air reading
     we know is roastlab's own model of a 3 kg batch charged into a 5 kg gas drum, whose outlet gas
-    falls 0.4 of the way (tests/test_roaster_setup.py's synthetic gas drum). None when either
-    reading is missing in that window, or the probe's lowest is not above the room."""
+    falls 0.4 of the way (tests/test_roaster_setup.py's synthetic gas drum). A bean reading then
+    climbs with the roast: an ET that never rises above the probe's lowest (a channel left
+    unconnected, reading 0) reads nothing and is not taken for the beans. None
+    when either reading is missing in that window, or the probe's lowest is not above the room."""
     t = np.asarray(time_s, dtype=float)
     et, bt = np.asarray(et_C, dtype=float), np.asarray(bt_C, dtype=float)
     w = (t >= 0.0) & (t <= BEANS_IN_VIEW_S)
@@ -346,6 +348,9 @@ def et_reads_beans(time_s, et_C, bt_C, room_C: float) -> bool | None:
     bt_low = float(bt[ok_bt].min())
     if bt_low <= room_C:
         return None  # the probe itself at the room's temperature: nothing to tell them apart by
+    later = (t > BEANS_IN_VIEW_S) & np.isfinite(et)
+    if not later.any() or float(et[later].max()) <= bt_low:
+        return False  # no reading that climbs with the roast
     return bool(float(et[ok_et].min()) - room_C < BEANS_SHARE * (bt_low - room_C))
 
 

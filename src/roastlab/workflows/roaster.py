@@ -364,7 +364,7 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
         heater,
         fan,
         "drumTemperature" if fmt == "roastime" and "drumTemperature" in names else None,
-        "ET" in names and np.isfinite(log.channels["ET"]).any(),
+        "ET" in names and bool(np.nanmax(log.channels["ET"], initial=-np.inf) > default("T_room_C")),  # a live reading
         float(np.nanmax(log.channels[heater])) if heater else 0.0,
         float(np.nanmax(log.channels[fan])) if fan else 0.0,
         log.started_epoch_s,
