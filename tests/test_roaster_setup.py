@@ -54,7 +54,7 @@ def test_init_takes_the_event_types_before_a_device_named_like_them(cli, tmp_pat
     code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
     assert code == 0, err
     assert "heater: Heater (" in out and "fan: Fan (" in out and "RPM" not in out
-    unit = "percent" if events else "level"
+    unit = "tens" if events else "level"  # the events in tens (70: P7, as Artisan's Aillio setup shows it)
     heater = (tmp_path / "cfg" / "map.toml").read_text().split("[heater]")[1].split("[")[0]
     assert 'column = "Heater"' in heater and f'unit = "{unit}"' in heater
 
@@ -97,6 +97,9 @@ def test_init_reads_an_et_that_falls_to_the_green_beans_as_a_second_bean_reading
     assert '[Tb2]\ncolumn = "ET"' in text["map"] and "[ET]" not in text["map"]
     assert 'Tm0_C = ["ET before CHARGE", "BT"]' in text["map"]
     assert "Tb2 = 1.0" in text["fit"] and "\nET = " not in text["fit"]
+    # an Aillio named in the logs: Artisan's setup shows its levels in tens, so 70 and 30 are P7 and F3
+    assert "heater: Heater (tens); fan: Fan (tens)" in out
+    assert load_map(tmp_path / "cfg" / "map.toml").actuator("heater").describe() == "heater P0-P7 in steps of 1"
     batch = import_log(logs[0], load_map(tmp_path / "cfg" / "map.toml"))
     assert batch.initial["Tm0_C"] == 240.0  # the drum, not BT (130) nor the beans (25)
     assert batch.Tb2_C is not None and batch.ET_C is None
@@ -201,6 +204,7 @@ def test_a_fan_logged_in_tens_above_100_is_the_machines_levels(cli, tmp_path):
     assert code == 0 and "fan: Fan (tens)" in out, err
     fan = load_map(tmp_path / "cfg" / "map.toml").actuator("fan")
     assert (fan.unit, fan.high, fan.step, fan.label(120), fan.label(70)) == ("tens", 120.0, 10.0, "F12", "F7")
+    assert fan.describe() == "fan F0-F12 in steps of 1"
     heater = load_map(tmp_path / "cfg" / "map.toml").actuator("heater")  # 70 % on both logs: moved in 10 % steps
     assert (heater.unit, heater.high, heater.step) == ("percent", 70.0, 10.0)
     assert "Gg_fan_kg_s = [0, 0.001, 0.0001]" in (tmp_path / "cfg" / "fit.toml").read_text()

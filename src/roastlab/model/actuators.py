@@ -94,5 +94,6 @@ class Actuator:
     def describe(self) -> str:
         """``heater P0-P9 in steps of 1`` / ``fan 0-100 % in 5 % steps``."""
         if self.stepped:
-            return f"{self.name} {self.label(self.low)}-{self.label(self.high)} in steps of {self.step:g}"
+            step = self.step * _STEPS_PER_UNIT.get(self.unit, 1.0)  # a level shown in tens steps by 1 level
+            return f"{self.name} {self.label(self.low)}-{self.label(self.high)} in steps of {step:g}"
         return f"{self.name} {self.label(self.low)}-{self.label(self.high)} (continuous)"

@@ -80,7 +80,10 @@ class Machine:
     when it has one, is the model number, which these makers set to the rated batch in
     ``per_unit_kg`` units (Giesen W6: 6 kg; San Franciscan SF25: 25 lb); an entry without a group
     has the fixed ``capacity_kg``. ``heat`` says where the heater's power enters: ``"drum"``
-    (induction), ``"air"`` (hot air or a convection burner) or ``"both"``.
+    (induction), ``"air"`` (hot air or a convection burner) or ``"both"``. ``tens``: Artisan's
+    machine setups for it show its levels in tens (the Aillio Bullet's: fan F1-F12 as 10-120,
+    power P0-P9 as 0-90, the R2's P0-P14 as 0-140), so a setting its Artisan logs move in whole
+    tens is those levels, not a percent, even where the logs stay under 100.
     """
 
     pattern: str
@@ -88,6 +91,7 @@ class Machine:
     source: str
     capacity_kg: float | None = None
     per_unit_kg: float = 1.0
+    tens: bool = False
 
     def capacity(self, machine: str) -> float | None:
         """The rated green batch [kg] of ``machine`` if this entry names it, else None."""
@@ -103,7 +107,7 @@ class Machine:
 #: number rule). The model lists are Artisan's machine pages (artisan-scope.org/machines/...);
 #: drum dimensions are not published by these makers, so the plant is estimated from the capacity.
 CATALOGUE = (
-    Machine(r"aillio|bullet", "drum", "Aillio Bullet R1: 1 kg maximum batch, induction-heated drum (aillio.com product page)", 1.0),
+    Machine(r"aillio|bullet", "drum", "Aillio Bullet R1: 1 kg maximum batch, induction-heated drum (aillio.com product page)", 1.0, tens=True),
     Machine(r"hottop", "both", "Hottop KN-8828B-2K+: 250 g maximum batch, electric element (hottopusa.com)", 0.25),
     Machine(r"behmor", "both", "Behmor 1600+: 1 lb maximum batch, quartz elements (behmor.com)", WEIGHT_UNITS["lb"]),
     Machine(r"kaffelogic", "air", "Kaffelogic Nano 7: 120 g maximum batch, hot-air (kaffelogic.com)", 0.12),
@@ -442,6 +446,17 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
         if (seen := [i.seen[what] for i in infos if what in i.seen])
     }
     heater_unit, fan_unit = (_unit_of(pooled[what]) if what in pooled else None for what in ("heater", "fan"))
+    in_tens = {
+        what: bool(np.all(np.round(v) % 10 == 0) and np.all(np.abs(v - np.round(v)) < 1e-9))
+        for what, v in pooled.items()
+    }
+    named = {i.machine for i in infos if i.machine}
+    if first.format in ("alog", "artisan-csv") and len(named) == 1 and artisan_shows_tens(next(iter(named))):
+        # Artisan's setup for this machine shows its levels in tens: a percent in whole tens is those levels
+        heater_unit, fan_unit = (
+            "tens" if unit == "percent" and in_tens.get(what) else unit
+            for unit, what in ((heater_unit, "heater"), (fan_unit, "fan"))
+        )
     notes = []
     if unweighed:
         names = list(unweighed)
@@ -539,10 +554,7 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
         batch_kg,
         list(unweighed),
         et_is_bean,
-        {
-            what: bool(np.all(np.round(v) % 10 == 0) and np.all(np.abs(v - np.round(v)) < 1e-9))
-            for what, v in pooled.items()
-        },
+        in_tens,
         inlet,
     )
 
@@ -555,6 +567,13 @@ def catalogue_entry(machine: str) -> tuple[float, str, str] | None:
         if cap is not None and cap > 0:
             return cap, entry.heat, entry.source
     return None
+
+
+def artisan_shows_tens(machine: str) -> bool:
+    """Whether Artisan's setup for ``machine`` (its ``roastertype``) shows the machine's levels in
+    tens (:attr:`Machine.tens` of the first :data:`CATALOGUE` entry that names it)."""
+    entry = next((e for e in CATALOGUE if e.capacity(machine)), None)
+    return bool(entry and entry.tens)
 
 
 def batch_capacity(s: Survey, capacity_kg=None) -> tuple[float, str]:
@@ -673,7 +692,7 @@ def map_text(s: Survey) -> str:
         if col:
             why = {
                 "level": "whole steps",
-                "tens": "whole tens above 100: levels shown in tens, as Artisan's Aillio setup shows them",
+                "tens": "whole tens: the machine's levels as Artisan's setup for it shows them, in tens",
                 "percent": "percent",
                 "W": "above 100: a power in watts",
             }[unit]
@@ -779,14 +798,13 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
         rows.append("# no ET logged to tell the heater's paths apart: the heater heats the drum metal alone")
     if s.heater:
         span = _setting_span(s.heater_unit, s.heater_max)
+        per = "logged unit, a level is 10" if s.heater_unit == "tens" else s.heater_unit
         qe_hi = round(10.0 * capacity_kg / span, 4)  # ~10 kW per kg of capacity at full setting, generous
         if s.heater_unit == "W":  # a power readout: the drum gets at most all of it
             qe_hi = KW_PER_W
         if path in ("drum", "both"):
             rows.append(
-                line(
-                    "Qe_gain_kW", 0.0, qe_hi, qe_hi / 10, f"heater -> heat into the drum metal [kW per {s.heater_unit}]"
-                )
+                line("Qe_gain_kW", 0.0, qe_hi, qe_hi / 10, f"heater -> heat into the drum metal [kW per {per}]")
             )
         if path in ("air", "both"):
             rows.append(
@@ -795,7 +813,7 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
                     0.0,
                     round(1000.0 / span, 4),
                     round(200.0 / span, 4),
-                    f"heater -> the air it heats [degC per {s.heater_unit}]",
+                    f"heater -> the air it heats [degC per {per}]",
                 )
             )
         rows.append(line("tau_heater_s", 1.0, 300.0, 30.0, "lag of the heater's effect [s]"))
