@@ -205,6 +205,13 @@ def test_a_fan_logged_in_tens_above_100_is_the_machines_levels(cli, tmp_path):
     fan = load_map(tmp_path / "cfg" / "map.toml").actuator("fan")
     assert (fan.unit, fan.high, fan.step, fan.label(120), fan.label(70)) == ("tens", 120.0, 10.0, "F12", "F7")
     assert fan.describe() == "fan F0-F12 in steps of 1"
+    from roastlab.fit.program import ProgramLimits, limit_spans
+    from roastlab.model.actuators import Actuator
+
+    power = Actuator("heater", "tens", 0.0, 90.0, 10.0, 120.0)  # Artisan's Bullet setup: P0-P9 as 0-90
+    t, u = np.arange(0.0, 60.0, 5.0), np.array([50.0, 60.0, 70.0, 80.0, 90.0] + [90.0] * 7)
+    said = [s["limit"] for s in limit_spans(t, u, ProgramLimits(0.0, 90.0, 120.0, decide="heater", actuator=power))]
+    assert "heater at its P9 ceiling" in said and "heater rising at its 12 levels/min rate limit" in said
     heater = load_map(tmp_path / "cfg" / "map.toml").actuator("heater")  # 70 % on both logs: moved in 10 % steps
     assert (heater.unit, heater.high, heater.step) == ("percent", 70.0, 10.0)
     assert "Gg_fan_kg_s = [0, 0.001, 0.0001]" in (tmp_path / "cfg" / "fit.toml").read_text()

@@ -183,9 +183,11 @@ function draw() {
   });
 }
 
+// A setting's unit as the page shows it (a level shown in tens, as Artisan's Aillio setup logs it: "steps ×10").
+const shownUnit = (u) => ({ level: "steps", tens: "steps ×10", percent: "%" }[u] || u);
 function unitName(name) {
   const a = (state.open && state.open.actuators || {})[name];
-  return a ? ({ level: "steps", tens: "steps ×10", percent: "%" }[a.unit] || a.unit) : "as logged";
+  return a ? shownUnit(a.unit) : "as logged";
 }
 
 function drawTable() {
@@ -296,7 +298,7 @@ async function openLog() {
       for (const id of [k, `${k}_range`]) if ($(id)) { $(id).min = lo; $(id).max = hi; }
     }
     const lim = r.transfer_limits;
-    $("tr_limits_label").textContent = `${lim.decide} lowest / highest [${lim.unit}]`;
+    $("tr_limits_label").textContent = `${lim.decide} lowest / highest [${shownUnit(lim.unit)}]`;
     $("tr_low").placeholder = lim.low; $("tr_high").placeholder = lim.high;
     $("tr_low").value = ""; $("tr_high").value = "";
     $("batch_kg").value = r.batch_kg ?? "";
@@ -383,11 +385,11 @@ async function runTransfer() {
     Plotly.react("transfer-plot", [
       { x, y: r.target.map(temp), name: "target BT", line: { color: "#333", width: 2 } },
       { x, y: r.predicted.map(temp), name: "predicted BT with the program", line: { color: "#1f77b4" } },
-      { x, y: r.program, name: `program: ${r.decide} [${r.unit}]`, yaxis: "y2", line: { shape: "hv", color: "#d62728" } },
+      { x, y: r.program, name: `program: ${r.decide} [${shownUnit(r.unit)}]`, yaxis: "y2", line: { shape: "hv", color: "#d62728" } },
     ], {
       margin: { t: 20, r: 60, l: 60, b: 40 }, legend: { orientation: "h", y: -0.2 },
       xaxis: { title: { text: "time after CHARGE [m:ss]" }, ...mmssTicks(x) }, yaxis: { title: { text: `BT [${unit()}]` } },
-      yaxis2: { title: { text: `${r.decide} [${r.unit}]` }, overlaying: "y", side: "right", showgrid: false,
+      yaxis2: { title: { text: `${r.decide} [${shownUnit(r.unit)}]` }, overlaying: "y", side: "right", showgrid: false,
                 range: [r.low - (r.step || (r.high - r.low) / 20), r.high + (r.step || (r.high - r.low) / 20)],
                 ...(r.step ? { dtick: r.step, tickformat: "d" } : {}) },
     });

@@ -550,16 +550,20 @@ def limit_spans(t, u, limits: ProgramLimits) -> list[dict]:
     u = np.asarray(u, dtype=float)
     tol = 1e-4 * (limits.high - limits.low)
     name, unit = limits.decide, limits.unit
+    high, low, rate = f"{limits.high:g} {unit}", f"{limits.low:g} {unit}", f"{limits.rate_per_min:g} {unit}/min"
+    if unit == "tens":  # levels shown in tens (the actuator's unit): said as the machine's levels
+        high, low = limits.actuator.label(limits.high), limits.actuator.label(limits.low)
+        rate = f"{limits.rate_per_min / 10.0:g} levels/min"
     flags = {
-        f"{name} at its {limits.high:g} {unit} ceiling": u >= limits.high - tol,
-        f"{name} at its {limits.low:g} {unit} floor": u <= limits.low + tol,
+        f"{name} at its {high} ceiling": u >= limits.high - tol,
+        f"{name} at its {low} floor": u <= limits.low + tol,
     }
     step = np.diff(u)
     cap = limits.rate_per_min / 60.0 * np.diff(t)
     up = np.concatenate([[False], step >= 0.99 * cap])
     down = np.concatenate([[False], step <= -0.99 * cap])
-    flags[f"{name} rising at its {limits.rate_per_min:g} {unit}/min rate limit"] = up
-    flags[f"{name} falling at its {limits.rate_per_min:g} {unit}/min rate limit"] = down
+    flags[f"{name} rising at its {rate} rate limit"] = up
+    flags[f"{name} falling at its {rate} rate limit"] = down
     spans = []
     for name, mask in flags.items():
         # the direction the limit holds the program back: a ceiling or a rising rate keeps it
