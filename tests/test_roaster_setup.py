@@ -193,7 +193,7 @@ def test_a_fan_logged_in_tens_above_100_is_the_machines_levels(cli, tmp_path):
     assert _unit_of(np.array([0.0, 70.0, 140.0])) == "tens"  # Artisan's Bullet R2 setup: power P0-P14 as 0-140
     assert _unit_of(np.array([10.0, 20.0, 70.0])) == "percent"  # within Artisan's 0-100: a percent
     assert _unit_of(np.array([900.0, 1350.0])) == "W" and _unit_of(np.array([15.0, 125.0])) == "W"
-    assert _unit_of(np.array([0.0, 5.0, 9.0])) == "level"
+    assert _unit_of(np.array([0.0, 5.0, 9.0])) == "level" and _unit_of(np.array([np.nan])) == "percent"
     logs = []
     for k, top in enumerate((20.0, 120.0)):  # Artisan's internal values: 1 + shown / 10
         extra = {"specialevents": [5, 40], "specialeventstype": [3, 0], "specialeventsvalue": [8.0, 1.0 + top / 10],

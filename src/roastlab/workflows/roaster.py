@@ -209,6 +209,12 @@ KW_PER_W = 1e-3
 TENS_MAX = UNIT_DEFAULTS["tens"][1]
 
 
+def _in_whole_tens(values: np.ndarray) -> bool:
+    """Every finite value a whole multiple of ten (a level shown in tens, or a percent so moved)."""
+    v = values[np.isfinite(values)]
+    return bool(v.size) and bool(np.all(np.abs(v / 10.0 - np.round(v / 10.0)) < 1e-9))
+
+
 def _unit_of(values: np.ndarray) -> str:
     """A logged setting's unit by its values (every log's, pooled: one unit for the channel): whole
     steps up to 20 a level; whole tens above 100 and up to :data:`TENS_MAX` levels shown in tens
@@ -218,7 +224,7 @@ def _unit_of(values: np.ndarray) -> str:
     whole = bool(v.size) and bool(np.all(np.abs(v - np.round(v)) < 1e-9))
     if whole and v.max() <= 20:
         return "level"
-    if whole and 100.0 < v.max() <= TENS_MAX and np.all(np.round(v) % 10 == 0):
+    if v.size and 100.0 < v.max() <= TENS_MAX and _in_whole_tens(v):
         return "tens"
     return "W" if v.size and v.max() > 100.0 else "percent"
 
@@ -446,10 +452,7 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
         if (seen := [i.seen[what] for i in infos if what in i.seen])
     }
     heater_unit, fan_unit = (_unit_of(pooled[what]) if what in pooled else None for what in ("heater", "fan"))
-    in_tens = {
-        what: bool(np.all(np.round(v) % 10 == 0) and np.all(np.abs(v - np.round(v)) < 1e-9))
-        for what, v in pooled.items()
-    }
+    in_tens = {what: _in_whole_tens(v) for what, v in pooled.items()}
     named = {i.machine for i in infos if i.machine}
     if first.format in ("alog", "artisan-csv") and len(named) == 1 and artisan_shows_tens(next(iter(named))):
         # Artisan's setup for this machine shows its levels in tens: a percent in whole tens is those levels
