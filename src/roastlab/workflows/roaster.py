@@ -453,8 +453,7 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
     }
     heater_unit, fan_unit = (_unit_of(pooled[what]) if what in pooled else None for what in ("heater", "fan"))
     in_tens = {what: _in_whole_tens(v) for what, v in pooled.items()}
-    named = {i.machine for i in infos if i.machine}
-    if first.format in ("alog", "artisan-csv") and len(named) == 1 and artisan_shows_tens(next(iter(named))):
+    if first.format in ("alog", "artisan-csv") and len(machines) == 1 and artisan_shows_tens(next(iter(machines))):
         # Artisan's setup for this machine shows its levels in tens: a percent in whole tens is those levels
         heater_unit, fan_unit = (
             "tens" if unit == "percent" and in_tens.get(what) else unit
@@ -562,21 +561,23 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
     )
 
 
+def _catalogued(machine: str) -> tuple[Machine, float] | None:
+    """The first :data:`CATALOGUE` entry that names ``machine`` (Artisan's ``roastertype``) with its
+    rated batch [kg], or None for a machine the catalogue does not know."""
+    return next(((e, cap) for e in CATALOGUE if (cap := e.capacity(machine)) is not None and cap > 0), None)
+
+
 def catalogue_entry(machine: str) -> tuple[float, str, str] | None:
-    """``(rated batch [kg], heat path, source)`` of the first :data:`CATALOGUE` entry that names
-    ``machine`` (Artisan's ``roastertype``), or None for a machine the catalogue does not know."""
-    for entry in CATALOGUE:
-        cap = entry.capacity(machine)
-        if cap is not None and cap > 0:
-            return cap, entry.heat, entry.source
-    return None
+    """``(rated batch [kg], heat path, source)`` of the catalogue's entry for ``machine``, or None."""
+    found = _catalogued(machine)
+    return None if found is None else (found[1], found[0].heat, found[0].source)
 
 
 def artisan_shows_tens(machine: str) -> bool:
     """Whether Artisan's setup for ``machine`` (its ``roastertype``) shows the machine's levels in
-    tens (:attr:`Machine.tens` of the first :data:`CATALOGUE` entry that names it)."""
-    entry = next((e for e in CATALOGUE if e.capacity(machine)), None)
-    return bool(entry and entry.tens)
+    tens (:attr:`Machine.tens` of its catalogue entry)."""
+    found = _catalogued(machine)
+    return found is not None and found[0].tens
 
 
 def batch_capacity(s: Survey, capacity_kg=None) -> tuple[float, str]:

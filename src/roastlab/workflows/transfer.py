@@ -294,7 +294,7 @@ def et_source(cmap) -> str:
     Skywalker's and the Bullet's ET is the drum's temperature, as their maps' [initial] Tm0_C says)."""
     if cmap is not None and cmap.Tgi.get("column") == "ET":
         return "Tgi"
-    if cmap is not None and (cmap.Tb2 or {}).get("column") == "ET":
+    if cmap is not None and cmap.et_is_bean_reading:
         return "Tb"
     return "Tm" if cmap is not None and cmap.inlet_is_constant else "Tgi"
 

@@ -177,6 +177,12 @@ class ColumnMap:
         return "constant_C" in self.Tgi
 
     @property
+    def et_is_bean_reading(self) -> bool:
+        """True if the map reads the log's ET as its second bean reading (``[Tb2] column = "ET"``: an
+        infrared bean sensor logged as ET, as ``roastlab init`` maps it), so ET is no drum air."""
+        return (self.Tb2 or {}).get("column") == "ET"
+
+    @property
     def identifies_flow(self) -> bool:
         """True if the map writes a 1 kg/s placeholder flow for the fit to scale (``[Gg] identify``)."""
         return bool(self.Gg.get("identify"))
@@ -584,7 +590,7 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
             extra["Tp"] = channel({"column": gg["pitot"]["T_column"]}, "Gg.pitot.T_column")
         series = {k: channel(spec, k) + (spec.get("offset_C") or 0.0) for k, spec in settings.items()}
         # Artisan's ET (temp1): drawn beside the model, never an input; unless the map reads it as the beans
-        if et_spec is None and fmt != "roastime" and "ET" in available and (cmap.Tb2 or {}).get("column") != "ET":
+        if et_spec is None and fmt != "roastime" and "ET" in available and not cmap.et_is_bean_reading:
             et_spec = {"column": "ET"}
         rejected = set()  # channels that do not read what the map says (no initial state from them)
         if et_spec is not None:
