@@ -321,6 +321,57 @@ def test_a_log_with_no_green_weight_is_named_and_left_out(cli, tmp_path):
     assert code == 0 and "left out" not in out, err
 
 
+def test_a_folder_of_logs_is_read_and_a_recording_that_is_no_roast_is_named_and_left_out(cli, tmp_path):
+    """SYNTHETIC: a roaster's folder as Artisan users keep it: three roasts beside an empty
+    recording (no samples), an aborted one (no BT reading), a licence and a hidden file. Given the
+    folder, init reads its logs, names the two recordings with why and sets up the three roasts
+    (it refused the whole set on the first bad log); fit-roaster likewise."""
+    folder = tmp_path / "roasts"
+    folder.mkdir()
+    for k in range(3):
+        (folder / f"r{k}.alog").write_text(fake_alog(extra=_BURNER_AIR))
+    (folder / "empty.alog").write_text(fake_alog(extra={"timex": [], "temp1": [], "temp2": []}))
+    (folder / "aborted.alog").write_text(fake_alog(bt=[-1.0] * 8, et=[-1.0] * 8, n=8))
+    (folder / "LICENSE").write_text("MIT License\n")
+    (folder / ".r9.alog").write_text("not read: a hidden file")
+    code, out, err = cli("init", folder, "--out", tmp_path / "cfg")
+    assert code == 0, err
+    assert out.startswith("3 log(s)"), out
+    assert "left out: aborted.alog cannot be read as a roast (no bean temperature (BT) in this log" in out
+    assert "left out: empty.alog cannot be read as a roast (key timex: needs at least 2 samples" in out
+    assert "LICENSE" not in out and ".r9" not in out
+    code, out, err = cli("fit-roaster", tmp_path / "cfg", folder)
+    assert code == 0, err
+    assert out.count("left out: ") == 2 and "left out: empty.alog cannot be read as a roast" in out
+    assert "held out: FIT" in out
+    # the logs named one by one read the same; a folder with no log, or only recordings that are no
+    # roast, is one line naming it (the latter: the first log's own problem)
+    named = [folder / f"{name}.alog" for name in ("r0", "empty", "r1", "aborted", "r2")]
+    code, out, err = cli("init", *named, "--out", tmp_path / "cfg2")
+    assert code == 0 and out.startswith("3 log(s)") and out.count("left out: ") == 2, (out, err)
+    (tmp_path / "none").mkdir()
+    code, out, err = cli("init", tmp_path / "none", "--out", tmp_path / "cfg3")
+    assert code == 2 and "none: no roast logs in this folder" in err and len(err.strip().splitlines()) == 1
+    code, out, err = cli("init", folder / "aborted.alog", folder / "empty.alog", "--out", tmp_path / "cfg4")
+    assert code == 2 and "aborted.alog: no bean temperature (BT)" in err, err
+
+
+def test_a_log_without_a_suffix_is_read_by_its_content(tmp_path):
+    """RoasTime keeps its logs without a suffix: such a file is a RoasTime log by its series, an
+    Artisan log by its Python-literal dict with 'timex'; anything else is refused, naming it."""
+    from roastlab.io.importers.mapping import detect_format
+
+    rt, al, other = tmp_path / "zl9ZdStWgBkMIm5TrsOR", tmp_path / "roast", tmp_path / "LICENSE"
+    rt.write_text(json.dumps({"beanTemperature": [20.0, 21.0], "sampleRate": 2}))
+    al.write_text(fake_alog())
+    other.write_text("MIT License {'timex'}\n")
+    assert detect_format(rt) == "roastime" and detect_format(al) == "alog"
+    with pytest.raises(
+        InputError, match="LICENSE: no suffix, and the content is neither a RoasTime nor an Artisan log"
+    ):
+        detect_format(other)
+
+
 def test_a_csv_of_a_european_spreadsheet_reads_as_any_other():
     from roastlab.io.batch import as_comma_separated
 

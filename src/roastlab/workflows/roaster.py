@@ -402,13 +402,66 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
     return info
 
 
+#: The suffixes of the logs a folder given as LOG stands for (Artisan .alog and .csv, RoasTime .json,
+#: a plain CSV); a file without a suffix, as RoasTime keeps its logs, where its content is a RoasTime
+#: or Artisan log (:func:`roastlab.io.importers.mapping.detect_format`).
+FOLDER_LOG_SUFFIXES = (".alog", ".csv", ".json")
+
+
+def log_paths(paths) -> list[Path]:
+    """The LOG arguments as files: a folder stands for the logs directly inside it, by name (its
+    hidden files, subfolders and files of other suffixes are not logs: :data:`FOLDER_LOG_SUFFIXES`).
+    A folder with no log in it is refused, naming it."""
+    out: list[Path] = []
+    for arg in map(Path, paths):
+        if not arg.is_dir():
+            out.append(arg)
+            continue
+        found = []
+        for p in sorted(arg.iterdir()):
+            if p.name.startswith(".") or not p.is_file():
+                continue
+            if p.suffix.lower() in FOLDER_LOG_SUFFIXES:
+                found.append(p)
+            elif not p.suffix:
+                try:
+                    detect_format(p)
+                except InputError:
+                    continue  # LICENSE, a Makefile: not a log
+                found.append(p)
+        if not found:
+            raise InputError("no roast logs in this folder (Artisan .alog/.csv, RoasTime .json, CSV)", arg)
+        out += found
+    return out
+
+
+def readable_logs(paths, batch_kg: float | None = None) -> tuple[list[LogInfo], dict[str, str]]:
+    """Each log inspected (:func:`inspect_log`), and those that cannot be read as a roast, each
+    with why (``{name: why}``). A roaster's folder often holds an aborted or empty recording beside
+    its roasts: that log is named and left out, not the whole set refused. Where fewer than two logs
+    can be read beside one that cannot (fit-roaster needs two: one to fit, one to hold out), the
+    first unreadable log's error is raised, one line, as for any bad input."""
+    infos, unreadable, first_error = [], {}, None
+    for p in map(Path, paths):
+        try:
+            infos.append(inspect_log(p, batch_kg))
+        except InputError as exc:
+            first_error = first_error or exc
+            where = f"{exc.where}: " if exc.where else ""
+            unreadable[p.name] = f"{p.name} cannot be read as a roast ({where}{exc.problem})"
+    if first_error is not None and len(infos) < 2:
+        raise first_error
+    return infos, unreadable
+
+
 def survey(paths, batch_kg: float | None = None) -> Survey:
     """Inspect every log; refuse logs that disagree (formats, channels, machines) or have no
-    batch mass, each with one message saying what to pass."""
-    paths = [Path(p) for p in paths]
+    batch mass, each with one message saying what to pass. A log that cannot be read as a roast
+    is left out and named (:func:`readable_logs`)."""
+    paths = log_paths(paths)
     if not paths:
         raise InputError("give the roast logs of one roaster", "init")
-    infos = [inspect_log(p, batch_kg) for p in paths]
+    infos, unreadable = readable_logs(paths, batch_kg)
     first = infos[0]
     for key, what in (("format", "formats"), ("heater", "heater channels"), ("fan", "fan channels")):
         kinds = {getattr(i, key) for i in infos} - {None}  # a log without a control: below
@@ -459,7 +512,7 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
             "tens" if unit == "percent" and in_tens.get(what) else unit
             for unit, what in ((heater_unit, "heater"), (fan_unit, "fan"))
         )
-    notes = []
+    notes = [f"left out: {why}" for why in unreadable.values()]
     if unweighed:
         names = list(unweighed)
         notes.append(
@@ -866,6 +919,7 @@ def init_roaster(paths, out_dir, *, batch_kg=None, capacity_kg=None, diameter_m=
     """Survey the logs and write ``out_dir``/map.toml, plant.toml, fit.toml; returns a summary."""
     from ..io.files import Outputs
 
+    paths = log_paths(paths)
     s = survey(paths, batch_kg)
     plant, notes = estimate_plant(s, capacity_kg, diameter_m, length_m)
     cap, _ = batch_capacity(s, capacity_kg)
@@ -1012,7 +1066,7 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: b
     for name in ("map.toml", "plant.toml", "fit.toml"):
         if not (d / name).is_file():
             raise InputError(f"no {name} here: run 'roastlab init LOG... --out {d}' first", d)
-    paths = [Path(p) for p in paths]
+    paths = log_paths(paths)
     if len(paths) < 2:
         raise InputError(
             "give at least two logs: one to fit, one to hold out; one log alone is fitted, unchecked, by "
@@ -1020,18 +1074,20 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: b
             "fit-roaster",
         )
     cmap = load_map(d / "map.toml")
-    infos = [inspect_log(p, cmap.batch_kg) for p in paths]
-    left_out = {
+    infos, unreadable = readable_logs(paths, cmap.batch_kg)
+    paths = [i.path for i in infos]
+    unusable = {
         **logs_without_weight(infos),
         **logs_without_controls(infos, {k: (getattr(cmap, k) or {}).get("column") for k in ("heater", "fan")}),
     }
+    left_out = {**unreadable, **unusable}
     if left_out:
-        keep = [k for k, i in enumerate(infos) if i.path.name not in left_out]
+        keep = [k for k, i in enumerate(infos) if i.path.name not in unusable]
         paths, infos = [paths[k] for k in keep], [infos[k] for k in keep]
         if len(paths) < 2:
             raise InputError(
-                f"fewer than two logs record their green weight and the settings the map drives the model with "
-                f"({'; '.join(left_out.values())})",
+                f"fewer than two logs can be read and record their green weight and the settings the map drives "
+                f"the model with ({'; '.join(left_out.values())})",
                 "fit-roaster",
             )
     if all(i.started_epoch_s for i in infos):  # by when they were roasted, else by name

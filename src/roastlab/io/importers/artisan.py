@@ -22,6 +22,7 @@ import io
 import json
 import math
 import re
+import warnings
 from array import array
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -173,7 +174,9 @@ def _running_median3(x: np.ndarray) -> np.ndarray:
     a fall); the ends by the median of the three nearest."""
     if len(x) < 3:
         return x.copy()
-    y = np.nanmedian(np.stack([x[:-2], x[1:-1], x[2:]]), axis=0)
+    with warnings.catch_warnings():  # three missing samples in a row stay missing (NaN), said by no warning
+        warnings.simplefilter("ignore", RuntimeWarning)
+        y = np.nanmedian(np.stack([x[:-2], x[1:-1], x[2:]]), axis=0)
     return np.concatenate([y[:1], y, y[-1:]])
 
 

@@ -414,7 +414,9 @@ def grams_in_name(path: Path) -> tuple[float, str] | None:
 
 
 def detect_format(path: Path, fmt: str = "auto") -> str:
-    """The log format of ``path``: ``fmt`` unless "auto", else by suffix and content."""
+    """The log format of ``path``: ``fmt`` unless "auto", else by suffix and content (a file without a
+    suffix, as RoasTime keeps its logs, by its content alone: a JSON object with RoasTime's series, or
+    a Python-literal dict with Artisan's ``'timex'``)."""
     if fmt != "auto":
         return fmt
     suffix = path.suffix.lower()
@@ -429,6 +431,16 @@ def detect_format(path: Path, fmt: str = "auto") -> str:
     if suffix in (".csv", ".txt", ".tsv"):
         first = read_input_bytes(path)[:4096].split(b"\n", 1)[0]  # through the guard: never a FIFO
         return "artisan-csv" if b"Unit:" in first else "csv"
+    if suffix == "":  # RoasTime keeps its logs without a suffix; an Artisan log can lose its own
+        head = read_input_bytes(path)[:65536]
+        if head.lstrip().startswith(b"{"):
+            if b'"beanTemperature"' in head or b'"actionTimeList"' in head:
+                return "roastime"
+            if b"'timex'" in head:
+                return "alog"
+        raise InputError(
+            "no suffix, and the content is neither a RoasTime nor an Artisan log; set format in the map", path
+        )
     raise InputError(f"cannot tell the log format from suffix {suffix!r}; set format in the map", path)
 
 
