@@ -323,8 +323,8 @@ def test_a_log_with_no_green_weight_is_named_and_left_out(cli, tmp_path):
 
 def test_a_folder_of_logs_is_read_and_a_recording_that_is_no_roast_is_named_and_left_out(cli, tmp_path):
     """SYNTHETIC: a roaster's folder as Artisan users keep it: three roasts beside an empty
-    recording (no samples), an aborted one (no BT reading), a licence and a hidden file. Given the
-    folder, init reads its logs, names the two recordings with why and sets up the three roasts
+    recording (no samples), an aborted one (no BT reading), a CSV export, a licence and a hidden
+    file. Given the folder, init reads its .alog logs, names the two recordings with why and sets up the three roasts
     (it refused the whole set on the first bad log); fit-roaster likewise."""
     folder = tmp_path / "roasts"
     folder.mkdir()
@@ -334,12 +334,13 @@ def test_a_folder_of_logs_is_read_and_a_recording_that_is_no_roast_is_named_and_
     (folder / "aborted.alog").write_text(fake_alog(bt=[-1.0] * 8, et=[-1.0] * 8, n=8))
     (folder / "LICENSE").write_text("MIT License\n")
     (folder / ".r9.alog").write_text("not read: a hidden file")
+    (folder / "r0.csv").write_text("not read: Artisan's CSV export of r0.alog, the same roast\n")
     code, out, err = cli("init", folder, "--out", tmp_path / "cfg")
     assert code == 0, err
     assert out.startswith("3 log(s)"), out
     assert "left out: aborted.alog cannot be read as a roast (no bean temperature (BT) in this log" in out
     assert "left out: empty.alog cannot be read as a roast (key timex: needs at least 2 samples" in out
-    assert "LICENSE" not in out and ".r9" not in out
+    assert "LICENSE" not in out and ".r9" not in out and "r0.csv" not in out
     code, out, err = cli("fit-roaster", tmp_path / "cfg", folder)
     assert code == 0, err
     assert out.count("left out: ") == 2 and "left out: empty.alog cannot be read as a roast" in out

@@ -79,9 +79,10 @@ def add_parsers(sub) -> None:
         "(which channel is BT, the heater, the fan, a second bean reading, ET, the inlet air), DIR/plant.toml (the drum, from its "
         "dimensions, a catalogue entry or the batch capacity, each estimate stated) and DIR/fit.toml (what these "
         "logs can determine), each commented with what was detected and what was guessed. A LOG that is a folder "
-        "stands for the logs in it (.alog, .csv, .json, and RoasTime's files without a suffix). A log that cannot be "
-        "read as a roast (an empty or aborted recording), records no green weight (nor one in its file name) or no "
-        "setting the others record is named, and fit-roaster leaves it out. Logs are never modified. "
+        "stands for its logs of one format (.alog where it has any, else .json, RoasTime's files without a suffix, .csv). "
+        "A log that cannot be "
+        "read as a roast (an empty or aborted recording), is a copy of another (the same recording start), records no "
+        "green weight (nor one in its file name) or no setting the others record is named, and fit-roaster leaves it out. Logs are never modified. "
         "Then 'roastlab fit-roaster DIR LOG...' fits the model (MODEL.json) and writes a report.",
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog="examples:\n  roastlab init roasts/*.alog --out myroaster\n  roastlab fit-roaster myroaster roasts/*.alog\n"
@@ -106,8 +107,8 @@ def add_parsers(sub) -> None:
         description="With DIR from 'roastlab init': sort LOG... by when they were roasted (by name when a log has no date) and split them alternately (1st, 3rd, ... fit; "
         "2nd, 4th, ... held out), identify the model, validate it on the held-out logs, fit the first-order "
         "baseline on the same inputs, and write DIR/model.json (MODEL.json for every other command), "
-        "DIR/report.md and DIR/heldout.png. A log that cannot be read as a roast, records no green weight or no "
-        "setting the map drives the model with is left out; a fit whose drum runs below the beans with the heater free to heat the air is refitted with the "
+        "DIR/report.md and DIR/heldout.png. A log that cannot be read as a roast, is a copy of another, records no green weight or "
+        "no setting the map drives the model with is left out; a fit whose drum runs below the beans with the heater free to heat the air is refitted with the "
         "heater heating the drum alone; a model worse than the baseline on the held-out logs is called not "
         "usable; each is said. Exit status 1 when the fit failed (states the machine cannot have, "
         "such as drum metal below the beans; the files are written and say so), 2 on bad input.",

@@ -404,36 +404,37 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
     return info
 
 
-#: The suffixes of the logs a folder given as LOG stands for (Artisan .alog and .csv, RoasTime .json,
-#: a plain CSV); a file without a suffix, as RoasTime keeps its logs, where its content is a RoasTime
-#: or Artisan log (:func:`roastlab.io.importers.mapping.detect_format`).
-FOLDER_LOG_SUFFIXES = (".alog", ".csv", ".json")
+#: The suffixes of the logs a folder given as LOG stands for, in the order one is preferred to
+#: another where a folder holds several (Artisan's .alog before the CSV exports beside it, which
+#: are the same roasts): Artisan .alog, RoasTime .json, RoasTime's files without a suffix (where
+#: their content is a RoasTime or Artisan log: :func:`roastlab.io.importers.mapping.detect_format`),
+#: then .csv (Artisan's export or a plain CSV).
+FOLDER_LOG_SUFFIXES = (".alog", ".json", "", ".csv")
 
 
 def log_paths(paths) -> list[Path]:
-    """The LOG arguments as files: a folder stands for the logs directly inside it, by name (its
-    hidden files, subfolders and files of other suffixes are not logs: :data:`FOLDER_LOG_SUFFIXES`).
-    A folder with no log in it is refused, naming it."""
+    """The LOG arguments as files. A folder stands for the logs directly inside it, by name, of one
+    format: the first of :data:`FOLDER_LOG_SUFFIXES` it holds (its hidden files, subfolders and
+    files of other suffixes are not logs). A folder with no log in it is refused, naming it."""
     out: list[Path] = []
     for arg in map(Path, paths):
         if not arg.is_dir():
             out.append(arg)
             continue
-        found = []
+        found: dict[str, list[Path]] = {}
         for p in sorted(arg.iterdir()):
-            if p.name.startswith(".") or not p.is_file():
+            suffix = p.suffix.lower()
+            if p.name.startswith(".") or not p.is_file() or suffix not in FOLDER_LOG_SUFFIXES:
                 continue
-            if p.suffix.lower() in FOLDER_LOG_SUFFIXES:
-                found.append(p)
-            elif not p.suffix:
+            if not suffix:
                 try:
                     detect_format(p)
                 except InputError:
                     continue  # LICENSE, a Makefile: not a log
-                found.append(p)
+            found.setdefault(suffix, []).append(p)
         if not found:
             raise InputError("no roast logs in this folder (Artisan .alog/.csv, RoasTime .json, CSV)", arg)
-        out += found
+        out += found[next(s for s in FOLDER_LOG_SUFFIXES if s in found)]
     return out
 
 
