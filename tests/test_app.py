@@ -401,3 +401,13 @@ def test_a_model_is_fitted_on_the_page_in_the_background(client, data_dir):
     assert "no heater setting is logged" in st["verdict"] and st["report"].count("**Not usable**") == 1
     one = client.post("/api/fit", json={"logs": logs[:1]}, headers=H)
     assert one.status_code == 400 and "at least two logs" in one.json()["error"]
+
+
+def test_the_file_list_takes_a_roastime_file_without_a_suffix_for_a_log(tmp_path):
+    """RoasTime keeps its roasts without a suffix: such a file is listed among the logs by its
+    content; a LICENSE beside it is not."""
+    from roastlab.app.server import list_files
+
+    (tmp_path / "zl9ZdStWgBkMIm5TrsOR").write_text(json.dumps({"beanTemperature": [20.0, 21.0], "sampleRate": 2}))
+    (tmp_path / "LICENSE").write_text("MIT License\n")
+    assert list_files(tmp_path)["logs"] == ["zl9ZdStWgBkMIm5TrsOR"]

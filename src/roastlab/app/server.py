@@ -100,7 +100,8 @@ def inside(data_dir: Path, rel: str) -> Path:
 
 
 def list_files(data_dir: Path, limit: int = 2000) -> dict:
-    """Logs, models and plants under ``data_dir`` (relative paths; links leaving it skipped)."""
+    """Logs, models and plants under ``data_dir`` (relative paths; links leaving it skipped); a file
+    without a suffix is a log where its content is one (RoasTime's own files)."""
     root = data_dir.resolve()
     logs, models, plants = [], [], []
     for path in sorted(root.rglob("*")):
@@ -121,9 +122,20 @@ def list_files(data_dir: Path, limit: int = 2000) -> dict:
                 plants.append(rel)
         elif suffix == ".json" and b"roastlab-model" in path.read_bytes()[:4096]:
             models.append(rel)
-        elif suffix in LOG_SUFFIXES:
+        elif suffix in LOG_SUFFIXES or (not suffix and _log_by_content(path)):
             logs.append(rel)
     return {"logs": logs, "models": models, "plants": plants}
+
+
+def _log_by_content(path: Path) -> bool:
+    """A file without a suffix that is a roast log by its content (RoasTime keeps its roasts so)."""
+    from ..io.importers.mapping import detect_format
+
+    try:
+        detect_format(path)
+    except InputError:
+        return False
+    return True
 
 
 def _series(values) -> list | None:
