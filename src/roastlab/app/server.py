@@ -38,6 +38,7 @@ import numpy as np
 
 from ..errors import InputError, RoastlabError
 from ..io.files import Outputs
+from ..io.importers.mapping import is_log_by_content
 from ..metrics.profile import rate_of_rise_C_per_min
 
 #: Largest upload [bytes]: a 30-minute log sampled every second is ~2 MB.
@@ -122,20 +123,9 @@ def list_files(data_dir: Path, limit: int = 2000) -> dict:
                 plants.append(rel)
         elif suffix == ".json" and b"roastlab-model" in path.read_bytes()[:4096]:
             models.append(rel)
-        elif suffix in LOG_SUFFIXES or (not suffix and _log_by_content(path)):
+        elif suffix in LOG_SUFFIXES or (not suffix and is_log_by_content(path)):
             logs.append(rel)
     return {"logs": logs, "models": models, "plants": plants}
-
-
-def _log_by_content(path: Path) -> bool:
-    """A file without a suffix that is a roast log by its content (RoasTime keeps its roasts so)."""
-    from ..io.importers.mapping import detect_format
-
-    try:
-        detect_format(path)
-    except InputError:
-        return False
-    return True
 
 
 def _series(values) -> list | None:

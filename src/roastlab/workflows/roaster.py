@@ -50,7 +50,14 @@ import numpy as np
 from ..errors import InputError
 from ..io.importers.artisan import DRUM_AT_CHARGE as ARTISAN_DRUM_AT_CHARGE
 from ..io.importers.artisan import ET_BEFORE_CHARGE, WEIGHT_UNITS, RoomReading, read_alog, read_artisan_csv
-from ..io.importers.mapping import bare_room_unit, detect_format, grams_in_name, hot_drop, probe_fault
+from ..io.importers.mapping import (
+    bare_room_unit,
+    detect_format,
+    grams_in_name,
+    hot_drop,
+    is_log_by_content,
+    probe_fault,
+)
 from ..io.importers.roastime import DRUM_AT_CHARGE, read_roastime
 from ..metrics.profile import et_minus_bt_C, et_not_drum_air, et_reads_beans
 from ..model.actuators import UNIT_DEFAULTS
@@ -426,12 +433,8 @@ def log_paths(paths) -> list[Path]:
             suffix = p.suffix.lower()
             if p.name.startswith(".") or not p.is_file() or suffix not in FOLDER_LOG_SUFFIXES:
                 continue
-            if not suffix:
-                try:
-                    detect_format(p)
-                except InputError:
-                    continue  # LICENSE, a Makefile: not a log
-            found.setdefault(suffix, []).append(p)
+            if suffix or is_log_by_content(p):  # without a suffix, a LICENSE or a Makefile is no log
+                found.setdefault(suffix, []).append(p)
         if not found:
             raise InputError("no roast logs in this folder (Artisan .alog/.csv, RoasTime .json, CSV)", arg)
         out += found[next(s for s in FOLDER_LOG_SUFFIXES if s in found)]

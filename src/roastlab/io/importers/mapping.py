@@ -444,6 +444,16 @@ def detect_format(path: Path, fmt: str = "auto") -> str:
     raise InputError(f"cannot tell the log format from suffix {suffix!r}; set format in the map", path)
 
 
+def is_log_by_content(path: Path) -> bool:
+    """Whether a file is a roast log by its content alone (:func:`detect_format`): how a file without
+    a suffix, as RoasTime keeps its roasts, is told from a LICENSE or a Makefile beside it."""
+    try:
+        detect_format(path)
+    except InputError:
+        return False
+    return True
+
+
 #: Most rows a Parquet log may declare; checked from its footer before any column is decoded,
 #: so a small file that would decompress to gigabytes is refused first.
 MAX_PARQUET_ROWS = 2_000_000
