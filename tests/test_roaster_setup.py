@@ -323,8 +323,8 @@ def test_a_log_with_no_green_weight_is_named_and_left_out(cli, tmp_path):
 
 def test_a_folder_of_logs_is_read_and_a_recording_that_is_no_roast_is_named_and_left_out(cli, tmp_path):
     """SYNTHETIC: a roaster's folder as Artisan users keep it: three roasts beside an empty
-    recording (no samples), an aborted one (no BT reading), a CSV export, a licence and a hidden
-    file. Given the folder, init reads its .alog logs, names the two recordings with why and sets up the three roasts
+    recording (no samples), an aborted one (no BT reading), one whose probe read 0 degC throughout,
+    a CSV export, a licence and a hidden file. Given the folder, init reads its .alog logs, names the two recordings with why and sets up the three roasts
     (it refused the whole set on the first bad log); fit-roaster likewise."""
     folder = tmp_path / "roasts"
     folder.mkdir()
@@ -332,6 +332,7 @@ def test_a_folder_of_logs_is_read_and_a_recording_that_is_no_roast_is_named_and_
         (folder / f"r{k}.alog").write_text(fake_alog(extra=_BURNER_AIR))
     (folder / "empty.alog").write_text(fake_alog(extra={"timex": [], "temp1": [], "temp2": []}))
     (folder / "aborted.alog").write_text(fake_alog(bt=[-1.0] * 8, et=[-1.0] * 8, n=8))
+    (folder / "dead_probe.alog").write_text(fake_alog(bt=[0.0] * 120, extra=_BURNER_AIR))  # BT reads 0 degC
     (folder / "LICENSE").write_text("MIT License\n")
     (folder / ".r9.alog").write_text("not read: a hidden file")
     (folder / "r0.csv").write_text("not read: Artisan's CSV export of r0.alog, the same roast\n")
@@ -340,16 +341,17 @@ def test_a_folder_of_logs_is_read_and_a_recording_that_is_no_roast_is_named_and_
     assert out.startswith("3 log(s)"), out
     assert "left out: aborted.alog cannot be read as a roast (no bean temperature (BT) in this log" in out
     assert "left out: empty.alog cannot be read as a roast (key timex: needs at least 2 samples" in out
+    assert "left out: dead_probe.alog cannot be read as a roast (BT never reaches 150 degC, DRY END (highest 0" in out
     assert "LICENSE" not in out and ".r9" not in out and "r0.csv" not in out
     code, out, err = cli("fit-roaster", tmp_path / "cfg", folder)
     assert code == 0, err
-    assert out.count("left out: ") == 2 and "left out: empty.alog cannot be read as a roast" in out
+    assert out.count("left out: ") == 3 and "left out: empty.alog cannot be read as a roast" in out
     assert "held out: FIT" in out
     # the logs named one by one read the same; a folder with no log, or only recordings that are no
     # roast, is one line naming it (the latter: the first log's own problem)
-    named = [folder / f"{name}.alog" for name in ("r0", "empty", "r1", "aborted", "r2")]
+    named = [folder / f"{name}.alog" for name in ("r0", "empty", "r1", "aborted", "r2", "dead_probe")]
     code, out, err = cli("init", *named, "--out", tmp_path / "cfg2")
-    assert code == 0 and out.startswith("3 log(s)") and out.count("left out: ") == 2, (out, err)
+    assert code == 0 and out.startswith("3 log(s)") and out.count("left out: ") == 3, (out, err)
     (tmp_path / "none").mkdir()
     code, out, err = cli("init", tmp_path / "none", "--out", tmp_path / "cfg3")
     assert code == 2 and "none: no roast logs in this folder" in err and len(err.strip().splitlines()) == 1

@@ -59,7 +59,7 @@ from ..io.importers.mapping import (
     probe_fault,
 )
 from ..io.importers.roastime import DRUM_AT_CHARGE, read_roastime
-from ..metrics.profile import et_minus_bt_C, et_not_drum_air, et_reads_beans
+from ..metrics.profile import DRY_END_C, et_minus_bt_C, et_not_drum_air, et_reads_beans
 from ..model.actuators import UNIT_DEFAULTS
 from ..model.bed import CROSS_VALIDATED, PROBE_DEPTH_OVER_DIAMETER
 from ..model.constants import GREEN_BULK_DENSITY_KG_M3
@@ -354,6 +354,12 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
     bt = bt[: fault + 1] if (fault := probe_fault(bt)) is not None else bt  # the import cuts a probe fault so
     if log.drop_index is not None and (why := hot_drop(float(bt[-1]))):
         raise InputError(why, path)  # the import refuses it too; say it before the files are written
+    if not bt.max() >= DRY_END_C:  # a probe that read nothing (0 degC), a recording stopped in the drying
+        raise InputError(
+            f"BT never reaches {DRY_END_C:.0f} degC, DRY END (highest {bt.max():.0f} degC): no roast recorded, "
+            "an unconnected probe or a recording stopped early",
+            path,
+        )
     others = [n for n in names if n not in ("BT", "ET", "beanTemperature", "drumTemperature", "exitTemperature")]
     temps = [n for n in others if ("temp" in n.lower() or "°" in n if fmt == "csv" else n in log.temperature_channels)]
     inlet = _find([n for n in temps if np.isfinite(log.channels[n]).any()], INLET_NAMES)
