@@ -115,6 +115,24 @@ def test_init_reads_an_et_that_falls_to_the_green_beans_as_a_second_bean_reading
     assert et_source(load_map(tmp_path / "cfg2" / "map.toml")) == "Tm"  # the drum, as for the Skywalker
 
 
+def test_an_et_below_bt_through_every_roast_is_not_used_and_a_swap_is_suggested(cli, tmp_path):
+    """SYNTHETIC logs whose ET reads 15 degC below BT through every roast (ET and BT swapped in the
+    device setup, or a probe outside the drum): not the drum's air on any log, which runs above the
+    beans it heats. init does not weigh it against the model's air (before, only logs far below the
+    others' median were dropped, so a machine whose every log read so kept it), and says a swap is
+    likely; the heater then heats the drum alone, as without ET."""
+    bt = [130.0 - 0.2 * i if i < 30 else 124.0 + 0.5 * (i - 30) for i in range(120)]
+    logs = [tmp_path / f"r{k}.alog" for k in range(3)]
+    for k, p in enumerate(logs):
+        p.write_text(fake_alog(bt=bt, et=[b - 15.0 + k for b in bt], extra={**_BURNER_AIR, "roastepoch": 1e9 + k}))
+    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
+    assert code == 0, err
+    assert "ET: below BT on every log, not used" in out
+    assert "ET reads below BT through the roast on every log (by 13 to 15 degC)" in out and "swap them back" in out
+    spec = (tmp_path / "cfg" / "fit.toml").read_text()
+    assert "\nET = " not in spec and "Tgi_gain_C" not in spec.split("[free]")[1].split("[")[0], spec
+
+
 def test_init_takes_the_damper_as_the_fan_when_no_fan_is_logged(cli, tmp_path):
     """SYNTHETIC logs with Burner and Damper events and no Air: on a drum with one fixed-speed
     exhaust fan the damper sets the air flow, so it stands for the fan, and init says so; with an

@@ -25,7 +25,15 @@ def cmd_init(args) -> int:
     print(
         f"  bean probe BT; heater: {s.heater or 'none'} ({s.heater_unit or '-'}); fan: {s.fan or 'none'} ({s.fan_unit or '-'})"
     )
-    et = "yes" if s.has_et else ("a bean reading, not the drum's air" if s.et_is_bean else "no")
+    et = (
+        "yes"
+        if s.has_et
+        else "a bean reading, not the drum's air"
+        if s.et_is_bean
+        else "below BT on every log, not used (below)"
+        if s.et_below_bt
+        else "no"
+    )
     role = "offered in the map" if s.heater else "the model's input"
     inlet = f"; inlet air: {s.inlet} ({role})" if s.inlet else ""
     print(f"  second bean reading: {s.second_bean or 'none'}; ET: {et}{inlet}")

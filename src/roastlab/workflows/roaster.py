@@ -204,6 +204,7 @@ class Survey:
     et_is_bean: bool = False  # ET is a bean reading (the second one, an infrared sensor), not the drum's air
     in_tens: dict = field(default_factory=dict)  # {"heater": True, ...}: every logged value a whole ten
     inlet: str | None = None  # the inlet-air channel every log records (INLET_NAMES), else None
+    et_below_bt: bool = False  # ET reads below BT through every roast: not the drum's air, not used
 
 
 #: A heater logged in watts heats the drum by at most its electric power [kW per W].
@@ -605,9 +606,21 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
             f"{' ...' if len(beans) > 3 else ''}), unlike the others: a bean sensor there, not the drum's air; "
             "set up those logs apart"
         )
+    # ET below BT through every roast is not the drum's air on any log (metrics.profile.et_minus_bt_C):
+    # weighed against the model's air it would pull the fit off; perhaps the two are swapped
+    differences = [i.et_minus_bt_C for i in infos if i.has_et]
+    et_below_bt = (
+        not et_is_bean and len(differences) == len(infos) and all(d is not None and d < 0.0 for d in differences)
+    )
+    if et_below_bt:
+        notes.append(
+            f"ET reads below BT through the roast on every log (by {-max(differences):.0f} to "
+            f"{-min(differences):.0f} degC): not the drum's air, which runs above the beans it heats, so the "
+            "map does not use it; if ET and BT are swapped in the device setup, swap them back and run init again"
+        )
     odd = (
         []
-        if et_is_bean
+        if et_is_bean or et_below_bt
         else [i.path.name for i, bad in zip(infos, et_not_drum_air([i.et_minus_bt_C for i in infos])) if bad]
     )
     if odd:
@@ -624,7 +637,7 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
         fan,
         fan_unit,
         first.second_bean or (((first.columns or {}).get("ET") or "ET") if et_is_bean else None),
-        all(i.has_et for i in infos) and not et_is_bean,
+        all(i.has_et for i in infos) and not et_is_bean and not et_below_bt,
         max(i.heater_max for i in infos),
         max(i.fan_max for i in infos),
         {k: v for i in infos for k, v in i.unused.items()},
@@ -638,6 +651,7 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
         et_is_bean,
         in_tens,
         inlet,
+        et_below_bt,
     )
 
 
