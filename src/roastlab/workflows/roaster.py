@@ -59,7 +59,7 @@ from ..io.importers.mapping import (
     probe_fault,
 )
 from ..io.importers.roastime import DRUM_AT_CHARGE, read_roastime
-from ..metrics.profile import DRY_END_C, et_minus_bt_C, et_not_drum_air, et_reads_beans
+from ..metrics.profile import et_minus_bt_C, et_not_drum_air, et_reads_beans
 from ..model.actuators import UNIT_DEFAULTS
 from ..model.bed import CROSS_VALIDATED, PROBE_DEPTH_OVER_DIAMETER
 from ..model.constants import GREEN_BULK_DENSITY_KG_M3
@@ -333,6 +333,12 @@ def read_plain_csv(path: Path):
     return log, cols
 
 
+def live_reading(values_C) -> bool:
+    """Whether a temperature channel reads anything: above the room (the quantity table's
+    ``T_room_C``) at some sample. An unconnected thermocouple reads 0 (or Artisan's -1) throughout."""
+    return bool(np.nanmax(np.asarray(values_C, dtype=float), initial=-np.inf) > default("T_room_C"))
+
+
 def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
     """One log's layout (format, channels, heater/fan, second bean reading, batch)."""
     path = Path(path)
@@ -355,10 +361,10 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
     bt = bt[: fault + 1] if (fault := probe_fault(bt)) is not None else bt  # the import cuts a probe fault so
     if log.drop_index is not None and (why := hot_drop(float(bt[-1]))):
         raise InputError(why, path)  # the import refuses it too; say it before the files are written
-    if not bt.max() >= DRY_END_C:  # a probe that read nothing (0 degC), a recording stopped in the drying
+    if not live_reading(bt):  # a probe that read nothing (0 degC throughout)
         raise InputError(
-            f"BT never reaches {DRY_END_C:.0f} degC, DRY END (highest {bt.max():.0f} degC): no roast recorded, "
-            "an unconnected probe or a recording stopped early",
+            f"BT never reads above the room ({default('T_room_C'):g} degC; highest {bt.max():.0f} degC): no roast "
+            "recorded, an unconnected probe?",
             path,
         )
     others = [n for n in names if n not in ("BT", "ET", "beanTemperature", "drumTemperature", "exitTemperature")]
@@ -389,7 +395,7 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
         heater,
         fan,
         "drumTemperature" if fmt == "roastime" and "drumTemperature" in names else None,
-        "ET" in names and bool(np.nanmax(log.channels["ET"], initial=-np.inf) > default("T_room_C")),  # a live reading
+        "ET" in names and live_reading(log.channels["ET"]),
         float(np.nanmax(log.channels[heater])) if heater else 0.0,
         float(np.nanmax(log.channels[fan])) if fan else 0.0,
         log.started_epoch_s,
