@@ -210,3 +210,17 @@ def test_the_lowest_aic_is_weighed_against_the_best_by_one_standard_error():
     assert "within one standard error of best, 0.3 ± 4.9 points over 3 groups" in text and "prefer" not in text
     text = ModelComparison([best, far], groups, 1.0).summary()
     assert "predicts unseen sizes worse by 9.7 ± 0.3 points over 3 groups: prefer best" in text
+
+
+def test_a_roast_given_twice_is_left_out_once():
+    """SYNTHETIC: a roast given twice (a renamed copy keeps the second its recording started) would be
+    fitted in one copy and held out in the other; compare-models keeps the first and says so."""
+    import dataclasses
+
+    batches = [dataclasses.replace(b, started_epoch_s=1.7e9 + 3600.0 * k) for k, b in enumerate(synthetic_sizes()[:3])]
+    copy = dataclasses.replace(batches[1], name="renamed_copy")
+    result = compare_models([*batches, copy], "120kg", None, [TRUTH], group_by="log", starts=1)
+    assert list(result.groups) == [b.name for b in batches]
+    why = f"renamed_copy is a copy of {batches[1].name} (recorded from the same second: one roast)"
+    assert result.left_out == {"renamed_copy": why}
+    assert f"left out: {why}" in result.summary() and result.to_json_dict()["left_out"] == result.left_out

@@ -73,6 +73,7 @@ class Batch:
     events: dict = field(default_factory=dict)
     ET_C: np.ndarray | None = None
     unit: str = ""  # which roaster of its make recorded it (RoasTime serial number), empty if unknown
+    started_epoch_s: float | None = None  # when its recording started (a copy keeps it: first_of_each_roast)
 
     @property
     def n(self) -> int:
@@ -121,6 +122,28 @@ class Batch:
         if self.Mb_kg is not None:
             check_value("Mb_kg", self.Mb_kg, src)
         return self
+
+
+def first_of_each_roast(items, started_epoch_s, name) -> tuple[list, dict[str, str]]:
+    """``items`` without their copies, and each copy left out with why (``{name: why}``).
+
+    A roast saved twice (renamed with its batch number, annotated after the roast) keeps the second
+    its recording started (Artisan's ``roastepoch``, RoasTime's ``dateTime``): of the items whose
+    ``started_epoch_s(item)`` agree to the second, the first in the order given is kept. Read as two
+    roasts, one copy would be fitted and the other held out, scoring a model on a roast it was
+    fitted to. An item with no start (a plain CSV) is a roast of its own.
+    """
+    kept, copies, seen = [], {}, {}
+    for item in items:
+        t = started_epoch_s(item)
+        key = round(t) if t else None
+        if key is not None and key in seen:
+            copies[name(item)] = f"{name(item)} is a copy of {seen[key]} (recorded from the same second: one roast)"
+            continue
+        if key is not None:
+            seen[key] = name(item)
+        kept.append(item)
+    return kept, copies
 
 
 def read_text(path: Path) -> str:

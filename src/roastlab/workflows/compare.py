@@ -39,6 +39,7 @@ import numpy as np
 from ..errors import InputError, ParameterError
 from ..evaluate.bands import BAND_LEVEL, band_coverage, share_inside, stored_spread, why_no_band
 from ..evaluate.metrics import size_labels
+from ..io.batch import first_of_each_roast
 from ..model.bed import LAWS, VARIANTS, BedLaws
 from ..model.limits import check_value
 from ..model.parameters import FREE_NAMES, N_STARTS, FreeParameter
@@ -238,6 +239,7 @@ class ModelComparison(Result):
     groups: dict[str, list[str]]
     step_kg: float | None
     group_by: str = "size"
+    left_out: dict = field(default_factory=dict)  # {log: why}: copies of a roast given twice
 
     @property
     def best(self) -> VariantScore:
@@ -350,6 +352,7 @@ class ModelComparison(Result):
                     f"{s.name}: without {', '.join(s.cv_band_parameters_only)} the fit had one log, so its band is the "
                     "parameters' alone (no spread between roasts) and holds few of the held-out samples"
                 )
+        lines += [f"left out: {why}" for why in self.left_out.values()]
         return "\n".join(lines)
 
     def to_json_dict(self) -> dict:
@@ -358,6 +361,7 @@ class ModelComparison(Result):
             "group_by": self.group_by,
             "step_kg": self.step_kg,
             "groups": self.groups,
+            "left_out": self.left_out,
             "best": self.best.name,
             "variants": [
                 {
@@ -459,6 +463,10 @@ def compare_models(
 ) -> ModelComparison:
     """Fit each variant on ``batches`` and cross-validate it leaving one batch size (or one roaster) out.
 
+    A log that is a copy of another (the same recording start: :func:`roastlab.io.batch.first_of_each_roast`)
+    is left out and said (``ModelComparison.left_out``): fitted in one copy and held out in the other,
+    a roast would score the model on itself.
+
     Parameters
     ----------
     batches : list of Batch (each with its green weight ``Mb_kg``)
@@ -485,7 +493,8 @@ def compare_models(
         raise InputError("no model variants to compare", "command line")
     if group_by not in GROUPINGS:
         raise InputError(f"group logs by one of {', '.join(GROUPINGS)}, got {group_by!r}", "command line")
-    batches = list(batches)
+    # a roast given twice would be fitted in one copy and held out in the other
+    batches, left_out = first_of_each_roast(list(batches), lambda b: b.started_epoch_s, lambda b: b.name)
     if group_by == "size":
         labels, step = size_groups(batches, step_kg)
         order = sorted(set(labels), key=lambda g: float(g.split()[0].split("-")[0]))
@@ -557,7 +566,7 @@ def compare_models(
     if progress:
         progress(total, total, "done")
     scores.sort(key=lambda s: -s.cv_FIT)
-    return ModelComparison(scores, groups, step, group_by)
+    return ModelComparison(scores, groups, step, group_by, left_out)
 
 
 __all__ = [

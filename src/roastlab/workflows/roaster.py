@@ -48,6 +48,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
+from ..io.batch import first_of_each_roast
 from ..io.importers.artisan import DRUM_AT_CHARGE as ARTISAN_DRUM_AT_CHARGE
 from ..io.importers.artisan import ET_BEFORE_CHARGE, WEIGHT_UNITS, RoomReading, read_alog, read_artisan_csv
 from ..io.importers.mapping import (
@@ -175,7 +176,6 @@ class LogInfo:
     et_before_charge: bool = False  # the log has ET's reading before CHARGE (artisan.ET_BEFORE_CHARGE)
     seen: dict = field(default_factory=dict)  # the heater's and the fan's distinct logged values (their unit: survey)
     inlet: str | None = None  # a temperature channel named as the inlet air (INLET_NAMES)
-    roast: tuple = ()  # what tells this roast from another (:func:`same_roast_key`)
 
 
 @dataclass
@@ -416,7 +416,6 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
         info.et_reads_beans = et_reads_beans(log.time_s, log.channels["ET"], log.channels["BT"], default("T_room_C"))
         info.et_before_charge = ET_BEFORE_CHARGE in log.fields
     info.inlet = inlet
-    info.roast = same_roast_key(log.started_epoch_s)
     for what, channel in (("heater", heater), ("fan", fan)):
         if channel:
             values = log.channels[channel]
@@ -454,38 +453,25 @@ def log_paths(paths) -> list[Path]:
     return out
 
 
-def same_roast_key(started_epoch_s: float | None) -> tuple:
-    """What tells one roast from another: the second its recording started (Artisan's ``roastepoch``,
-    RoasTime's ``dateTime``), which a copy keeps whatever it is renamed to or annotated with; ``()``
-    for a log that records none (a plain CSV), which is then taken for a roast of its own."""
-    return ("started", round(started_epoch_s)) if started_epoch_s else ()
-
-
 def readable_logs(paths, batch_kg: float | None = None) -> tuple[list[LogInfo], dict[str, str]]:
     """Each log inspected (:func:`inspect_log`), and those that cannot be read as a roast, each
     with why (``{name: why}``). A roaster's folder often holds an aborted or empty recording beside
     its roasts: that log is named and left out, not the whole set refused. So is a second copy of
-    one roast (renamed, annotated: :func:`same_roast_key`), which would otherwise be fitted and
-    held out at once, scoring the model on a roast it was fitted to. Where fewer than two logs
+    one roast (renamed, annotated: :func:`roastlab.io.batch.first_of_each_roast`). Where fewer than two logs
     can be read beside one that cannot (fit-roaster needs two: one to fit, one to hold out), the
     first unreadable log's error is raised, one line, as for any bad input."""
-    infos, unreadable, first_error, seen = [], {}, None, {}
+    infos, unreadable, first_error = [], {}, None
     for p in map(Path, paths):
         try:
-            info = inspect_log(p, batch_kg)
+            infos.append(inspect_log(p, batch_kg))
         except InputError as exc:
             first_error = first_error or exc
             where = f"{exc.where}: " if exc.where else ""
             unreadable[p.name] = f"{p.name} cannot be read as a roast ({where}{exc.problem})"
-            continue
-        if info.roast and (twin := seen.get(info.roast)) is not None:  # a copy would sit on both sides of the split
-            unreadable[p.name] = f"{p.name} is a copy of {twin} (recorded from the same second: one roast)"
-            continue
-        seen[info.roast] = p.name
-        infos.append(info)
     if first_error is not None and len(infos) < 2:
         raise first_error
-    return infos, unreadable
+    infos, copies = first_of_each_roast(infos, lambda i: i.started_epoch_s, lambda i: i.path.name)
+    return infos, {**unreadable, **copies}
 
 
 def survey(paths, batch_kg: float | None = None) -> Survey:

@@ -577,6 +577,7 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
     initial: dict = {}
     events: dict = {}
     unit = ""
+    started_epoch_s = None  # when the recording started (Artisan roastepoch, RoasTime dateTime)
     settings = {k: spec for k, spec in (("heater", cmap.heater), ("fan", cmap.fan), ("Tb2", cmap.Tb2)) if spec}
     et_spec = cmap.ET
     if fmt in ("alog", "artisan-csv", "roastime"):
@@ -622,6 +623,7 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
             et_spec = settings.get("ET")
         Mb = log.weight_in_kg
         unit = log.unit
+        started_epoch_s = log.started_epoch_s
         drop_known = log.drop_index is not None
         events = dict(log.events)
         for state, sources in cmap.initial.items():
@@ -794,6 +796,7 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
         ET_C=series.get("ET"),
         events=events,
         unit=unit,
+        started_epoch_s=started_epoch_s,
     )
     batch.initial.update(initial)
     batch.notes = notes
