@@ -107,6 +107,17 @@ def cmd_fleet_synthetic(args) -> int:
     return 0
 
 
+def _add_wait(q) -> None:
+    """The ``--wait`` option of the commands that write the store."""
+    q.add_argument(
+        "--wait",
+        type=count_arg("--wait", 0, 86_400),
+        default=0,
+        metavar="SECONDS",
+        help="if another process has the store open, wait up to this long for it (default 0: refuse at once)",
+    )
+
+
 def add_parsers(sub) -> None:
     """Register ``roastlab fleet`` and its subcommands on the subparsers ``sub``."""
     parser_class = Parser
@@ -142,13 +153,7 @@ def add_parsers(sub) -> None:
     )
     q.add_argument("--db", required=True, metavar="FLEET.duckdb", help="the store (created if missing)")
     q.add_argument("--manifest", required=True, metavar="MANIFEST.csv", help="CSV: path,machine,plant,started_at[,map]")
-    q.add_argument(
-        "--wait",
-        type=count_arg("--wait", 0, 86_400),
-        default=0,
-        metavar="SECONDS",
-        help="if another process has the store open, wait up to this long for it (default 0: refuse at once)",
-    )
+    _add_wait(q)
     q.set_defaults(func=cmd_fleet_ingest)
 
     q = fsub.add_parser(
@@ -175,13 +180,7 @@ def add_parsers(sub) -> None:
         default=500,
         help="batches per task and commit (default 500)",
     )
-    q.add_argument(
-        "--wait",
-        type=count_arg("--wait", 0, 86_400),
-        default=0,
-        metavar="SECONDS",
-        help="if another process has the store open, wait up to this long for it (default 0: refuse at once)",
-    )
+    _add_wait(q)
     q.set_defaults(func=cmd_fleet_fit)
 
     q = fsub.add_parser(
