@@ -224,3 +224,19 @@ def test_a_roast_given_twice_is_left_out_once():
     why = f"renamed_copy is a copy of {batches[1].name} (recorded from the same second: one roast)"
     assert result.left_out == {"renamed_copy": why}
     assert f"left out: {why}" in result.summary() and result.to_json_dict()["left_out"] == result.left_out
+
+
+def test_a_fit_given_one_roast_twice_says_so():
+    """SYNTHETIC: identify keeps what it is given (the fit is the user's), but a roast given twice
+    weighs twice, and the fit's warnings say which."""
+    import dataclasses
+
+    import roastlab
+
+    a, b = (dataclasses.replace(x, started_epoch_s=1.7e9 + 60.0 * k) for k, x in enumerate(synthetic_sizes()[:2]))
+    copy = dataclasses.replace(a, name="a_copy")
+    warned = roastlab.fit([a, b, copy], "120kg", bed=TRUTH, starts=1).warnings
+    assert any(
+        f"one roast given twice, so it weighs twice in the fit: a_copy is a copy of {a.name}" in w for w in warned
+    )
+    assert not any("given twice" in w for w in roastlab.fit([a, b], "120kg", bed=TRUTH, starts=1).warnings)

@@ -18,7 +18,7 @@ from ..errors import InputError, ParameterError
 from ..evaluate.bands import roast_spread
 from ..evaluate.validate import ValidationResult
 from ..fit.identify import NO_ET_READING, NO_SECOND_READING, IdentificationResult, build_free_parameters, identify
-from ..io.batch import Batch
+from ..io.batch import Batch, first_of_each_roast
 from ..io.fitspec import FitSpec, load_fit_spec
 from ..io.importers.mapping import ET_NOT_DRUM_AIR, ColumnMap
 from ..io.plants import load_plant
@@ -216,6 +216,10 @@ def fit(
         doc["bed"] = laws.as_dict()
     model = FittedModel(doc)
     validation = model.validate(batches)
+    _, copies = first_of_each_roast(batches, lambda b: b.started_epoch_s, lambda b: b.name)
+    if copies:  # said, not dropped: a fit is what it is given
+        ident.warnings.append(f"one roast given twice, so it weighs twice in the fit: {'; '.join(copies.values())}")
+        doc["fit"]["warnings"] = ident.warnings
     # a fit whose states a drum roaster cannot have has failed, however small its SSR (metrics.profile);
     # the model file is still written, marked, so it can be looked at
     odd = [f"{r.name}: {w}" for r in validation.results for w in implausible_states(r)]
