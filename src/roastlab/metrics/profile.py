@@ -317,6 +317,15 @@ def et_not_drum_air(differences_C) -> list[bool]:
     return [bool(ok[i] and d[i] < min(0.0, med - 3.0 * sd)) for i in range(len(d))]
 
 
+def et_below_bt_on_every_log(differences_C) -> bool:
+    """For each log's ET - BT (:func:`et_minus_bt_C`, None where unknown or no live ET) of one
+    machine: True where every log's ET reads below BT through the roast. Then no log's ET is the
+    drum's air (:func:`et_not_drum_air` finds the odd logs against the others; here there are no
+    others): ET and BT swapped in the device setup, or a probe outside the drum. ``roastlab init``
+    then does not use ET."""
+    return bool(differences_C) and all(d is not None and d < 0.0 for d in differences_C)
+
+
 #: The first part of a roast in which an ET that reads the beans shows it [s after CHARGE].
 BEANS_IN_VIEW_S = 60.0
 #: ET's lowest reading in :data:`BEANS_IN_VIEW_S`, as a share of the way from the room to the

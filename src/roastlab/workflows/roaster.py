@@ -60,7 +60,7 @@ from ..io.importers.mapping import (
     probe_fault,
 )
 from ..io.importers.roastime import DRUM_AT_CHARGE, read_roastime
-from ..metrics.profile import et_minus_bt_C, et_not_drum_air, et_reads_beans
+from ..metrics.profile import et_below_bt_on_every_log, et_minus_bt_C, et_not_drum_air, et_reads_beans
 from ..model.actuators import UNIT_DEFAULTS
 from ..model.bed import CROSS_VALIDATED, PROBE_DEPTH_OVER_DIAMETER
 from ..model.constants import GREEN_BULK_DENSITY_KG_M3
@@ -598,12 +598,9 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
             f"{' ...' if len(beans) > 3 else ''}), unlike the others: a bean sensor there, not the drum's air; "
             "set up those logs apart"
         )
-    # ET below BT through every roast is not the drum's air on any log (metrics.profile.et_minus_bt_C):
-    # weighed against the model's air it would pull the fit off; perhaps the two are swapped
-    differences = [i.et_minus_bt_C for i in infos if i.has_et]
-    et_below_bt = (
-        not et_is_bean and len(differences) == len(infos) and all(d is not None and d < 0.0 for d in differences)
-    )
+    # weighed against the model's air, an ET that is the drum's air on no log would pull the fit off
+    differences = [i.et_minus_bt_C if i.has_et else None for i in infos]
+    et_below_bt = not et_is_bean and et_below_bt_on_every_log(differences)
     if et_below_bt:
         notes.append(
             f"ET reads below BT through the roast on every log (by {-max(differences):.0f} to "
