@@ -56,6 +56,7 @@ def data_dir(tmp_path_factory):
         (d / "logs").mkdir()
         shutil.copy(bullet / "bullet_2020-10-01_2053_500g.json", d / "logs" / "bullet-500g.json")  # a temp copy
         shutil.copy(bullet / "bullet_2021-01-21_2313_800g.json", d / "logs" / "bullet-800g-unit2054.json")
+        shutil.copy(logs[1], d / "logs" / "renamed-fitted-490g.json")  # a roast the model was fitted on
     return d
 
 
@@ -97,6 +98,10 @@ def test_open_gives_phases_band_fit_figures_and_the_machines_controls(client, da
     assert np.all(lower <= bt + 1e-9) and np.all(bt <= upper + 1e-9) and band["median_width_C"] > 0.5
     assert 0 < r["metrics"]["FIT_pct"] <= 100 and r["metrics"]["MAE_C"] > 0
     assert r["actuators"]["heater"]["unit"] == "level" and r["actuators"]["heater"]["step"] == 1
+    assert r["metrics"]["fitted_on"] is False
+    # a roast the model was fitted on, under another name: its figures are said not to be held out
+    f = client.post("/api/open", json={"log": "logs/renamed-fitted-490g.json", "model": "bullet-model.json"}, headers=H)
+    assert f.json()["metrics"]["fitted_on"] is True
 
 
 def test_a_program_step_through_the_api_holds_for_its_span_only(client, data_dir):

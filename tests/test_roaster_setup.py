@@ -398,6 +398,32 @@ def test_a_copy_of_a_roast_is_named_and_left_out(cli, tmp_path):
     assert "left out: roast_1_R15_annotated.alog is a copy of roast_1.alog (recorded from the same second" in out
     code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs, copy)
     assert code == 0 and out.count("left out: ") == 1 and "is a copy of roast_1.alog" in out, (out, err)
+    # validate is given what the user gives it, and says which of it the model was fitted on (by name,
+    # or a copy of one by its start) and which roast is given twice; the held-out average leaves them out
+    cfg = tmp_path / "cfg"
+    fitted = json.loads((cfg / "model.json").read_text())["fit"]["batches"]
+    assert fitted == ["roast_0", "roast_2"]  # sorted by date, alternately
+    twice = tmp_path / "roast_3_again.alog"
+    twice.write_text(logs[3].read_text())
+    files = ("--plant", cfg / "plant.toml", "--map", cfg / "map.toml", "--model", cfg / "model.json")
+    code, out, err = cli("validate", *files, logs[0], logs[3], twice, copy, "--json", tmp_path / "v.json")
+    assert code == 0, err
+    assert "note: roast_0 is a log the model was fitted on: its figures are the fit set's, not held out" in err
+    assert "note: roast_3_again is a copy of roast_3 (recorded from the same second: one roast), so it counts" in err
+    assert "note: roast_1_R15_annotated" not in err  # a copy of roast_1, which was held out
+    doc = json.loads((tmp_path / "v.json").read_text())
+    assert sorted(doc["not_held_out"]) == ["roast_0", "roast_3_again"]
+    held = [r for r in doc["batches"] if r["name"] in ("roast_3", "roast_1_R15_annotated")]
+    assert doc["average_held_out"]["n"] == sum(r["n"] for r in held)
+    assert f"held out only (2 of 4 logs; the others are named above): FIT {doc['average_held_out']['FIT']:.1f} %" in out
+    renamed = tmp_path / "renamed" / "R2_final.alog"  # a fitted roast under another name
+    renamed.parent.mkdir()
+    renamed.write_text(logs[2].read_text())
+    code, out, err = cli("validate", *files, renamed, logs[1])
+    assert (
+        code == 0
+        and "note: R2_final is a copy of roast_2, which the model was fitted on (recorded from the same" in err
+    )
     from roastlab.io.batch import first_of_each_roast
 
     kept, copies = first_of_each_roast(

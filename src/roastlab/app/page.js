@@ -211,7 +211,7 @@ function drawTable() {
   }
   $("table").innerHTML = html;
   const m = state.open && state.open.metrics, b = state.open && state.open.band;
-  $("figures").textContent = (m ? `model as run against this log: FIT ${m.FIT_pct.toFixed(1)} %, MAE ${dtemp(m.MAE_C).toFixed(2)} ${unit()}` : "") +
+  $("figures").textContent = (m ? `model as run against this log${m.fitted_on ? " (it was fitted on this roast: not held out)" : ""}: FIT ${m.FIT_pct.toFixed(1)} %, MAE ${dtemp(m.MAE_C).toFixed(2)} ${unit()}` : "") +
     (b && b.lower ? `; ${Math.round(b.level * 100)} % band median width ${dtemp(b.median_width_C).toFixed(1)} ${unit()}` : b && b.why ? `; ${b.why}` : "") +
     (state.changed && state.changedBand ? `; changed: ${dtemp(state.changedBand.median_width_C).toFixed(1)} ${unit()}` : "");
   const bandNotes = [b && b.note, state.changed && state.changedBand && state.changedBand.note];

@@ -190,15 +190,16 @@ def band_dict(b, note: str | None = None) -> dict:
     }
 
 
-def _fit_figures(batch, result) -> dict | None:
+def _fit_figures(batch, result, fitted: bool = False) -> dict | None:
     """FIT [%] and MAE [degC] of the model as run against the measured BT (the paper's indexes,
-    :func:`roastlab.evaluate.metrics.batch_metrics`)."""
+    :func:`roastlab.evaluate.metrics.batch_metrics`); ``fitted_on``: the model was fitted on this
+    roast (:meth:`roastlab.workflows.model.FittedModel.fitted_roasts`), so they are not a prediction's."""
     from ..evaluate.metrics import batch_metrics
 
     if batch.Ta_C is None:
         return None
     m = batch_metrics(batch.Ta_C, result.Ta_C)
-    return {"FIT_pct": round(m["FIT"], 1), "MAE_C": round(m["MAE"], 2)}
+    return {"FIT_pct": round(m["FIT"], 1), "MAE_C": round(m["MAE"], 2), "fitted_on": fitted}
 
 
 def _program_sets(body: dict, units: dict) -> list:
@@ -348,7 +349,7 @@ def create_app(data_dir: str | Path):
             "ET_model_is": ET_NAMES[session.et],
             "phases": phases(ms),
             "band": band(model, batch),
-            "metrics": _fit_figures(batch, w.as_run),
+            "metrics": _fit_figures(batch, w.as_run, fitted=batch.name in model.fitted_roasts([batch])),
             "table": w.to_json_dict(),
             "settings": model.column_map.setting_units() if model.column_map else {},
             "actuators": actuators,

@@ -127,7 +127,8 @@ def cmd_validate(args) -> int:
             "--band scores the model as fitted: drop --plant/--tgi-offset/--tb0/--tm0/--x0", "command line"
         )
     result = model.validate(batches, plant=plant_spec, **changes)
-    say(result.notes)
+    fitted = model.fitted_roasts(batches)
+    say(result.notes + list(fitted.values()))
     th = model.theta
     print(
         result.table(
@@ -135,6 +136,17 @@ def cmd_validate(args) -> int:
         )
     )
     doc = result.to_json_dict()
+    if fitted:
+        from ..evaluate.metrics import average_metrics
+
+        doc["not_held_out"] = fitted
+        held = [row for name, row in zip(result.names, result.rows) if name not in fitted]
+        if held:
+            doc["average_held_out"] = avg = average_metrics(held)
+            print(
+                f"held out only ({len(held)} of {len(result.names)} logs; the others are named above): "
+                f"FIT {avg['FIT']:.1f} %, MAE {avg['MAE']:.2f} °C"
+            )
     bands = None
     if args.band is not None:
         doc["band"], bands = _band_table(model, batches, args.band)
@@ -364,7 +376,9 @@ def add_parsers(sub) -> None:
         "validate",
         help="apply a model file to batches and report the paper's metrics",
         description="Apply MODEL.json (all of it: theta, fitted flow and constants, initial states; default: the "
-        "paper's theta*) to each batch and report n, SSR, ||e||, MAE, MPE, MAPE, FIT, rho per batch and on average.",
+        "paper's theta*) to each batch and report n, SSR, ||e||, MAE, MPE, MAPE, FIT, rho per batch and on average. "
+        "A batch the model was fitted on (by name, or a copy of one by its recording start) or one roast given "
+        "twice is named, and the held-out batches' own average is printed beside the table's.",
         epilog="example: roastlab validate --model model.json --plant 360kg dataset-V/ --predictions pred/",
     )
     add_batch_options(

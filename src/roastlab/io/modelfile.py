@@ -12,6 +12,7 @@ A model file is JSON::
      "moisture": "schwartzberg", "hold": "linear",
      "map": {the column map as TOML-shaped data} or null,
      "fit": {"SSR": ..., "n_residuals": ..., "method": ..., "seed": ..., "correlation": ..., "warnings": [...],
+             "batches": [the fitted batches' names], "started_epoch_s": [when each one's recording started, or null],
              "outputs": {"Ta" | "Tb2" | "ET": {"weight": w, "n": n, "SSR": unweighted}},
              "spread": {"time_s", "rms_C", "logs", "held_out", "batch_kg"} (the bands' roast-to-roast part),
              "failed": why, when the fitted states are ones the machine cannot have},

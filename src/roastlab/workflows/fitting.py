@@ -212,6 +212,8 @@ def fit(
     packed = pack_batches(batches, plant, THETA_START, InitialState(**init), moisture, hold, bed=laws)
     ident = identify(packed, free, fixed, method=method, seed=seed, n_starts=starts, progress=progress, weights=weights)
     doc = _document(ident, free, fixed, init, plant, moisture, hold, column_map)
+    # when each fitted roast's recording started: validate finds a copy of one by it (FittedModel.fitted_roasts)
+    doc["fit"]["started_epoch_s"] = [b.started_epoch_s for b in batches]
     if laws != PAPER_BED:
         doc["bed"] = laws.as_dict()
     model = FittedModel(doc)

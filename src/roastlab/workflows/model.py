@@ -21,13 +21,14 @@ import copy
 import dataclasses
 import datetime
 import html
+import math
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import InputError, ParameterError
 from ..evaluate.validate import ValidationResult, score
-from ..io.batch import Batch
+from ..io.batch import Batch, first_of_each_roast
 from ..io.files import Outputs, input_digest
 from ..io.importers.mapping import ColumnMap, map_from_mapping
 from ..io.modelfile import model_document_text, read_model_document
@@ -120,6 +121,41 @@ class FittedModel:
         """Why this model's fit failed (its states are ones the machine cannot have:
         :func:`roastlab.metrics.profile.implausible_states`), or None for a fit that stands."""
         return (self.doc.get("fit") or {}).get("failed")
+
+    def fitted_roasts(self, batches) -> dict[str, str]:
+        """Which of ``batches`` this model was fitted on, or are one roast twice: ``{name: why}``.
+
+        A batch is a fitted roast when its recording started in the same second as one the model
+        file lists under ``fit.batches`` (``fit.started_epoch_s``; a renamed or annotated copy keeps
+        it, :func:`roastlab.io.batch.first_of_each_roast`), or, where either start is unknown, when
+        it has that one's name: its figures are then the fit set's, not held out. Of two given
+        batches that are one roast, the later is named too: it counts twice in an average.
+        """
+        fit = self.doc.get("fit")
+        fit = fit if isinstance(fit, dict) else {}
+        names, starts = fit.get("batches"), fit.get("started_epoch_s")
+        names = [str(n) for n in names] if isinstance(names, list) else []
+        starts = [
+            round(t) if isinstance(t, (int, float)) and math.isfinite(t) and t else None
+            for t in (starts if isinstance(starts, list) else [])
+        ]
+        starts += [None] * (len(names) - len(starts))  # a model file from before the starts were kept has names alone
+        start_of = dict(zip(names, starts))
+        fitted = {t: n for n, t in zip(names, starts) if t is not None}
+        why = {}
+        for b in batches:
+            t = round(b.started_epoch_s) if b.started_epoch_s else None
+            if b.name in start_of and (None in (t, start_of[b.name]) or start_of[b.name] == t):
+                why[b.name] = f"{b.name} is a log the model was fitted on: its figures are the fit set's, not held out"
+            elif t is not None and t in fitted:
+                why[b.name] = (
+                    f"{b.name} is a copy of {fitted[t]}, which the model was fitted on (recorded from the "
+                    "same second): its figures are the fit set's, not held out"
+                )
+        _, copies = first_of_each_roast(list(batches), lambda b: b.started_epoch_s, lambda b: b.name)
+        for name, text in copies.items():
+            why.setdefault(name, f"{text}, so it counts twice in the average")
+        return why
 
     @property
     def bed(self) -> BedLaws:
