@@ -21,10 +21,10 @@ GOOD_ROWS = "".join(f"{t},0.4,450,{30 + t / 10}\n" for t in range(0, 301, 30))
 GOOD_ALOG = repr(
     {
         "mode": "C",
-        "timex": [1.5 * i for i in range(40)],
-        "temp1": [150.0 + i for i in range(40)],
-        "temp2": [120.0 + 0.5 * i for i in range(40)],
-        "timeindex": [2, 0, 0, 0, 0, 0, 35, 0],
+        "timex": [1.5 * i for i in range(80)],  # 1:49 from CHARGE to DROP: a roast init sets up (over a minute)
+        "temp1": [150.0 + 0.5 * i for i in range(80)],
+        "temp2": [120.0 + 0.25 * i for i in range(80)],
+        "timeindex": [2, 0, 0, 0, 0, 0, 75, 0],
         "weight": [200, 0, "g"],
     }
 )

@@ -351,6 +351,8 @@ def test_a_folder_of_logs_is_read_and_a_recording_that_is_no_roast_is_named_and_
     (folder / "empty.alog").write_text(fake_alog(extra={"timex": [], "temp1": [], "temp2": []}))
     (folder / "aborted.alog").write_text(fake_alog(bt=[-1.0] * 8, et=[-1.0] * 8, n=8))
     (folder / "dead_probe.alog").write_text(fake_alog(bt=[0.0] * 120, extra=_BURNER_AIR))  # BT reads 0 degC
+    # stopped 30 s after CHARGE (Artisan's own roast templates mark CHARGE 30 s before their end, too)
+    (folder / "stopped.alog").write_text(fake_alog(extra={**_BURNER_AIR, "timeindex": [100, 0, 0, 0, 0, 0, 0, 0]}))
     (folder / "LICENSE").write_text("MIT License\n")
     (folder / ".r9.alog").write_text("not read: a hidden file")
     (folder / "r0.csv").write_text("not read: Artisan's CSV export of r0.alog, the same roast\n")
@@ -362,10 +364,14 @@ def test_a_folder_of_logs_is_read_and_a_recording_that_is_no_roast_is_named_and_
     assert (
         "left out: dead_probe.alog cannot be read as a roast (BT never reads above the room (22 degC; highest 0" in out
     )
+    assert (
+        "left out: stopped.alog cannot be read as a roast (the log ends 0:28 after CHARGE, shorter than any roast "
+        "(1:00): an aborted recording, or CHARGE marked where the beans did not go in?)" in out
+    )
     assert "LICENSE" not in out and ".r9" not in out and "r0.csv" not in out
     code, out, err = cli("fit-roaster", tmp_path / "cfg", folder)
     assert code == 0, err
-    assert out.count("left out: ") == 3 and "left out: empty.alog cannot be read as a roast" in out
+    assert out.count("left out: ") == 4 and "left out: empty.alog cannot be read as a roast" in out
     assert "held out: FIT" in out
     # the logs named one by one read the same; a folder with no log, or only recordings that are no
     # roast, is one line naming it (the latter: the first log's own problem)

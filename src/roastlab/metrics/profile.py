@@ -39,6 +39,10 @@ from scipy import sparse
 ROR_SPAN_S = 30.0
 #: Window over which a curve that stops short is extended at its rate of rise [s].
 PROJECTION_WINDOW_S = 120.0
+#: Shortest recording after CHARGE that can be a roast [s]: the fastest roasts, industrial hot-air
+#: ones, take about 90 s, shop drum roasters eight minutes or more; a log that ends within a minute
+#: of CHARGE is an aborted recording, or one whose CHARGE mark is not where the beans went in.
+SHORTEST_ROAST_S = 60.0
 #: Bean temperature of DRY END (yellowing) when the log marks none [degC]: Artisan's default
 #: phase boundary between drying and Maillard.
 DRY_END_C = 150.0

@@ -60,7 +60,14 @@ from ..io.importers.mapping import (
     probe_fault,
 )
 from ..io.importers.roastime import DRUM_AT_CHARGE, read_roastime
-from ..metrics.profile import et_below_bt_on_every_log, et_minus_bt_C, et_not_drum_air, et_reads_beans
+from ..metrics.profile import (
+    SHORTEST_ROAST_S,
+    et_below_bt_on_every_log,
+    et_minus_bt_C,
+    et_not_drum_air,
+    et_reads_beans,
+    mmss,
+)
 from ..model.actuators import UNIT_DEFAULTS
 from ..model.bed import CROSS_VALIDATED, PROBE_DEPTH_OVER_DIAMETER
 from ..model.constants import GREEN_BULK_DENSITY_KG_M3
@@ -365,6 +372,12 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
         raise InputError(
             f"BT never reads above the room ({default('T_room_C'):g} degC; highest {bt.max():.0f} degC): no roast "
             "recorded, an unconnected probe?",
+            path,
+        )
+    if (length := float(log.time_s[-1] - log.time_s[0])) < SHORTEST_ROAST_S:
+        raise InputError(
+            f"the log ends {mmss(length)} after CHARGE, shorter than any roast ({mmss(SHORTEST_ROAST_S)}): an "
+            "aborted recording, or CHARGE marked where the beans did not go in?",
             path,
         )
     others = [n for n in names if n not in ("BT", "ET", "beanTemperature", "drumTemperature", "exitTemperature")]
