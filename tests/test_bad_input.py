@@ -269,6 +269,21 @@ CASES = {
         "fit.toml",
         "the ET output has a weight but no batch has an ET reading",
     ),
+    "fit spec weights an output by a word it does not know": (
+        lambda d: _spec(d, '[free]\nhgm = [0.001, 1, 0.02]\n[weights]\nET = "auto"\n'),
+        "fit.toml",
+        "weights.ET: must be a number or \"residual\" (set from a first fit's residuals), got 'auto'",
+    ),
+    "fit spec weights the probe by its own residuals": (
+        lambda d: _spec(d, '[free]\nhgm = [0.001, 1, 0.02]\n[weights]\nTa = "residual"\n'),
+        "fit.toml",
+        "weights.Ta: the probe is what weights from the residuals are relative to",
+    ),
+    "fit spec weights ET by its residuals on logs without ET": (
+        lambda d: _spec(d, '[free]\nhgm = [0.001, 1, 0.02]\n[weights]\nET = "residual"\n'),
+        "fit.toml",
+        "the ET output has a weight but no batch has an ET reading",
+    ),
     "fit spec with a negative weight": (
         lambda d: _spec(d, "[free]\nhgm = [0.001, 1, 0.02]\n[weights]\nTb2 = -1\n"),
         "fit.toml",

@@ -341,3 +341,51 @@ def test_screening_tolerance_ranks_trial_points_as_the_full_accuracy_does():
     assert np.any(screened != full)
     assert np.max(np.abs(screened - full)) < 0.02 * full.min()
     assert list(np.argsort(screened)[:8]) == list(np.argsort(full)[:8])
+
+
+def test_residual_weights_are_the_probes_residual_variance_over_the_outputs():
+    """The rule by hand: Ta 400 degC^2 over 100 samples (4), ET 1250 over 50 (25): ET weighs 4/25."""
+    from roastlab.errors import ParameterError
+    from roastlab.fit.identify import residual_weights
+
+    outputs = {"Ta": {"weight": 1.0, "n": 100, "SSR": 400.0}, "ET": {"weight": 1.0, "n": 50, "SSR": 1250.0}}
+    assert residual_weights(outputs, ["ET"]) == {"ET": pytest.approx(0.16)}
+    with pytest.raises(ParameterError, match="relative to the bean probe"):
+        residual_weights({"ET": outputs["ET"]}, ["ET"])
+    with pytest.raises(ParameterError, match="no Tb2 sample was fitted"):
+        residual_weights(outputs, ["Tb2"])
+
+
+def test_an_output_weighed_by_its_residuals_pulls_the_beans_less_than_at_weight_one(tmp_path):
+    """SYNTHETIC, seeded: the probe is the model's at hbm 0.02 with 0.5 degC of noise; ET is the model's
+    outlet gas at the same hbm plus an error the model has no term for (a slow 12 degC swing) and 0.5 degC
+    of noise. At weight 1 that error pulls hbm off; weighed by the residuals (ET = "residual" in the
+    spec) the weight is the first fit's residual variance ratio, recorded in the model file, and hbm
+    lands nearer the truth."""
+    import roastlab
+    from roastlab.sim.kernels import I_TGO
+    from roastlab.sim.population import simulate_population
+
+    truth = (THETA_START.hgm, 0.02, THETA_START.Pbm)
+    batches = noise_free_batches(11, "120kg", truth, count=3)
+    tgo = simulate_population(pack_batches(batches, "120kg", truth, InitialState(Ta0_C=30.0)))[0, :, :, I_TGO]
+    rng = np.random.default_rng(5)
+    for i, b in enumerate(batches):
+        b.Ta_C = b.Ta_C + rng.normal(0.0, 0.5, b.n)
+        b.ET_C = tgo[i, : b.n] + 12.0 * np.sin(b.time_s / 300.0) + rng.normal(0.0, 0.5, b.n)
+    spec = tmp_path / "fit.toml"
+    for w in ("1.0", '"residual"'):
+        spec.write_text(
+            f"[free]\nhbm = [0.001, 0.2, 0.05]\n[fixed]\nhgm = {truth[0]}\nPbm = {truth[2]}\n[weights]\nET = {w}\n"
+        )
+        fit = roastlab.fit(batches, "120kg", spec, initial={"Ta0_C": 30.0}, starts=2)
+        if w == "1.0":
+            at_one = fit.model.parameters["hbm"]["value"]
+            o = fit.identification.outputs
+            ratio = (o["Ta"]["SSR"] / o["Ta"]["n"]) / (o["ET"]["SSR"] / o["ET"]["n"])
+            assert "weights_from_residuals" not in fit.model.doc["fit"]
+    doc = fit.model.doc["fit"]
+    assert doc["outputs"]["ET"]["weight"] == pytest.approx(ratio, rel=1e-6) and 0.01 < ratio < 1.0
+    assert doc["weights_from_residuals"]["outputs"] == ["ET"]
+    weighed = fit.model.parameters["hbm"]["value"]
+    assert abs(weighed - 0.02) < 0.9 * abs(at_one - 0.02), (at_one, weighed)

@@ -804,7 +804,7 @@ def test_an_unseen_gas_drum_that_logs_its_inlet_air_and_no_burner_is_driven_by_t
     code, out, err = cli("init", *logs, "--out", tmp_path / "cfg", "--batch-capacity-kg", "5")
     assert code == 0 and "heater: none" in out and "inlet air: Zuluft (the model's input)" in out, err
     text = {n: (tmp_path / "cfg" / f"{n}.toml").read_text() for n in ("map", "fit")}
-    assert '[Tgi]\ncolumn = "Zuluft"' in text["map"] and "ET = 1.0" in text["fit"], text
+    assert '[Tgi]\ncolumn = "Zuluft"' in text["map"] and 'ET = "residual"' in text["fit"], text
     code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
     assert code == 0, err
     held = float(out.split("held out: FIT ")[1].split(" %")[0])

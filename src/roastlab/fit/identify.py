@@ -166,6 +166,31 @@ def check_weights(weights: dict | None) -> dict[str, float]:
     return out
 
 
+def residual_weights(outputs: dict, names) -> dict[str, float]:
+    """Each named output's weight from a fit's residuals: the probe's residual variance over the
+    output's, ``(SSR_Ta / n_Ta) / (SSR_k / n_k)`` (``outputs`` as :attr:`IdentificationResult.outputs`,
+    from a fit with the output at weight 1).
+
+    Derivation: with each output's errors Gaussian and of its own variance s_k^2, the likelihood is
+    largest where sum_k SSR_k / s_k^2 is least, and each s_k^2 is estimated by its output's mean squared
+    residual (generalised least squares with per-response variances; Bates and Watts, *Nonlinear
+    Regression Analysis*, 1988, ch. 4). Relative to the probe's, the weight of an output the model
+    reads less closely (the drum's air through the well-mixed outlet of eq. 15e) falls, so its
+    model-structure error does not pull the beans; one the model reads as closely counts alike.
+    """
+    ta = outputs.get("Ta") or {}
+    if not ta.get("n") or not ta.get("SSR"):
+        raise ParameterError("a weight from the residuals is relative to the bean probe's (Ta): fit Ta as well")
+    var_ta = ta["SSR"] / ta["n"]
+    out = {}
+    for name in names:
+        o = outputs.get(name) or {}
+        if not o.get("n"):
+            raise ParameterError(f"no {name} sample was fitted: its weight cannot come from its residuals")
+        out[name] = var_ta / max(o["SSR"] / o["n"], 1e-12 * var_ta)
+    return out
+
+
 class Objective:
     """Weighted residuals of the free parameters over packed batches, evaluated in populations.
 

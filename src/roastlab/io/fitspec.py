@@ -24,6 +24,7 @@ A fit spec is a TOML file::
     Ta = 1.0                    # the bean probe, model Ta (eq. 16)
     Tb2 = 0.25                  # a second bean reading (map [Tb2]), model Tb (eq. 15a)
     ET = 0.1                    # the logged ET (drum air), model outlet gas Tgo (eq. 15e)
+                                # or "residual": the probe's residual variance over ET's
 
 Names: the theta coefficients ``hgm, hbm, Pbm``, process constants ``A, cm, cw, Ha_R, Het,
 k1, k2, Kt, lam``, the metal mass ``Mm``, the gas flow ``Gg_kg_s``, and initial states
@@ -42,6 +43,7 @@ from ..model.parameters import (
     DEFAULT_WEIGHTS,
     FREE_NAMES,
     OUTPUTS,
+    RESIDUAL_WEIGHT,
     STATE0,
     THETA_NAMES,
     THETA_PAPER,
@@ -137,10 +139,20 @@ def load_fit_spec(path: str | Path) -> FitSpec:
     for name, v in table.items():
         if name not in OUTPUTS:
             raise InputError(f"unknown output (allowed: {', '.join(OUTPUTS)})", path, f"weights.{name}")
+        if v == RESIDUAL_WEIGHT and name != "Ta":  # set from a first fit's residuals (fit.identify.residual_weights)
+            weights[name] = v
+            continue
+        if isinstance(v, str):
+            why = (
+                "the probe is what weights from the residuals are relative to: give it a number"
+                if v == RESIDUAL_WEIGHT
+                else f'must be a number or "{RESIDUAL_WEIGHT}" (set from a first fit\'s residuals), got {v[:40]!r}'
+            )
+            raise InputError(why, path, f"weights.{name}")
         w = finite_number(v, path, f"weights.{name}")
         if w < 0:
             raise InputError(f"must be >= 0, got {w:g}", path, f"weights.{name}")
         weights[name] = w
-    if weights and not any(w > 0 for w in {**DEFAULT_WEIGHTS, **weights}.values()):
+    if weights and not any(w == RESIDUAL_WEIGHT or w > 0 for w in {**DEFAULT_WEIGHTS, **weights}.values()):
         raise InputError("every output weight is 0: nothing to fit", path, "weights")
     return FitSpec(free, fixed, initial, str(path), weights, bed)

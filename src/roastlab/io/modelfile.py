@@ -14,6 +14,7 @@ A model file is JSON::
      "fit": {"SSR": ..., "n_residuals": ..., "method": ..., "seed": ..., "correlation": ..., "warnings": [...],
              "batches": [the fitted batches' names], "started_epoch_s": [when each one's recording started, or null],
              "outputs": {"Ta" | "Tb2" | "ET": {"weight": w, "n": n, "SSR": unweighted}},
+             "weights_from_residuals": {"outputs", "rule", "first_pass": {output: {"rms_C"}}} (a spec's "residual"),
              "spread": {"time_s", "rms_C", "logs", "held_out", "batch_kg"} (the bands' roast-to-roast part),
              "failed": why, when the fitted states are ones the machine cannot have},
      "metrics": {"batches": [...], "average": {...}},

@@ -158,6 +158,9 @@ OUTPUTS = ("Ta", "Tb2", "ET")
 #: The model quantity each output is compared with: probe Ta, bean Tb, outlet gas Tgo.
 MODEL_OF_OUTPUT = {"Ta": "Ta", "Tb2": "Tb", "ET": "Tgo"}
 DEFAULT_WEIGHTS = {"Ta": 1.0, "Tb2": 0.0, "ET": 0.0}
+#: A weight given as this word is set from the residuals (:func:`roastlab.fit.identify.residual_weights`):
+#: the probe's residual variance over the output's, both from a first fit with the output at weight 1.
+RESIDUAL_WEIGHT = "residual"
 #: Starts a global search chooses for a local polish by default (:func:`roastlab.fit.identify.identify`:
 #: the paper's theta0 and the best distinct trial points; one inside a found basin is skipped).
 N_STARTS = 6

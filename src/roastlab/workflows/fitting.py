@@ -10,6 +10,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 from pathlib import Path
 
 import numpy as np
@@ -17,14 +18,21 @@ import numpy as np
 from ..errors import InputError, ParameterError
 from ..evaluate.bands import roast_spread
 from ..evaluate.validate import ValidationResult
-from ..fit.identify import NO_ET_READING, NO_SECOND_READING, IdentificationResult, build_free_parameters, identify
+from ..fit.identify import (
+    NO_ET_READING,
+    NO_SECOND_READING,
+    IdentificationResult,
+    build_free_parameters,
+    identify,
+    residual_weights,
+)
 from ..io.batch import Batch, first_of_each_roast
 from ..io.fitspec import FitSpec, load_fit_spec
 from ..io.importers.mapping import ET_NOT_DRUM_AIR, ColumnMap
 from ..io.plants import load_plant
 from ..metrics.profile import implausible_states
 from ..model.bed import PAPER_BED, BedLaws
-from ..model.parameters import N_STARTS, REGISTRY, STATE0, THETA_NAMES, THETA_START
+from ..model.parameters import N_STARTS, REGISTRY, RESIDUAL_WEIGHT, STATE0, THETA_NAMES, THETA_START
 from ..report.result import Result
 from ..sim.population import pack_batches
 from ..sim.simulate import InitialState
@@ -108,6 +116,14 @@ class FitResult(Result):
         return f"<FitResult {self.model!r}, fit-set FIT {a['FIT']:.2f} %, MAE {a['MAE']:.3f} °C>"
 
 
+def _started_at(f, values: dict):
+    """Free parameter ``f`` started at its value in ``values`` (inside its bounds); a per-batch one as it was."""
+    v = values.get(f.name)
+    if f.per_batch or not isinstance(v, (int, float)) or not math.isfinite(v):
+        return f
+    return dataclasses.replace(f, start=min(max(float(v), f.lower), f.upper))
+
+
 def _spec_parts(spec, fix, bounds, estimate_tm0):
     if spec is None:
         free, fixed = build_free_parameters(fix, bounds, estimate_tm0=estimate_tm0)
@@ -161,7 +177,9 @@ def fit(
     progress : callable ``progress(done, total, text)`` or None
     weights : {output: weight}: ``Ta`` (the bean probe, default 1), ``Tb2`` (a second bean
         reading compared with Tb, default 0) and ``ET`` (the logged ET compared with the outlet gas
-        Tgo, default 0); overrides the spec's ``[weights]``
+        Tgo, default 0), or ``"residual"`` for an output other than Ta: set from a first fit's residuals
+        (:func:`roastlab.fit.identify.residual_weights`), the second fit polished from the first's
+        optimum; overrides the spec's ``[weights]``
     bed : bed laws (:class:`roastlab.model.bed.BedLaws`, its text or mapping); overrides the spec's
         ``[bed]``; default the paper's bed
     """
@@ -189,9 +207,14 @@ def fit(
     laws = BedLaws.parse(bed if bed is not None else spec_bed)
     given = dict(weights or {})
     weights = {**spec_weights, **given}
-    if weights.get("Tb2", 0) > 0 and all(b.Tb2_C is None or not np.isfinite(b.Tb2_C).any() for b in batches):
+    from_residuals = [k for k, w in weights.items() if w == RESIDUAL_WEIGHT]  # set below, from a first fit
+
+    def weighed(name: str) -> bool:
+        return name in from_residuals or weights.get(name, 0) > 0
+
+    if weighed("Tb2") and all(b.Tb2_C is None or not np.isfinite(b.Tb2_C).any() for b in batches):
         raise InputError(NO_SECOND_READING, "command line" if "Tb2" in given else spec_source)
-    if weights.get("ET", 0) > 0 and all(b.ET_C is None or not np.isfinite(b.ET_C).any() for b in batches):
+    if weighed("ET") and all(b.ET_C is None or not np.isfinite(b.ET_C).any() for b in batches):
         dropped = sum(any(ET_NOT_DRUM_AIR in n for n in b.notes) for b in batches)
         message = NO_ET_READING
         if dropped:  # the map's [ET] above_BT dropped it on every log given (io.importers.mapping)
@@ -210,8 +233,27 @@ def fit(
         )
     init = {**PAPER_INITIAL, **(initial or {}), **spec_initial}
     packed = pack_batches(batches, plant, THETA_START, InitialState(**init), moisture, hold, bed=laws)
-    ident = identify(packed, free, fixed, method=method, seed=seed, n_starts=starts, progress=progress, weights=weights)
+    first_pass = None
+    if (
+        from_residuals
+    ):  # a first fit with those outputs at weight 1 sets their weights; the second starts where it ended
+        at_one = {**weights, **dict.fromkeys(from_residuals, 1.0)}
+        first = identify(
+            packed, free, fixed, method=method, seed=seed, n_starts=starts, progress=progress, weights=at_one
+        )
+        weights = {**weights, **residual_weights(first.outputs, from_residuals)}
+        free = [_started_at(f, first.values) for f in free]
+        first_pass = {k: {"rms_C": round(math.sqrt(o["SSR"] / o["n"]), 4)} for k, o in first.outputs.items() if o["n"]}
+    # with weights from the residuals, the first fit's optimum is the start: a polish from it (one start)
+    again = 1 if from_residuals else starts
+    ident = identify(packed, free, fixed, method=method, seed=seed, n_starts=again, progress=progress, weights=weights)
     doc = _document(ident, free, fixed, init, plant, moisture, hold, column_map)
+    if first_pass:
+        doc["fit"]["weights_from_residuals"] = {
+            "outputs": from_residuals,
+            "rule": "the probe's residual variance over the output's, from a first fit with it at weight 1",
+            "first_pass": first_pass,
+        }
     # when each fitted roast's recording started: validate finds a copy of one by it (FittedModel.fitted_roasts)
     doc["fit"]["started_epoch_s"] = [b.started_epoch_s for b in batches]
     if laws != PAPER_BED:

@@ -71,6 +71,7 @@ from ..metrics.profile import (
 from ..model.actuators import UNIT_DEFAULTS
 from ..model.bed import CROSS_VALIDATED, PROBE_DEPTH_OVER_DIAMETER
 from ..model.constants import GREEN_BULK_DENSITY_KG_M3
+from ..model.parameters import RESIDUAL_WEIGHT
 from ..model.quantities import default
 
 #: Names of a heater/burner and a fan/air channel in Artisan's languages (lower case, substrings).
@@ -943,8 +944,12 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
     if s.has_et and (s.heater or s.inlet):
         # ET is then a reading, not the inlet (map_text): fitted against the outlet gas, it tells the
         # heater's paths (into the air, into the drum) apart, which BT alone cannot, and pins the
-        # air's heat to the beans where the inlet is logged
-        weights.append("ET = 1.0                              # the logged ET vs the model's outlet gas Tgo")
+        # air's heat to the beans where the inlet is logged; weighed by its residuals against the probe's
+        # (fit.identify.residual_weights), so the model's coarser reading of the air does not pull the beans
+        weights.append(
+            f'ET = "{RESIDUAL_WEIGHT}"'.ljust(38) + "# the logged ET vs the model's outlet gas Tgo, weighed "
+            "by the probe's residual variance over its own (a first fit at weight 1)"
+        )
     if weights:
         rows += ["", "[weights]", "Ta = 1.0", *weights]
     return "\n".join(rows) + "\n"
