@@ -387,5 +387,6 @@ def test_an_output_weighed_by_its_residuals_pulls_the_beans_less_than_at_weight_
     doc = fit.model.doc["fit"]
     assert doc["outputs"]["ET"]["weight"] == pytest.approx(ratio, rel=1e-6) and 0.01 < ratio < 1.0
     assert doc["weights_from_residuals"]["outputs"] == ["ET"]
+    assert f"weight of ET from the residuals: {ratio:.3g} (a first fit at weight 1 missed Ta by" in fit.model.report()
     weighed = fit.model.parameters["hbm"]["value"]
     assert abs(weighed - 0.02) < 0.9 * abs(at_one - 0.02), (at_one, weighed)

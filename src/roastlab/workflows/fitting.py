@@ -247,6 +247,8 @@ def fit(
     # with weights from the residuals, the first fit's optimum is the start: a polish from it (one start)
     again = 1 if from_residuals else starts
     ident = identify(packed, free, fixed, method=method, seed=seed, n_starts=again, progress=progress, weights=weights)
+    if from_residuals:  # the work of both fits, as the search's figures say it
+        ident.nfev, ident.wall_s = ident.nfev + first.nfev, ident.wall_s + first.wall_s
     doc = _document(ident, free, fixed, init, plant, moisture, hold, column_map)
     if first_pass:
         doc["fit"]["weights_from_residuals"] = {

@@ -444,6 +444,18 @@ class FittedModel:
         avg = (self.doc.get("metrics") or {}).get("average")
         if avg:
             lines.append(f"fit set: FIT {avg['FIT']:.2f} %, MAE {avg['MAE']:.3f} °C, MAPE {avg['MAPE']:.3f} %")
+        by_residuals = fit.get("weights_from_residuals") or {}
+        outputs, first = fit.get("outputs") or {}, by_residuals.get("first_pass") or {}
+        for name in by_residuals.get("outputs") or []:
+            w, rms = (
+                (outputs.get(name) or {}).get("weight"),
+                {k: (first.get(k) or {}).get("rms_C") for k in ("Ta", name)},
+            )
+            if isinstance(w, (int, float)) and all(isinstance(v, (int, float)) for v in rms.values()):
+                lines.append(
+                    f"weight of {name} from the residuals: {w:.3g} (a first fit at weight 1 missed Ta by "
+                    f"{rms['Ta']:.2f} °C RMS and {name} by {rms[name]:.2f} °C RMS: (Ta/{name})^2)"
+                )
         lines += [f"warning: {w}" for w in fit.get("warnings", [])]
         return "\n".join(lines)
 
