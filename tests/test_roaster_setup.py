@@ -809,6 +809,7 @@ def test_an_unseen_gas_drum_that_logs_its_inlet_air_and_no_burner_is_driven_by_t
     assert code == 0, err
     held = float(out.split("held out: FIT ")[1].split(" %")[0])
     assert held > 90.0, out
+    assert "\nWeight of ET from the residuals: " in (tmp_path / "cfg" / "report.md").read_text()
 
 
 @pytest.mark.parametrize(

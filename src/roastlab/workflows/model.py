@@ -444,20 +444,31 @@ class FittedModel:
         avg = (self.doc.get("metrics") or {}).get("average")
         if avg:
             lines.append(f"fit set: FIT {avg['FIT']:.2f} %, MAE {avg['MAE']:.3f} °C, MAPE {avg['MAPE']:.3f} %")
-        by_residuals = fit.get("weights_from_residuals") or {}
-        outputs, first = fit.get("outputs") or {}, by_residuals.get("first_pass") or {}
-        for name in by_residuals.get("outputs") or []:
-            w, rms = (
-                (outputs.get(name) or {}).get("weight"),
-                {k: (first.get(k) or {}).get("rms_C") for k in ("Ta", name)},
-            )
-            if isinstance(w, (int, float)) and all(isinstance(v, (int, float)) for v in rms.values()):
+        lines += self.residual_weight_lines()
+        lines += [f"warning: {w}" for w in fit.get("warnings", [])]
+        return "\n".join(lines)
+
+    def residual_weight_lines(self) -> list[str]:
+        """One line per output whose weight the fit set from its residuals (a spec's ``"residual"``,
+        :func:`roastlab.fit.identify.residual_weights`), with the first fit's errors it came from."""
+
+        def table(d, key) -> dict:  # a model file is a user's file: anything but a table reads as none
+            v = d.get(key) if isinstance(d, dict) else None
+            return v if isinstance(v, dict) else {}
+
+        fit = table(self.doc, "fit")
+        by_residuals, outputs = table(fit, "weights_from_residuals"), table(fit, "outputs")
+        first, names = table(by_residuals, "first_pass"), by_residuals.get("outputs")
+        lines = []
+        for name in [n for n in names if isinstance(n, str)] if isinstance(names, list) else []:
+            w = table(outputs, name).get("weight")
+            rms = {k: table(first, k).get("rms_C") for k in ("Ta", name)}
+            if all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in (w, *rms.values())):
                 lines.append(
                     f"weight of {name} from the residuals: {w:.3g} (a first fit at weight 1 missed Ta by "
                     f"{rms['Ta']:.2f} °C RMS and {name} by {rms[name]:.2f} °C RMS: (Ta/{name})^2)"
                 )
-        lines += [f"warning: {w}" for w in fit.get("warnings", [])]
-        return "\n".join(lines)
+        return lines
 
     def __repr__(self) -> str:
         th = self.theta

@@ -1196,6 +1196,8 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: b
         "",
         f"Baseline: the first-order lag fed the same inputs ({describe(base)}).",
         "",
+        *(f"{line[0].upper()}{line[1:]}." for line in model.residual_weight_lines()),
+        *([""] if model.residual_weight_lines() else []),
         "| parameter | value | std. error | unit |",
         "|---|---|---|---|",
     ]
