@@ -176,8 +176,9 @@ def test_skywalker_logs_in_the_aillio_r1_layout_find_their_heater_and_fan(cli, r
 def test_a_log_without_burner_events_is_left_out_and_a_non_physical_fit_refitted(cli, real_data, tmp_path):
     """Six Skywalker logs (October-November 2025, rewritten in tmp_path), one with its Burner events
     removed, as Artisan writes a roast whose burner never moved while it recorded: init sets up the
-    other five's layout and says so, fit-roaster leaves that log out; on the five, the fit with both
-    heater paths free puts the drum below the beans, and fit-roaster refits with the drum's path alone."""
+    other five's layout and says so, fit-roaster leaves that log out. On the five, with ET weighed by
+    its residuals (init's fit.toml) the fit stands; with ET weighed like BT, the fit with both heater
+    paths free puts the drum below the beans, and fit-roaster refits with the drum's path alone."""
     names = ["roast_25-10-04_1155", "roast_25-10-04_1229", "roast_25-10-25_1544", "roast_25-10-25_1609",
              "roast_25-11-16_1235", "roast_25-11-16_1259"]  # fmt: skip
     if not all((real_data / f"{n}.alog").is_file() for n in names):
@@ -193,8 +194,13 @@ def test_a_log_without_burner_events_is_left_out_and_a_non_physical_fit_refitted
     code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
     assert code == 0 and "1 log(s) record no Burner (roast_25-10-25_1544.alog)" in out, err
     code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
-    assert code == 0 and "failed" not in err, err
+    assert code == 0 and "failed" not in err and "refitted" not in out, (out, err)
     assert "left out: roast_25-10-25_1544.alog records no Burner" in out
+    spec = tmp_path / "cfg" / "fit.toml"
+    assert 'ET = "residual"' in spec.read_text()
+    spec.write_text(spec.read_text().replace('ET = "residual"', "ET = 1.0"))
+    code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
+    assert code == 0 and "failed" not in err, err
     assert "refitted: with the heater free to heat the air and the drum, the fit failed on non-physical" in out
     held, base = out.split("held out: FIT ")[1].split(" %")[0], out.split("first-order baseline: ")[1].split(" %")[0]
     assert float(held) > float(base) + 10, out  # 71.0 % against 44.4 % measured on 2026-11-26
