@@ -209,8 +209,9 @@ def fit(
     weights = {**spec_weights, **given}
     from_residuals = [k for k, w in weights.items() if w == RESIDUAL_WEIGHT]  # set below, from a first fit
 
-    def weighed(name: str) -> bool:
-        return name in from_residuals or weights.get(name, 0) > 0
+    def weighed(name: str) -> bool:  # a weight that is no number is refused by identify (check_weights)
+        w = weights.get(name, 0)
+        return name in from_residuals or (isinstance(w, (int, float)) and w > 0)
 
     if weighed("Tb2") and all(b.Tb2_C is None or not np.isfinite(b.Tb2_C).any() for b in batches):
         raise InputError(NO_SECOND_READING, "command line" if "Tb2" in given else spec_source)
