@@ -70,6 +70,9 @@ def test_identify_bad_options(cli, tmp_path):
         (["--bounds", "hbm=0.3:0.1"], "inverted"),
         (["--fix", "nope=1"], "unknown parameter"),
         (["--fix", "hgm"], "NAME=VALUE"),
+        (["--weight", "ET=auto"], "--weight ET: cannot read 'auto' as a number"),
+        (["--weight", "Ta=residual"], "--weight Ta: cannot read 'residual' as a number"),
+        (["--weight", "ET=residual"], "the ET output has a weight but no batch has an ET reading"),
     ):
         code, _, err = cli(*base, *extra)
         assert code == 2 and needle in err and err.count("\n") == 1, err
@@ -109,3 +112,10 @@ def test_identify_per_batch(cli, tmp_path):
     assert {"hgm", "hbm", "Pbm", "SSR", "FIT"} <= set(doc["batches"][0])
     assert all(b["hgm"] == 0.01 for b in doc["batches"])  # --fix with --per-batch (was refused)
     assert "mean" in stdout
+
+
+def test_a_weight_from_the_residuals_is_read_from_the_command_line():
+    """--weight ET=residual is the fit spec's ET = "residual" (set from a first fit's residuals)."""
+    from roastlab.cli.common import weights_arg
+
+    assert weights_arg(["ET=residual", "Tb2=0.5"]) == {"ET": "residual", "Tb2": 0.5}

@@ -343,16 +343,24 @@ def fit_inputs(args) -> list:
     return [*args.batches, args.map, getattr(args, "spec", None), args.plant, getattr(args, "model", None)]
 
 
-def weights_arg(items) -> dict[str, float]:
-    """``--weight OUTPUT=W`` options as checked output weights (errors name the command line)."""
+def weights_arg(items) -> dict:
+    """``--weight OUTPUT=W`` options as checked output weights (errors name the command line); W may be
+    ``residual`` for an output other than Ta (set from a first fit's residuals, as in a fit spec)."""
     from ..fit.identify import check_weights
+    from ..model.parameters import RESIDUAL_WEIGHT
 
-    given = parse_assignments(items, "--weight", ranged=False)
+    items = list(items or [])
+    by_residuals = {
+        name.strip(): RESIDUAL_WEIGHT
+        for name, _, w in (i.partition("=") for i in items)
+        if w.strip() == RESIDUAL_WEIGHT and name.strip() != "Ta"
+    }
+    given = parse_assignments([i for i in items if i.partition("=")[0].strip() not in by_residuals], "--weight", False)
     try:
-        check_weights(given)
+        check_weights({**given, **dict.fromkeys(by_residuals, 1.0)})
     except ParameterError as exc:
         raise InputError(f"--weight: {exc.problem}", "command line") from None
-    return given
+    return {**given, **by_residuals}
 
 
 FIT_HELP = "batch CSVs (time_s,Gg_kg_s,Tgi_C,Ta_C) and/or dataset folders with a dataset.toml; raw logs with --map"

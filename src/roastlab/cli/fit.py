@@ -304,9 +304,10 @@ def add_parsers(sub) -> None:
         "--weight",
         action="append",
         metavar="OUTPUT=W",
-        help="weight of a fitted output: Ta (the bean probe, default 1) or Tb2 (a second bean reading read by the "
-        "map's [Tb2], compared with the model's Tb; default 0), e.g. --weight Tb2=0.25 (repeatable; overrides "
-        "the spec's [weights])",
+        help="weight of a fitted output: Ta (the bean probe, default 1), Tb2 (a second bean reading read by the "
+        "map's [Tb2], compared with the model's Tb; default 0) or ET (the logged ET, compared with the model's "
+        "outlet gas; default 0), e.g. --weight Tb2=0.25; W = residual sets it from a first fit's residuals "
+        "(--weight ET=residual) (repeatable; overrides the spec's [weights])",
     )
     add_model_options(p, with_model=False)
     p.set_defaults(func=cmd_identify)
