@@ -238,7 +238,7 @@ def test_the_skywalker_as_plain_csv_logs_is_set_up_and_fitted(cli, real_data, tm
     code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
     assert code == 0, err
     held = float(out.split("held out: FIT ")[1].split(" %")[0])
-    assert held >= 75.0, out  # 77.8 % measured on 2026-11-26
+    assert held >= 75.0, out  # 79.9 % measured on 2026-11-26 (77.8 % with ET weighed like BT)
 
 
 def test_an_unmarked_charge_and_drop_are_found_where_the_roaster_marked_them(real_data):
