@@ -1165,6 +1165,7 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: b
     _, b_val = validate_first_order(val_b, base)
     bf, bv = average_metrics(b_fit), average_metrics(b_val)
     verdict = below_baseline(v_val.average["FIT"], bv["FIT"], cmap)
+    weighed = [f"{line[0].upper()}{line[1:]}." for line in model.residual_weight_lines()]
     lines = [
         f"# {model.plant.name if model.plant else 'roaster'}: fitted by roastlab fit-roaster",
         "",
@@ -1196,8 +1197,8 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: b
         "",
         f"Baseline: the first-order lag fed the same inputs ({describe(base)}).",
         "",
-        *(f"{line[0].upper()}{line[1:]}." for line in model.residual_weight_lines()),
-        *([""] if model.residual_weight_lines() else []),
+        *weighed,
+        *([""] if weighed else []),
         "| parameter | value | std. error | unit |",
         "|---|---|---|---|",
     ]
