@@ -124,6 +124,11 @@ class Batch:
         return self
 
 
+def recording_second(started_epoch_s) -> int | None:
+    """The second a recording started, the key by which two logs are one roast (None: unknown)."""
+    return round(started_epoch_s) if started_epoch_s else None
+
+
 def first_of_each_roast(items, started_epoch_s, name) -> tuple[list, dict[str, str]]:
     """``items`` without their copies, and each copy left out with why (``{name: why}``).
 
@@ -135,8 +140,7 @@ def first_of_each_roast(items, started_epoch_s, name) -> tuple[list, dict[str, s
     """
     kept, copies, seen = [], {}, {}
     for item in items:
-        t = started_epoch_s(item)
-        key = round(t) if t else None
+        key = recording_second(started_epoch_s(item))
         if key is not None and key in seen:
             copies[name(item)] = f"{name(item)} is a copy of {seen[key]} (recorded from the same second: one roast)"
             continue

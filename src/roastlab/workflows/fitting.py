@@ -234,28 +234,26 @@ def fit(
         )
     init = {**PAPER_INITIAL, **(initial or {}), **spec_initial}
     packed = pack_batches(batches, plant, THETA_START, InitialState(**init), moisture, hold, bed=laws)
-    first_pass = None
-    if (
-        from_residuals
-    ):  # a first fit with those outputs at weight 1 sets their weights; the second starts where it ended
+    first = None
+    if from_residuals:  # a first fit with those outputs at weight 1 sets their weights; the second polishes from it
         at_one = {**weights, **dict.fromkeys(from_residuals, 1.0)}
         first = identify(
             packed, free, fixed, method=method, seed=seed, n_starts=starts, progress=progress, weights=at_one
         )
         weights = {**weights, **residual_weights(first.outputs, from_residuals)}
         free = [_started_at(f, first.values) for f in free]
-        first_pass = {k: {"rms_C": round(math.sqrt(o["SSR"] / o["n"]), 4)} for k, o in first.outputs.items() if o["n"]}
-    # with weights from the residuals, the first fit's optimum is the start: a polish from it (one start)
-    again = 1 if from_residuals else starts
+    again = starts if first is None else 1  # from the first fit's optimum, one start
     ident = identify(packed, free, fixed, method=method, seed=seed, n_starts=again, progress=progress, weights=weights)
-    if from_residuals:  # the work of both fits, as the search's figures say it
+    if first is not None:  # the work of both fits, as the search's figures say it
         ident.nfev, ident.wall_s = ident.nfev + first.nfev, ident.wall_s + first.wall_s
     doc = _document(ident, free, fixed, init, plant, moisture, hold, column_map)
-    if first_pass:
+    if first is not None:
         doc["fit"]["weights_from_residuals"] = {
             "outputs": from_residuals,
             "rule": "the probe's residual variance over the output's, from a first fit with it at weight 1",
-            "first_pass": first_pass,
+            "first_pass": {
+                k: {"rms_C": round(math.sqrt(o["SSR"] / o["n"]), 4)} for k, o in first.outputs.items() if o["n"]
+            },
         }
     # when each fitted roast's recording started: validate finds a copy of one by it (FittedModel.fitted_roasts)
     doc["fit"]["started_epoch_s"] = [b.started_epoch_s for b in batches]

@@ -28,7 +28,7 @@ import numpy as np
 
 from ..errors import InputError, ParameterError
 from ..evaluate.validate import ValidationResult, score
-from ..io.batch import Batch, first_of_each_roast
+from ..io.batch import Batch, first_of_each_roast, recording_second
 from ..io.files import Outputs, input_digest
 from ..io.importers.mapping import ColumnMap, map_from_mapping
 from ..io.modelfile import model_document_text, read_model_document
@@ -135,8 +135,8 @@ class FittedModel:
         fit = fit if isinstance(fit, dict) else {}
         names, starts = fit.get("batches"), fit.get("started_epoch_s")
         names = [str(n) for n in names] if isinstance(names, list) else []
-        starts = [
-            round(t) if isinstance(t, (int, float)) and math.isfinite(t) and t else None
+        starts = [  # a model file is a user's file: a start that is no finite number is unknown
+            recording_second(t) if isinstance(t, (int, float)) and math.isfinite(t) else None
             for t in (starts if isinstance(starts, list) else [])
         ]
         starts += [None] * (len(names) - len(starts))  # a model file from before the starts were kept has names alone
@@ -144,7 +144,7 @@ class FittedModel:
         fitted = {t: n for n, t in zip(names, starts) if t is not None}
         why = {}
         for b in batches:
-            t = round(b.started_epoch_s) if b.started_epoch_s else None
+            t = recording_second(b.started_epoch_s)
             if b.name in start_of and (None in (t, start_of[b.name]) or start_of[b.name] == t):
                 why[b.name] = f"{b.name} is a log the model was fitted on: its figures are the fit set's, not held out"
             elif t is not None and t in fitted:
