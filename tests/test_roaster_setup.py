@@ -147,6 +147,13 @@ def test_init_takes_the_damper_as_the_fan_when_no_fan_is_logged(cli, tmp_path):
     assert "fan: Damper (percent)" in out and "no fan channel: the Damper sets the air flow" in out
     fan = (tmp_path / "cfg" / "map.toml").read_text().split("[fan]")[1].split("[")[0]
     assert 'column = "Damper"' in fan
+    # "the model's flow rises with it": the fit spec frees the flow per % of the setting (it did not,
+    # so a percent fan or damper moved nothing in the model, a what-if on it changed nothing)
+    gg_hi = (tmp_path / "cfg" / "fit.toml").read_text().split("Gg_kg_s = [")[1].split("]")[0].split(", ")[1]
+    assert (
+        f"Gg_fan_kg_s = [0, {float(gg_hi) / 100:g}, {float(gg_hi) / 1000:g}]"
+        in (tmp_path / "cfg" / "fit.toml").read_text()
+    )
     both = dict(damper, specialevents=[10, 40, 50], specialeventstype=[3, 2, 0], specialeventsvalue=[8.0, 4.0, 3.0])
     for p in logs:
         p.write_text(fake_alog(extra=both))

@@ -37,6 +37,22 @@ UNIT_DEFAULTS: dict[str, tuple[float, float, float | None, float]] = {
 _PREFIX = {("heater", "level"): "P", ("fan", "level"): "F", ("heater", "tens"): "P", ("fan", "tens"): "F"}
 #: What a logged value is worth in the machine's own steps, per unit (a level in tens: a tenth).
 _STEPS_PER_UNIT = {"tens": 0.1}
+#: The fitted gains through which each control moves the model (:func:`roastlab.model.rhs.heater_power_kW`,
+#: :func:`roastlab.model.rhs.gas_inputs`): the heater heats the drum metal and the air it heats, the
+#: fan adds to the gas flow. A model whose gains of a control are all 0 does not respond to it.
+SETTING_GAINS: dict[str, tuple[str, ...]] = {"heater": ("Qe_gain_kW", "Tgi_gain_C"), "fan": ("Gg_fan_kg_s",)}
+
+
+def inert_settings(values: dict, settings) -> list[str]:
+    """The ``settings`` ("heater", "fan") that move nothing in a model with these parameter
+    ``values`` (registry names): every gain of :data:`SETTING_GAINS` 0 or absent.
+
+    >>> inert_settings({"Qe_gain_kW": 0.005, "Gg_fan_kg_s": 0.0}, ["heater", "fan"])
+    ['fan']
+    """
+    return [s for s in dict.fromkeys(settings) if not any(values.get(k, 0.0) for k in SETTING_GAINS[s])]
+
+
 #: The inlet gas temperature as a decided input (the paper's gas roaster): lowest and highest
 #: [degC] and fastest change [degC/min] a program may use unless told otherwise.
 TGI_LIMITS = (150.0, 550.0, 120.0)

@@ -925,6 +925,19 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
             "air flow per fan step [kg/s]" if step == 1 else f"air flow per logged fan unit [kg/s] (a step is {step:g})"
         )
         rows.append(line("Gg_fan_kg_s", 0.0, 0.01 / step, 0.001 / step, why))
+    elif s.fan and s.fan_unit == "percent":
+        # the flow rises with the fan (or damper) the roaster moves through the roast: at full setting it
+        # adds at most the largest base flow, a tenth of that to start (rhs.gas_inputs, Gg + Gg_fan fan)
+        span = UNIT_DEFAULTS["percent"][1]
+        rows.append(
+            line(
+                "Gg_fan_kg_s",
+                0.0,
+                round(gg_hi / span, 8),
+                round(gg_hi / span / 10, 8),
+                "air flow per % of the fan [kg/s]",
+            )
+        )
     rows += ["", "[initial]", "Tb0_C = 22.0                          # green beans at room temperature",
              "X0 = 0.11                             # typical green-coffee moisture [kg/kg dry]"]  # fmt: skip
     rows += [  # the probe's immersion in the bed: the laws and depth scale cross-validation chose

@@ -29,6 +29,7 @@ from ..metrics.profile import (  # noqa: F401  (re-exported)
     milestones,
     mmss,
 )
+from ..model.actuators import SETTING_GAINS, inert_settings
 from ..report.result import Result, draw_curves
 from ..sim.simulate import SimulationResult
 from .model import FittedModel
@@ -182,6 +183,9 @@ class WhatIf(Result):
     #: why the band may hold fewer samples than its level (a batch size the spread was not measured
     #: at, a roaster it was not measured on: :func:`roastlab.evaluate.bands.band_note`), else None
     band_note: str | None = None
+    #: the changed settings the model does not respond to (its gains for them are 0:
+    #: :func:`roastlab.model.actuators.inert_settings`), with the gains' names
+    inert: dict = field(default_factory=dict)
 
     def band_line(self, units: str = "C") -> str | None:
         """The changed probe BT's band in one line: its level, median width and BT at DROP."""
@@ -238,7 +242,12 @@ class WhatIf(Result):
         """What the table alone would hide: milestones a curve reaches only past DROP, and rows
         where the change is smaller than the model's own error on this log (the change may be
         real, but this log cannot confirm the model that close)."""
-        out = []
+        out = [
+            f"the model does not respond to the {setting} ({' and '.join(gains)} = 0 in this model file: its fit "
+            f"spec held {'them' if len(gains) > 1 else 'it'} at 0, or the fit found no effect), so the change "
+            f"to it shows none; free {' or '.join(gains)} in the fit spec and refit to ask this"
+            for setting, gains in self.inert.items()
+        ]
         for r in self.rows:
             level = self.levels.get(r["reading"], {}).get("FCs")
             for col in r["projected"]:
@@ -400,4 +409,5 @@ def whatif(
 
         band = prediction_bands(model, [changed_batch], band_level, **changes)[0]
         note = band_note(model, [changed_batch], changes.get("batch_kg"))
-    return WhatIf(batch, as_run, changed, labels, rows, levels, band, note)
+    inert = {s: SETTING_GAINS[s] for s in inert_settings(model.values, [c.setting for c in setting_changes])}
+    return WhatIf(batch, as_run, changed, labels, rows, levels, band, note, inert)
