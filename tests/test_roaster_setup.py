@@ -38,6 +38,9 @@ def test_init_detects_an_artisan_layout_and_writes_commented_files(cli, tmp_path
     assert "Qe_gain_kW" in text["fit"] and "Tgi_gain_C" in text["fit"] and "\n[fixed]\nh_probe_m = " in text["fit"]
     assert 'Tm0_C = ["BT", "ET"]' in text["map"]  # the drum at CHARGE: the probe soaked in the empty drum
     assert "Hottop" in out and [p.read_bytes() for p in logs] == before  # logs never modified
+    # Air at 30 % throughout both logs: its share of the flow cannot be told from the base flow
+    assert "\nGg_fan_kg_s" not in text["fit"] and "# the fan sits at 30 in every log" in text["fit"]
+    assert "the Air sits at 30 in every log" in out
 
 
 @pytest.mark.parametrize("events", [True, False])
@@ -137,7 +140,7 @@ def test_init_takes_the_damper_as_the_fan_when_no_fan_is_logged(cli, tmp_path):
     """SYNTHETIC logs with Burner and Damper events and no Air: on a drum with one fixed-speed
     exhaust fan the damper sets the air flow, so it stands for the fan, and init says so; with an
     Air channel too, the damper stays unused."""
-    damper = {"specialevents": [10, 40], "specialeventstype": [3, 2], "specialeventsvalue": [8.0, 4.0],
+    damper = {"specialevents": [10, 40, 60], "specialeventstype": [3, 2, 2], "specialeventsvalue": [8.0, 4.0, 6.0],
               "etypes": ["Air", "Drum", "Damper", "Burner", "--"]}  # fmt: skip
     logs = [tmp_path / f"r{k}.alog" for k in range(2)]
     for p in logs:
@@ -203,6 +206,36 @@ def test_a_heater_logged_in_watts_is_read_as_a_power(cli, tmp_path):
     heater = load_map(tmp_path / "cfg" / "map.toml").actuator("heater")
     assert (heater.unit, heater.high, heater.step, heater.label(900)) == ("W", 900.0, None, "900 W")
     assert f"Qe_gain_kW = [0, {KW_PER_W:g}," in (tmp_path / "cfg" / "fit.toml").read_text()
+
+
+def test_a_fan_logged_only_as_its_speed_in_rpm_sets_the_flow(cli, tmp_path):
+    """SYNTHETIC logs whose only fan channel is an extra device "Fan RPM" reading 1200-2400 (no fan
+    events): the fan's speed, the flow in proportion to it (the fan laws), not dropped as it was; the map
+    says rpm with the logs' top, the fit frees the flow per rpm (at the top, at most the largest base
+    flow), a what-if changes it in rpm; a fan speed that never moves is named and not fitted."""
+    from roastlab.io.importers.mapping import load_map
+
+    n = 120
+    logs = [tmp_path / f"rpm{k}.alog" for k in range(2)]
+    for k, p in enumerate(logs):
+        rpm = [1200.0 if i < 60 else 1800.0 + 600.0 * k for i in range(n)]
+        extra = {"extratimex": [[1.5 * i for i in range(n)]], "extraname1": ["Fan RPM"], "extraname2": ["Voltage"],
+                 "extratemp1": [rpm], "extratemp2": [[230.0] * n], "extraNoneTempHint1": [True],
+                 "extraNoneTempHint2": [True], "specialevents": [10, 40], "specialeventstype": [3, 3],
+                 "specialeventsvalue": [8.0, 6.0], "etypes": ["Air", "Drum", "Damper", "Burner", "--"]}  # fmt: skip
+        p.write_text(fake_alog(extra=extra))
+    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
+    assert code == 0 and "fan: Fan RPM (rpm)" in out and "taken as the fan's speed in rpm" in out, (out, err)
+    fan = load_map(tmp_path / "cfg" / "map.toml").actuator("fan")
+    assert (fan.unit, fan.high, fan.step, fan.label(1800)) == ("rpm", 2400.0, None, "1800 rpm")
+    fit = (tmp_path / "cfg" / "fit.toml").read_text()
+    gg_hi = float(fit.split("Gg_kg_s = [")[1].split("]")[0].split(", ")[1])
+    assert f"Gg_fan_kg_s = [0, {float(f'{gg_hi / 2400:.3g}'):g}," in fit and "per rpm of the fan" in fit
+    for p in logs:  # the same speed throughout every log: its share cannot be told from the base flow
+        p.write_text(p.read_text().replace("1800.0", "1200.0").replace("2400.0", "1200.0"))
+    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg2")
+    assert code == 0 and "the Fan RPM sits at 1200 in every log" in out, (out, err)
+    assert "\nGg_fan_kg_s" not in (tmp_path / "cfg2" / "fit.toml").read_text()
 
 
 def test_a_fan_logged_in_tens_above_100_is_the_machines_levels(cli, tmp_path):

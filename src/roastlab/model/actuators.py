@@ -32,6 +32,7 @@ UNIT_DEFAULTS: dict[str, tuple[float, float, float | None, float]] = {
     "tens": (0.0, 200.0, 10.0, 120.0),
     "kW": (0.0, 1e4, None, 1e4),
     "W": (0.0, 1e5, None, 1e5),  # a heater's power readout in watts (an Artisan extra device)
+    "rpm": (0.0, 1e5, None, 1e5),  # a fan's speed readout (an Artisan extra device such as "Fan RPM")
 }
 #: How a setting's value reads to a roaster, per control and unit ("P7", "F3", "35 %").
 _PREFIX = {("heater", "level"): "P", ("fan", "level"): "F", ("heater", "tens"): "P", ("fan", "tens"): "F"}
@@ -64,7 +65,7 @@ MIN_HOLD_S = 30.0
 @dataclass(frozen=True)
 class Actuator:
     """One control of a roaster: ``name`` ("heater" or "fan"), its ``unit`` ("percent",
-    "level", "tens", "kW", "W"), the range ``low``..``high`` in that unit, the ``step`` between settings the
+    "level", "tens", "kW", "W", "rpm"), the range ``low``..``high`` in that unit, the ``step`` between settings the
     machine offers (None: continuous) and the fastest change ``rate_per_min`` [unit/min]."""
 
     name: str

@@ -213,6 +213,7 @@ class Survey:
     in_tens: dict = field(default_factory=dict)  # {"heater": True, ...}: every logged value a whole ten
     inlet: str | None = None  # the inlet-air channel every log records (INLET_NAMES), else None
     et_below_bt: bool = False  # ET reads below BT through every roast: not the drum's air, not used
+    fan_at: float | None = None  # the one fan setting of every log, where the fan never moves; else None
 
 
 #: A heater logged in watts heats the drum by at most its electric power [kW per W].
@@ -553,11 +554,13 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
             f"{len(names)} log(s) record no green weight, nor one in the file name ({', '.join(names[:3])}"
             f"{' ...' if len(names) > 3 else ''}): fit-roaster leaves them out (--batch-kg gives them one)"
         )
-    if fan_unit == "W":  # above 100: not a percent or a level (a speed in rpm?); the model's flow law cannot read it
+    if fan_unit == "W":  # above 100 and not in tens: a fan's speed readout, whose flow rises in proportion
+        fan_unit = "rpm"
         notes.append(
-            f"the {fan} channel reads above 100, neither a percent nor a level: not used (set its unit in the map)"
+            f"the {fan} channel reads above 100 (up to {pooled['fan'].max():g}), neither a percent nor a level: "
+            "taken as the fan's speed in rpm, the air flow rising in proportion to it (the fan laws); "
+            "set its unit in the map if it is not"
         )
-        fan = fan_unit = None
     if fan and _find([fan], OTHER_NAMES["damper"]):
         notes.append(
             f"no fan channel: the {fan} sets the air flow through the drum, so the map takes it as the fan "
@@ -631,6 +634,12 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
             f"ET reads below BT through the roast on {len(odd)} log(s) ({', '.join(odd[:3])}{' ...' if len(odd) > 3 else ''}), "
             "unlike the others: not the drum's air there, so the map drops ET on such logs ([ET] above_BT)"
         )
+    fan_at = _one_setting(pooled.get("fan")) if fan else None
+    if fan_at is not None:
+        notes.append(
+            f"the {fan} sits at {fan_at:g} in every log: its share of the air flow cannot be told from the base "
+            "flow, so the fit does not free it (the model's flow stays one constant)"
+        )
     return Survey(
         infos,
         first.format,
@@ -655,7 +664,14 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
         in_tens,
         inlet,
         et_below_bt,
+        fan_at=fan_at,
     )
+
+
+def _one_setting(values) -> float | None:
+    """The setting every logged value is (a control that never moved in any log), else None."""
+    v = np.unique(np.asarray(values, dtype=float)[np.isfinite(values)]) if values is not None else np.array([])
+    return float(v[0]) if v.size == 1 else None
 
 
 def _catalogued(machine: str) -> tuple[Machine, float] | None:
@@ -727,7 +743,7 @@ def estimate_plant(s: Survey, capacity_kg=None, diameter_m=None, length_m=None) 
 
 def _setting_span(unit: str, top: float) -> float:
     """The range of a logged setting: 0..100 for percent, 0..the highest logged level."""
-    return 100.0 if unit == "percent" else max(top, 1.0)  # levels (also in tens) and W: the highest logged
+    return 100.0 if unit == "percent" else max(top, 1.0)  # levels (also in tens), W and rpm: the highest logged
 
 
 def map_text(s: Survey) -> str:
@@ -796,13 +812,14 @@ def map_text(s: Survey) -> str:
                 "tens": "whole tens: the machine's levels as Artisan's setup for it shows them, in tens",
                 "percent": "percent",
                 "W": "above 100: a power in watts",
+                "rpm": "above 100: the fan's speed",
             }[unit]
             lines += [
                 f"[{name}]",
                 f'column = "{col}"      # detected by name',
                 f'unit = "{unit}"       # by the logged values ({why})',
             ]
-            if unit in ("level", "tens", "W"):
+            if unit in ("level", "tens", "W", "rpm"):
                 lines += ["min = 0", f"max = {top:g}                # the highest setting the logs use"]
             if unit in ("level", "tens"):
                 lines.append(f"step = {UNIT_DEFAULTS[unit][2]:g}")
@@ -919,25 +936,26 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
             )
         rows.append(line("tau_heater_s", 1.0, 300.0, 30.0, "lag of the heater's effect [s]"))
         rows.append(line("U_shell_kW_m2K", 0.0, 0.1, 0.01, "drum shell heat loss to the room [kW/(m2 K)]"))
-    if s.fan and s.fan_unit in ("level", "tens"):
+    if s.fan and s.fan_at is not None:
+        # Gg + Gg_fan fan with one fan setting in every log: the two cannot be told apart
+        rows.append(
+            f"# the fan sits at {s.fan_at:g} in every log: its share of the flow cannot be told from the base "
+            "flow Gg_kg_s, so it is not fitted (logs that move the fan can fit Gg_fan_kg_s)"
+        )
+    elif s.fan and s.fan_unit in ("level", "tens"):
         step = UNIT_DEFAULTS[s.fan_unit][2]  # per unit of the logged value: a level shown in tens is ten of them
         why = (
             "air flow per fan step [kg/s]" if step == 1 else f"air flow per logged fan unit [kg/s] (a step is {step:g})"
         )
         rows.append(line("Gg_fan_kg_s", 0.0, 0.01 / step, 0.001 / step, why))
-    elif s.fan and s.fan_unit == "percent":
+    elif s.fan and s.fan_unit in ("percent", "rpm"):
         # the flow rises with the fan (or damper) the roaster moves through the roast: at full setting it
-        # adds at most the largest base flow, a tenth of that to start (rhs.gas_inputs, Gg + Gg_fan fan)
-        span = UNIT_DEFAULTS["percent"][1]
-        rows.append(
-            line(
-                "Gg_fan_kg_s",
-                0.0,
-                round(gg_hi / span, 8),
-                round(gg_hi / span / 10, 8),
-                "air flow per % of the fan [kg/s]",
-            )
-        )
+        # adds at most the largest base flow, a tenth of that to start (rhs.gas_inputs, Gg + Gg_fan fan);
+        # a speed in rpm: in proportion to it (the fan laws: volume flow ~ speed), the highest logged as full
+        span = _setting_span(s.fan_unit, s.fan_max)
+        per = "%" if s.fan_unit == "percent" else "rpm"
+        hi, start = (float(f"{x:.3g}") for x in (gg_hi / span, gg_hi / span / 10))
+        rows.append(line("Gg_fan_kg_s", 0.0, hi, start, f"air flow per {per} of the fan [kg/s]"))
     rows += ["", "[initial]", "Tb0_C = 22.0                          # green beans at room temperature",
              "X0 = 0.11                             # typical green-coffee moisture [kg/kg dry]"]  # fmt: skip
     rows += [  # the probe's immersion in the bed: the laws and depth scale cross-validation chose
