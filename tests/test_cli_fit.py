@@ -71,7 +71,10 @@ def test_identify_bad_options(cli, tmp_path):
         (["--fix", "nope=1"], "unknown parameter"),
         (["--fix", "hgm"], "NAME=VALUE"),
         (["--weight", "ET=auto"], "--weight ET: cannot read 'auto' as a number"),
-        (["--weight", "Ta=residual"], "--weight Ta: cannot read 'residual' as a number"),
+        (
+            ["--weight", "Ta=residual"],
+            "--weight Ta=residual: the probe is what weights from the residuals are relative to",
+        ),
         (["--weight", "ET=residual"], "the ET output has a weight but no batch has an ET reading"),
     ):
         code, _, err = cli(*base, *extra)

@@ -347,20 +347,18 @@ def weights_arg(items) -> dict:
     """``--weight OUTPUT=W`` options as checked output weights (errors name the command line); W may be
     ``residual`` for an output other than Ta (set from a first fit's residuals, as in a fit spec)."""
     from ..fit.identify import check_weights
-    from ..model.parameters import RESIDUAL_WEIGHT
+    from ..model.parameters import RESIDUAL_REFERENCE, RESIDUAL_REFERENCE_WHY, RESIDUAL_WEIGHT, by_residuals
 
-    items = list(items or [])
-    by_residuals = {
-        name.strip(): RESIDUAL_WEIGHT
-        for name, _, w in (i.partition("=") for i in items)
-        if w.strip() == RESIDUAL_WEIGHT and name.strip() != "Ta"
-    }
-    given = parse_assignments([i for i in items if i.partition("=")[0].strip() not in by_residuals], "--weight", False)
+    pairs = [(name.strip(), w.strip()) for name, _, w in (i.partition("=") for i in items or [])]
+    if (RESIDUAL_REFERENCE, RESIDUAL_WEIGHT) in pairs:
+        raise InputError(f"--weight {RESIDUAL_REFERENCE}={RESIDUAL_WEIGHT}: {RESIDUAL_REFERENCE_WHY}", "command line")
+    residual = {name: w for name, w in pairs if by_residuals(name, w)}
+    given = parse_assignments([f"{n}={w}" for n, w in pairs if n not in residual], "--weight", False)
     try:
-        check_weights({**given, **dict.fromkeys(by_residuals, 1.0)})
+        check_weights({**given, **dict.fromkeys(residual, 1.0)})
     except ParameterError as exc:
         raise InputError(f"--weight: {exc.problem}", "command line") from None
-    return {**given, **by_residuals}
+    return {**given, **residual}
 
 
 FIT_HELP = "batch CSVs (time_s,Gg_kg_s,Tgi_C,Ta_C) and/or dataset folders with a dataset.toml; raw logs with --map"

@@ -36,6 +36,7 @@ from ..model.parameters import (
     N_STARTS,
     OUTPUTS,
     REGISTRY,
+    RESIDUAL_REFERENCE,
     THETA_NAMES,
     THETA_START,
     FreeParameter,
@@ -178,9 +179,11 @@ def residual_weights(outputs: dict, names) -> dict[str, float]:
     reads less closely (the drum's air through the well-mixed outlet of eq. 15e) falls, so its
     model-structure error does not pull the beans; one the model reads as closely counts alike.
     """
-    ta = outputs.get("Ta") or {}
+    ta = outputs.get(RESIDUAL_REFERENCE) or {}
     if not ta.get("n") or not ta.get("SSR"):
-        raise ParameterError("a weight from the residuals is relative to the bean probe's (Ta): fit Ta as well")
+        raise ParameterError(
+            f"a weight from the residuals is relative to the bean probe's ({RESIDUAL_REFERENCE}): fit it as well"
+        )
     var_ta = ta["SSR"] / ta["n"]
     out = {}
     for name in names:

@@ -43,11 +43,13 @@ from ..model.parameters import (
     DEFAULT_WEIGHTS,
     FREE_NAMES,
     OUTPUTS,
+    RESIDUAL_REFERENCE_WHY,
     RESIDUAL_WEIGHT,
     STATE0,
     THETA_NAMES,
     THETA_PAPER,
     FreeParameter,
+    by_residuals,
 )
 from .files import finite_number, read_toml
 
@@ -139,12 +141,12 @@ def load_fit_spec(path: str | Path) -> FitSpec:
     for name, v in table.items():
         if name not in OUTPUTS:
             raise InputError(f"unknown output (allowed: {', '.join(OUTPUTS)})", path, f"weights.{name}")
-        if v == RESIDUAL_WEIGHT and name != "Ta":  # set from a first fit's residuals (fit.identify.residual_weights)
+        if by_residuals(name, v):  # set from a first fit's residuals (fit.identify.residual_weights)
             weights[name] = v
             continue
         if isinstance(v, str):
             why = (
-                "the probe is what weights from the residuals are relative to: give it a number"
+                RESIDUAL_REFERENCE_WHY
                 if v == RESIDUAL_WEIGHT
                 else f'must be a number or "{RESIDUAL_WEIGHT}" (set from a first fit\'s residuals), got {v[:40]!r}'
             )

@@ -161,6 +161,22 @@ DEFAULT_WEIGHTS = {"Ta": 1.0, "Tb2": 0.0, "ET": 0.0}
 #: A weight given as this word is set from the residuals (:func:`roastlab.fit.identify.residual_weights`):
 #: the probe's residual variance over the output's, both from a first fit with the output at weight 1.
 RESIDUAL_WEIGHT = "residual"
+#: The output weights from the residuals are relative to, the bean probe: its own weight is a number.
+RESIDUAL_REFERENCE = "Ta"
+#: Why the reference output cannot be weighed by the residuals (the fit spec's and --weight's error).
+RESIDUAL_REFERENCE_WHY = "the probe is what weights from the residuals are relative to: give it a number"
+
+
+def by_residuals(output: str, weight) -> bool:
+    """Whether ``weight`` asks for ``output``'s weight from the residuals (:data:`RESIDUAL_WEIGHT`),
+    which any output but :data:`RESIDUAL_REFERENCE` may.
+
+    >>> by_residuals("ET", "residual"), by_residuals("Ta", "residual"), by_residuals("ET", 0.2)
+    (True, False, False)
+    """
+    return weight == RESIDUAL_WEIGHT and output != RESIDUAL_REFERENCE
+
+
 #: Starts a global search chooses for a local polish by default (:func:`roastlab.fit.identify.identify`:
 #: the paper's theta0 and the best distinct trial points; one inside a found basin is skipped).
 N_STARTS = 6
