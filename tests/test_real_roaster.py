@@ -53,6 +53,20 @@ def test_first_order_fit_with_settings_recovers_the_gains():
     assert min(r["FIT"] for r in rows) > 99.9
 
 
+def test_first_order_fit_with_a_fan_and_no_heater():
+    """A roaster that logs its fan and no heater (the inlet air drives it): the baseline fits the fan's
+    gain (its start had averaged over no heater and warned "Mean of empty slice")."""
+    t = np.arange(0, 601, 5.0)
+    batches = []
+    for k in range(3):
+        tgi = 200.0 + 0.1 * t + 5.0 * k
+        fan = np.where(t < 250 + 40 * k, 40.0, 70.0)
+        bt = first_order_response(t, tgi - 0.5 * fan, 110.0 + k, 180.0, 8.0)
+        batches.append(Batch(f"b{k}", t, np.ones_like(t), tgi, bt, fan=fan))
+    fit = fit_first_order(batches)
+    assert fit["tau_s"] == pytest.approx(180.0, rel=1e-4) and fit["fan_gain_C"] == pytest.approx(-0.5, rel=1e-3)
+
+
 def test_skywalker_fit_and_validate(cli, real_data, tmp_path):
     logs = sorted(real_data.glob("*.alog"))[3:]  # from October 2025 on, ET reads the drum's air (the map)
     fit_logs, val_logs = logs[0:4:2], logs[1:4:2]

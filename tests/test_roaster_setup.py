@@ -843,6 +843,8 @@ def test_an_unseen_gas_drum_that_logs_its_inlet_air_and_no_burner_is_driven_by_t
     logs = _synthetic_gas_drum_logs(tmp_path, inlet=True)
     code, out, err = cli("init", *logs, "--out", tmp_path / "cfg", "--batch-capacity-kg", "5")
     assert code == 0 and "heater: none" in out and "inlet air: Zuluft (the model's input)" in out, err
+    # its exhaust air "Abluft" (a temperature, named like the air: "Luft") is no fan in rpm
+    assert "fan: none (-)" in out, out
     text = {n: (tmp_path / "cfg" / f"{n}.toml").read_text() for n in ("map", "fit")}
     assert '[Tgi]\ncolumn = "Zuluft"' in text["map"] and 'ET = "residual"' in text["fit"], text
     code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)

@@ -68,7 +68,8 @@ def fit_first_order(batches) -> dict:
     hi = [BOUNDS["tau_s"][1], BOUNDS["offset_C"][1]] + [1e3] * len(settings)
     # start: the heater alone (else the offset) carries the probe ~200 degC above its inputs;
     # a few time constants, the best local solution kept
-    heater_mean = np.mean([np.mean(b.heater) for b in batches if b.heater is not None]) if settings else 0.0
+    heaters = [np.mean(b.heater) for b in batches if b.heater is not None]  # none where only a fan is logged
+    heater_mean = float(np.mean(heaters)) if heaters else 0.0
     g0 = [200.0 / heater_mean if k == "heater_gain_C" and heater_mean > 0 else 0.0 for k in settings]
     res = None
     for tau0 in (120.0, 400.0, 1200.0):

@@ -389,9 +389,16 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
         others = [n for n in others if n not in temps]
     others = [n for n in others if n != inlet]  # the inlet air is no setting ("Inlet Air" is not the fan)
     heater = "heater" if fmt == "roastime" and "heater" in names else _find(others, HEATER_NAMES)
-    fan = "fan" if fmt == "roastime" and "fan" in names else _find([n for n in others if n != heater], FAN_NAMES)
+    # a channel the log marks as a temperature and that reads above 100 is no fan setting (a speed would be
+    # marked otherwise): an exhaust air "Abluft" named like the air ("Luft"), not a fan in rpm
+    hot = {n for n in others if n in temps and np.nanmax(log.channels[n], initial=-np.inf) > 100.0}
+    fan = (
+        "fan"
+        if fmt == "roastime" and "fan" in names
+        else _find([n for n in others if n not in (heater, *hot)], FAN_NAMES)
+    )
     if fan is None:  # no fan channel: a damper sets the air flow through the drum (one fixed-speed exhaust fan)
-        fan = _find([n for n in others if n != heater], OTHER_NAMES["damper"])
+        fan = _find([n for n in others if n not in (heater, *hot)], OTHER_NAMES["damper"])
     if log.weight_in_kg:  # the import's order (mapping.import_log): the log, its file name, the map's batch_kg
         mass, source = log.weight_in_kg, "the log's green weight"
     elif named := grams_in_name(path):
