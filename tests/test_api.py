@@ -306,3 +306,15 @@ def test_whatif_on_the_fan_moves_the_roast_and_a_model_deaf_to_it_says_so(sky_mo
     assert "does not respond" not in "\n".join(
         whatif(model, batch, [parse_setting_change("heater", "+5@5:00")]).warnings()
     )
+
+
+def test_transfer_deciding_a_heater_the_model_is_deaf_to_says_so(sky_model):
+    """A program decided on the heater of a model whose heater gains are all 0 (SETTING_GAINS, the
+    one table whatif reads too) is refused with the gains named, not optimised over a flat response."""
+    from roastlab.errors import InputError
+    from roastlab.workflows.transfer import transfer
+
+    model_path, log = sky_model
+    model = roastlab.load_model(model_path).with_values(Qe_gain_kW=0.0, Tgi_gain_C=0.0)
+    with pytest.raises(InputError, match=r"the heater has no effect on .*\(Qe_gain_kW, Tgi_gain_C\) are 0"):
+        transfer(model, roastlab.load_log(log, model.column_map), None, None)

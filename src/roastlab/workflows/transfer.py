@@ -30,11 +30,11 @@ from ..fit.program import (
 )
 from ..io.batch import Batch
 from ..metrics.profile import DRY_END_C, FIRST_CRACK_C, crossing_or_projected_s, crossing_time_s, mmss
-from ..model.actuators import MIN_HOLD_S
-from ..model.layout import I_QEG, I_TGIG, S_TB, S_TM
+from ..model.actuators import MIN_HOLD_S, SETTING_GAINS
+from ..model.layout import S_TB, S_TM, P
 from ..model.limits import check_value
 from ..model.plant import Plant
-from ..model.quantities import QUANTITIES
+from ..model.quantities import QUANTITIES, quantity
 from ..report.result import Result, draw_curves
 
 #: Probe temperatures [degC] whose crossing times define the phases of the retimed baseline:
@@ -419,11 +419,12 @@ def transfer(
         grid_b.Gg_kg_s = res_a.Gg_kg_s.copy()
     res_same = model.predict(grid_b, plant=pb, **changes)
     p_b = res_same.params
-    if limits.decide == "heater" and p_b[I_QEG] == 0.0 and p_b[I_TGIG] == 0.0:
+    gains = SETTING_GAINS.get(limits.decide, ())
+    if gains and not any(p_b[P[quantity(g).slot]] for g in gains):
         raise InputError(
-            f"the heater has no effect on {pb.name}: its gains (Qe_gain_kW, Tgi_gain_C) are 0 there "
+            f"the {limits.decide} has no effect on {pb.name}: its gains ({', '.join(gains)}) are 0 there "
             "(plant-specific values do not carry over to another plant); decide Tgi",
-            "--decide heater",
+            f"--decide {limits.decide}",
         )
     x0 = res_same.states[0].copy()
     # on its own plant a model that fitted a constant flow applies it; elsewhere that value is dropped
