@@ -239,8 +239,9 @@ class WhatIf(Result):
         return "\n".join(lines)
 
     def warnings(self) -> list[str]:
-        """What the table alone would hide: milestones a curve reaches only past DROP, and rows
-        where the change is smaller than the model's own error on this log (the change may be
+        """What the table alone would hide: a changed setting the model does not respond to (its
+        "+0.0" is the model file's, not the roast's), milestones a curve reaches only past DROP, and
+        rows where the change is smaller than the model's own error on this log (the change may be
         real, but this log cannot confirm the model that close)."""
         out = [
             f"the model does not respond to the {setting} ({' and '.join(gains)} = 0 in this model file: its fit "
