@@ -944,3 +944,15 @@ def test_notes_said_alike_on_many_logs_are_one_line_with_the_range():
         "3 logs (a.alog, e.alog, f.alog): ET reads -3.5 to 40 degC below BT (median from 60 s)"
         in roaster.grouped_notes(notes)
     )
+
+
+def test_the_examples_fit_specs_bound_the_gas_flow_as_init_does():
+    """The examples' hand-written fit specs and init's share one gas-flow range (GAS_FLOW_MIN_KG_S to
+    GAS_FLOW_MAX_FLOOR_KG_S for roasters of their size): a change to one is a change to both."""
+    from roastlab.io.fitspec import load_fit_spec
+    from roastlab.workflows.roaster import GAS_FLOW_MAX_FLOOR_KG_S, GAS_FLOW_MIN_KG_S
+
+    for machine in ("skywalker", "bullet"):
+        spec = load_fit_spec(Path(__file__).resolve().parents[1] / "examples" / machine / "fit.toml")
+        gg = next(p for p in spec.free if p.name == "Gg_kg_s")
+        assert (gg.lower, gg.upper) == (GAS_FLOW_MIN_KG_S, GAS_FLOW_MAX_FLOOR_KG_S), machine

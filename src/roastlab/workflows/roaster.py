@@ -151,6 +151,10 @@ METAL_KG_PER_KG = 3.0
 GAS_FLOW_MAX_KG_S_PER_KG = 0.02
 #: The gas-flow bound of the small roasters the examples fit (Skywalker, Bullet) [kg/s].
 GAS_FLOW_MAX_FLOOR_KG_S = 0.05
+#: Lowest gas flow a fit may reach [kg/s]: half a gram of air per second (about 0.4 L/s), below the
+#: flow of any drum with a fan; the Skywalker's fit ends on it (docs/real-roaster.md), the examples'
+#: fit specs use the same bound.
+GAS_FLOW_MIN_KG_S = 0.0005
 #: Lower bound of the heat-transfer coefficients a small roaster's fit may reach [kW/(m2 K)]: an
 #: order below the quantity table's fit bounds (made for the paper's industrial drums), inside
 #: its plausible range (the Bullet's gas-metal coefficient ends near it).
@@ -910,7 +914,7 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
         line("hgm", SMALL_COEFF_FLOOR, 1.0, 0.02, "gas-metal coefficient [kW/(m2 K)]"),
         line("hbm", SMALL_COEFF_FLOOR, 1.0, 0.02, "metal-bean coefficient [kW/(m2 K)]"),
         line("Pbm", 0.05, 0.95, 0.5, "bean area touching metal [-]"),
-        line("Gg_kg_s", 0.0005, gg_hi, gg_hi / 10, "gas flow [kg/s] (not logged)"),
+        line("Gg_kg_s", GAS_FLOW_MIN_KG_S, gg_hi, gg_hi / 10, "gas flow [kg/s] (not logged)"),
         line("Kt", 0.002, 0.2, 0.02, "bean-probe inverse time constant [1/s]"),
     ]
     entry = catalogue_entry(s.machine) if s.machine else None
