@@ -31,11 +31,12 @@ from ..fit.program import (
 from ..io.batch import Batch
 from ..metrics.profile import DRY_END_C, FIRST_CRACK_C, crossing_or_projected_s, crossing_time_s, mmss
 from ..model.actuators import MIN_HOLD_S, SETTING_GAINS
-from ..model.layout import S_TB, S_TM, P
+from ..model.layout import S_TB, S_TM
 from ..model.limits import check_value
 from ..model.plant import Plant
-from ..model.quantities import QUANTITIES, quantity
+from ..model.quantities import QUANTITIES
 from ..report.result import Result, draw_curves
+from ..sim.population import PARAM_SLOTS
 
 #: Probe temperatures [degC] whose crossing times define the phases of the retimed baseline:
 #: end of drying (~150 degC, Artisan's DRY) and start of first crack (~196 degC, FCs).
@@ -420,7 +421,7 @@ def transfer(
     res_same = model.predict(grid_b, plant=pb, **changes)
     p_b = res_same.params
     gains = SETTING_GAINS.get(limits.decide, ())
-    if gains and not any(p_b[P[quantity(g).slot]] for g in gains):
+    if gains and not any(p_b[PARAM_SLOTS[g]] for g in gains):
         raise InputError(
             f"the {limits.decide} has no effect on {pb.name}: its gains ({', '.join(gains)}) are 0 there "
             "(plant-specific values do not carry over to another plant); decide Tgi",
