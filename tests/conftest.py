@@ -41,6 +41,12 @@ def real_data():
     return folder
 
 
+def printed_percent(out: str, label: str) -> float:
+    """The percentage a command printed right after ``label`` (fit-roaster's "held out: FIT ",
+    "baseline: ", "band:"), read up to its " %"."""
+    return float(out.split(label)[1].split(" %")[0])
+
+
 @pytest.fixture
 def cli(tmp_path):
     """Run the CLI in-process; returns (exit code, stdout, stderr)."""

@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import REAL_DATA, drop_events, rewritten_alog
+from conftest import REAL_DATA, drop_events, printed_percent, rewritten_alog
 from roastlab.fit.baseline import first_order_response, fit_first_order
 from roastlab.io.batch import Batch
 
@@ -150,7 +150,7 @@ def test_skywalker_logs_without_et_fit_with_the_heater_into_the_drum(cli, real_d
     assert "Tgi_gain_C" not in (tmp_path / "cfg" / "fit.toml").read_text()
     code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
     assert code == 0 and "failed" not in err and "drum metal colder" not in err, err
-    held = float(out.split("held out: FIT ")[1].split(" %")[0])
+    held = printed_percent(out, "held out: FIT ")
     assert held >= 80.0, out  # 83.6 % measured on 2026-11-26 with the fan's flow freed (83.3 % before)
 
 
@@ -179,7 +179,7 @@ def test_skywalker_logs_whose_fan_is_only_a_speed_readout_fit_as_with_its_events
     assert code == 0 and "fan: Fan RPM (rpm)" in out, (out, err)
     code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
     assert code == 0, err
-    held = float(out.split("held out: FIT ")[1].split(" %")[0])
+    held = printed_percent(out, "held out: FIT ")
     assert held >= 78.0, out  # 82.0 % measured on 2026-11-26 (82.1 % from the Air events)
     code, out, err = cli("whatif", logs[8], "--model", tmp_path / "cfg" / "model.json", "--fan", "+480@5:00")
     assert code == 0 and "fan +480 rpm from 5:00" in out, err
@@ -221,7 +221,7 @@ def test_skywalker_logs_in_the_aillio_r1_layout_find_their_heater_and_fan(cli, r
     assert code == 0 and "heater: Heater (percent); fan: Fan (percent)" in out, (out, err)
     code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
     assert code == 0, err
-    held = float(out.split("held out: FIT ")[1].split(" %")[0])
+    held = printed_percent(out, "held out: FIT ")
     assert held >= 75.0, out  # 82.1 % with the events (as the default layout), 82.3 % the readouts alone (2026-11-26)
 
 
@@ -255,8 +255,8 @@ def test_a_log_without_burner_events_is_left_out_and_a_non_physical_fit_refitted
     code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
     assert code == 0 and "failed" not in err, err
     assert "refitted: with the heater free to heat the air and the drum, the fit failed on non-physical" in out
-    held, base = out.split("held out: FIT ")[1].split(" %")[0], out.split("first-order baseline: ")[1].split(" %")[0]
-    assert float(held) > float(base) + 10, out  # 71.0 % against 44.4 % measured on 2026-11-26
+    held, base = printed_percent(out, "held out: FIT "), printed_percent(out, "first-order baseline: ")
+    assert held > base + 10, out  # 71.0 % against 44.4 % measured on 2026-11-26
     assert "note: roast_25-10-25_1609.alog: bean temperature jumps" in err  # what the import did, said
     report = (tmp_path / "cfg" / "report.md").read_text()
     assert "Read from the logs:" in report and "- roast_25-10-25_1609.alog: bean temperature jumps" in report
@@ -290,7 +290,7 @@ def test_the_skywalker_as_plain_csv_logs_is_set_up_and_fitted(cli, real_data, tm
     assert code == 0 and "format csv" in out, err
     code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
     assert code == 0, err
-    held = float(out.split("held out: FIT ")[1].split(" %")[0])
+    held = printed_percent(out, "held out: FIT ")
     assert held >= 75.0, (
         out
     )  # 79.7 % measured on 2026-11-26 (79.9 % with the fan's flow held, 77.8 % with ET weighed like BT)
@@ -498,12 +498,12 @@ def test_bullet_logs_recorded_through_artisan_fit_as_the_roastime_logs_do(cli, b
     assert 'Tm0_C = ["ET before CHARGE", "BT"]' in (tmp_path / "cfg" / "map.toml").read_text()
     code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
     assert code == 0, err
-    held = float(out.split("held out: FIT ")[1].split(" %")[0])
+    held = printed_percent(out, "held out: FIT ")
     code, out, err = cli("init", *sorted(bullet_data.glob("*.json")), "--out", tmp_path / "rt")
     assert code == 0, err
     code, out, err = cli("fit-roaster", tmp_path / "rt", *sorted(bullet_data.glob("*.json")))
     assert code == 0, err
-    assert abs(held - float(out.split("held out: FIT ")[1].split(" %")[0])) < 1.5, (held, out)
+    assert abs(held - printed_percent(out, "held out: FIT ")) < 1.5, (held, out)
 
 
 def test_roastime_without_weight_is_refused_with_the_way_out(cli, bullet_data, tmp_path):

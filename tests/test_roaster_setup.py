@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import REAL_DATA
+from conftest import REAL_DATA, printed_percent
 from roastlab.errors import InputError
 from roastlab.workflows import roaster
 from test_importers import fake_alog
@@ -622,9 +622,9 @@ def test_init_and_fit_roaster_reach_the_hand_written_examples_on_the_shared_logs
     for cfg in ("cfg", "example"):
         code, out, err = cli("fit-roaster", tmp_path / cfg, *logs)
         assert code == 0, err
-        held[cfg] = float(out.split("held out: FIT ")[1].split(" %")[0])
-        base = float(out.split("baseline: ")[1].split(" %")[0])
-        inside[cfg] = float(out.split("band:")[1].split(" %")[0])
+        held[cfg] = printed_percent(out, "held out: FIT ")
+        base = printed_percent(out, "baseline: ")
+        inside[cfg] = printed_percent(out, "band:")
         width[cfg] = float(out.split("median width ")[1].split(" °C")[0])
     assert abs(held["cfg"] - held["example"]) <= 2.0 and held["cfg"] > base + 20, held
     # the 90 % band on the held-out logs: about its level and not uselessly wide (measured
@@ -715,8 +715,8 @@ def test_an_unseen_fahrenheit_hottop_is_fitted_with_no_hand_edits(cli, tmp_path)
     assert 'column = "Heater"' in text and 'column = "Fan"' in text
     code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
     assert code == 0, err
-    held = float(out.split("held out: FIT ")[1].split(" %")[0])
-    base = float(out.split("baseline: ")[1].split(" %")[0])
+    held = printed_percent(out, "held out: FIT ")
+    base = printed_percent(out, "baseline: ")
     assert held > 80.0 and held > base + 10.0, out
 
 
@@ -730,7 +730,7 @@ def test_fit_roaster_every_log_holds_each_log_out_once(cli, tmp_path):
     assert code == 0, err
     line = out.split("each log held out once: FIT ")[1]
     cv = float(line.split(" %")[0])
-    held = float(out.split("held out: FIT ")[1].split(" %")[0])
+    held = printed_percent(out, "held out: FIT ")
     assert 80.0 < cv <= 100.0 and abs(cv - held) < 10.0, out
     assert "inside the band of the fit without their log" in line
     report = (tmp_path / "cfg" / "report.md").read_text()
@@ -811,8 +811,8 @@ def test_an_unseen_gas_drum_with_burner_events_is_fitted_with_no_hand_edits(cli,
     assert 'column = "Brenner"' in text and "ET: yes" in out, text
     code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
     assert code == 0, err
-    held = float(out.split("held out: FIT ")[1].split(" %")[0])
-    base = float(out.split("baseline: ")[1].split(" %")[0])
+    held = printed_percent(out, "held out: FIT ")
+    base = printed_percent(out, "baseline: ")
     assert held > 80.0 and held > base + 10.0, out
 
 
@@ -849,7 +849,7 @@ def test_an_unseen_gas_drum_that_logs_its_inlet_air_and_no_burner_is_driven_by_t
     assert '[Tgi]\ncolumn = "Zuluft"' in text["map"] and 'ET = "residual"' in text["fit"], text
     code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
     assert code == 0, err
-    held = float(out.split("held out: FIT ")[1].split(" %")[0])
+    held = printed_percent(out, "held out: FIT ")
     assert held > 90.0, out
     assert "\nWeight of ET from the residuals: " in (tmp_path / "cfg" / "report.md").read_text()
 
