@@ -392,6 +392,21 @@ def test_a_model_is_fitted_on_the_page_in_the_background(client, data_dir):
         time.sleep(0.2)
     assert "error" not in st, st
     assert "## Every log held out once" in st["report"] and -100 < st["every_log"]["FIT"] <= 100
+    # the page's "also predict other batch sizes": fit-roaster --by-size behind it; four logs of one size
+    # cannot, and the page says why
+    assert client.post("/api/fit", json={"logs": logs, "name": "sky", "by_size": True}, headers=H).json()["started"]
+    while (st := client.get("/api/fit-status", headers=H).json()).get("running"):
+        time.sleep(0.2)
+    assert "all one batch size (0.15-0.152 kg)" in st["error"], st
+    for p in sorted(sky.glob("*.alog"))[4:6]:  # two more: 150 g and 200 g
+        shutil.copy(p, data_dir / "sky" / p.name)
+        logs.append(f"sky/{p.name}")
+    assert client.post("/api/fit", json={"logs": logs, "name": "sky", "by_size": True}, headers=H).json()["started"]
+    deadline = time.monotonic() + 180
+    while (st := client.get("/api/fit-status", headers=H).json()).get("running") and time.monotonic() < deadline:
+        time.sleep(0.2)
+    assert "error" not in st, st
+    assert "## Across batch sizes" in st["report"] and "fitted on 0.15-0.152 kg (3 logs)" in st["across_sizes"]
     # logs with no heater or fan setting: ET drives the model, worse than the baseline here, and the page says so
     (data_dir / "bare").mkdir(exist_ok=True)
     bare = []

@@ -334,7 +334,9 @@ async function runFit() {
   const logs = Array.from($("fit_logs").selectedOptions).map((o) => o.value);
   say("");
   try {
-    await api("/api/fit", { logs, name: $("fit_name").value, every_log: $("fit_every_log").checked });
+    await api("/api/fit", {
+      logs, name: $("fit_name").value, every_log: $("fit_every_log").checked, by_size: $("fit_by_size").checked,
+    });
     const poll = async () => {
       const st = await api("/api/fit-status");
       $("fit_progress").max = st.total || 1;
@@ -344,7 +346,8 @@ async function runFit() {
       if (st.error) { say(st.error); return; }
       $("fit-report").textContent = st.report;
       $("fit_text").textContent = `held out: FIT ${st.held_out.FIT.toFixed(1)} %, MAE ${st.held_out.MAE.toFixed(2)} °C` +
-        (st.every_log ? `; each log held out once: FIT ${st.every_log.FIT.toFixed(1)} %` : "");
+        (st.every_log ? `; each log held out once: FIT ${st.every_log.FIT.toFixed(1)} %` : "") +
+        (st.across_sizes ? `; across sizes: ${st.across_sizes}` : "");
       if (st.verdict) say(`not usable: ${st.verdict}`);
       pickModel = st.model;
       await refreshFiles($("log").value);

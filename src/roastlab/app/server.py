@@ -13,7 +13,8 @@ repository); the page talks JSON to a handful of endpoints, each a thin call int
   (:func:`roastlab.workflows.transfer.transfer`, as ``roastlab transfer``)
 * ``POST /api/upload``    a log file into ``<data>/uploads/`` (size-limited, read as data)
 * ``POST /api/fit``       fit a model on chosen logs in the background (``roastlab init`` +
-  ``fit-roaster`` into ``<data>/roasters/<name>/``; ``every_log``: each log also held out once);
+  ``fit-roaster`` into ``<data>/roasters/<name>/``; ``every_log``: each log also held out once;
+  ``by_size``: fitted at one batch size, the others predicted);
   ``GET /api/fit-status`` its progress and report
 * ``GET  /downloads/...`` what a transfer wrote
 
@@ -423,6 +424,7 @@ def create_app(data_dir: str | Path):
 
     def fit_start(session: Session, body: dict) -> dict:
         from ..workflows.roaster import fit_roaster, init_roaster
+        from ..workflows.sizes import across_sizes_sentence
 
         logs = body.get("logs") or []
         if not isinstance(logs, list) or len(logs) < 2:
@@ -440,7 +442,13 @@ def create_app(data_dir: str | Path):
         def work():
             try:
                 init_roaster(paths, folder, batch_kg=body.get("batch_kg") or None)
-                r = fit_roaster(folder, paths, progress=progress, every_log=bool(body.get("every_log")))
+                r = fit_roaster(
+                    folder,
+                    paths,
+                    progress=progress,
+                    every_log=bool(body.get("every_log")),
+                    by_size=bool(body.get("by_size")),
+                )
                 session.fit.update(
                     running=False,
                     model=(folder / "model.json").relative_to(data).as_posix(),
@@ -448,6 +456,7 @@ def create_app(data_dir: str | Path):
                     held_out=r["held_out"],
                     verdict=r["below_baseline"],
                     every_log=r["every_log"] and {"FIT": r["every_log"]["FIT"]},
+                    across_sizes=r["across_sizes"] and across_sizes_sentence(r["across_sizes"]),
                 )
             except RoastlabError as exc:
                 session.fit.update(running=False, error=str(exc))

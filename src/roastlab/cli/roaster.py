@@ -49,8 +49,17 @@ def cmd_init(args) -> int:
 
 def cmd_fit_roaster(args) -> int:
     from ..workflows.roaster import band_sentence, every_log_sentence, fit_roaster, grouped_notes
+    from ..workflows.sizes import across_sizes_sentence
 
-    r = fit_roaster(args.dir, args.logs, progress=progress("fit-roaster"), seed=args.seed, every_log=args.every_log)
+    r = fit_roaster(
+        args.dir,
+        args.logs,
+        progress=progress("fit-roaster"),
+        seed=args.seed,
+        every_log=args.every_log,
+        by_size=args.by_size,
+        fit_size_kg=args.fit_size_kg,
+    )
     f, h, b = r["fit"], r["held_out"], r["baseline_held_out"]
     for line in grouped_notes(r["notes"]):
         print(f"note: {line}", file=sys.stderr)
@@ -71,6 +80,11 @@ def cmd_fit_roaster(args) -> int:
     e = r["every_log"]
     if e:
         print(f"each log held out once: {every_log_sentence(e['FIT'], e['band_inside'], e['band_median_width_C'])}")
+    a = r["across_sizes"]
+    if a:
+        print(f"across sizes: {across_sizes_sentence(a)}")
+        if a["failed"]:
+            print(f"warning: the fit on {a['fit_size']} alone failed: {a['failed']}", file=sys.stderr)
     for w in r["warnings"]:
         print(f"warning: {w}", file=sys.stderr)
     print(f"wrote {r['model']}, {r['report']}")
@@ -122,7 +136,8 @@ def add_parsers(sub) -> None:
         "such as drum metal below the beans; the files are written and say so), 2 on bad input.",
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog="examples:\n  roastlab fit-roaster myroaster roasts/*.alog\n"
-        "  roastlab fit-roaster myroaster roasts/*.alog --every-log   each log also held out once (minutes)",
+        "  roastlab fit-roaster myroaster roasts/*.alog --every-log   each log also held out once (minutes)\n"
+        "  roastlab fit-roaster myroaster roasts/*.alog --by-size     fitted at one batch size, the others predicted",
     )
     p.add_argument("dir", metavar="DIR", help="the folder 'roastlab init' wrote")
     p.add_argument("logs", nargs="+", metavar="LOG", help="the roaster's logs, or a folder of them")
@@ -133,5 +148,19 @@ def add_parsers(sub) -> None:
         help="also hold every log out once, predicted by a fit on all the others (leave-one-log-out: one fit "
         "per log, plus one), and report each log's FIT and its share inside the 90 %% band: the figure to judge "
         "the model by when one split of a few roasts is too few",
+    )
+    p.add_argument(
+        "--by-size",
+        action="store_true",
+        help="also fit on the logs of one batch size alone (the size with the most logs, split alternately) and "
+        "predict every other size with nothing refitted: the paper's claim that the machine's parameters carry "
+        "over to another batch; the report gains a table per size (FIT, signed error, share inside the band, "
+        "the gap to the held-out logs of the fit size with its 90 %% interval) and DIR/sizes.png (one more fit)",
+    )
+    p.add_argument(
+        "--fit-size-kg",
+        type=float_arg("--fit-size-kg"),
+        metavar="KG",
+        help="with --by-size (implied): the batch size to fit on [kg], e.g. 0.5 (default: the size with the most logs)",
     )
     p.set_defaults(func=cmd_fit_roaster)

@@ -1123,7 +1123,16 @@ def band_sentence(band: dict) -> str:
     )
 
 
-def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: bool = False) -> dict:
+def fit_roaster(
+    config_dir,
+    paths,
+    *,
+    progress=None,
+    seed: int = 0,
+    every_log: bool = False,
+    by_size: bool = False,
+    fit_size_kg: float | None = None,
+) -> dict:
     """Fit, validate and report a roaster set up by :func:`init_roaster`.
 
     The logs, sorted by when they were roasted (Artisan ``roastepoch``, RoasTime ``dateTime``;
@@ -1142,6 +1151,11 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: b
     (leave-one-log-out, :func:`roastlab.workflows.compare.compare_models` with the fit spec's own
     bed laws), and report each log's FIT and its share inside the 90 % band: one split of a few
     roasts moves the held-out figure by points, this uses every roast (one fit per log, plus one).
+
+    ``by_size`` (or ``fit_size_kg``, the fit size named): also fit on the logs of one batch size
+    alone and predict every other size with nothing refitted, the paper's scaling claim on this
+    roaster (:mod:`roastlab.workflows.sizes`; one more fit), written to the report and
+    ``config_dir``/sizes.png.
     """
     from ..evaluate.metrics import average_metrics
     from ..fit.baseline import describe, fit_first_order, validate_first_order
@@ -1149,8 +1163,9 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: b
     from ..io.fitspec import load_fit_spec
     from ..io.importers.mapping import load_map
     from ..io.modelfile import model_document_text
-    from .fitting import FAILED_HINT, fit
+    from .fitting import FAILED_HINT
     from .model import load_log
+    from .sizes import across_sizes, across_sizes_figure, across_sizes_lines, size_split
 
     d = Path(config_dir)
     for name in ("map.toml", "plant.toml", "fit.toml"):
@@ -1186,20 +1201,9 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: b
         order, by = sorted(range(len(paths)), key=lambda k: paths[k].name), "name"
     paths = [paths[k] for k in order]
     batches = [load_log(p, cmap) for p in paths]
+    sizes = size_split(batches, fit_size_kg) if (by_size or fit_size_kg is not None) else None
     fit_b, val_b = batches[0::2], batches[1::2]
-    spec = load_fit_spec(d / "fit.toml")
-    result = fit(fit_b, d / "plant.toml", spec, column_map=cmap, progress=progress, seed=seed)
-    refit = None
-    drum_only = drum_path_alone(spec) if result.failed else None
-    if drum_only is not None:  # both heater paths free and the drum below the beans: the drum's path alone
-        again = fit(fit_b, d / "plant.toml", drum_only, column_map=cmap, progress=progress, seed=seed)
-        if not again.failed:
-            refit = (
-                f"with the heater free to heat the air and the drum, the fit failed on {result.failed}; "
-                "refitted with the heater heating the drum alone (Tgi_gain_C held at 0), the path of a drum "
-                "roaster; to keep this, remove Tgi_gain_C from [free] in fit.toml"
-            )
-            result, spec = again, drum_only
+    result, spec, refit = fit_checked(fit_b, d, load_fit_spec(d / "fit.toml"), cmap, seed, progress)
     model = result.model
     v_fit, v_val = model.validate(fit_b), model.validate(val_b)
     base = fit_first_order(fit_b)
@@ -1276,6 +1280,16 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: b
     every = held_out_one_by_one(batches, d, cmap, seed, progress, spec) if every_log else None
     if every is not None:
         lines += every_log_lines(every, len(batches))
+    across = None
+    if sizes is not None:
+        size_fit, _, size_refit = fit_checked([batches[k] for k in sizes.fit], d, spec, cmap, seed, progress)
+        across = across_sizes(size_fit.model, batches, sizes)
+        across["failed"], across["refit"] = size_fit.failed, size_refit
+        lines += across_sizes_lines(across, "sizes.png")
+        if size_refit:
+            lines += ["", f"Refitted (the fit on {sizes.fit_size} alone): {size_refit}."]
+        if size_fit.failed:
+            lines += ["", f"**The fit on {sizes.fit_size} alone failed**: {size_fit.failed}."]
     from ..report.figures import figure_bytes
 
     fig = v_val.plot()
@@ -1283,6 +1297,8 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: b
         out.write_text(d / "model.json", model_document_text(model.to_document()))
         out.write_text(d / "report.md", "\n".join(lines) + "\n")
         out.write_bytes(d / "heldout.png", figure_bytes(fig, d / "heldout.png"))
+        if across is not None:
+            out.write_bytes(d / "sizes.png", figure_bytes(across_sizes_figure(across), d / "sizes.png"))
     return {
         "fit": {"FIT": v_fit.average["FIT"], "MAE": v_fit.average["MAE"]},
         "held_out": {"FIT": v_val.average["FIT"], "MAE": v_val.average["MAE"]},
@@ -1299,11 +1315,33 @@ def fit_roaster(config_dir, paths, *, progress=None, seed: int = 0, every_log: b
             "band_median_width_C": every.cv_band_width_C,
             "by_log": every.cv_by_group,
         },
+        "across_sizes": across,
         "warnings": result.warnings,
         "failed": result.failed,
         "model": d / "model.json",
         "report": d / "report.md",
     }
+
+
+def fit_checked(batches, config_dir: Path, spec, column_map, seed: int, progress=None):
+    """Fit ``batches`` with ``spec`` (:func:`roastlab.workflows.fitting.fit`); a fit that fails on
+    its states with both of the heater's paths free is refitted with the drum's path alone
+    (:func:`drum_path_alone`). Returns ``(result, spec as used, refit sentence or None)``."""
+    from .fitting import fit
+
+    plant = Path(config_dir) / "plant.toml"
+    result = fit(batches, plant, spec, column_map=column_map, progress=progress, seed=seed)
+    drum_only = drum_path_alone(spec) if result.failed else None
+    if drum_only is not None:  # both heater paths free and the drum below the beans: the drum's path alone
+        again = fit(batches, plant, drum_only, column_map=column_map, progress=progress, seed=seed)
+        if not again.failed:
+            refit = (
+                f"with the heater free to heat the air and the drum, the fit failed on {result.failed}; "
+                "refitted with the heater heating the drum alone (Tgi_gain_C held at 0), the path of a drum "
+                "roaster; to keep this, remove Tgi_gain_C from [free] in fit.toml"
+            )
+            return again, drum_only, refit
+    return result, spec, None
 
 
 def drum_path_alone(spec):
