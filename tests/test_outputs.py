@@ -28,6 +28,8 @@ INPUTS |= {"--from", "--to", "--reference", "--scenario", "--scenarios", "--mani
 #: Options that take no path: numbers, names, choices and flags.
 VALUES = {
     "--every-log",
+    "--by-size",
+    "--fit-size-kg",
     "--batch-capacity-kg",
     "--drum-diameter-m",
     "--drum-length-m",
