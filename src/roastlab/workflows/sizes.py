@@ -40,6 +40,7 @@ class SizeSplit:
     fit: list[int]
     reference: list[int]
     others: list[int]
+    named: bool = False  # the fit size was named (``fit_size_kg``), not the one with the most logs
 
 
 def size_split(batches, fit_size_kg: float | None = None) -> SizeSplit:
@@ -75,12 +76,12 @@ def size_split(batches, fit_size_kg: float | None = None) -> SizeSplit:
             "--fit-size-kg" if fit_size_kg is not None else "--by-size",
         )
     others = [k for k, lab in enumerate(labels) if lab != fit_size]
-    return SizeSplit(labels, fit_size, members[0::2], members[1::2], others)
+    return SizeSplit(labels, fit_size, members[0::2], members[1::2], others, fit_size_kg is not None)
 
 
 def across_sizes(model, batches, split: SizeSplit) -> dict:
     """How ``model`` (fitted on ``split.fit``) predicts the reference and every other size:
-    ``{"fit_size", "fit_logs", "reference": {"logs", "FIT", "MAE", "MPE", "inside"},
+    ``{"fit_size", "fit_size_named", "fit_logs", "reference": {"logs", "FIT", "MAE", "MPE", "inside"},
     "sizes": [{"size", "logs", "FIT", "MAE", "MPE", "inside", "gap"}, ...] (lightest first),
     "others": {... the same over every other log, "gap"}, "rows": [per log: "name", "size", "unit",
     "Mb_kg", "FIT", "MAE", "MPE", "inside", "reference"], "band_level"}``. ``inside`` is the share
@@ -127,6 +128,7 @@ def across_sizes(model, batches, split: SizeSplit) -> dict:
         sizes.append({"size": label, **summary(members), "gap": mean_gap([m["FIT"] for m in members], ref_fit)})
     return {
         "fit_size": split.fit_size,
+        "fit_size_named": split.named,
         "fit_logs": [batches[k].name for k in split.fit],
         "reference": summary(reference),
         "sizes": sizes,
@@ -134,6 +136,11 @@ def across_sizes(model, batches, split: SizeSplit) -> dict:
         "rows": rows,
         "band_level": BAND_LEVEL,
     }
+
+
+def _logs(n: int) -> str:
+    """``"1 log"``, ``"3 logs"``."""
+    return f"{n} log" if n == 1 else f"{n} logs"
 
 
 def gap_words(gap: dict) -> str:
@@ -148,8 +155,8 @@ def across_sizes_sentence(res: dict) -> str:
     """The result in one line (the terminal's)."""
     o, ref = res["others"], res["reference"]
     return (
-        f"fitted on {res['fit_size']} ({len(res['fit_logs'])} logs), every other size (FIT {o['FIT']:.1f} % over "
-        f"{o['logs']} logs) against the fit size's held-out logs ({ref['FIT']:.1f} % over {ref['logs']}): "
+        f"fitted on {res['fit_size']} ({_logs(len(res['fit_logs']))}), every other size (FIT {o['FIT']:.1f} % over "
+        f"{_logs(o['logs'])}) against the fit size's held-out logs ({ref['FIT']:.1f} % over {ref['logs']}): "
         f"{gap_words(o['gap'])} points"
     )
 
@@ -169,8 +176,9 @@ def across_sizes_lines(res: dict, figure_name: str) -> list[str]:
         "",
         "## Across batch sizes",
         "",
-        f"The model fitted on {len(res['fit_logs'])} logs of {res['fit_size']} alone (the size with the most "
-        f"logs, split alternately: the 1st, 3rd, ... fit) predicts the {ref['logs']} other logs of that size and "
+        f"The model fitted on {_logs(len(res['fit_logs']))} of {res['fit_size']} alone "
+        f"({'the size named' if res['fit_size_named'] else 'the size with the most logs'}, split alternately: the "
+        f"1st, 3rd, ... fit) predicts the other {_logs(ref['logs'])} of that size and "
         "every log of another size with nothing refitted: each batch's areas and masses scale with its green "
         "weight (the paper's section 3.1), the machine's parameters are the fit's. A size predicted about as "
         "well as the held-out logs of the fit's size is the paper's claim holding on this roaster. Signed "
