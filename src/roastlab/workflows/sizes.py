@@ -82,18 +82,24 @@ def size_split(batches, fit_size_kg: float | None = None) -> SizeSplit:
 def across_sizes(model, batches, split: SizeSplit) -> dict:
     """How ``model`` (fitted on ``split.fit``) predicts the reference and every other size:
     ``{"fit_size", "fit_size_named", "fit_logs", "reference": {"logs", "FIT", "MAE", "MPE", "inside"},
-    "sizes": [{"size", "logs", "FIT", "MAE", "MPE", "inside", "gap"}, ...] (lightest first),
+    "sizes": [{"size", "logs", "FIT", "MAE", "MPE", "inside", "FIT_beans", "gap"}, ...] (lightest first),
     "others": {... the same over every other log, "gap"}, "rows": [per log: "name", "size", "unit",
-    "Mb_kg", "FIT", "MAE", "MPE", "inside", "reference"], "band_level"}``. ``inside`` is the share
-    of the probe's samples inside the 90 % band (NaN when the model file carries no band); a
+    "Mb_kg", "FIT", "MAE", "MPE", "inside", "reference", "FIT_beans"], "band_level"}``. ``inside`` is
+    the share of the probe's samples inside the 90 % band (NaN when the model file carries no band);
+    ``FIT_beans`` the model's bean temperature against a second bean reading (an infrared sensor; NaN
+    where the log has none), which judges the beans without the probe's model; a
     ``gap`` is :func:`roastlab.evaluate.metrics.mean_gap` of the logs' FIT against the reference's."""
-    from ..evaluate.bands import BAND_LEVEL, band_report, share_inside, why_no_band
+    from ..evaluate.bands import BAND_LEVEL, share_inside
     from ..evaluate.metrics import mean_gap
+    from .roaster import held_out_band
 
     order = split.reference + split.others
     chosen = [batches[k] for k in order]
     validation = model.validate(chosen)
-    band_rows = band_report(model, chosen, BAND_LEVEL)[0]["batches"] if why_no_band(model) is None else None
+    band = held_out_band(model, chosen)
+    band_rows = band["batches"] if band else None
+    second = validation.outputs.get("Tb2", {})  # the model's beans against a second bean reading (an IR)
+    beans = dict(zip(second.get("names", []), second.get("rows", [])))
     rows = []
     for j, k in enumerate(order):
         r = validation.rows[j]
@@ -109,6 +115,7 @@ def across_sizes(model, batches, split: SizeSplit) -> dict:
                 "n": int(band_rows[j]["n"]) if band_rows else 0,
                 "inside": float(band_rows[j]["inside"]) if band_rows else math.nan,
                 "reference": j < len(split.reference),
+                "FIT_beans": float(beans[validation.names[j]]["FIT"]) if validation.names[j] in beans else math.nan,
             }
         )
 
@@ -117,6 +124,8 @@ def across_sizes(model, batches, split: SizeSplit) -> dict:
         for key in ("FIT", "MAE", "MPE"):
             out[key] = float(np.mean([m[key] for m in members]))
         out["inside"] = share_inside(members) if band_rows else math.nan
+        read = [m["FIT_beans"] for m in members if math.isfinite(m["FIT_beans"])]
+        out["FIT_beans"] = float(np.mean(read)) if read else math.nan
         return out
 
     reference = [r for r in rows if r["reference"]]
@@ -165,11 +174,15 @@ def across_sizes_lines(res: dict, figure_name: str) -> list[str]:
     """The report's section (Markdown lines)."""
     level = f"{100 * res['band_level']:.0f} %"
     has_band = math.isfinite(res["reference"]["inside"])
+    has_beans = any(math.isfinite(r["FIT_beans"]) for r in res["rows"])
     units = sorted({r["unit"] for r in res["rows"]} - {""})
+
+    def beans(x: float) -> str:
+        return (f" {x:.1f} |" if math.isfinite(x) else " - |") if has_beans else ""
 
     def cells(s: dict) -> str:
         band = f" {100 * s['inside']:.0f} % |" if has_band else ""
-        return f" {s['logs']} | {s['FIT']:.1f} | {s['MAE']:.2f} | {s['MPE']:+.2f} |{band}"
+        return f" {s['logs']} | {s['FIT']:.1f} | {s['MAE']:.2f} | {s['MPE']:+.2f} |{band}{beans(s['FIT_beans'])}"
 
     ref = res["reference"]
     lines = [
@@ -182,11 +195,17 @@ def across_sizes_lines(res: dict, figure_name: str) -> list[str]:
         "every log of another size with nothing refitted: each batch's areas and masses scale with its green "
         "weight (the paper's section 3.1), the machine's parameters are the fit's. A size predicted about as "
         "well as the held-out logs of the fit's size is the paper's claim holding on this roaster. Signed "
-        "error (MPE) positive where the model reads low.",
+        "error (MPE) positive where the model reads low."
+        + (
+            " Where the logs have a second bean reading (an infrared sensor), the model's beans against it "
+            "judge the beans without the probe's model."
+            if has_beans
+            else ""
+        ),
         "",
-        f"| batch size | logs | FIT % | MAE °C | signed error % |{f' inside the {level} band |' if has_band else ''} "
-        "gap to the held-out fit size, FIT points |",
-        f"|---|---|---|---|---|{'---|' if has_band else ''}---|",
+        f"| batch size | logs | FIT % | MAE °C | signed error % |{f' inside the {level} band |' if has_band else ''}"
+        f"{' beans vs the second reading, FIT % |' if has_beans else ''} gap to the held-out fit size, FIT points |",
+        f"|---|---|---|---|---|{'---|' if has_band else ''}{'---|' if has_beans else ''}---|",
         f"| {res['fit_size']}, held out |{cells(ref)} |",
     ]
     lines += [f"| {s['size']} |{cells(s)} {gap_words(s['gap'])} |" for s in res["sizes"]]
@@ -197,14 +216,17 @@ def across_sizes_lines(res: dict, figure_name: str) -> list[str]:
         "or two roasts cannot pin it.",
         "",
         f"| log | batch | {'roaster | ' if len(units) > 1 else ''}FIT % | signed error % |"
-        f"{' inside the band |' if has_band else ''}",
-        f"|---|---|{'---|' if len(units) > 1 else ''}---|---|{'---|' if has_band else ''}",
+        f"{' inside the band |' if has_band else ''}{' beans vs the second reading, FIT % |' if has_beans else ''}",
+        f"|---|---|{'---|' if len(units) > 1 else ''}---|---|{'---|' if has_band else ''}{'---|' if has_beans else ''}",
     ]
     for r in sorted(res["rows"], key=lambda r: (r["Mb_kg"], r["name"])):
         who = f" {r['unit'] or '-'} |" if len(units) > 1 else ""
         band = f" {100 * r['inside']:.0f} % |" if has_band else ""
         mark = " (held out, fit size)" if r["reference"] else ""
-        lines.append(f"| {r['name']}{mark} | {1000 * r['Mb_kg']:.0f} g |{who} {r['FIT']:.1f} | {r['MPE']:+.2f} |{band}")
+        lines.append(
+            f"| {r['name']}{mark} | {1000 * r['Mb_kg']:.0f} g |{who} {r['FIT']:.1f} | {r['MPE']:+.2f} |{band}"
+            f"{beans(r['FIT_beans'])}"
+        )
     if len(units) > 1:
         lines += [
             "",
