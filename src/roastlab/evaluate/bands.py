@@ -362,6 +362,14 @@ def band_report(model, batches, level: float = BAND_LEVEL) -> tuple[dict, list[B
     return doc, bands
 
 
+def held_out_band(model, batches) -> dict | None:
+    """How well the model's 90 % prediction band holds logs it was not fitted on (:func:`band_report`
+    at :data:`BAND_LEVEL`); None when the model file can carry no band (:func:`why_no_band`)."""
+    if why_no_band(model) is not None:
+        return None
+    return band_report(model, batches, BAND_LEVEL)[0]
+
+
 def band_coverage(model, batches, level: float = BAND_LEVEL) -> list[dict]:
     """Per batch: ``{"name", "n", "inside" (share of measured probe samples inside the band),
     "median_width_C", "Mb_kg"}``."""

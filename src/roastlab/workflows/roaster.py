@@ -1101,19 +1101,8 @@ def below_baseline(model_fit_pct: float, baseline_fit_pct: float, column_map) ->
     return text
 
 
-def held_out_band(model, batches) -> dict | None:
-    """How well the model's 90 % prediction band holds logs it was not fitted on
-    (:func:`roastlab.evaluate.bands.band_report`); None when the model file can carry no band
-    (:func:`roastlab.evaluate.bands.why_no_band`)."""
-    from ..evaluate.bands import BAND_LEVEL, band_report, why_no_band
-
-    if why_no_band(model) is not None:
-        return None
-    return band_report(model, batches, BAND_LEVEL)[0]
-
-
 def band_sentence(band: dict) -> str:
-    """:func:`held_out_band` in words: the share inside against the level and the width (its note apart)."""
+    """:func:`roastlab.evaluate.bands.held_out_band` in words: the share inside against the level and the width (its note apart)."""
     level = f"{100 * band['level']:.0f} %"
     return (
         f"{100 * band['inside_all']:.0f} % of the held-out logs' probe samples lie inside the {level} prediction "
@@ -1157,6 +1146,7 @@ def fit_roaster(
     roaster (:mod:`roastlab.workflows.sizes`; one more fit), written to the report and
     ``config_dir``/sizes.png.
     """
+    from ..evaluate.bands import held_out_band
     from ..evaluate.metrics import average_metrics
     from ..fit.baseline import describe, fit_first_order, validate_first_order
     from ..io.files import Outputs

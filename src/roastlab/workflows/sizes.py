@@ -89,9 +89,8 @@ def across_sizes(model, batches, split: SizeSplit) -> dict:
     ``FIT_beans`` the model's bean temperature against a second bean reading (an infrared sensor; NaN
     where the log has none), which judges the beans without the probe's model; a
     ``gap`` is :func:`roastlab.evaluate.metrics.mean_gap` of the logs' FIT against the reference's."""
-    from ..evaluate.bands import BAND_LEVEL, share_inside
+    from ..evaluate.bands import BAND_LEVEL, held_out_band, share_inside
     from ..evaluate.metrics import mean_gap
-    from .roaster import held_out_band
 
     order = split.reference + split.others
     chosen = [batches[k] for k in order]
