@@ -860,6 +860,7 @@ def test_fit_roaster_by_size_carries_a_synthetic_drum_over_to_other_batches(cli,
     assert set(right["rows"]) >= {"2 kg", "4 kg"}
     assert sum("(held out, fit size)" in r for r in right["rows"]) == 2  # the 2nd and 4th 3 kg logs
     assert "second reading" not in right["section"]  # these logs have no second bean reading
+    assert "other roasters" not in right["section"]  # nor name their roaster
     # the truth roasted 3 kg where the 2 and 4 kg logs say otherwise: the model, told 2 and 4 kg, misses them
     (tmp_path / "wrong").mkdir()
     wrong_logs = _synthetic_gas_drum_logs(tmp_path / "wrong", batches_g=_SIZES_G, simulated_g=[3000.0] * 9)
@@ -891,6 +892,11 @@ def test_fit_roaster_by_size_on_the_bullet_reads_the_scaling_gap_from_inits_file
     section = (tmp_path / "cfg" / "report.md").read_text().split("## Across batch sizes")[1]
     assert section.count("(held out, fit size)") == 9 and "| 200 g | 2054 |" in section
     assert "from 5 roasters (1447, 1737, 2054, 2779, 536895084)" in section
+    # the fit's own drum's other sizes apart from the other drums' (the issue's two figures), each a gap
+    own = next(r for r in section.splitlines() if r.startswith("| other sizes, the fit's own roaster 2779 |"))
+    foreign = next(r for r in section.splitlines() if r.startswith("| other sizes, other roasters |"))
+    assert own.split("|")[2].strip() == "4" and foreign.split("|")[2].strip() == "5"
+    assert "; the fit's own roaster's other sizes " in line and "other roasters' " in line
     # the IR reading judges the beans apart from the probe: the held-out fit size's beans read well
     ref_row = next(r for r in section.splitlines() if r.startswith("| 0.47-0.5 kg, held out |"))
     assert "beans vs the second reading" in section and float(ref_row.split("|")[7]) > 85.0, ref_row

@@ -83,7 +83,9 @@ def across_sizes(model, batches, split: SizeSplit) -> dict:
     """How ``model`` (fitted on ``split.fit``) predicts the reference and every other size:
     ``{"fit_size", "fit_size_named", "fit_logs", "reference": {"logs", "FIT", "MAE", "MPE", "inside"},
     "sizes": [{"size", "logs", "FIT", "MAE", "MPE", "inside", "FIT_beans", "gap"}, ...] (lightest first),
-    "others": {... the same over every other log, "gap"}, "rows": [per log: "name", "size", "unit",
+    "others": {... the same over every other log, "gap"}, "by_roaster": {"fit_roasters", "own": {...
+    the fit's roaster's other sizes}, "other_roasters": {...}} or None (only where the logs name
+    roasters and the other sizes come from both), "rows": [per log: "name", "size", "unit",
     "Mb_kg", "FIT", "MAE", "MPE", "inside", "reference", "FIT_beans"], "band_level"}``. ``inside`` is
     the share of the probe's samples inside the 90 % band (NaN when the model file carries no band);
     ``FIT_beans`` the model's bean temperature against a second bean reading (an infrared sensor; NaN
@@ -134,6 +136,18 @@ def across_sizes(model, batches, split: SizeSplit) -> dict:
     for label in dict.fromkeys(split.labels[k] for k in sorted(split.others, key=lambda k: batches[k].Mb_kg)):
         members = [r for r in other_rows if r["size"] == label]
         sizes.append({"size": label, **summary(members), "gap": mean_gap([m["FIT"] for m in members], ref_fit)})
+    # where the logs name their roasters and some other-size logs come from another one: the fit's own
+    # roaster's other sizes apart from the other roasters' (a log of another drum tests two things at once)
+    fit_units = sorted({str(getattr(batches[k], "unit", "") or "") for k in split.fit} - {""})
+    own = [r for r in other_rows if r["unit"] in fit_units]
+    foreign = [r for r in other_rows if r["unit"] not in fit_units]
+    by_roaster = None
+    if fit_units and own and foreign:
+        by_roaster = {
+            "fit_roasters": fit_units,
+            "own": {**summary(own), "gap": mean_gap([r["FIT"] for r in own], ref_fit)},
+            "other_roasters": {**summary(foreign), "gap": mean_gap([r["FIT"] for r in foreign], ref_fit)},
+        }
     return {
         "fit_size": split.fit_size,
         "fit_size_named": split.named,
@@ -141,6 +155,7 @@ def across_sizes(model, batches, split: SizeSplit) -> dict:
         "reference": summary(reference),
         "sizes": sizes,
         "others": {**summary(other_rows), "gap": mean_gap([r["FIT"] for r in other_rows], ref_fit)},
+        "by_roaster": by_roaster,
         "rows": rows,
         "band_level": BAND_LEVEL,
     }
@@ -161,12 +176,18 @@ def gap_words(gap: dict) -> str:
 
 def across_sizes_sentence(res: dict) -> str:
     """The result in one line (the terminal's)."""
-    o, ref = res["others"], res["reference"]
-    return (
+    o, ref, r = res["others"], res["reference"], res["by_roaster"]
+    text = (
         f"fitted on {res['fit_size']} ({_logs(len(res['fit_logs']))}), every other size (FIT {o['FIT']:.1f} % over "
         f"{_logs(o['logs'])}) against the fit size's held-out logs ({ref['FIT']:.1f} % over {ref['logs']}): "
         f"{gap_words(o['gap'])} points"
     )
+    if r:
+        text += (
+            f"; the fit's own roaster's other sizes {r['own']['FIT']:.1f} % (gap {r['own']['gap']['gap']:+.1f}), "
+            f"other roasters' {r['other_roasters']['FIT']:.1f} % (gap {r['other_roasters']['gap']['gap']:+.1f})"
+        )
+    return text
 
 
 def across_sizes_lines(res: dict, figure_name: str) -> list[str]:
@@ -208,8 +229,15 @@ def across_sizes_lines(res: dict, figure_name: str) -> list[str]:
         f"| {res['fit_size']}, held out |{cells(ref)} |",
     ]
     lines += [f"| {s['size']} |{cells(s)} {gap_words(s['gap'])} |" for s in res["sizes"]]
+    lines.append(f"| **every other size** |{cells(res['others'])} **{gap_words(res['others']['gap'])}** |")
+    r = res["by_roaster"]
+    if r:
+        own = f"roaster {r['fit_roasters'][0]}" if len(r["fit_roasters"]) == 1 else "roasters"
+        lines += [
+            f"| other sizes, the fit's own {own} |{cells(r['own'])} {gap_words(r['own']['gap'])} |",
+            f"| other sizes, other roasters |{cells(r['other_roasters'])} {gap_words(r['other_roasters']['gap'])} |",
+        ]
     lines += [
-        f"| **every other size** |{cells(res['others'])} **{gap_words(res['others']['gap'])}** |",
         "",
         "A gap's interval is Welch's t over the logs' FIT (`roastlab.evaluate.metrics.mean_gap`): a size of one "
         "or two roasts cannot pin it.",
