@@ -132,10 +132,12 @@ def across_sizes(model, batches, split: SizeSplit) -> dict:
     reference = [r for r in rows if r["reference"]]
     other_rows = [r for r in rows if not r["reference"]]
     ref_fit = [r["FIT"] for r in reference]
-    sizes = []
-    for label in dict.fromkeys(split.labels[k] for k in sorted(split.others, key=lambda k: batches[k].Mb_kg)):
-        members = [r for r in other_rows if r["size"] == label]
-        sizes.append({"size": label, **summary(members), "gap": mean_gap([m["FIT"] for m in members], ref_fit)})
+
+    def group(members: list[dict]) -> dict:  # a group of other logs, with its gap to the reference
+        return {**summary(members), "gap": mean_gap([m["FIT"] for m in members], ref_fit)}
+
+    labels = dict.fromkeys(split.labels[k] for k in sorted(split.others, key=lambda k: batches[k].Mb_kg))
+    sizes = [{"size": label, **group([r for r in other_rows if r["size"] == label])} for label in labels]
     # where the logs name their roasters and some other-size logs come from another one: the fit's own
     # roaster's other sizes apart from the other roasters' (a log of another drum tests two things at once)
     fit_units = sorted({str(getattr(batches[k], "unit", "") or "") for k in split.fit} - {""})
@@ -143,18 +145,14 @@ def across_sizes(model, batches, split: SizeSplit) -> dict:
     foreign = [r for r in other_rows if r["unit"] not in fit_units]
     by_roaster = None
     if fit_units and own and foreign:
-        by_roaster = {
-            "fit_roasters": fit_units,
-            "own": {**summary(own), "gap": mean_gap([r["FIT"] for r in own], ref_fit)},
-            "other_roasters": {**summary(foreign), "gap": mean_gap([r["FIT"] for r in foreign], ref_fit)},
-        }
+        by_roaster = {"fit_roasters": fit_units, "own": group(own), "other_roasters": group(foreign)}
     return {
         "fit_size": split.fit_size,
         "fit_size_named": split.named,
         "fit_logs": [batches[k].name for k in split.fit],
         "reference": summary(reference),
         "sizes": sizes,
-        "others": {**summary(other_rows), "gap": mean_gap([r["FIT"] for r in other_rows], ref_fit)},
+        "others": group(other_rows),
         "by_roaster": by_roaster,
         "rows": rows,
         "band_level": BAND_LEVEL,
