@@ -384,6 +384,8 @@ def test_a_model_is_fitted_on_the_page_in_the_background(client, data_dir):
     assert "held out" in st["report"] and st["held_out"]["FIT"] > 0
     assert st["model"] in client.get("/api/files", headers=H).json()["models"]
     assert st["every_log"] is None and "Every log held out once" not in st["report"]
+    # the report's figure comes with it, drawn under the report on the page
+    assert set(st["figures"]) == {"heldout"} and st["figures"]["heldout"].startswith("data:image/png;base64,")
     assert st["verdict"] is None and "Not usable" not in st["report"]  # it beats the first-order baseline
     # the page's "also hold each log out once": fit-roaster --every-log behind it
     assert client.post("/api/fit", json={"logs": logs, "name": "sky", "every_log": True}, headers=H).json()["started"]
@@ -407,6 +409,7 @@ def test_a_model_is_fitted_on_the_page_in_the_background(client, data_dir):
         time.sleep(0.2)
     assert "error" not in st, st
     assert "## Across batch sizes" in st["report"] and "fitted on 0.15-0.152 kg (3 logs)" in st["across_sizes"]
+    assert set(st["figures"]) == {"heldout", "sizes"}
     # logs with no heater or fan setting: ET drives the model, worse than the baseline here, and the page says so
     (data_dir / "bare").mkdir(exist_ok=True)
     bare = []

@@ -333,6 +333,7 @@ let pickModel = null;
 async function runFit() {
   const logs = Array.from($("fit_logs").selectedOptions).map((o) => o.value);
   say("");
+  $("fit-figures").replaceChildren();
   try {
     await api("/api/fit", {
       logs, name: $("fit_name").value, every_log: $("fit_every_log").checked, by_size: $("fit_by_size").checked,
@@ -345,6 +346,12 @@ async function runFit() {
       if (st.running) { setTimeout(poll, 300); return; }
       if (st.error) { say(st.error); return; }
       $("fit-report").textContent = st.report;
+      $("fit-figures").replaceChildren(...Object.entries(st.figures || {}).map(([name, src]) => {
+        const img = document.createElement("img");  // the report's figures: held-out curves, FIT by batch size
+        Object.assign(img, { src, alt: name, title: `${name}.png` });
+        img.style.maxWidth = "100%";
+        return img;
+      }));
       $("fit_text").textContent = `held out: FIT ${st.held_out.FIT.toFixed(1)} %, MAE ${st.held_out.MAE.toFixed(2)} °C` +
         (st.every_log ? `; each log held out once: FIT ${st.every_log.FIT.toFixed(1)} %` : "") +
         (st.across_sizes ? `; across sizes: ${st.across_sizes}` : "");

@@ -28,6 +28,7 @@ so two tabs do not share or overwrite state. A bad file or an infeasible request
 
 from __future__ import annotations
 
+import base64
 import re
 import threading
 import time
@@ -457,6 +458,12 @@ def create_app(data_dir: str | Path):
                     verdict=r["below_baseline"],
                     every_log=r["every_log"] and {"FIT": r["every_log"]["FIT"]},
                     across_sizes=r["across_sizes"] and across_sizes_sentence(r["across_sizes"]),
+                    figures={  # the report's figures, drawn under it on the page
+                        name: "data:image/png;base64,"
+                        + base64.b64encode((folder / f"{name}.png").read_bytes()).decode()
+                        for name, made in (("heldout", True), ("sizes", r["across_sizes"] is not None))
+                        if made
+                    },
                 )
             except RoastlabError as exc:
                 session.fit.update(running=False, error=str(exc))
