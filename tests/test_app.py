@@ -395,15 +395,18 @@ def test_a_model_is_fitted_on_the_page_in_the_background(client, data_dir):
     assert "error" not in st, st
     assert "## Every log held out once" in st["report"] and -100 < st["every_log"]["FIT"] <= 100
     # the page's "also predict other batch sizes": fit-roaster --by-size behind it; four logs of one size
-    # cannot, and the page says why
-    assert client.post("/api/fit", json={"logs": logs, "name": "sky", "by_size": True}, headers=H).json()["started"]
+    # (150-152 g) cannot, and the page says why
+    one_size = ["roast_25-09-27_1236_R14", "roast_25-10-04_1155", "roast_25-10-04_1229", "roast_25-10-25_1544"]
+    sized = []
+    for stem in [*one_size, "roast_25-10-25_1609", "roast_25-11-16_1235"]:  # two more: 150 g and 200 g
+        shutil.copy(sky / f"{stem}.alog", data_dir / "sky" / f"{stem}.alog")
+        sized.append(f"sky/{stem}.alog")
+    body = {"logs": sized[:4], "name": "sky", "by_size": True}
+    assert client.post("/api/fit", json=body, headers=H).json()["started"]
     while (st := client.get("/api/fit-status", headers=H).json()).get("running"):
         time.sleep(0.2)
     assert "all one batch size (0.15-0.152 kg)" in st["error"], st
-    for p in sorted(sky.glob("*.alog"))[4:6]:  # two more: 150 g and 200 g
-        shutil.copy(p, data_dir / "sky" / p.name)
-        logs.append(f"sky/{p.name}")
-    assert client.post("/api/fit", json={"logs": logs, "name": "sky", "by_size": True}, headers=H).json()["started"]
+    assert client.post("/api/fit", json={**body, "logs": sized}, headers=H).json()["started"]
     deadline = time.monotonic() + 180
     while (st := client.get("/api/fit-status", headers=H).json()).get("running") and time.monotonic() < deadline:
         time.sleep(0.2)
