@@ -26,6 +26,20 @@ def rewritten_alog(src: Path, dst: Path, edit) -> Path:
     return dst
 
 
+def event_steps(doc: dict, event_type: int) -> list[float]:
+    """The step series ``doc``'s special events of ``event_type`` make, per sample, as the machine would
+    report the setting (its external value; before the first change, the first one)."""
+    import numpy as np
+
+    from roastlab.io.importers.artisan import events_internal_to_external
+
+    s = np.full(len(doc["timex"]), np.nan)
+    for i, t, v in zip(doc["specialevents"], doc["specialeventstype"], doc["specialeventsvalue"]):
+        if t == event_type:
+            s[i:] = events_internal_to_external(v)
+    return [float(x) for x in np.where(np.isnan(s), s[np.isfinite(s)][0], s)]
+
+
 def drop_events(doc: dict, event_type: int | None = None) -> None:
     """Remove ``doc``'s special events of ``event_type`` (an index into ``etypes``), or all of them."""
     keep = [k for k, t in enumerate(doc["specialeventstype"]) if event_type is not None and t != event_type]

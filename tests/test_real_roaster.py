@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import REAL_DATA, drop_events, printed_percent, rewritten_alog
+from conftest import REAL_DATA, drop_events, event_steps, printed_percent, rewritten_alog
 from roastlab.fit.baseline import first_order_response, fit_first_order
 from roastlab.io.batch import Batch
 
@@ -160,15 +160,10 @@ def test_skywalker_logs_whose_fan_is_only_a_speed_readout_fit_as_with_its_events
     readout (600 rpm at 0 % to 3000 rpm at 100 %, following the logged setting): init takes it as the
     fan in rpm (until 2026-11-26 dropped as "above 100"), and the fit predicts the held-out half as
     from the Air events (82.1 %), and a what-if on it moves the roast the way the percent fan does."""
-    from roastlab.io.importers.artisan import events_internal_to_external
 
     def rpm_only(doc):
         n = len(doc["timex"])
-        s = np.full(n, np.nan)
-        for i, t, v in zip(doc["specialevents"], doc["specialeventstype"], doc["specialeventsvalue"]):
-            if t == 0:  # the Skywalker's Air
-                s[i:] = events_internal_to_external(v)
-        s = np.where(np.isnan(s), s[np.isfinite(s)][0], s)
+        s = event_steps(doc, 0)  # the Skywalker's Air
         drop_events(doc, 0)
         doc.update(extradevices=[25], extraname1=["Fan RPM"], extraname2=["Voltage"], extratimex=[doc["timex"]],
                    extratemp1=[[float(600.0 + 24.0 * x) for x in s]], extratemp2=[[230.0] * n],
@@ -196,19 +191,10 @@ def test_skywalker_logs_in_the_aillio_r1_layout_find_their_heater_and_fan(cli, r
     beside a "Fan RPM" (and, without events, the readouts alone). init finds the heater and the fan
     (it took "Fan RPM", above 100 so unused, and found no heater in the readouts), and the fit predicts
     the held-out half as the Artisan-default layout does (82.1 %)."""
-    from roastlab.io.importers.artisan import events_internal_to_external
 
     def aillio(doc):
         n = len(doc["timex"])
-
-        def setting(kind):  # the step series an event type's events make, as the machine reports it
-            s = np.full(n, np.nan)  # (reporting its setting before the first change too: the first one)
-            for i, t, v in zip(doc["specialevents"], doc["specialeventstype"], doc["specialeventsvalue"]):
-                if t == kind:
-                    s[i:] = events_internal_to_external(v)
-            return [float(x) for x in np.where(np.isnan(s), s[np.isfinite(s)][0], s)]
-
-        heater, fan = setting(3), setting(0)  # the Skywalker's Burner and Air
+        heater, fan = event_steps(doc, 3), event_steps(doc, 0)  # the Skywalker's Burner and Air
         doc["etypes"] = ["Fan", "Drum", "Damper", "Heater", "--"]
         doc.update(extradevices=[84, 85], extraname1=["{3}", "Voltage"], extraname2=["{0}", "Fan RPM"],
                    extraNoneTempHint1=[True, True], extraNoneTempHint2=[True, True], extratimex=[doc["timex"]] * 2,
