@@ -3,8 +3,9 @@
 theta* = argmin sum_j SSR_j(theta) within bounds. Two global strategies:
 
 * ``"global"`` (default), in the spirit of MATLAB's GlobalSearch that the paper used:
-  score many scattered trial points (a scrambled Sobol set, seeded) in one parallel
-  population call, then polish the paper's start theta0 and the best distinct trial points
+  score many scattered trial points (a scrambled Sobol set, seeded; evenly in each parameter,
+  or in its logarithm where its bounds span two decades, :data:`LOG_SAMPLED_SPAN`; the outer
+  tenth of each range on its bound, :data:`ON_BOUND_SHARE`) in one parallel population call, then polish the paper's start theta0 and the best distinct trial points
   with a bounded trust-region least-squares solver (SciPy ``least_squares``, ``trf``). As in
   GlobalSearch, a start inside the basin of an optimum already found is not polished again
   (:data:`BASIN_FACTOR`), and the trial points are only ranked, so they are scored with the
@@ -378,6 +379,67 @@ def build_free_parameters(
     return free, fixed
 
 
+#: A parameter whose bounds span at least this ratio (two decades) is sampled evenly in its
+#: logarithm by the global search's trial points: a coefficient in [0.001, 1] kW/(m2 K) or a rate
+#: factor A in [1e5, 1e10] is as likely a decade from its floor as near its ceiling, while evenly in
+#: the value 99 % of the trial points would lie above a tenth of the ceiling.
+LOG_SAMPLED_SPAN = 100.0
+
+
+def log_sampled(lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
+    """Which parameters the trial points sample in their logarithm (:data:`LOG_SAMPLED_SPAN`).
+
+    >>> log_sampled(np.array([0.001, 0.05, 0.0, 5000.0]), np.array([1.0, 0.95, 0.1, 13000.0])).tolist()
+    [True, False, False, False]
+    """
+    lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return (lower > 0) & (upper >= LOG_SAMPLED_SPAN * lower)
+
+
+#: The share of each parameter's range, at either end, whose trial points are moved onto the bound:
+#: the optima of this model often sit on a bound (the paper's hgm, the Skywalker's hbm and base flow
+#: and the Bullet's hgm on their floors), where a scattered point would almost never land, so about
+#: one coordinate in five of the trial points lies on a face of the box.
+ON_BOUND_SHARE = 0.1
+
+
+def on_bounds(unit: np.ndarray) -> np.ndarray:
+    """Unit-cube trial points with each coordinate within :data:`ON_BOUND_SHARE` of 0 or 1 moved there.
+
+    >>> on_bounds(np.array([[0.05, 0.5, 0.95]])).tolist()
+    [[0.0, 0.5, 1.0]]
+    """
+    return np.where(unit < ON_BOUND_SHARE, 0.0, np.where(unit > 1.0 - ON_BOUND_SHARE, 1.0, unit))
+
+
+def trial_points(unit: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
+    """Points of the unit cube (rows) as parameter values: evenly in the value, or in its logarithm
+    for :func:`log_sampled` parameters (the inverse of :func:`trial_unit`).
+
+    >>> trial_points(np.array([[0.0, 0.5, 1.0]]), np.array([1e-3, 1e-3, 0.0]), np.array([1.0, 1.0, 2.0])).round(6).tolist()
+    [[0.001, 0.031623, 2.0]]
+    """
+    logs = log_sampled(lower, upper)
+    lin = lower + unit * (upper - lower)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        geo = lower * (upper / np.where(logs, lower, 1.0)) ** unit
+    return np.where(logs, geo, lin)
+
+
+def trial_unit(z: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
+    """Parameter values (rows) as points of the unit cube of :func:`trial_points`.
+
+    >>> trial_unit(np.array([[0.001, 0.031623, 2.0]]), np.array([1e-3, 1e-3, 0.0]), np.array([1.0, 1.0, 2.0])).round(4).tolist()
+    [[0.0, 0.5, 1.0]]
+    """
+    logs = log_sampled(lower, upper)
+    z = np.asarray(z, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        geo = np.log(z / np.where(logs, lower, 1.0)) / np.log(np.where(logs, upper / lower, 2.0))
+    return np.where(logs, geo, (z - lower) / (upper - lower))
+
+
 #: A start closer to an optimum already found than this share of that optimum's basin radius is
 #: not polished (MATLAB GlobalSearch's ``DistanceThresholdFactor``, 0.75). A basin's radius is the
 #: longest distance a polish travelled to reach its optimum, both in units of the bounds' widths.
@@ -487,15 +549,15 @@ def identify(
     starts_log = []
     if method == "global":
         sampler = qmc.Sobol(nz, scramble=True, seed=rng)
-        trial = qmc.scale(sampler.random(n_trial), obj.lower, obj.upper)
-        trial = np.vstack([obj.start[None, :], trial])
+        unit = np.vstack([trial_unit(obj.start[None, :], obj.lower, obj.upper), on_bounds(sampler.random(n_trial))])
+        trial = trial_points(unit, obj.lower, obj.upper)
         ssr = obj.ssr_many(trial, SCREENING_TOL_SCALE)
         order = np.argsort(ssr[1:]) + 1
         chosen = [0]
         for i in order:  # the best trial points that are not near-duplicates of a chosen one
             if len(chosen) >= n_starts:
                 break
-            if all(np.max(np.abs(trial[i] - trial[c]) / width) > 0.05 for c in chosen):
+            if all(np.max(np.abs(unit[i] - unit[c])) > 0.05 for c in chosen):
                 chosen.append(int(i))
         candidates = [trial[i] for i in chosen]
     else:
