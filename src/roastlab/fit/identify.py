@@ -5,9 +5,10 @@ theta* = argmin sum_j SSR_j(theta) within bounds. Two global strategies:
 * ``"global"`` (default), in the spirit of MATLAB's GlobalSearch that the paper used:
   score many scattered trial points (a scrambled Sobol set, seeded; evenly in each parameter,
   or in its logarithm where its bounds span two decades, :data:`LOG_SAMPLED_SPAN`; the outer
-  tenth of each range on its bound, :data:`ON_BOUND_SHARE`) in one parallel population call, then polish the paper's start theta0 and the best distinct trial points
-  with a bounded trust-region least-squares solver (SciPy ``least_squares``, ``trf``). As in
-  GlobalSearch, a start inside the basin of an optimum already found is not polished again
+  tenth of each range on its bound, :data:`ON_BOUND_SHARE`) in one parallel population call,
+  then polish the paper's start theta0 and the best distinct trial points with a bounded
+  trust-region least-squares solver (SciPy ``least_squares``, ``trf``). As in GlobalSearch, a
+  start inside the basin of an optimum already found is not polished again
   (:data:`BASIN_FACTOR`), and the trial points are only ranked, so they are scored with the
   integrator's tolerances loosened (:data:`SCREENING_TOL_SCALE`);
 * ``"de"``: SciPy's differential evolution, evaluating each generation as one population
