@@ -135,16 +135,23 @@ def test_skywalker_fit_on_bt_alone_fails_on_its_states(cli, real_data, tmp_path)
     assert code == 0 and "failed" not in err, err
 
 
+def _skywalker_without_et(real_data, tmp_path) -> list:
+    """The Skywalker's logs rewritten in tmp_path with ET removed (Artisan's "no sample"), as a
+    roaster that logs BT and the settings only; the shared logs untouched."""
+
+    def no_et(doc):
+        doc["temp1"] = [-1.0] * len(doc["temp1"])
+
+    return [rewritten_alog(p, tmp_path / p.name, no_et) for p in sorted(real_data.glob("*.alog"))]
+
+
 @pytest.mark.slow
 def test_skywalker_logs_without_et_fit_with_the_heater_into_the_drum(cli, real_data, tmp_path):
     """The Skywalker's 16 logs with their ET removed (rewritten in tmp_path; the shared logs untouched),
     as a roaster that logs BT and the settings only: init sends the heater into the drum alone, and the
     fit is physical and predicts the held-out half (free to use both paths, it failed on its states)."""
 
-    def no_et(doc):
-        doc["temp1"] = [-1.0] * len(doc["temp1"])  # Artisan's "no sample"
-
-    logs = [rewritten_alog(p, tmp_path / p.name, no_et) for p in sorted(real_data.glob("*.alog"))]
+    logs = _skywalker_without_et(real_data, tmp_path)
     code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
     assert code == 0 and "ET: no" in out, err
     assert "Tgi_gain_C" not in (tmp_path / "cfg" / "fit.toml").read_text()
@@ -163,10 +170,7 @@ def test_the_global_search_reaches_the_bt_only_fits_corner_of_the_bounds(cli, re
     degC2). Trial points spread in the logarithm and put on the bounds near them reach it
     (roastlab.fit.identify.trial_points, on_bounds; docs/your-roaster.md, "No ET in the logs")."""
 
-    def no_et(doc):
-        doc["temp1"] = [-1.0] * len(doc["temp1"])
-
-    logs = [rewritten_alog(p, tmp_path / p.name, no_et) for p in sorted(real_data.glob("*.alog"))]
+    logs = _skywalker_without_et(real_data, tmp_path)
     assert cli("init", *logs, "--out", tmp_path / "cfg")[0] == 0
     cfg = tmp_path / "cfg"
     code, out, err = cli("identify", "--plant", cfg / "plant.toml", "--map", cfg / "map.toml",
