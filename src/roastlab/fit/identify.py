@@ -394,8 +394,13 @@ def log_sampled(lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
     [True, False, False, False]
     """
     lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return (lower > 0) & (upper >= LOG_SAMPLED_SPAN * lower)
+    return (lower > 0) & (upper >= LOG_SAMPLED_SPAN * lower)
+
+
+def _sampling_coordinate(z, logs: np.ndarray) -> np.ndarray:
+    """Values as the trial points spread them: the logarithm where ``logs``, else the value."""
+    z = np.asarray(z, dtype=float)
+    return np.where(logs, np.log(np.where(logs, z, 1.0)), z)
 
 
 #: The share of each parameter's range, at either end, whose trial points are moved onto the bound:
@@ -416,16 +421,19 @@ def on_bounds(unit: np.ndarray) -> np.ndarray:
 
 def trial_points(unit: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
     """Points of the unit cube (rows) as parameter values: evenly in the value, or in its logarithm
-    for :func:`log_sampled` parameters (the inverse of :func:`trial_unit`).
+    for :func:`log_sampled` parameters (the inverse of :func:`trial_unit`); a coordinate of 0 or 1
+    is the bound itself, never one rounded past it.
 
     >>> trial_points(np.array([[0.0, 0.5, 1.0]]), np.array([1e-3, 1e-3, 0.0]), np.array([1.0, 1.0, 2.0])).round(6).tolist()
     [[0.001, 0.031623, 2.0]]
+    >>> trial_points(np.array([[0.0, 1.0]]), np.array([1e-4, 1e-4]), np.array([0.03, 0.03])).tolist()
+    [[0.0001, 0.03]]
     """
     logs = log_sampled(lower, upper)
-    lin = lower + unit * (upper - lower)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        geo = lower * (upper / np.where(logs, lower, 1.0)) ** unit
-    return np.where(logs, geo, lin)
+    lo, hi = _sampling_coordinate(lower, logs), _sampling_coordinate(upper, logs)
+    c = lo + unit * (hi - lo)
+    inside = np.clip(np.where(logs, np.exp(np.where(logs, c, 0.0)), c), lower, upper)
+    return np.where(unit <= 0.0, lower, np.where(unit >= 1.0, upper, inside))
 
 
 def trial_unit(z: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
@@ -435,10 +443,8 @@ def trial_unit(z: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> np.ndarra
     [[0.0, 0.5, 1.0]]
     """
     logs = log_sampled(lower, upper)
-    z = np.asarray(z, dtype=float)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        geo = np.log(z / np.where(logs, lower, 1.0)) / np.log(np.where(logs, upper / lower, 2.0))
-    return np.where(logs, geo, (z - lower) / (upper - lower))
+    lo, hi = _sampling_coordinate(lower, logs), _sampling_coordinate(upper, logs)
+    return (_sampling_coordinate(z, logs) - lo) / (hi - lo)
 
 
 #: A start closer to an optimum already found than this share of that optimum's basin radius is
