@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from roastlab import InitialState, simulate
-from roastlab.fit.batchfit import identify_each
+from roastlab.fit.batchfit import identify_each, trial_set
 from roastlab.fit.identify import build_free_parameters, identify
 from roastlab.io.batch import read_dataset
 from roastlab.model.parameters import THETA_PAPER, THETA_START
@@ -69,6 +69,22 @@ def test_fleet_fit_recovers_per_batch_truth():
     fleet = identify_each(pack_batches(batches, "120kg", THETA_START))
     assert np.all(fleet.SSR < 1e-6)
     assert np.all(fleet.FIT > 99.9)
+
+
+def test_the_fleets_trial_points_spread_as_the_global_searchs():
+    """The per-batch fitter scores its trial points where identify's global search would put them:
+    a parameter over three decades (the reaction's A) spread in its logarithm, some coordinates on
+    the bounds themselves, a fixed one held; evenly in the value (the rule before), 29 of these 32 points of
+    A would lie above a tenth of its ceiling."""
+    lo, hi = np.array([0.01, 1e5, 0.6]), np.array([0.35, 1e8, 0.6])
+    z = trial_set([0.1, 1.162e5, 0.6], lo, hi, seed=0, n_trial=32)
+    assert z.shape == (33, 3)
+    assert z[0, 1] == pytest.approx((1.162e5 - 1e5) / (1e8 - 1e5))
+    a = lo[1] + z[1:, 1] * (hi[1] - lo[1])
+    assert 0.3 < np.mean(a < 1e7) < 0.8  # a third of the decades below 1e7: about two thirds of the points
+    assert np.any(z[1:, :2] == 0.0) and np.any(z[1:, :2] == 1.0)
+    assert np.all(z[:, 2] == 0.0)
+    assert np.array_equal(z, trial_set([0.1, 1.162e5, 0.6], lo, hi, seed=0, n_trial=32))
 
 
 def test_the_benchmarks_fresh_process_measurement_runs():

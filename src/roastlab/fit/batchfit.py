@@ -5,8 +5,9 @@ for all but the spread of theta across batches: drift, outliers, machine-to-mach
 differences. :func:`identify_each` fits theta_b for every batch b independently, but runs
 the batches in lock-step so that each iteration is one compiled, parallel population call:
 
-1. score ``n_trial`` scrambled-Sobol trial points (plus the paper's theta0) on every batch
-   and start each batch from its best one (a one-start GlobalSearch);
+1. score ``n_trial`` trial points (plus the paper's theta0) on every batch, spread over the bounds
+   as :func:`roastlab.fit.identify.trial_points` spreads the global search's, and start each batch
+   from its best one (a one-start GlobalSearch);
 2. projected Levenberg-Marquardt per batch: central-difference Jacobians (6 runs), a damped
    Gauss-Newton step clipped to the bounds, accepted if the batch's SSR falls, damping
    adapted; it stops when a step gains less than ``gain_tol`` (1e-10) of the SSR or moves
@@ -44,7 +45,7 @@ from ..sim.cache import compiled
 from ..sim.kernels import H0_S, N_OUT, integrate_into
 from ..sim.population import PackedBatches, predict_ta
 from . import uncertainty
-from .identify import FD_STEP
+from .identify import FD_STEP, on_bounds, trial_points
 
 #: Where a free value goes: a parameter-vector entry or an initial state.
 KIND_PARAM, KIND_STATE = 0, 1
@@ -349,6 +350,18 @@ def _sobol_points(seed: int, n: int, k: int = 3) -> np.ndarray:
     return pts
 
 
+def trial_set(start, lo: np.ndarray, hi: np.ndarray, seed: int, n_trial: int) -> np.ndarray:
+    """The trial points every batch scores, in scaled units (0 at ``lo``, 1 at ``hi``): ``start`` first,
+    then ``n_trial`` scrambled Sobol points spread over the bounds as the global search spreads its own
+    (:func:`roastlab.fit.identify.trial_points`: in the logarithm over two decades or more, the outer
+    tenth of each range on its bound). A fixed component (``lo == hi``) is 0 in every row.
+    """
+    span = hi - lo
+    unit = on_bounds(_sobol_points(seed, n_trial, len(lo)))
+    values = np.vstack([np.clip(start, lo, hi), trial_points(unit, lo, hi)])
+    return np.clip((values - lo) / np.where(span > 0, span, 1.0), 0.0, 1.0)
+
+
 def standard_errors(jtj: np.ndarray, z: np.ndarray, ssr: np.ndarray, n: np.ndarray, span: np.ndarray) -> np.ndarray:
     """Per-batch standard errors (nb, k) from J'J in scaled units (z in [0, 1] of each bound's
     span), by the one rule of :mod:`roastlab.fit.uncertainty`: NaN on a bound, fixed (span 0),
@@ -401,13 +414,9 @@ def identify_each(
     nb = packed.n_batches
     if np.any(~np.isfinite(packed.TA[packed.mask()])):
         raise InputError("per-batch identification needs a measured Ta at every sample")
-    # the same trial points for every batch: the start and a scrambled Sobol set, in scaled units
-    trial = _sobol_points(seed, n_trial, k)
     theta0 = THETA_START.as_dict()
     start = {**{n: theta0.get(n, 0.5 * (lo[j] + hi[j])) for j, n in enumerate(names)}, **(start or {})}
-    z0 = (np.clip([start[n] for n in names], lo, hi) - lo) / np.where(span > 0, span, 1.0)
-    trial = np.clip(np.vstack([z0, trial]), 0.0, 1.0)
-    trial[:, span == 0] = 0.0
+    trial = trial_set([start[n] for n in names], lo, hi, seed, n_trial)
     Z = np.zeros((nb, k))
     SSR = np.zeros(nb)
     SIMS = np.zeros(nb, dtype=np.int64)
