@@ -343,7 +343,7 @@ def _fit_population(
 
 
 @functools.cache
-def _sobol_points(seed: int, n: int, k: int = 3) -> np.ndarray:
+def _sobol_points(seed: int, n: int, k: int) -> np.ndarray:
     """Scrambled Sobol points in [0, 1)^k, cached: building the generator costs ~1 ms a call."""
     pts = qmc.Sobol(k, scramble=True, seed=np.random.default_rng(seed)).random(n)
     pts.setflags(write=False)
