@@ -47,11 +47,11 @@ wheel-check:
 
 # The measured figures of docs/real-roaster.md, from the real logs in ../shared/data/real.
 # Then every bed-law variant and the probe depth scale's profile cross-validated by batch size on the
-# Bullet (12 variants x 9 fits), then by roaster (3 variants x 6 fits): 77 min on 2 cores on 2026-11-25
-# (part of it beside a test run, with the example's exotherm bounds wider than now). Then the band's
+# Bullet (12 variants x 9 fits), then by roaster (3 variants x 6 fits). Then the band's
 # calibration: the example leave-one-log-out on the 17 nominal logs (18 fits) and on 16 splits of
-# them into 9 fit and 8 held out (docs/band_splits.py): about 13 min more. Last, the Skywalker's
-# 16 logs one by one, the example's bed laws against the paper's probe (2 x 17 fits): about 3 min.
+# them into 9 fit and 8 held out (docs/band_splits.py). Last, the Skywalker's 16 logs one by one,
+# the example's bed laws against the paper's probe (2 x 17 fits). All of it: 29 min on 2 cores on
+# 2026-11-26 (docs/real_roaster.py 5 min, the 12 variants 13, the roasters 3, the bands 5, the Skywalker 2).
 BULLET = ../shared/data/real/bullet
 SKYWALKER = ../shared/data/real/skywalker
 real-roaster: $(STAMP)
