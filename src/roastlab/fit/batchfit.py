@@ -11,7 +11,8 @@ the batches in lock-step so that each iteration is one compiled, parallel popula
 2. projected Levenberg-Marquardt per batch: central-difference Jacobians (6 runs), a damped
    Gauss-Newton step clipped to the bounds, accepted if the batch's SSR falls, damping
    adapted; it stops when a step gains less than ``gain_tol`` (1e-10) of the SSR or moves
-   less than 1e-6 of the bounds' span.
+   less than 1e-6 of the bounds' span. A parameter whose bounds span two decades or more is
+   moved in its logarithm, as the global search samples it (:func:`roastlab.fit.identify.log_sampled`).
 
 Any parameter-vector entry or initial state (except X0, which also sets the dry mass) can be
 free, not only theta: a fleet fit spec may free, say, Kt or Tm0_C per batch. Standard errors
@@ -45,7 +46,7 @@ from ..sim.cache import compiled
 from ..sim.kernels import H0_S, N_OUT, integrate_into
 from ..sim.population import PackedBatches, predict_ta
 from . import uncertainty
-from .identify import FD_STEP, on_bounds, trial_points
+from .identify import FD_STEP, log_sampled, on_bounds, sampling_coordinate, trial_points, trial_unit
 
 #: Where a free value goes: a parameter-vector entry or an initial state.
 KIND_PARAM, KIND_STATE = 0, 1
@@ -129,10 +130,16 @@ class FleetResult:
 
 
 @compiled(inline="always")
-def _set_free(z, lo, span, kinds, slots, p, x0):
-    """Scaled z in [0, 1]^k -> the free values in their slots of p (model.rhs.PARAM_NAMES) or x0."""
+def _set_free(z, lo, span, logs, kinds, slots, p, x0):
+    """Scaled z in [0, 1]^k -> the free values in their slots of p (model.rhs.PARAM_NAMES) or x0.
+
+    ``lo + z span`` is the value, or its logarithm where ``logs`` (the search's sampling coordinate,
+    :func:`roastlab.fit.identify.trial_points`: a parameter over decades is searched in its logarithm).
+    """
     for j in range(z.shape[0]):
         v = lo[j] + z[j] * span[j]
+        if logs[j]:
+            v = np.exp(v)
         if kinds[j] == 0:
             p[slots[j]] = v
         else:
@@ -140,18 +147,18 @@ def _set_free(z, lo, span, kinds, slots, p, x0):
 
 
 @compiled
-def _residual_vec(z, lo, span, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, out):
+def _residual_vec(z, lo, span, logs, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, out):
     """Residuals T^a - Ta for scaled parameters z in [0, 1]^k, into out[:n]."""
-    _set_free(z, lo, span, kinds, slots, p, x0)
+    _set_free(z, lo, span, logs, kinds, slots, p, x0)
     integrate_into(t, Gg, Tgi, Q, F, n, x0, p, zoh, h_max, scratch, H0_S, False)
     for i in range(n):
         out[i] = scratch[i, S_TA] - Ta[i]
 
 
 @compiled
-def _ssr_of(z, lo, span, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, r):
+def _ssr_of(z, lo, span, logs, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, r):
     """SSR of the probe reading (a failed simulation counts as 1e300); r is a work buffer."""
-    _residual_vec(z, lo, span, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, r)
+    _residual_vec(z, lo, span, logs, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, r)
     s = 0.0
     for i in range(n):
         s += r[i] * r[i]
@@ -161,10 +168,12 @@ def _ssr_of(z, lo, span, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_ma
 
 
 @compiled
-def _jacobian(z, lo, span, kinds, slots, free, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, r0, rp, rm, zt, J):
+def _jacobian(
+    z, lo, span, logs, kinds, slots, free, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, r0, rp, rm, zt, J
+):
     """Residuals r0 at z and their central-difference Jacobian J (n, k) in scaled units; returns sims."""
     k = z.shape[0]
-    _residual_vec(z, lo, span, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, r0)
+    _residual_vec(z, lo, span, logs, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, r0)
     sims = 1
     for j in range(k):
         if not free[j]:
@@ -175,9 +184,9 @@ def _jacobian(z, lo, span, kinds, slots, free, t, Gg, Tgi, Q, F, n, Ta, x0, p, z
         zp = min(z[j] + FD_STEP, 1.0)
         zm = max(z[j] - FD_STEP, 0.0)
         zt[j] = zp
-        _residual_vec(zt, lo, span, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, rp)
+        _residual_vec(zt, lo, span, logs, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, rp)
         zt[j] = zm
-        _residual_vec(zt, lo, span, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, rm)
+        _residual_vec(zt, lo, span, logs, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, rm)
         sims += 2
         for i in range(n):
             J[i, j] = (rp[i] - rm[i]) / (zp - zm)
@@ -201,7 +210,27 @@ def _normal(J, r0, n, A, g):
 
 @compiled
 def _fit_one(
-    t, Gg, Tgi, Q, F, n, Ta, x0_in, p_in, kinds, slots, lo, span, trial, zoh, h_max, max_iter, gain_tol, z_out, jtj_out
+    t,
+    Gg,
+    Tgi,
+    Q,
+    F,
+    n,
+    Ta,
+    x0_in,
+    p_in,
+    kinds,
+    slots,
+    lo,
+    span,
+    logs,
+    trial,
+    zoh,
+    h_max,
+    max_iter,
+    gain_tol,
+    z_out,
+    jtj_out,
 ):
     """Score the trial points, then projected Levenberg-Marquardt from the best; returns (SSR, sims).
 
@@ -216,7 +245,7 @@ def _fit_one(
     z = np.empty(k)
     sims = 0
     for m in range(trial.shape[0]):
-        s = _ssr_of(trial[m], lo, span, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, rs)
+        s = _ssr_of(trial[m], lo, span, logs, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, rs)
         sims += 1
         if s < best:
             best = s
@@ -242,7 +271,30 @@ def _fit_one(
     for _it in range(max_iter):
         if need_jac:
             sims += _jacobian(
-                z, lo, span, kinds, slots, free, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, r0, rp, rm, zt, J
+                z,
+                lo,
+                span,
+                logs,
+                kinds,
+                slots,
+                free,
+                t,
+                Gg,
+                Tgi,
+                Q,
+                F,
+                n,
+                Ta,
+                x0,
+                p,
+                zoh,
+                h_max,
+                scratch,
+                r0,
+                rp,
+                rm,
+                zt,
+                J,
             )
             _normal(J, r0, n, A, g)
             need_jac = False
@@ -282,7 +334,7 @@ def _fit_one(
                 break
         for j in range(k):
             zt[j] = min(max(z[j] + step[j], 0.0), 1.0)
-        s = _ssr_of(zt, lo, span, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, rs)
+        s = _ssr_of(zt, lo, span, logs, kinds, slots, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, rs)
         sims += 1
         if s < ssr:
             gain = (ssr - s) / max(ssr, 1e-300)
@@ -303,7 +355,30 @@ def _fit_one(
                 break
     if need_jac:  # J'J at the optimum, for the standard errors
         sims += _jacobian(
-            z, lo, span, kinds, slots, free, t, Gg, Tgi, Q, F, n, Ta, x0, p, zoh, h_max, scratch, r0, rp, rm, zt, J
+            z,
+            lo,
+            span,
+            logs,
+            kinds,
+            slots,
+            free,
+            t,
+            Gg,
+            Tgi,
+            Q,
+            F,
+            n,
+            Ta,
+            x0,
+            p,
+            zoh,
+            h_max,
+            scratch,
+            r0,
+            rp,
+            rm,
+            zt,
+            J,
         )
         _normal(J, r0, n, A, g)
     jtj_out[:, :] = A
@@ -313,7 +388,29 @@ def _fit_one(
 
 @compiled(parallel=True)
 def _fit_population(
-    T, GG, TGI, QQ, FF, N, TA, X0, PB, kinds, slots, lo, span, trial, zoh, h_max, max_iter, gain_tol, Z, SSR, SIMS, JTJ
+    T,
+    GG,
+    TGI,
+    QQ,
+    FF,
+    N,
+    TA,
+    X0,
+    PB,
+    kinds,
+    slots,
+    lo,
+    span,
+    logs,
+    trial,
+    zoh,
+    h_max,
+    max_iter,
+    gain_tol,
+    Z,
+    SSR,
+    SIMS,
+    JTJ,
 ):
     for b in prange(N.shape[0]):
         ssr, sims = _fit_one(
@@ -330,6 +427,7 @@ def _fit_population(
             slots,
             lo,
             span,
+            logs,
             trial,
             zoh,
             h_max,
@@ -351,15 +449,16 @@ def _sobol_points(seed: int, n: int, k: int) -> np.ndarray:
 
 
 def trial_set(start, lo: np.ndarray, hi: np.ndarray, seed: int, n_trial: int) -> np.ndarray:
-    """The trial points every batch scores, in scaled units (0 at ``lo``, 1 at ``hi``): ``start`` first,
-    then ``n_trial`` scrambled Sobol points spread over the bounds as the global search spreads its own
-    (:func:`roastlab.fit.identify.trial_points`: in the logarithm over two decades or more, the outer
-    tenth of each range on its bound). A fixed component (``lo == hi``) is 0 in every row.
+    """The trial points every batch scores, in the fitter's scaled units (0 at ``lo``, 1 at ``hi``, evenly
+    in the value or, over two decades or more, in its logarithm: :func:`roastlab.fit.identify.trial_unit`):
+    ``start`` first, then ``n_trial`` scrambled Sobol points spread as the global search spreads its own
+    (the outer tenth of each range on its bound, :func:`roastlab.fit.identify.on_bounds`). A fixed
+    component (``lo == hi``) is 0 in every row.
     """
-    span = hi - lo
+    free = hi > lo
     unit = on_bounds(_sobol_points(seed, n_trial, len(lo)))
-    values = np.vstack([np.clip(start, lo, hi), trial_points(unit, lo, hi)])
-    return np.clip((values - lo) / np.where(span > 0, span, 1.0), 0.0, 1.0)
+    start_unit = trial_unit(np.clip(start, lo, hi)[None, :], np.where(free, lo, 0.0), np.where(free, hi, 1.0))
+    return np.where(free, np.clip(np.vstack([start_unit, unit]), 0.0, 1.0), 0.0)
 
 
 def standard_errors(jtj: np.ndarray, z: np.ndarray, ssr: np.ndarray, n: np.ndarray, span: np.ndarray) -> np.ndarray:
@@ -410,7 +509,11 @@ def identify_each(
         )
     lo = np.array([fix.get(n, bounds[n][0]) for n in names], dtype=float)
     hi = np.array([fix.get(n, bounds[n][1]) for n in names], dtype=float)
-    span = hi - lo
+    # the fitter moves z in [0, 1] along the search's sampling coordinate (a parameter over decades
+    # in its logarithm, identify.trial_points): c = c_lo + z c_span, the value c or exp(c)
+    logs = log_sampled(lo, hi)
+    c_lo = sampling_coordinate(lo, logs)
+    c_span = sampling_coordinate(hi, logs) - c_lo
     nb = packed.n_batches
     if np.any(~np.isfinite(packed.TA[packed.mask()])):
         raise InputError("per-batch identification needs a measured Ta at every sample")
@@ -434,8 +537,9 @@ def identify_each(
                 packed.PB[sl],
                 kinds,
                 slots,
-                lo,
-                span,
+                c_lo,
+                c_span,
+                logs,
                 trial,
                 packed.zoh,
                 packed.h_max_s,
@@ -448,13 +552,14 @@ def identify_each(
             )
         if progress is not None:
             progress(sl.stop, nb, "batches fitted")
-    values = lo + Z * span
+    values = trial_points(Z, lo, hi)
     # the scalar integrator, as the fit itself: a batch's figures must not depend on how many batches
     # share the call (a fleet's chunks, Dask or in-process)
     ta = predict_ta(packed, names, values[None], use_lanes=False)[0]
     fits = np.array([fit_percent(packed.TA[b, :n], ta[b, :n]) for b, n in enumerate(packed.N)])
     mae = np.nanmean(np.abs(np.where(packed.mask(), ta - packed.TA, np.nan)), axis=1)
-    stderr = standard_errors(JTJ, Z, SSR, packed.N, span)
+    stderr = standard_errors(JTJ, Z, SSR, packed.N, c_span)
+    stderr = np.where(logs, values * stderr, stderr)  # of the value: d exp(c) = exp(c) dc
     return FleetResult(
         list(packed.names),
         values,

@@ -397,7 +397,7 @@ def log_sampled(lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
     return (lower > 0) & (upper >= LOG_SAMPLED_SPAN * lower)
 
 
-def _sampling_coordinate(z, logs: np.ndarray) -> np.ndarray:
+def sampling_coordinate(z, logs: np.ndarray) -> np.ndarray:
     """Values as the trial points spread them: the logarithm where ``logs``, else the value."""
     z = np.asarray(z, dtype=float)
     return np.where(logs, np.log(np.where(logs, z, 1.0)), z)
@@ -430,7 +430,7 @@ def trial_points(unit: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> np.n
     [[0.0001, 0.03]]
     """
     logs = log_sampled(lower, upper)
-    lo, hi = _sampling_coordinate(lower, logs), _sampling_coordinate(upper, logs)
+    lo, hi = sampling_coordinate(lower, logs), sampling_coordinate(upper, logs)
     c = lo + unit * (hi - lo)
     inside = np.clip(np.where(logs, np.exp(np.where(logs, c, 0.0)), c), lower, upper)
     return np.where(unit <= 0.0, lower, np.where(unit >= 1.0, upper, inside))
@@ -443,8 +443,8 @@ def trial_unit(z: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> np.ndarra
     [[0.0, 0.5, 1.0]]
     """
     logs = log_sampled(lower, upper)
-    lo, hi = _sampling_coordinate(lower, logs), _sampling_coordinate(upper, logs)
-    return (_sampling_coordinate(z, logs) - lo) / (hi - lo)
+    lo, hi = sampling_coordinate(lower, logs), sampling_coordinate(upper, logs)
+    return (sampling_coordinate(z, logs) - lo) / (hi - lo)
 
 
 #: A start closer to an optimum already found than this share of that optimum's basin radius is
