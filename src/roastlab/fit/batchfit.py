@@ -461,20 +461,19 @@ def trial_set(start, lo: np.ndarray, hi: np.ndarray, seed: int, n_trial: int) ->
     return np.where(free, np.clip(np.vstack([start_unit, unit]), 0.0, 1.0), 0.0)
 
 
-def standard_errors(jtj: np.ndarray, z: np.ndarray, ssr: np.ndarray, n: np.ndarray, span: np.ndarray) -> np.ndarray:
-    """Per-batch standard errors (nb, k) from J'J in scaled units (z in [0, 1] of each bound's
-    span), by the one rule of :mod:`roastlab.fit.uncertainty`: NaN on a bound, fixed (span 0),
-    without effect or with no degrees of freedom left."""
-    nb, k = z.shape
+def standard_errors(jtj, values, lo, hi, ssr, n, c_span, logs) -> np.ndarray:
+    """Per-batch standard errors (nb, k) of the ``values`` from J'J in the fitter's scaled units (z in
+    [0, 1] along each parameter's sampling coordinate, ``c_span`` wide), by the one rule of
+    :mod:`roastlab.fit.uncertainty`: NaN on a bound (judged on the value, as :mod:`.identify` judges
+    it), fixed (``lo == hi``), without effect or with no degrees of freedom left. An error in the
+    coordinate is carried to the value: times ``c_span``, and times the value where the coordinate
+    is its logarithm (d exp(c) = exp(c) dc)."""
+    nb, k = values.shape
     out = np.full((nb, k), np.nan)
-    free = span > 0
     names = [str(j) for j in range(k)]
     for b in range(nb):
-        u = uncertainty.from_normal(
-            jtj[b], z[b], np.where(free, 0.0, z[b]), np.where(free, 1.0, z[b]), ssr[b], n[b], names
-        )
-        out[b] = u.stderr * span
-    return out
+        out[b] = uncertainty.from_normal(jtj[b], values[b], lo, hi, ssr[b], n[b], names).stderr * c_span
+    return np.where(logs, values * out, out)
 
 
 def identify_each(
@@ -558,8 +557,7 @@ def identify_each(
     ta = predict_ta(packed, names, values[None], use_lanes=False)[0]
     fits = np.array([fit_percent(packed.TA[b, :n], ta[b, :n]) for b, n in enumerate(packed.N)])
     mae = np.nanmean(np.abs(np.where(packed.mask(), ta - packed.TA, np.nan)), axis=1)
-    stderr = standard_errors(JTJ, Z, SSR, packed.N, c_span)
-    stderr = np.where(logs, values * stderr, stderr)  # of the value: d exp(c) = exp(c) dc
+    stderr = standard_errors(JTJ, values, lo, hi, SSR, packed.N, c_span, logs)
     return FleetResult(
         list(packed.names),
         values,
