@@ -268,7 +268,9 @@ def _fit_one(
     lam = 1e-3
     ssr = best
     need_jac = True
-    for _it in range(max_iter):
+    done = False
+    # one pass more than max_iter steps: the last only refreshes J'J at the optimum (for the errors)
+    for _it in range(max_iter + 1):
         if need_jac:
             sims += _jacobian(
                 z,
@@ -298,6 +300,8 @@ def _fit_one(
             )
             _normal(J, r0, n, A, g)
             need_jac = False
+        if done or _it == max_iter:
+            break
         # damped normal equations (M = A + lam diag(A)). Fixed parameters, those on a bound whose
         # gradient pushes outward, and those whose step would cross a bound are pinned (the last
         # at the bound they hit) and the others re-solved given that move: clipping a step
@@ -348,39 +352,10 @@ def _fit_one(
             # converged: the SSR barely moves, or the step (in units of the bounds) is tiny,
             # which ends the slow crawl along a valley of correlated parameters
             if gain < gain_tol or moved < 1e-6:
-                break
+                done = True
         else:
             lam *= 4.0
-            if lam > 1e10:
-                break
-    if need_jac:  # J'J at the optimum, for the standard errors
-        sims += _jacobian(
-            z,
-            lo,
-            span,
-            logs,
-            kinds,
-            slots,
-            free,
-            t,
-            Gg,
-            Tgi,
-            Q,
-            F,
-            n,
-            Ta,
-            x0,
-            p,
-            zoh,
-            h_max,
-            scratch,
-            r0,
-            rp,
-            rm,
-            zt,
-            J,
-        )
-        _normal(J, r0, n, A, g)
+            done = lam > 1e10
     jtj_out[:, :] = A
     z_out[:] = z
     return ssr, sims
