@@ -49,7 +49,8 @@ def make_rhs(plant: str, theta, X0: float, moisture: str = "schwartzberg", act=N
     """The slow reference right-hand side. ``act`` holds the actuator extension's values
     (Qe_gain, Qe_offset, Tgi_gain, tau, Gg_fan, U_shell, T_room); None = the paper's model.
     ``bed`` the bed laws and the probe's depth: {"contact": "paper"|"wall", "probe": "rest"|"tumbling",
-    "probe_gas": "outlet"|"mean", "h_probe": m}; None = the paper's. ``process`` overrides values
+    "probe_gas": "outlet"|"mean", "h_probe": m, "eps_rad": the wall's radiation to the bed's free
+    surface, 0-1}; None = the paper's. ``process`` overrides values
     of PROCESS (and the plant's metal mass Mm)."""
     process = dict(process or {})
     g = {**PLANTS[plant], **({"Mm": process.pop("Mm")} if "Mm" in process else {})}
@@ -57,8 +58,9 @@ def make_rhs(plant: str, theta, X0: float, moisture: str = "schwartzberg", act=N
     hgm, hbm, Pbm = theta
     Agm = math.pi * g["Dch"] * (g["Lch"] + g["Hflap"] * g["Lch"] / g["Sflap"] + g["Dch"] / 2)
     Ab = g["Mb"] / c["mb"] * math.pi * c["Db"] ** 2
-    bed = {"contact": "paper", "probe": "rest", "probe_gas": "outlet", "h_probe": 0.0, **(bed or {})}
-    _, h_bed, A_wall = bed_segment(g["Mb"], g["Dch"], g["Lch"])
+    bed = {"contact": "paper", "probe": "rest", "probe_gas": "outlet", "h_probe": 0.0, "eps_rad": 0.0, **(bed or {})}
+    angle, h_bed, A_wall = bed_segment(g["Mb"], g["Dch"], g["Lch"])
+    A_surf = 2 * (g["Dch"] / 2) * math.sin(angle / 2) * g["Lch"]  # the segment's chord along the drum
     if bed["contact"] == "wall":  # beans touch the wetted wall; the rest of their surface meets the gas
         Abm = Pbm * A_wall
         Agb = Ab - Abm
@@ -95,10 +97,12 @@ def make_rhs(plant: str, theta, X0: float, moisture: str = "schwartzberg", act=N
         dX = -k1 * max(X, 0.0) ** xexp / c["Db"] ** 2 * math.exp(-c["k2"] / (Tb + 273.15)) if X > 0 else 0.0
         Qr = c["A"] * (c["Het"] - He) / c["Het"] * math.exp(-c["HaR"] / (Tb + 273.15))
         cs = 1.099 + 0.007 * Tb
-        dTb = (Qgb - Qgm + Qbm + Mbd * (Qr + c["lam"] * dX)) / (Mbd * (cs + c["cw"] * X))
+        # grey-body radiation of the wall (kelvin) to the bed's free surface, Stefan-Boltzmann in kW
+        Qrad = bed["eps_rad"] * 5.670374419e-11 * A_surf * ((Tm + 273.15) ** 4 - (Tb + 273.15) ** 4)
+        dTb = (Qgb - Qgm + Qbm + Qrad + Mbd * (Qr + c["lam"] * dX)) / (Mbd * (cs + c["cw"] * X))
         # shell loss to the room from the outer drum surface (mantle and two end discs)
         Qloss = a.get("U_shell", 0.0) * math.pi * g["Dch"] * (g["Lch"] + g["Dch"] / 2) * (Tm - a.get("T_room", 22.0))
-        dTm = (Qgm - Qbm + Qe - Qloss) / (g["Mm"] * c["cm"])
+        dTm = (Qgm - Qbm - Qrad + Qe - Qloss) / (g["Mm"] * c["cm"])
         # the uncovered probe sees the outlet gas, or the mean of the exponential profile along the path
         Tg = Tgi - drop if bed["probe_gas"] == "outlet" else Tstar + (Tgi - Tstar) * (1 - math.exp(-ntu)) / ntu
         dTa = c["Kt"] * (cover * (Tb - Ta) + (1 - cover) * (Tg - Ta))

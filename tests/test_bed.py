@@ -164,3 +164,25 @@ def test_cli_bad_bed_is_exit_2(tmp_path):
     )
     assert out.returncode == 2
     assert "unknown probe law" in out.stderr and "Traceback" not in out.stderr
+
+
+def test_bed_surface_and_wall_radiation_by_hand():
+    """The bed's free surface is its chord along the drum (the diameter when half full, nothing when
+    full); the radiation a drum wall at 300 degC sends to beans at 200 degC is eps sigma A (T1^4 - T2^4),
+    computed here in watts from CODATA's sigma; it is the paper's model at eps_rad 0; per kilogram a small
+    batch gets more of it than a large one."""
+    plant = as_plant("120kg")
+    R, L = plant.Dch_m / 2, plant.Lch_m
+    full = GREEN_BULK_DENSITY_KG_M3 * math.pi * R**2 * L
+    assert dataclasses.replace(plant, Mb_kg=full / 2).bed_surface_area_m2 == pytest.approx(2 * R * L, rel=1e-12)
+    assert dataclasses.replace(plant, Mb_kg=full).bed_surface_area_m2 == pytest.approx(0.0, abs=1e-9)
+    small = dataclasses.replace(plant, Mb_kg=0.05 * full)
+    t, _, _ = bed_segment(small.Mb_kg, small.Dch_m, small.Lch_m)
+    assert small.bed_surface_area_m2 == pytest.approx(2 * R * math.sin(t / 2) * L, rel=1e-9)
+    p = rhs.pack_params(small, (0.01, 0.03, 0.5))
+    assert rhs.wall_radiation_kW(200.0, 300.0, p) == 0.0  # eps_rad 0: the paper
+    p[P["eps_rad"]] = 0.8
+    watts = 0.8 * 5.670374419e-8 * small.bed_surface_area_m2 * (573.15**4 - 473.15**4)
+    assert rhs.wall_radiation_kW(200.0, 300.0, p) == pytest.approx(watts / 1000.0, rel=1e-12)
+    large = dataclasses.replace(plant, Mb_kg=0.3 * full)
+    assert small.bed_surface_area_m2 / small.Mb_kg > 2.5 * large.bed_surface_area_m2 / large.Mb_kg

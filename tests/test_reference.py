@@ -240,3 +240,24 @@ def test_count_evaluations_counts_every_right_hand_side_call(monkeypatch, zoh):
     restarts = t.size - 1 if zoh else 1
     assert (compiled_count - restarts) % 6 == 0
     assert compiled_count >= restarts + 6 * (t.size - 1)  # at least one trial per sample interval
+
+
+def test_wall_radiation_matches_reference():
+    """The wall's radiation to the bed's free surface (roastlab.model.rhs.wall_radiation_kW), with the
+    heater heating the metal: compiled vs reference, whose chord is computed from its own bisection;
+    eps_rad 0 is the paper's model."""
+    t, Gg, Tgi, x0 = random_case(23, "120kg")
+    theta = (0.01, 0.01, 0.5)  # little contact, so the metal runs well above the beans
+    heater = np.full(len(t), 600.0)
+    runs = {}
+    for eps in (0.0, 0.8):
+        values = {"Qe_gain_kW": 0.5, "eps_rad": eps}
+        runs[eps] = simulate("120kg", t, Gg, Tgi - 200.0, theta=theta, initial=x0, heater=heater, values=values)
+        ref, _ = reference_simulate(
+            "120kg", theta, t, Gg, Tgi - 200.0, x0.vector(), heater=heater, act={"Qe_gain": 0.5}, bed={"eps_rad": eps}
+        )
+        for j in (0, 1, 4):
+            assert np.max(np.abs(runs[eps].states[:, j] - ref[:, j])) < TOL_C
+    # the term acts: the metal gives heat to the beans, so they end warmer and it cooler
+    assert runs[0.8].states[-1, 0] > runs[0.0].states[-1, 0] + 0.5
+    assert runs[0.8].states[-1, 1] < runs[0.0].states[-1, 1] - 0.1  # a 2 t drum: its fall is smaller

@@ -32,6 +32,7 @@ def _params(codes: dict, rng) -> np.ndarray:
     p[P["Gg_fan"]] = rng.uniform(0.001, 0.01)
     p[P["U_shell"]] = rng.uniform(0.001, 0.01)
     p[P["h_probe"]] = p[P["h_bed"]] * rng.uniform(1.2, 3.0)  # a partly covered probe
+    p[P["eps_rad"]] = rng.uniform(0.3, 0.9)  # the wall's radiation to the bed
     for name, value in codes.items():
         p[P[name]] = value
     return p

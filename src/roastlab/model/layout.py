@@ -77,6 +77,9 @@ PARAM_NAMES = (
     "contact_law",  # 0: Abm = Pbm Ab (section 3.1); 1: Abm = Pbm A_wall, Agb = Ab - Abm
     "probe_law",  # 0: covered share min(1, h_bed/h_probe) (bed at rest); 1: 1 - exp(-h_bed/h_probe) (tumbling)
     "probe_gas_law",  # 0: the uncovered probe sees Tgo (eq. 15e); 1: the gas's mean along its path
+    # wall-to-bed radiation (extension; eps_rad 0 = the paper, whose metal reaches the beans by contact alone)
+    "eps_rad",  # effective emissivity of the drum wall's exchange with the bed's free surface [-]
+    "A_surf",  # the bed's free surface, its chord along the drum [m2] (plant- and batch-derived)
 )
 P = {name: i for i, name in enumerate(PARAM_NAMES)}
 N_PARAMS = len(PARAM_NAMES)
@@ -88,3 +91,4 @@ I_QEG, I_QEO, I_TGIG, I_TAUH, I_GGF = (P[k] for k in ("Qe_gain", "Qe_offset", "T
 I_USH, I_ASH, I_TROOM = (P[k] for k in ("U_shell", "Ashell", "T_room"))
 I_HBED, I_HPROBE = P["h_bed"], P["h_probe"]
 I_AWALL, I_CONTACT, I_PROBELAW, I_PROBEGAS = (P[k] for k in ("A_wall", "contact_law", "probe_law", "probe_gas_law"))
+I_EPSRAD, I_ASURF = P["eps_rad"], P["A_surf"]

@@ -181,6 +181,22 @@ class Plant:
         return self.Dch_m / 2.0 * t * self.Lch_m + 2.0 * self.Dch_m**2 / 8.0 * (t - math.sin(t))
 
     @property
+    def bed_surface_area_m2(self) -> float:
+        """The bed's free surface [m^2]: the chord of its circular segment, D sin(t/2), along the
+        drum length (0 when overfilled: the beans then touch the wall all round).
+
+        Not in the paper; the surface the drum wall radiates to (:func:`roastlab.model.rhs.wall_radiation_kW`).
+        A tumbling bed tilts it without changing its chord. It grows more slowly than the mass (as the
+        fill to the power ~1/3 for a shallow bed) and is the drum's diametral plane when half full.
+
+        >>> q = Plant("half", 1.0, 1.0, 1.0, 0.1, 0.1, 10.0)   # a 1 m drum ...
+        >>> q = Plant("half", q.capacity_kg / 2, 1.0, 1.0, 0.1, 0.1, 10.0)   # ... filled half way
+        >>> round(q.bed_surface_area_m2, 9)   # its diameter times its length
+        1.0
+        """
+        return self.Dch_m * math.sin(self.bed_angle_rad / 2.0) * self.Lch_m
+
+    @property
     def Ab_m2(self) -> float:
         """Total bean surface, (Mb/mb) * pi * Db^2 [m^2] (section 3.1)."""
         return self.Mb_kg / self.process.mb * math.pi * self.process.Db**2
@@ -219,6 +235,7 @@ class Plant:
             ("Ashell", self.Ashell_m2, "m2", "outer drum surface (shell-loss extension)"),
             ("h_bed", self.bed_depth_m, "m", "bean-bed depth at rest (probe-immersion extension)"),
             ("A_wall", self.wall_contact_area_m2, "m2", "drum wall the bed at rest wets (bed law contact=wall)"),
+            ("A_surf", self.bed_surface_area_m2, "m2", "the bed's free surface (wall-radiation extension)"),
             ("Ab", self.Ab_m2, "m2", "total bean area"),
             ("Agb", self.Agb_m2(Pbm), "m2", f"gas-bean area at Pbm={Pbm:g}"),
             ("Abm", self.Abm_m2(Pbm), "m2", f"metal-bean area at Pbm={Pbm:g}"),

@@ -161,6 +161,9 @@ _TABLE: tuple[Quantity, ...] = (
     Quantity("h_probe_m", "m", "extension", 0.0, (0.0, 10.0),
              "bean-bed depth that covers the bean probe; shallower beds leave part of it in the gas (eq. 17 extension)",
              (0.0, 0.5), False, "h_probe"),
+    Quantity("eps_rad", "-", "extension", 0.0, (0.0, 1.0),
+             "effective emissivity of the drum wall's radiation to the bed's free surface (eq. 12/15a extension)",
+             (0.0, 1.0), True, "eps_rad"),
     # --- closed-loop scenarios (roastlab.io.scenario) --------------------------------------------
     Quantity("mass_factor", "-", "scenario", 1.0, (0.1, 5.0), "batch mass over the reference's"),
     Quantity("Gg_factor", "-", "scenario", 1.0, (0.1, 5.0), "gas flow the plant gets over the flow set"),

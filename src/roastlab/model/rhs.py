@@ -23,8 +23,9 @@ affinely, Gg Gg_scale + Gg_fan fan [kg/s]. A heat loss of the drum shell to the 
 U_shell Ashell (Tm - T_room) [kW], leaves the metal (eq. 12; the paper's shell is adiabatic).
 The probe-immersion extension lets the bean probe see the gas where the bean bed does not cover
 it (eq. 17 extended, :func:`probe_coverage`): a small batch in a large drum reads low when the
-gas is cooler than the beans. With the gains, U_shell and h_probe at their default 0 and no
-heater input the model is the paper's (MODEL.md's check value holds; tests/test_physics.py).
+gas is cooler than the beans. The radiation extension lets the drum wall radiate to the bed's free
+surface (:func:`wall_radiation_kW`, eqs. 15a/15b extended). With the gains, U_shell, h_probe and
+eps_rad at their default 0 and no heater input the model is the paper's (MODEL.md's check value holds; tests/test_physics.py).
 """
 
 from __future__ import annotations
@@ -45,11 +46,13 @@ from .layout import (  # noqa: E402, F401
     I_AB,
     I_AGM,
     I_ASH,
+    I_ASURF,
     I_AWALL,
     I_CM,
     I_CONTACT,
     I_CW,
     I_DB,
+    I_EPSRAD,
     I_GGF,
     I_GGS,
     I_HAR,
@@ -91,6 +94,9 @@ from .layout import (  # noqa: E402, F401
     U_TGI,
     P,
 )
+
+#: Stefan-Boltzmann constant [kW/(m2 K4)] (5.670374419e-8 W/(m2 K4), CODATA 2018).
+STEFAN_BOLTZMANN_KW_M2K4 = 5.670374419e-11
 
 #: Smallest gas flow the fan map may give [kg/s] (a fan map fitted below zero is clipped here).
 GG_MIN_KG_S = 1e-6
@@ -198,6 +204,28 @@ def shell_loss_kW(Tm, p):
     geometry, so the loss scales with the drum and not with the batch).
     """
     return p[I_USH] * p[I_ASH] * (Tm - p[I_TROOM])
+
+
+@register_jitable
+def wall_radiation_kW(Tb, Tm, p):
+    """Heat the drum wall radiates to the bean bed, Qrad = eps sigma A_surf (Tm^4 - Tb^4) [kW]
+    (temperatures in kelvin; ``Tb``, ``Tm`` [degC]).
+
+    An extension of eqs. 12 and 15a (the paper's metal reaches the beans by contact alone, eq. 11).
+    The bed's free surface ``A_surf`` [m2] (:attr:`roastlab.model.plant.Plant.bed_surface_area_m2`)
+    sees nothing but the drum's inner wall (view factor 1), which is far larger than it; for two
+    grey surfaces the exchange is sigma A_surf (Tm^4 - Tb^4) / (1/eps_b + A_surf/A_wall (1/eps_w - 1))
+    (e.g. Incropera, the two-surface enclosure), lumped here into one effective emissivity
+    ``eps_rad`` [-] (about 0.8 for beans at 0.9 in a steel drum at 0.6 whose wall is six times
+    the surface, the Bullet at 500 g). The surface grows more slowly than the batch (the chord of the bed's segment), so a
+    small batch takes more of this heat per kilogram than a large one; eps_rad 0 (the default) is the
+    paper's model.
+    """
+    a = Tm + KELVIN
+    b = Tb + KELVIN
+    a2 = a * a
+    b2 = b * b
+    return p[I_EPSRAD] * STEFAN_BOLTZMANN_KW_M2K4 * p[I_ASURF] * (a2 * a2 - b2 * b2)
 
 
 @register_jitable
@@ -325,9 +353,10 @@ def derivatives(Tb, Tm, X, He, Ta, H, Gg, Tgi, heater, fan, p):
     Qr = reaction_heat_rate_kW_kg(Tb, He, p)  # eq. 15d
     Mbd = p[I_MBD]
     cs = 1.099 + 0.007 * Tb  # partial heat capacity of bean solids, section 3.2
-    dTb = (Qgb - Qgm + Qbm + Mbd * (Qr + p[I_LAM] * dX)) / (Mbd * (cs + p[I_CW] * X))  # eq. 15a
+    Qrad = wall_radiation_kW(Tb, Tm, p)  # the wall's radiation to the bed (extension; 0 in the paper)
+    dTb = (Qgb - Qgm + Qbm + Qrad + Mbd * (Qr + p[I_LAM] * dX)) / (Mbd * (cs + p[I_CW] * X))  # eq. 15a
     # eq. 15b, eq. 12's Qe; 1/(Mm cm) and 1/tau depend on the parameters alone (once per run compiled)
-    dTm = (Qgm - Qbm + heater_power_kW(H, p) - shell_loss_kW(Tm, p)) * (1.0 / (p[I_MM] * p[I_CM]))
+    dTm = (Qgm - Qbm - Qrad + heater_power_kW(H, p) - shell_loss_kW(Tm, p)) * (1.0 / (p[I_MM] * p[I_CM]))
     dTa = probe_rate_C_s(Tb, Ta, probe_gas_C(T, Tgo, path[0], path[1], p), p)  # eq. 17 (probe immersion: extension)
     dH = (heater - H) * (1.0 / p[I_TAUH])  # actuator lag (extension)
     return dTb, dTm, dX, Qr, dTa, dH
@@ -493,6 +522,7 @@ def pack_params(plant, theta, X0: float = 0.1, moisture: str = "schwartzberg", b
         "Ashell": plant.Ashell_m2,
         "h_bed": plant.bed_depth_m,
         "A_wall": plant.wall_contact_area_m2,
+        "A_surf": plant.bed_surface_area_m2,
         **BedLaws.parse(bed).codes(),
     }
     # the extensions' defaults (each the paper's model) from the one quantity table
