@@ -25,7 +25,8 @@ The probe-immersion extension lets the bean probe see the gas where the bean bed
 it (eq. 17 extended, :func:`probe_coverage`): a small batch in a large drum reads low when the
 gas is cooler than the beans. The radiation extension lets the drum wall radiate to the bed's free
 surface (:func:`wall_radiation_kW`, eqs. 15a/15b extended). With the gains, U_shell, h_probe and
-eps_rad at their default 0 and no heater input the model is the paper's (MODEL.md's check value holds; tests/test_physics.py).
+eps_rad at their default 0 and no heater input the model is the paper's (MODEL.md's check value
+holds; tests/test_physics.py).
 """
 
 from __future__ import annotations
@@ -217,9 +218,9 @@ def wall_radiation_kW(Tb, Tm, p):
     grey surfaces the exchange is sigma A_surf (Tm^4 - Tb^4) / (1/eps_b + A_surf/A_wall (1/eps_w - 1))
     (e.g. Incropera, the two-surface enclosure), lumped here into one effective emissivity
     ``eps_rad`` [-] (about 0.8 for beans at 0.9 in a steel drum at 0.6 whose wall is six times
-    the surface, the Bullet at 500 g). The surface grows more slowly than the batch (the chord of the bed's segment), so a
-    small batch takes more of this heat per kilogram than a large one; eps_rad 0 (the default) is the
-    paper's model.
+    the surface, the Bullet at 500 g). The surface grows more slowly than the batch (the chord of
+    the bed's segment), so a small batch takes more of this heat per kilogram than a large one;
+    eps_rad 0 (the default) is the paper's model.
     """
     a = Tm + KELVIN
     b = Tb + KELVIN
