@@ -50,7 +50,7 @@ def make_rhs(plant: str, theta, X0: float, moisture: str = "schwartzberg", act=N
     (Qe_gain, Qe_offset, Tgi_gain, tau, Gg_fan, U_shell, T_room); None = the paper's model.
     ``bed`` the bed laws and the probe's depth: {"contact": "paper"|"wall", "probe": "rest"|"tumbling",
     "probe_gas": "outlet"|"mean", "h_probe": m, "eps_rad": the wall's radiation to the bed's free
-    surface, 0-1}; None = the paper's. ``process`` overrides values
+    surface, 0-1, "k_flight": the gas-bean area over that surface, 0 = the contact law's}; None = the paper's. ``process`` overrides values
     of PROCESS (and the plant's metal mass Mm)."""
     process = dict(process or {})
     g = {**PLANTS[plant], **({"Mm": process.pop("Mm")} if "Mm" in process else {})}
@@ -58,7 +58,15 @@ def make_rhs(plant: str, theta, X0: float, moisture: str = "schwartzberg", act=N
     hgm, hbm, Pbm = theta
     Agm = math.pi * g["Dch"] * (g["Lch"] + g["Hflap"] * g["Lch"] / g["Sflap"] + g["Dch"] / 2)
     Ab = g["Mb"] / c["mb"] * math.pi * c["Db"] ** 2
-    bed = {"contact": "paper", "probe": "rest", "probe_gas": "outlet", "h_probe": 0.0, "eps_rad": 0.0, **(bed or {})}
+    bed = {
+        "contact": "paper",
+        "probe": "rest",
+        "probe_gas": "outlet",
+        "h_probe": 0.0,
+        "eps_rad": 0.0,
+        "k_flight": 0.0,
+        **(bed or {}),
+    }
     angle, h_bed, A_wall = bed_segment(g["Mb"], g["Dch"], g["Lch"])
     A_surf = 2 * (g["Dch"] / 2) * math.sin(angle / 2) * g["Lch"]  # the segment's chord along the drum
     if bed["contact"] == "wall":  # beans touch the wetted wall; the rest of their surface meets the gas
@@ -66,6 +74,8 @@ def make_rhs(plant: str, theta, X0: float, moisture: str = "schwartzberg", act=N
         Agb = Ab - Abm
     else:
         Agb, Abm = Ab * (1 - Pbm), Ab * Pbm
+    if bed["k_flight"] > 0:  # the gas meets the beans at the bed's surface (and the beans in flight)
+        Agb = bed["k_flight"] * A_surf
     hp = bed["h_probe"]
     if hp == 0:
         cover = 1.0

@@ -186,3 +186,27 @@ def test_bed_surface_and_wall_radiation_by_hand():
     assert rhs.wall_radiation_kW(200.0, 300.0, p) == pytest.approx(watts / 1000.0, rel=1e-12)
     large = dataclasses.replace(plant, Mb_kg=0.3 * full)
     assert small.bed_surface_area_m2 / small.Mb_kg > 2.5 * large.bed_surface_area_m2 / large.Mb_kg
+
+
+def test_gas_area_at_the_bed_surface_by_hand():
+    """k_flight > 0: Agb = k_flight A_surf whatever the contact law and Pbm, Abm the contact law's;
+    k_flight 0 is the contact law's Agb; per kilogram a small batch meets more gas than a large one."""
+    plant = as_plant("120kg")
+    for bed in ("paper", "contact=wall"):
+        p = rhs.pack_params(plant, (0.01, 0.03, 0.5), bed=bed)
+        Agb0, Abm0 = rhs.bed_areas_m2(p)
+        p[P["k_flight"]] = 4.0
+        Agb, Abm = rhs.bed_areas_m2(p)
+        assert Agb == pytest.approx(4.0 * plant.bed_surface_area_m2, rel=1e-12) and Abm == Abm0
+        p[P["Pbm"]] = 0.7
+        assert rhs.bed_areas_m2(p)[0] == Agb  # the gas's area no longer depends on Pbm
+        assert Agb0 != Agb
+    small, large = (dataclasses.replace(plant, Mb_kg=m) for m in (40.0, 200.0))
+    per_kg = [rhs.bed_areas_m2(rhs.pack_params(q, (0.01, 0.03, 0.5)))[0] / q.Mb_kg for q in (small, large)]
+    assert per_kg[0] == pytest.approx(per_kg[1])  # the paper: the same gas area per kilogram
+    with_surface = []
+    for q in (small, large):
+        p = rhs.pack_params(q, (0.01, 0.03, 0.5))
+        p[P["k_flight"]] = 4.0
+        with_surface.append(rhs.bed_areas_m2(p)[0] / q.Mb_kg)
+    assert with_surface[0] > 2.0 * with_surface[1]

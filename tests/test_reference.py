@@ -261,3 +261,23 @@ def test_wall_radiation_matches_reference():
     # the term acts: the metal gives heat to the beans, so they end warmer and it cooler
     assert runs[0.8].states[-1, 0] > runs[0.0].states[-1, 0] + 0.5
     assert runs[0.8].states[-1, 1] < runs[0.0].states[-1, 1] - 0.1  # a 2 t drum: its fall is smaller
+
+
+@pytest.mark.parametrize("contact", ["paper", "wall"])
+def test_gas_at_the_bed_surface_matches_reference(contact):
+    """The gas meeting the beans at the bed's free surface (k_flight, roastlab.model.rhs.bed_areas_m2)
+    over either contact law: compiled vs reference; k_flight 0 is the contact law's own Agb."""
+    t, Gg, Tgi, x0 = random_case(29, "120kg")
+    theta = (0.03, 0.1, 0.5)
+    runs = {}
+    for k in (0.0, 3.0):
+        values = {"k_flight": k}
+        runs[k] = simulate("120kg", t, Gg, Tgi, theta=theta, initial=x0, values=values, bed={"contact": contact})
+        ref, ref_tgo = reference_simulate(
+            "120kg", theta, t, Gg, Tgi, x0.vector(), bed={"contact": contact, "k_flight": k}
+        )
+        for j in (0, 1, 4):
+            assert np.max(np.abs(runs[k].states[:, j] - ref[:, j])) < TOL_C
+        assert np.max(np.abs(runs[k].Tgo_C - ref_tgo)) < TOL_C
+    # 3 times the surface is far less than the beans' own area at 120 kg: the gas leaves hotter
+    assert np.max(runs[3.0].Tgo_C - runs[0.0].Tgo_C) > 5.0

@@ -80,6 +80,8 @@ PARAM_NAMES = (
     # wall-to-bed radiation (extension; eps_rad 0 = the paper, whose metal reaches the beans by contact alone)
     "eps_rad",  # effective emissivity of the drum wall's exchange with the bed's free surface [-]
     "A_surf",  # the bed's free surface, its chord along the drum [m2] (plant- and batch-derived)
+    # the gas meets the beans at the bed's surface (extension; k_flight 0 = the contact law's Agb)
+    "k_flight",  # gas-bean area over the bed's free surface [-] (>= 1: the beans in flight add to it)
 )
 P = {name: i for i, name in enumerate(PARAM_NAMES)}
 N_PARAMS = len(PARAM_NAMES)
@@ -91,4 +93,4 @@ I_QEG, I_QEO, I_TGIG, I_TAUH, I_GGF = (P[k] for k in ("Qe_gain", "Qe_offset", "T
 I_USH, I_ASH, I_TROOM = (P[k] for k in ("U_shell", "Ashell", "T_room"))
 I_HBED, I_HPROBE = P["h_bed"], P["h_probe"]
 I_AWALL, I_CONTACT, I_PROBELAW, I_PROBEGAS = (P[k] for k in ("A_wall", "contact_law", "probe_law", "probe_gas_law"))
-I_EPSRAD, I_ASURF = P["eps_rad"], P["A_surf"]
+I_EPSRAD, I_ASURF, I_KFLIGHT = P["eps_rad"], P["A_surf"], P["k_flight"]

@@ -164,6 +164,9 @@ _TABLE: tuple[Quantity, ...] = (
     Quantity("eps_rad", "-", "extension", 0.0, (0.0, 1.0),
              "effective emissivity of the drum wall's radiation to the bed's free surface (eq. 12/15a extension)",
              (0.0, 1.0), True, "eps_rad"),
+    Quantity("k_flight", "-", "extension", 0.0, (0.0, 1000.0),
+             "gas-bean area over the bed's free surface, beans in flight included (0: the contact law's Agb)",
+             (1.0, 100.0), False, "k_flight"),
     # --- closed-loop scenarios (roastlab.io.scenario) --------------------------------------------
     Quantity("mass_factor", "-", "scenario", 1.0, (0.1, 5.0), "batch mass over the reference's"),
     Quantity("Gg_factor", "-", "scenario", 1.0, (0.1, 5.0), "gas flow the plant gets over the flow set"),

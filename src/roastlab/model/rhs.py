@@ -24,9 +24,10 @@ U_shell Ashell (Tm - T_room) [kW], leaves the metal (eq. 12; the paper's shell i
 The probe-immersion extension lets the bean probe see the gas where the bean bed does not cover
 it (eq. 17 extended, :func:`probe_coverage`): a small batch in a large drum reads low when the
 gas is cooler than the beans. The radiation extension lets the drum wall radiate to the bed's free
-surface (:func:`wall_radiation_kW`, eqs. 15a/15b extended). With the gains, U_shell, h_probe and
-eps_rad at their default 0 and no heater input the model is the paper's (MODEL.md's check value
-holds; tests/test_physics.py).
+surface (:func:`wall_radiation_kW`, eqs. 15a/15b extended), and the gas-area extension lets the gas
+meet the beans at that surface rather than over a share of every bean (``k_flight``,
+:func:`bed_areas_m2`). With the gains, U_shell, h_probe, eps_rad and k_flight at their default 0
+and no heater input the model is the paper's (MODEL.md's check value holds; tests/test_physics.py).
 """
 
 from __future__ import annotations
@@ -64,6 +65,7 @@ from .layout import (  # noqa: E402, F401
     I_HPROBE,
     I_K1,
     I_K2,
+    I_KFLIGHT,
     I_KT,
     I_LAM,
     I_MBD,
@@ -152,17 +154,28 @@ def bean_areas_m2(Ab_m2, Pbm):
 
 @register_jitable
 def bed_areas_m2(p):
-    """(Agb, Abm) [m^2] under the model's contact law (:mod:`roastlab.model.bed`).
+    """(Agb, Abm) [m^2] under the model's contact law (:mod:`roastlab.model.bed`) and gas area.
 
     ``contact_law`` 0 (the paper, section 3.1): :func:`bean_areas_m2`, both shares of Ab.
     1 (``"wall"``): Abm = Pbm A_wall, the share Pbm of the drum wall the bed wets
     (:attr:`roastlab.model.plant.Plant.wall_contact_area_m2`), and Agb = Ab - Abm, every other
     bean surface (never below 1 % of Ab).
+
+    With ``k_flight`` > 0 (an extension; 0, the default, keeps the contact law's Agb) the gas meets
+    the beans where the bed faces it instead: Agb = k_flight A_surf, the bed's free surface
+    (:attr:`roastlab.model.plant.Plant.bed_surface_area_m2`) and, for k_flight above 1, the beans
+    the flights lift through the air, taken in proportion to that surface. The air drawn through a
+    drum passes over the bed more than through it, so the area it meets grows with the bed's
+    surface (as the fill to the power ~1/3 for a shallow bed), not with the number of beans: a small
+    batch loses less heat to cool air per kilogram than the paper's Agb gives. Agb then no longer
+    depends on Pbm, so hbm and Pbm act only as their product (hold Pbm when fitting).
     """
     if p[I_CONTACT] == 0.0:
-        return bean_areas_m2(p[I_AB], p[I_PBM])
-    Abm = p[I_PBM] * p[I_AWALL]
-    return fmax(p[I_AB] - Abm, 0.01 * p[I_AB]), Abm
+        Agb, Abm = bean_areas_m2(p[I_AB], p[I_PBM])
+    else:
+        Abm = p[I_PBM] * p[I_AWALL]
+        Agb = fmax(p[I_AB] - Abm, 0.01 * p[I_AB])
+    return where(p[I_KFLIGHT] > 0.0, p[I_KFLIGHT] * p[I_ASURF], Agb), Abm
 
 
 @register_jitable
