@@ -46,12 +46,13 @@ wheel-check:
 	cd /tmp/roastlab-wheel && venv/bin/roastlab reproduce --out X && test -s X/model.json && test -s X/fig2_profiles.png
 
 # The measured figures of docs/real-roaster.md, from the real logs in ../shared/data/real.
-# Then every bed-law variant and the probe depth scale's profile cross-validated by batch size on the
-# Bullet (12 variants x 9 fits), then by roaster (3 variants x 6 fits). Then the band's
-# calibration: the example leave-one-log-out on the 17 nominal logs (18 fits) and on 16 splits of
-# them into 9 fit and 8 held out (docs/band_splits.py). Last, the Skywalker's 16 logs one by one,
-# the example's bed laws against the paper's probe (2 x 17 fits). All of it: 29 min on 2 cores on
-# 2026-11-26 (docs/real_roaster.py 5 min, the 12 variants 13, the roasters 3, the bands 5, the Skywalker 2).
+# Then every bed-law variant, the probe depth scale's profile and the two surface-scaled heat paths
+# cross-validated by batch size on the Bullet (14 variants x 9 fits), then by roaster (3 variants x 6
+# fits). Then the band's calibration: the example leave-one-log-out on the 17 nominal logs (18 fits)
+# and on 16 splits of them into 9 fit and 8 held out (docs/band_splits.py). Last, the Skywalker's 16
+# logs one by one, the example's bed laws against the paper's probe (2 x 17 fits). All of it: 29 min
+# on 2 cores on 2026-11-27 (on 2026-11-26, with 12 variants: docs/real_roaster.py 5 min, the variants
+# 13, the roasters 3, the bands 5, the Skywalker 2).
 BULLET = ../shared/data/real/bullet
 SKYWALKER = ../shared/data/real/skywalker
 real-roaster: $(STAMP)
@@ -62,6 +63,7 @@ real-roaster: $(STAMP)
 	  $(foreach v,$(BED_VARIANTS),--variant $(v),h_probe_m=free,$(PAPER_EXOTHERM)) \
 	  $(foreach h,$(H_PROBE_PROFILE_M),--variant $(BED_EXAMPLE),h_probe_m=$(h),$(PAPER_EXOTHERM)) \
 	  --variant $(BED_BEFORE),h_probe_m=0.2,$(PAPER_EXOTHERM) \
+	  $(foreach x,$(SURFACE_HEAT),--variant $(BED_EXAMPLE),$(x)) \
 	  --json docs/real-roaster-compare.json --plot docs/real-roaster-compare.png
 	$(VENV)/bin/roastlab compare-models --plant examples/bullet/plant.toml --map examples/bullet/map.toml \
 	  --spec examples/bullet/fit.toml $$(ls $(BULLET)/*_*g.json) --group-by unit \
@@ -75,6 +77,9 @@ real-roaster: $(STAMP)
 	  --spec examples/skywalker/fit.toml $(SKYWALKER)/*.alog --group-by log \
 	  --variant $(BED_EXAMPLE) --variant paper,h_probe_m=0 \
 	  --json docs/real-roaster-skywalker.json --plot docs/real-roaster-skywalker.png
+# the two heat paths that grow with the bed's surface (roastlab.model.rhs; off in the examples): the
+# wall's radiation to the bed, the gas meeting the beans at the bed's surface (Pbm then held)
+SURFACE_HEAT = eps_rad=free k_flight=free,Pbm=0.5
 # each bed law with the probe's depth scale fitted, then that scale's profile under the example's laws
 BED_VARIANTS = paper probe=tumbling contact=wall probe=tumbling,probe_gas=mean contact=wall,probe=tumbling,probe_gas=mean
 # the laws cross-validation chose, as the code holds them (roastlab.model.bed.CROSS_VALIDATED)

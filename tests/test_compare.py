@@ -240,3 +240,21 @@ def test_a_fit_given_one_roast_twice_says_so():
         f"one roast given twice, so it weighs twice in the fit: a_copy is a copy of {a.name}" in w for w in warned
     )
     assert not any("given twice" in w for w in roastlab.fit([a, b], "120kg", bed=TRUTH, starts=1).warnings)
+
+
+@pytest.mark.parametrize("n", [3, 10, 14, 25])
+def test_every_variant_has_its_own_colour_in_the_figure(n):
+    """The bar chart gives each variant a colour no other has (matplotlib's ten-colour cycle repeats
+    from the eleventh: at 14 variants two pairs of bars were one colour), and up to ten variants the
+    colours are the usual cycle's."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from matplotlib import colors
+
+    from roastlab.workflows.compare import variant_colours
+
+    got = [colors.to_hex(c) for c in variant_colours(n)]
+    assert len(set(got)) == n
+    if n <= 10:
+        assert got == [colors.to_hex(f"C{i}") for i in range(n)]

@@ -395,14 +395,16 @@ class ModelComparison(Result):
         groups = list(self.groups)
         x = np.arange(len(groups))
         width = 0.8 / max(len(self.scores), 1)
+        colours = variant_colours(len(self.scores))
         for i, s in enumerate(self.scores):
             at = x + (i - (len(self.scores) - 1) / 2) * width
             # the legend: the variant's mean FIT and (with the band panel) its share of all held-out samples in the band
             in_band = f"; {_percent(s.cv_band_inside)} in the band" if band_ax is not None else ""
-            bars = ax.bar(at, [s.cv_by_group[g] for g in groups], width, label=f"{s.name} ({s.cv_FIT:.1f} %{in_band})")
+            label = f"{s.name} ({s.cv_FIT:.1f} %{in_band})"
+            ax.bar(at, [s.cv_by_group[g] for g in groups], width, label=label, color=colours[i])
             if band_ax is not None:
                 inside = [100.0 * s.cv_band_by_group.get(g, math.nan) for g in groups]
-                band_ax.bar(at, inside, width, color=bars.patches[0].get_facecolor())
+                band_ax.bar(at, inside, width, color=colours[i])
         words = _GROUP_WORDS[self.group_by]
         ax.set_ylabel("probe FIT [%]")
         ax.set_ylim(max(min(0.0, ax.get_ylim()[0]), -50.0), 100.0)
@@ -441,6 +443,19 @@ class ModelComparison(Result):
         kind = _GROUP_WORDS[self.group_by]["kind"]
         title = title or f"{self.cv_name.capitalize()}: each {kind} predicted by a model fitted on the others"
         return finish_figure(fig, path, title, outputs)
+
+
+def variant_colours(n: int) -> list:
+    """One colour per variant, all different: matplotlib's ten-colour cycle up to ten variants (as
+    any other figure), its twenty-colour map up to twenty, an even spread of a perceptual map beyond
+    (the ten-colour cycle repeats from the eleventh, which made two variants one colour)."""
+    from matplotlib import colormaps
+
+    if n <= 10:
+        return [colormaps["tab10"](i) for i in range(n)]
+    if n <= 20:
+        return [colormaps["tab20"](i) for i in range(n)]
+    return [colormaps["turbo"](v) for v in np.linspace(0.05, 0.95, n)]
 
 
 def _percent(share: float) -> str:
