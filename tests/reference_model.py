@@ -50,8 +50,8 @@ def make_rhs(plant: str, theta, X0: float, moisture: str = "schwartzberg", act=N
     (Qe_gain, Qe_offset, Tgi_gain, tau, Gg_fan, U_shell, T_room); None = the paper's model.
     ``bed`` the bed laws and the probe's depth: {"contact": "paper"|"wall", "probe": "rest"|"tumbling",
     "probe_gas": "outlet"|"mean", "h_probe": m, "eps_rad": the wall's radiation to the bed's free
-    surface, 0-1, "k_flight": the gas-bean area over that surface, 0 = the contact law's}; None = the paper's. ``process`` overrides values
-    of PROCESS (and the plant's metal mass Mm)."""
+    surface, 0-1, "k_flight": the gas-bean area over that surface, 0 = the contact law's}; None =
+    the paper's. ``process`` overrides values of PROCESS (and the plant's metal mass Mm)."""
     process = dict(process or {})
     g = {**PLANTS[plant], **({"Mm": process.pop("Mm")} if "Mm" in process else {})}
     c = {**PROCESS, **process}
