@@ -77,9 +77,8 @@ real-roaster: $(STAMP)
 	  --spec examples/skywalker/fit.toml $(SKYWALKER)/*.alog --group-by log \
 	  --variant $(BED_EXAMPLE) --variant paper,h_probe_m=0 \
 	  --json docs/real-roaster-skywalker.json --plot docs/real-roaster-skywalker.png
-# the two heat paths that grow with the bed's surface (roastlab.model.rhs; off in the examples): the
-# wall's radiation to the bed, the gas meeting the beans at the bed's surface (Pbm then held)
-SURFACE_HEAT = eps_rad=free k_flight=free,Pbm=0.5
+# the two heat paths that grow with the bed's surface, as the code holds them (roastlab.model.bed.SURFACE_HEAT)
+SURFACE_HEAT = $(shell $(PY) -c "from roastlab.model.bed import SURFACE_HEAT as s; print(' '.join(s))")
 # each bed law with the probe's depth scale fitted, then that scale's profile under the example's laws
 BED_VARIANTS = paper probe=tumbling contact=wall probe=tumbling,probe_gas=mean contact=wall,probe=tumbling,probe_gas=mean
 # the laws cross-validation chose, as the code holds them (roastlab.model.bed.CROSS_VALIDATED)

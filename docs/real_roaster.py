@@ -312,7 +312,7 @@ def variants_and_bands(column_map, paths, lines):
     FIT, every other size predicted, and the 90 % band's coverage (roastlab.evaluate.bands)."""
     from roastlab.evaluate.bands import band_coverage, share_inside
     from roastlab.io.fitspec import load_fit_spec
-    from roastlab.model.bed import VARIANTS
+    from roastlab.model.bed import SURFACE_HEAT, VARIANTS
     from roastlab.workflows.compare import FREE
 
     example = ROOT / "examples" / "bullet"
@@ -332,10 +332,9 @@ def variants_and_bands(column_map, paths, lines):
     spec = load_fit_spec(example / "fit.toml")
     variants = {f"{name}, h_probe_m {FREE}": Variant(laws, (("h_probe_m", FREE),)) for name, laws in VARIANTS.items()}
     variants[f"example: {spec.bed.name}, h_probe_m {spec.fixed['h_probe_m']:g} m"] = Variant(spec.bed)
-    # the two heat paths that grow with the bed's surface, off in the example (the Makefile's SURFACE_HEAT)
-    for extra in ((("eps_rad", FREE),), (("k_flight", FREE), ("Pbm", 0.5))):
-        variant = Variant(spec.bed, extra)
-        variants[f"example + {variant.name.removeprefix(spec.bed.name + ',')}"] = variant
+    # the two heat paths that grow with the bed's surface, off in the example (roastlab.model.bed.SURFACE_HEAT)
+    for extra in SURFACE_HEAT:
+        variants[f"example + {extra}"] = Variant.parse(f"{spec.bed.name},{extra}")
     for name, variant in variants.items():
         model = roastlab.fit(
             fit_b, example / "plant.toml", variant.spec(spec), column_map=column_map, bed=variant.laws

@@ -132,3 +132,10 @@ VARIANTS: dict[str, BedLaws] = {
         BedLaws(contact="wall", probe="tumbling", probe_gas="mean"),
     )
 }
+
+#: The two heat paths that grow with the bed's surface rather than its mass (:mod:`roastlab.model.rhs`,
+#: both off by default), as ``compare-models`` variant settings to add to a set of laws: the wall's
+#: radiation to the bed (``eps_rad``) and the gas meeting the beans at the bed's surface
+#: (``k_flight``), with Pbm held, because the gas's area then no longer depends on it and hbm and Pbm
+#: act only as their product. ``make real-roaster`` cross-validates both beside the example.
+SURFACE_HEAT: tuple[str, ...] = ("eps_rad=free", "k_flight=free,Pbm=0.5")
