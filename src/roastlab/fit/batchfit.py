@@ -219,23 +219,17 @@ def _fit_one(
     Ta,
     x0_in,
     p_in,
-    kinds,
-    slots,
-    lo,
-    span,
-    logs,
-    trial,
-    zoh,
-    h_max,
-    max_iter,
-    gain_tol,
+    search,
     z_out,
     jtj_out,
 ):
     """Score the trial points, then projected Levenberg-Marquardt from the best; returns (SSR, sims).
 
-    z_out gets the scaled optimum, jtj_out the Gauss-Newton matrix J'J there (scaled units).
+    ``search`` is what every batch's search shares: (kinds, slots, lo, span, logs, trial, zoh, h_max,
+    max_iter, gain_tol). z_out gets the scaled optimum, jtj_out the Gauss-Newton matrix J'J there
+    (scaled units).
     """
+    kinds, slots, lo, span, logs, trial, zoh, h_max, max_iter, gain_tol = search
     k = lo.shape[0]
     p = p_in.copy()
     x0 = x0_in.copy()
@@ -372,16 +366,7 @@ def _fit_population(
     TA,
     X0,
     PB,
-    kinds,
-    slots,
-    lo,
-    span,
-    logs,
-    trial,
-    zoh,
-    h_max,
-    max_iter,
-    gain_tol,
+    search,
     Z,
     SSR,
     SIMS,
@@ -398,16 +383,7 @@ def _fit_population(
             TA[b],
             X0[b],
             PB[b],
-            kinds,
-            slots,
-            lo,
-            span,
-            logs,
-            trial,
-            zoh,
-            h_max,
-            max_iter,
-            gain_tol,
+            search,
             Z[b],
             JTJ[b],
         )
@@ -500,6 +476,8 @@ def identify_each(
     JTJ = np.zeros((nb, k, k))
     TA = np.where(packed.mask(), packed.TA, 0.0)
     chunk = max(1, min(nb, chunk)) if progress is not None else nb
+    # what every batch's search shares, one argument through the parallel loop (_fit_one unpacks it)
+    search = (kinds, slots, c_lo, c_span, logs, trial, packed.zoh, packed.h_max_s, max_iter, gain_tol)
     for a in range(0, nb, chunk):
         sl = slice(a, min(a + chunk, nb))
         # batches differ several-fold in work: hand them out one at a time, not in equal blocks
@@ -509,16 +487,7 @@ def identify_each(
                 TA[sl],
                 packed.x0[sl],
                 packed.PB[sl],
-                kinds,
-                slots,
-                c_lo,
-                c_span,
-                logs,
-                trial,
-                packed.zoh,
-                packed.h_max_s,
-                max_iter,
-                gain_tol,
+                search,
                 Z[sl],
                 SSR[sl],
                 SIMS[sl],
