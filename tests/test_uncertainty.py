@@ -60,6 +60,23 @@ def test_bound_flat_and_no_dof_get_no_standard_error():
     assert "upper bound" in words and "no effect" in words
 
 
+def test_a_range_over_decades_is_judged_near_its_bound_in_the_logarithm():
+    """A rate factor in [1e5, 1e10] at 1e6, a decade above its floor, is determined by the data; in
+    the value it lay within 1e-4 of the span (1e6) of the floor and got no standard error."""
+    J = np.array([[1.0, 2.0], [1.0, 1.0], [1.0, 0.5], [1.0, 3.0]])
+    lo, hi = np.array([1e5, 0.0]), np.array([1e10, 1.0])
+    u = uncertainty.from_jacobian(J, [1e6, 0.5], lo, hi, 2.0, ["A", "b"])
+    assert not u.on_bound[0] and np.isfinite(u.stderr[0])
+    assert (1e6 - lo[0]) <= uncertainty.ON_BOUND_REL * (hi[0] - lo[0])  # what the value's rule called it
+    # on its floor to the rule's margin in the logarithm (1e-4 of ln 1e5, 0.12 %) it is held
+    held = uncertainty.from_jacobian(J, [1e5 * 1.001, 0.5], lo, hi, 2.0, ["A", "b"])
+    assert held.at_lower[0] and np.isnan(held.stderr[0])
+    # the two fitters' coordinate: both judge in it (the per-batch fitter imports it from here)
+    from roastlab.fit import batchfit, identify
+
+    assert identify.log_sampled is uncertainty.log_sampled is batchfit.log_sampled
+
+
 @pytest.fixture(scope="module")
 def one_batch():
     ds = roastlab.read_dataset(roastlab.default_dataset_root() / "dataset-I")

@@ -12,7 +12,7 @@ the batches in lock-step so that each iteration is one compiled, parallel popula
    Gauss-Newton step clipped to the bounds, accepted if the batch's SSR falls, damping
    adapted; it stops when a step gains less than ``gain_tol`` (1e-10) of the SSR or moves
    less than 1e-6 of the bounds' span. A parameter whose bounds span two decades or more is
-   moved in its logarithm, as the global search samples it (:func:`roastlab.fit.identify.log_sampled`).
+   moved in its logarithm, as the global search samples it (:func:`roastlab.fit.uncertainty.log_sampled`).
 
 Any parameter-vector entry or initial state (except X0, which also sets the dry mass) can be
 free, not only theta: a fleet fit spec may free, say, Kt or Tm0_C per batch. Standard errors
@@ -46,7 +46,8 @@ from ..sim.cache import compiled
 from ..sim.kernels import H0_S, N_OUT, integrate_into
 from ..sim.population import PackedBatches, predict_ta
 from . import uncertainty
-from .identify import FD_STEP, log_sampled, on_bounds, sampling_coordinate, trial_points, trial_unit
+from .identify import FD_STEP, on_bounds, trial_points, trial_unit
+from .uncertainty import log_sampled, sampling_coordinate
 
 #: Where a free value goes: a parameter-vector entry or an initial state.
 KIND_PARAM, KIND_STATE = 0, 1

@@ -47,7 +47,13 @@ from ..model.parameters import (
 from ..model.quantities import default
 from ..sim.population import PackedBatches, output_sensitivities, predict_outputs
 from . import uncertainty
-from .uncertainty import CORRELATION_WARN, Uncertainty  # noqa: F401  (CORRELATION_WARN: re-exported)
+from .uncertainty import (  # noqa: F401  (CORRELATION_WARN, LOG_SAMPLED_SPAN: re-exported)
+    CORRELATION_WARN,
+    LOG_SAMPLED_SPAN,
+    Uncertainty,
+    log_sampled,
+    sampling_coordinate,
+)
 
 #: Residual given to a sample whose simulation failed (NaN): a very bad fit, not a crash [degC].
 FAILED_RESIDUAL_C = 1e3
@@ -378,29 +384,6 @@ def build_free_parameters(
     if not free:
         raise ParameterError("every parameter is fixed: nothing to identify")
     return free, fixed
-
-
-#: A parameter whose bounds span at least this ratio (two decades) is sampled evenly in its
-#: logarithm by the global search's trial points: a coefficient in [0.001, 1] kW/(m2 K) or a rate
-#: factor A in [1e5, 1e10] is as likely a decade from its floor as near its ceiling, while evenly in
-#: the value 99 % of the trial points would lie above a tenth of the ceiling.
-LOG_SAMPLED_SPAN = 100.0
-
-
-def log_sampled(lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
-    """Which parameters the trial points sample in their logarithm (:data:`LOG_SAMPLED_SPAN`).
-
-    >>> log_sampled(np.array([0.001, 0.05, 0.0, 5000.0]), np.array([1.0, 0.95, 0.1, 13000.0])).tolist()
-    [True, False, False, False]
-    """
-    lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
-    return (lower > 0) & (upper >= LOG_SAMPLED_SPAN * lower)
-
-
-def sampling_coordinate(z, logs: np.ndarray) -> np.ndarray:
-    """Values as the trial points spread them: the logarithm where ``logs``, else the value."""
-    z = np.asarray(z, dtype=float)
-    return np.where(logs, np.log(np.where(logs, z, 1.0)), z)
 
 
 #: The share of each parameter's range, at either end, whose trial points are moved onto the bound:

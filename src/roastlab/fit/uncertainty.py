@@ -14,7 +14,9 @@ number of residuals and ^+ the pseudo-inverse. A parameter is *not* determined b
 and gets no standard error (NaN, ``None`` in JSON), when
 
 * it is held by a bound: within :data:`ON_BOUND_REL` of its bounds' span from a bound (the
-  constraint holds it there, not the data; including it would distort the others), or
+  constraint holds it there, not the data; including it would distort the others), the span
+  measured in the coordinate the fit searches (the logarithm for a range over two decades,
+  :func:`log_sampled`), or
 * the residuals do not move with it (its column of J is zero: a term switched off there), or
 * there are no degrees of freedom left (n <= k).
 
@@ -48,14 +50,51 @@ ON_BOUND_REL = 1e-4
 CORRELATION_WARN = 0.95
 
 
+#: A parameter whose bounds span at least this ratio (two decades) is sampled evenly in its
+#: logarithm by the global search's trial points, and judged there when it nears a bound: a coefficient in [0.001, 1] kW/(m2 K) or a rate
+#: factor A in [1e5, 1e10] is as likely a decade from its floor as near its ceiling, while evenly in
+#: the value 99 % of the trial points would lie above a tenth of the ceiling.
+LOG_SAMPLED_SPAN = 100.0
+
+
+def log_sampled(lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
+    """Which parameters the trial points sample in their logarithm (:data:`LOG_SAMPLED_SPAN`).
+
+    >>> log_sampled(np.array([0.001, 0.05, 0.0, 5000.0]), np.array([1.0, 0.95, 0.1, 13000.0])).tolist()
+    [True, False, False, False]
+    """
+    lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
+    return (lower > 0) & (upper >= LOG_SAMPLED_SPAN * lower)
+
+
+def sampling_coordinate(z, logs: np.ndarray) -> np.ndarray:
+    """Values as the trial points spread them: the logarithm where ``logs``, else the value."""
+    z = np.asarray(z, dtype=float)
+    return np.where(logs, np.log(np.where(logs, z, 1.0)), z)
+
+
 def at_bounds(z, lower, upper) -> tuple[np.ndarray, np.ndarray]:
-    """(at_lower, at_upper): where ``z`` is held by its lower or upper bound (:data:`ON_BOUND_REL`).
+    """(at_lower, at_upper): where ``z`` is held by its lower or upper bound: within
+    :data:`ON_BOUND_REL` of the bounds' span, both measured in the :func:`sampling_coordinate`.
+
+    In the value, a rate factor A in [1e5, 1e10] would be "on its floor" anywhere below 1.1e6, eleven
+    times the floor; in its logarithm the margin is 0.12 % of the floor, as it is 0.01 % of the span
+    for a range the fit searches in the value.
 
     Works elementwise on any shape; a fixed component (lower == upper) counts as held by both.
+
+    >>> lo, hi = np.array([1e5, 0.05]), np.array([1e10, 0.95])
+    >>> [a.tolist() for a in at_bounds(np.array([1e6, 0.0502]), lo, hi)]
+    [[False, False], [False, False]]
+    >>> [a.tolist() for a in at_bounds(np.array([1.0001e5, 0.95]), lo, hi)]
+    [[True, False], [False, True]]
     """
     z, lower, upper = (np.asarray(a, dtype=float) for a in (z, lower, upper))
-    tol = ON_BOUND_REL * (upper - lower)
-    return z - lower <= tol, upper - z <= tol
+    logs = log_sampled(lower, upper)
+    c_lo, c_hi = sampling_coordinate(lower, logs), sampling_coordinate(upper, logs)
+    c = sampling_coordinate(np.clip(z, lower, upper), logs)
+    tol = ON_BOUND_REL * (c_hi - c_lo)
+    return c - c_lo <= tol, c_hi - c <= tol
 
 
 def scaled_pinv(a: np.ndarray) -> np.ndarray:
