@@ -19,6 +19,7 @@ import numpy as np
 
 import roastlab
 from roastlab.evaluate.metrics import average_metrics, mean_gap
+from roastlab.fit import uncertainty
 from roastlab.fit.baseline import describe, fit_first_order, validate_first_order
 from roastlab.io.fitspec import load_fit_spec
 from roastlab.io.importers.mapping import load_map
@@ -167,8 +168,7 @@ def machine(title, example, paths, lines):
     for name, entry in model.parameters.items():
         se = entry.get("stderr")
         lo, hi = bounds.get(name, (None, None))
-        tol = 1e-4 * (hi - lo) if lo is not None else 0.0
-        on = lo is not None and min(abs(entry["value"] - lo), abs(entry["value"] - hi)) <= tol
+        on = lo is not None and any(a.item() for a in uncertainty.at_bounds(entry["value"], lo, hi))
         se_text = "on bound" if on else ("-" if se is None else f"{se:.3g}")
         b_text = "" if lo is None else f"[{lo:g}, {hi:g}]"
         lines.append(f"| {name} | {entry['value']:.4g} | {se_text} | {b_text} | {REGISTRY[name].unit} |")

@@ -468,3 +468,55 @@ def test_sigterm_during_a_long_command_cleans_up_like_ctrl_c(tmp_path):
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 128 + signal.SIGTERM and "terminated" in err, err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_batches_are_fitted_under_the_machine_model_as_validate_applies_it(cli, tmp_path, fleet):
+    """With --model, a batch's fleet fit is the model file with the batch's own free values: its
+    stored FIT is what `validate` gives that model with those values, bed laws and all."""
+    import roastlab
+    from roastlab.errors import InputError
+    from roastlab.io.batch import read_batch_csv
+
+    d, _, _ = fleet
+    rows = (d / "data" / "manifest.csv").read_text().splitlines()
+    mine = [r for r in rows[1:] if r.split(",")[1] == "roaster-A"][:4]
+    (d / "data" / "four.csv").write_text("\n".join([rows[0], *mine]) + "\n")
+    model = roastlab.FittedModel.paper("120kg").with_values(Kt=0.03, h_probe_m=0.5)
+    model.bed = "probe=tumbling,probe_gas=mean"
+    model.save(tmp_path / "model.json")
+    spec = tmp_path / "fleet.toml"
+    spec.write_text("[free]\nhgm = [0.001, 0.2, 0.02]\nhbm = [0.001, 0.2, 0.02]\n")
+    db = tmp_path / "m.duckdb"
+    ingest(db, d / "data" / "four.csv")
+    code, out, err = cli(
+        "fleet", "fit", "--db", db, "--spec", f"roaster-A={spec}", "--model", f"roaster-A={tmp_path / 'model.json'}"
+    )
+    assert code == 0, err
+    con = duckdb.connect(str(db), read_only=True)
+    got = con.execute(
+        "SELECT b.source, f.FIT, max(CASE WHEN v.parameter = 'hgm' THEN v.value END), "
+        "max(CASE WHEN v.parameter = 'hbm' THEN v.value END) FROM fits f JOIN batches b USING (batch_id) "
+        "JOIN fit_values v USING (batch_id, spec_id) GROUP BY b.source, f.FIT ORDER BY b.source"
+    ).fetchall()
+    document = json.loads(con.execute("SELECT spec_json FROM fit_specs").fetchone()[0])
+    con.close()
+    assert len(got) == 4 and document["model"]["bed"]["probe"] == "tumbling"
+    for source, fit, hgm, hbm in got:
+        batch = read_batch_csv(source)
+        again = model.with_values(hgm=hgm, hbm=hbm).validate([batch]).rows[0]["FIT"]
+        assert fit == pytest.approx(again, abs=1e-6)
+        paper_bed = model.with_values(hgm=hgm, hbm=hbm)
+        paper_bed.bed = "paper"
+        assert abs(paper_bed.validate([batch]).rows[0]["FIT"] - fit) > 0.01  # the bed laws were applied
+    # the spec holds nothing of its own beside a model; a model of another plant is refused
+    spec.write_text("[free]\nhbm = [0.001, 0.2, 0.02]\n[fixed]\nKt = 0.02\n")
+    with pytest.raises(InputError, match=r"\[fixed\].*machine model holds"):
+        fleet_spec(spec, tmp_path / "model.json")
+    spec.write_text("[free]\nhbm = [0.001, 0.2, 0.02]\n")
+    roastlab.FittedModel.paper("360kg").save(tmp_path / "other.json")
+    code, out, err = cli(
+        "fleet", "fit", "--db", db, "--spec", f"roaster-A={spec}", "--model", f"roaster-A={tmp_path / 'other.json'}"
+    )
+    assert code == 2 and "fitted on plant 360kg" in err and len(err.strip().splitlines()) == 1
+    code, out, err = cli("fleet", "fit", "--db", db, "--model", f"roaster-A={tmp_path / 'model.json'}")
+    assert code == 2 and "give the machine's --spec too" in err

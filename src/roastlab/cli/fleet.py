@@ -35,24 +35,40 @@ def cmd_fleet_ingest(args) -> int:
     return 2 if report.rejected else 0
 
 
-def _specs(values: list[str] | None):
-    from ..fleet import fleet_spec
-
-    if not values:
-        return None
-    specs: dict = {}
-    single = None
-    for v in values:
+def _per_machine(values: list[str] | None, what: str) -> tuple[str | None, dict[str, str]]:
+    """``[MACHINE=]FILE`` options: (one file for every machine or None, {machine: file})."""
+    single, named = None, {}
+    for v in values or []:
         name, sep, path = v.partition("=")
         if sep and not Path(v).exists():
-            specs[name] = fleet_spec(path)
+            named[name] = path
+        elif single is None:
+            single = v
         else:
-            if single is not None:
-                raise InputError("give one --spec FIT.toml for every machine, or --spec MACHINE=FIT.toml per machine")
-            single = fleet_spec(v)
-    if single is not None and specs:
-        raise InputError("give one --spec FIT.toml for every machine, or --spec MACHINE=FIT.toml per machine")
-    return single if single is not None else specs
+            raise InputError(f"give one {what} for every machine, or MACHINE={what} per machine", "command line")
+    if single is not None and named:
+        raise InputError(f"give one {what} for every machine, or MACHINE={what} per machine", "command line")
+    return single, named
+
+
+def _specs(values: list[str] | None, models: list[str] | None = None):
+    """The fleet specs of ``--spec`` (and the machine models of ``--model``): one for every machine
+    or ``{machine: FleetSpec}``; None for the default."""
+    from ..fleet import fleet_spec
+
+    spec, specs = _per_machine(values, "--spec FIT.toml")
+    model, models_of = _per_machine(models, "--model MODEL.json")
+    if model is not None and specs:
+        raise InputError("one --model for every machine needs one --spec for every machine", "command line")
+    lost = sorted(set(models_of) - set(specs)) if specs or spec is None else []
+    if lost or (models_of and spec is not None) or (model is not None and spec is None):
+        raise InputError(
+            f"--model {', '.join(lost) or 'MODEL.json'}: give the machine's --spec too (what each batch frees)",
+            "command line",
+        )
+    if spec is not None:
+        return fleet_spec(spec, model)
+    return {name: fleet_spec(path, models_of.get(name)) for name, path in specs.items()} or None
 
 
 def cmd_fleet_fit(args) -> int:
@@ -60,8 +76,9 @@ def cmd_fleet_fit(args) -> int:
 
     if args.workers is not None and args.scheduler:
         raise InputError("give --workers N or --scheduler ADDRESS, not both", "command line")
-    _db_output(args.db, [v.partition("=")[2] if "=" in v and not Path(v).exists() else v for v in args.spec or []])
-    spec = _specs(args.spec)
+    given = [*(args.spec or []), *(args.model or [])]
+    _db_output(args.db, [v.partition("=")[2] if "=" in v and not Path(v).exists() else v for v in given])
+    spec = _specs(args.spec, args.model)
     report = fit_fleet(
         args.db,
         spec,
@@ -127,9 +144,9 @@ def add_parsers(sub) -> None:
         help="many roasters and years of batches: a DuckDB store, a fit per batch, drift alarms",
         description="Keep every batch of every machine in one DuckDB file (FLEET.duckdb, no server), fit each "
         "batch's heat-transfer coefficients, and watch each machine's coefficients for drift (a fouling drum, a "
-        "failing burner or fan, a drifting probe). A per-machine fit spec holds the values of the machine's "
-        "MODEL.json (from 'roastlab identify') and frees the coefficients to watch. Schema, detector and "
-        "thresholds: docs/fleet.md.",
+        "failing burner or fan, a drifting probe). Each machine's batches are fitted under its machine model "
+        "(--model MODEL.json, from 'roastlab identify'), with the coefficients to watch freed per batch by its "
+        "fit spec (--spec). Schema, detector and thresholds: docs/fleet.md.",
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog="examples:\n"
         "  roastlab fleet synthetic --out fleet-data --batches 1000          # a SYNTHETIC fleet to try it on\n"
@@ -171,6 +188,14 @@ def add_parsers(sub) -> None:
         metavar="[MACHINE=]FIT.toml",
         help="what each batch's fit frees and holds (every free parameter is fitted per batch); MACHINE=FIT.toml "
         "for one machine (repeatable). Default: hgm and hbm free, Pbm held at theta*",
+    )
+    q.add_argument(
+        "--model",
+        action="append",
+        metavar="[MACHINE=]MODEL.json",
+        help="the machine model (from 'roastlab identify' or 'fit-roaster') each batch is fitted under: all its "
+        "values, bed laws, initial state and moisture law, as 'validate' applies it; the machine's --spec then "
+        "frees per batch only ([free]). MACHINE=MODEL.json for one machine (repeatable)",
     )
     q.add_argument("--workers", type=count_arg("--workers", 1, 1024), help="start a local Dask cluster of N processes")
     q.add_argument("--scheduler", metavar="ADDRESS", help="use an existing Dask cluster (e.g. tcp://host:8786)")

@@ -19,6 +19,7 @@ stored results are identical whichever path ran (tests/test_fleet.py checks it).
 
 from __future__ import annotations
 
+import dataclasses
 import datetime
 import hashlib
 import json
@@ -30,6 +31,7 @@ import numpy as np
 from ..errors import InputError
 from ..io.batch import Batch
 from ..io.fitspec import FitSpec, load_fit_spec
+from ..model.bed import LAWS, PAPER_BED, BedLaws
 from ..model.parameters import DEFAULT_WEIGHTS, REGISTRY, THETA_NAMES, THETA_PAPER, THETA_START, FreeParameter
 from .store import SERIES_COLUMNS, filled, open_store, plant_of, store_errors
 
@@ -58,9 +60,14 @@ class FleetSpec:
     n_trial: int = 32
     max_iter: int = 100
     source: str = ""
+    #: the spec's [bed] laws that are not the paper's (without a machine model)
+    bed: tuple[tuple[str, str], ...] = ()
+    #: the machine model (a :class:`roastlab.workflows.model.FittedModel`) whose every value, bed law,
+    #: initial state, moisture law and hold the batches are fitted under, or None
+    model: object = field(default=None, compare=False, repr=False)
 
     def document(self) -> dict:
-        return {
+        doc = {
             "free": {n: [lo, hi, st] for n, lo, hi, st in zip(self.names, self.lower, self.upper, self.start)},
             "fixed": dict(self.fixed),
             "initial": dict(self.initial),
@@ -70,6 +77,11 @@ class FleetSpec:
             "n_trial": self.n_trial,
             "max_iter": self.max_iter,
         }
+        if self.bed:
+            doc["bed"] = dict(self.bed)
+        if self.model is not None:
+            doc["model"] = model_summary(self.model)
+        return doc
 
     @property
     def spec_id(self) -> str:
@@ -78,8 +90,31 @@ class FleetSpec:
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
-def fleet_spec(spec: str | FitSpec | None = None, **options) -> FleetSpec:
-    """A :class:`FleetSpec` from a FIT.toml (every free parameter is per batch) or the default."""
+def model_summary(model) -> dict:
+    """What of a machine model a per-batch fit applies, as JSON (part of the spec's identity: a
+    refitted model is a new spec, its batches fitted anew): every value, the initial state, the bed
+    laws, the moisture law, the hold and the plant's name."""
+    return {
+        "parameters": {k: float(e["value"]) for k, e in sorted(model.parameters.items())},
+        "initial": {k: model.initial[k] for k in sorted(model.initial)},
+        "bed": model.bed.as_dict(),
+        "moisture": model.moisture,
+        "hold": model.hold,
+        "plant": None if model.plant is None else model.plant.name,
+    }
+
+
+def fleet_spec(spec: str | FitSpec | None = None, model=None, **options) -> FleetSpec:
+    """A :class:`FleetSpec` from a FIT.toml (every free parameter is per batch) or the default.
+
+    ``model`` (a MODEL.json path or a :class:`~roastlab.workflows.model.FittedModel`) is the
+    machine model: each batch is then fitted under all of it (its values, bed laws, initial state,
+    moisture law and hold, as ``validate`` applies it), with the spec's free parameters moved per
+    batch. The spec then holds nothing itself: its [fixed], [initial] and [bed] would be a second
+    copy of the model's, and are refused.
+    """
+    if model is not None:
+        return _model_spec(spec, model, **options)
     if spec is None:
         free = [FreeParameter(n, *REGISTRY[n].bounds, THETA_START.as_dict()[n]) for n in DEFAULT_FREE]
         fixed = {k: v for k, v in THETA_PAPER.as_dict().items() if k not in DEFAULT_FREE}
@@ -98,6 +133,7 @@ def fleet_spec(spec: str | FitSpec | None = None, **options) -> FleetSpec:
         free_slots([f.name for f in free])
     except InputError as exc:
         raise InputError(exc.problem, source or None) from None
+    bed = () if spec is None else tuple((k, v) for k, v in spec.bed.as_dict().items() if v != LAWS[k][0])
     return FleetSpec(
         tuple(f.name for f in free),
         tuple(float(f.lower) for f in free),
@@ -106,8 +142,34 @@ def fleet_spec(spec: str | FitSpec | None = None, **options) -> FleetSpec:
         tuple(sorted((k, float(v)) for k, v in fixed.items())),
         tuple(sorted((k, float(v)) for k, v in initial.items())),
         source=str(source),
+        bed=bed,
         **options,
     )
+
+
+def _model_spec(spec, model, **options) -> FleetSpec:
+    """:func:`fleet_spec` under a machine model: the spec frees, the model holds the rest."""
+    from ..workflows.model import FittedModel, load_model
+
+    if spec is None:
+        raise InputError("a machine model needs a fit spec saying what each batch frees ([free])")
+    where = model if not isinstance(model, FittedModel) else (model.source or "the machine model")
+    model = model if isinstance(model, FittedModel) else load_model(model)
+    if model.failed:
+        raise InputError(f"the model's fit failed ({model.failed}): it is no machine model to fit batches under", where)
+    spec = spec if isinstance(spec, FitSpec) else load_fit_spec(spec)
+    # a spec's theta components not free read as held at theta* (load_fit_spec): not a table of its own
+    written = {k: v for k, v in spec.fixed.items() if not (k in THETA_NAMES and v == THETA_PAPER.as_dict()[k])}
+    held = [t for t, v in (("[fixed]", written), ("[initial]", spec.initial)) if v]
+    held += ["[bed]"] if spec.bed != PAPER_BED else []
+    if held:
+        raise InputError(
+            f"{' and '.join(held)}: the machine model holds every value, initial state and bed law; a fleet spec "
+            "used with it frees per batch only ([free]): drop the table(s)",
+            spec.source,
+        )
+    base = fleet_spec(spec, **{k: v for k, v in options.items() if k not in ("moisture", "hold")})
+    return dataclasses.replace(base, fixed=(), moisture=model.moisture, hold=model.hold, model=model)
 
 
 def fit_chunk(batch_ids, batches: list[Batch], plant, spec: FleetSpec, threads: int | None = None) -> dict:
@@ -124,14 +186,21 @@ def fit_chunk(batch_ids, batches: list[Batch], plant, spec: FleetSpec, threads: 
         import numba
 
         numba.set_num_threads(threads)
-    fixed = dict(spec.fixed)
-    theta = [fixed.get(k, THETA_PAPER.as_dict()[k]) for k in THETA_NAMES]
-    init = InitialState(**{**PAPER_INITIAL, **dict(spec.initial)})
-    packed = pack_batches(batches, plant, theta, init, spec.moisture, spec.hold)
-    extra = [k for k in fixed if k not in THETA_NAMES]
-    if extra:  # held values other than theta: the same name-addressed setter as population runs
-        values = np.array([[[fixed[k] for k in extra]] * packed.n_batches])
-        _, packed.x0, packed.PB = run_arrays(packed, extra, values)
+    if spec.model is not None:  # the machine model as validate applies it: values, bed, initial state
+        applied = spec.model.apply(batches, plant)
+        packed = applied.packed
+        if applied.names:
+            _, packed.x0, packed.PB = run_arrays(packed, applied.names, applied.values)
+    else:
+        fixed = dict(spec.fixed)
+        theta = [fixed.get(k, THETA_PAPER.as_dict()[k]) for k in THETA_NAMES]
+        init = InitialState(**{**PAPER_INITIAL, **dict(spec.initial)})
+        bed = BedLaws(**dict(spec.bed))
+        packed = pack_batches(batches, plant, theta, init, spec.moisture, spec.hold, bed=bed)
+        extra = [k for k in fixed if k not in THETA_NAMES]
+        if extra:  # held values other than theta: the same name-addressed setter as population runs
+            values = np.array([[[fixed[k] for k in extra]] * packed.n_batches])
+            _, packed.x0, packed.PB = run_arrays(packed, extra, values)
     bounds = {n: (lo, hi) for n, lo, hi in zip(spec.names, spec.lower, spec.upper)}
     r = identify_each(
         packed,
@@ -344,6 +413,15 @@ def fit_fleet(
                     raise InputError(
                         f"no machine {', '.join(unknown)} in the store (has: {', '.join(m[1] for m in machines)})"
                     )
+            plants = {mid: plant_of(name, plant, toml) for mid, name, plant, toml in machines}
+            for mid, name, _plant, _toml in machines:
+                m = specs[mid].model
+                if m is not None and m.plant is not None and m.plant != plants[mid]:
+                    raise InputError(
+                        f"machine {name} is plant {plants[mid].name}, its machine model was fitted on plant "
+                        f"{m.plant.name}: fit its batches under a model of its own plant",
+                        m.source,
+                    )
             for s in {s.spec_id: s for s in specs.values()}.values():
                 con.execute(
                     "INSERT OR IGNORE INTO fit_specs VALUES (?, ?, ?)",
@@ -367,7 +445,6 @@ def fit_fleet(
                 ).fetchall()[0][0]
                 total += len(ids)
                 work += [(mid, ids[a : a + chunk]) for a in range(0, len(ids), chunk)]
-            plants = {mid: plant_of(name, plant, toml) for mid, name, plant, toml in machines}
             if client is None and (workers or scheduler):
                 client, owned = _client(workers, scheduler)
             report.where = (
