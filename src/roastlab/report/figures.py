@@ -15,6 +15,7 @@ from ..errors import InputError
 from ..io.files import Outputs
 from ..metrics.profile import ROR_SPAN_S, implausible_states, mmss, rate_of_rise_C_per_min, turning_point
 from ..model.layout import S_TB, S_TM
+from ..model.parameters import REGISTRY
 
 #: Image formats a figure may be saved as (by the file suffix).
 FIGURE_FORMATS = ("png", "svg", "pdf")
@@ -565,7 +566,7 @@ def plot_fleet_history(m, path=None, outputs=None):
         for per in a["periods"]:
             st = per["values"].get(p)
             if st:
-                ax.hlines(st["median"], per["first_index"], per["last_index"], color="k", lw=1.2)
+                ax.hlines(st["median"], per["first_index"], per["last_index"], color="k", lw=1.2, label="median")
         for al in a["alarms"]:
             if al["parameter"] != p:
                 continue
@@ -574,7 +575,8 @@ def plot_fleet_history(m, path=None, outputs=None):
             ax.plot(i, x[i], mark, color="C1", ms=10, mec="k", label=f"alarm {al['direction']}")
             if al["change_index"] is not None:
                 ax.axvline(al["change_index"], color="C1", ls=":", lw=1)
-        ax.set_ylabel(p)
+        unit = REGISTRY[p].unit if p in REGISTRY else ""
+        ax.set_ylabel(f"{p} [{unit}]" if unit and unit != "-" else p)
         handles, labels = ax.get_legend_handles_labels()
         uniq = dict(zip(labels, handles))
         ax.legend(uniq.values(), uniq.keys(), fontsize=7, loc="upper right")
