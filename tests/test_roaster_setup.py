@@ -825,6 +825,29 @@ def test_an_unseen_gas_drum_with_burner_events_is_fitted_with_no_hand_edits(cli,
     held = printed_percent(out, "held out: FIT ")
     base = printed_percent(out, "baseline: ")
     assert held > 80.0 and held > base + 10.0, out
+    # and as a fleet, with init's fleet spec under fit-roaster's model: still no hand-written file
+    pytest.importorskip("duckdb")
+    cfg = tmp_path / "cfg"
+    rows = ["path,machine,plant,started_at,map"]
+    rows += [f"{p},drum,{cfg / 'plant.toml'},2026-01-0{i + 1}T10:00:00,{cfg / 'map.toml'}" for i, p in enumerate(logs)]
+    (tmp_path / "m.csv").write_text("\n".join(rows) + "\n")
+    assert cli("fleet", "ingest", "--db", tmp_path / "f.duckdb", "--manifest", tmp_path / "m.csv")[0] == 0
+    free = roaster.fleet_spec_text((cfg / "fit.toml").read_text())
+    assert (cfg / "fleet.toml").read_text() == free and "\nQe_gain_kW = [" in free and "\nKt = [" in free
+    code, out, err = cli(
+        "fleet",
+        "fit",
+        "--db",
+        tmp_path / "f.duckdb",
+        "--spec",
+        f"drum={cfg / 'fleet.toml'}",
+        "--model",
+        f"drum={cfg / 'model.json'}",
+    )
+    assert code == 0, err
+    code, out, err = cli("fleet", "report", "--db", tmp_path / "f.duckdb")
+    assert code == 0 and "Qe_gain_kW" in out and "Kt" in out, err
+    assert float(out.splitlines()[1].split()[2]) > held, out  # each batch's own fit reads closer than held out
 
 
 #: Green weights [g] of the SYNTHETIC gas drum's logs in the batch-size tests: five at 3 kg (the fit size),

@@ -43,7 +43,7 @@ def cmd_init(args) -> int:
         print(f"  logs: {note}")
     for note in r["notes"]:
         print(f"  plant: {note}")
-    print(f"wrote {args.out}/map.toml, plant.toml, fit.toml; next: roastlab fit-roaster {args.out} LOG...")
+    print(f"wrote {args.out}/map.toml, plant.toml, fit.toml, fleet.toml; next: roastlab fit-roaster {args.out} LOG...")
     return 0
 
 

@@ -42,6 +42,7 @@ from __future__ import annotations
 import io
 import math
 import re
+import tomllib
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -1010,6 +1011,34 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
     return "\n".join(rows) + "\n"
 
 
+#: What a fleet fit frees per batch on a roaster ``init`` set up, each the first of its choices that
+#: the fit spec frees: the heater's heat into the drum (a weakening heater) or, without a heater, the
+#: metal-bean coefficient (a fouling drum), and the probe's time constant (a probe fouling with oils),
+#: as the examples' fleet specs do (docs/fleet.md). Everything else comes from the model file.
+FLEET_FREE = (("Qe_gain_kW", "hbm"), ("Kt",))
+
+
+def fleet_spec_text(fit_text: str) -> str:
+    """The fleet spec beside ``fit_text`` (a fit spec's text): :data:`FLEET_FREE`'s names with their
+    lines of its [free] table as they are (bounds, start and comment), to fit each batch under the
+    model ``fit-roaster`` writes from that spec."""
+    free = tomllib.loads(fit_text)["free"]
+    names = [next(n for n in choice if n in free) for choice in FLEET_FREE if any(n in free for n in choice)]
+    lines = {ln.split("=", 1)[0].strip(): ln for ln in fit_text.split("[free]", 1)[1].split("\n[", 1)[0].splitlines()}
+    return (
+        "\n".join(
+            [
+                "# Written by roastlab init: what a fleet fit frees per batch (roastlab.workflows.roaster.FLEET_FREE),",
+                "# under the machine model 'roastlab fit-roaster' writes (model.json in this folder), which holds the rest:",
+                "#   roastlab fleet fit --db FLEET.duckdb --spec MACHINE=fleet.toml --model MACHINE=model.json",
+                "[free]",
+                *(lines[n] for n in names),
+            ]
+        )
+        + "\n"
+    )
+
+
 def plant_text(plant: dict, notes: list[str]) -> str:
     lines = ["# Written by roastlab init. " + "; ".join(notes[:1])] + [f"# {n}" for n in notes[1:]]
     lines.append(f'name = "{plant["name"]}"')
@@ -1019,7 +1048,7 @@ def plant_text(plant: dict, notes: list[str]) -> str:
 
 
 def init_roaster(paths, out_dir, *, batch_kg=None, capacity_kg=None, diameter_m=None, length_m=None) -> dict:
-    """Survey the logs and write ``out_dir``/map.toml, plant.toml, fit.toml; returns a summary."""
+    """Survey the logs and write ``out_dir``/map.toml, plant.toml, fit.toml and fleet.toml; returns a summary."""
     from ..io.files import Outputs
 
     paths = log_paths(paths)
@@ -1031,7 +1060,9 @@ def init_roaster(paths, out_dir, *, batch_kg=None, capacity_kg=None, diameter_m=
         o.folder(out)
         o.write_text(out / "map.toml", map_text(s) + "\n")
         o.write_text(out / "plant.toml", plant_text(plant, notes))
-        o.write_text(out / "fit.toml", fit_spec_text(s, cap, plant["Dch_m"]))
+        fit_text = fit_spec_text(s, cap, plant["Dch_m"])
+        o.write_text(out / "fit.toml", fit_text)
+        o.write_text(out / "fleet.toml", fleet_spec_text(fit_text))
     return {"survey": s, "plant": plant, "notes": notes}
 
 
