@@ -520,3 +520,21 @@ def test_batches_are_fitted_under_the_machine_model_as_validate_applies_it(cli, 
     assert code == 2 and "fitted on plant 360kg" in err and len(err.strip().splitlines()) == 1
     code, out, err = cli("fleet", "fit", "--db", db, "--model", f"roaster-A={tmp_path / 'model.json'}")
     assert code == 2 and "give the machine's --spec too" in err
+
+
+def test_a_spec_without_a_model_applies_its_bed_laws(fleet):
+    """A fleet spec's [bed] was read and then dropped; it now reaches the simulator and the spec's identity."""
+    import roastlab
+    from roastlab.fleet.fitting import fit_chunk
+
+    d, _, _ = fleet
+    rows = (d / "data" / "manifest.csv").read_text().splitlines()[1:3]
+    batches = [roastlab.io.batch.read_batch_csv(d / "data" / r.split(",")[0]) for r in rows]
+    text = "[free]\nhbm = [0.005, 0.2, 0.02]\n[fixed]\nh_probe_m = 0.5\n"
+    paper, bed = d / "paper.toml", d / "bed.toml"
+    paper.write_text(text)
+    bed.write_text(text + '[bed]\nprobe = "tumbling"\n')
+    a, b = fleet_spec(paper), fleet_spec(bed)
+    assert "bed" not in a.document() and b.document()["bed"] == {"probe": "tumbling"} and a.spec_id != b.spec_id
+    fa, fb = (fit_chunk([1, 2], batches, "120kg", s)["SSR"] for s in (a, b))
+    assert np.all(np.abs(fa - fb) > 1e-6 * fa)
