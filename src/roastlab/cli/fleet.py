@@ -58,13 +58,12 @@ def _specs(values: list[str] | None, models: list[str] | None = None):
 
     spec, specs = _per_machine(values, "--spec FIT.toml")
     model, models_of = _per_machine(models, "--model MODEL.json")
-    if model is not None and specs:
-        raise InputError("one --model for every machine needs one --spec for every machine", "command line")
-    lost = sorted(set(models_of) - set(specs)) if specs or spec is None else []
-    if lost or (models_of and spec is not None) or (model is not None and spec is None):
+    if (model is not None and spec is None) or (models_of and spec is not None):
+        raise InputError("give --model and --spec alike: both for every machine, or both per machine", "command line")
+    lost = sorted(set(models_of) - set(specs))
+    if lost:
         raise InputError(
-            f"--model {', '.join(lost) or 'MODEL.json'}: give the machine's --spec too (what each batch frees)",
-            "command line",
+            f"--model {', '.join(lost)}=...: give the machine's --spec too (what each batch frees)", "command line"
         )
     if spec is not None:
         return fleet_spec(spec, model)
