@@ -538,3 +538,19 @@ def test_a_spec_without_a_model_applies_its_bed_laws(fleet):
     assert "bed" not in a.document() and b.document()["bed"] == {"probe": "tumbling"} and a.spec_id != b.spec_id
     fa, fb = (fit_chunk([1, 2], batches, "120kg", s)["SSR"] for s in (a, b))
     assert np.all(np.abs(fa - fb) > 1e-6 * fa)
+
+
+@pytest.mark.skipif(not (REAL / "bullet").is_dir(), reason="real logs not present")
+def test_a_batch_its_plant_cannot_take_is_rejected_at_ingest_naming_the_log(cli, tmp_path):
+    """A 490 g roast listed under the paper's 120 kg plant: one line naming the manifest row and the
+    log (a model's apply would refuse it in the middle of a fleet fit), the other rows ingest."""
+    root = Path(__file__).resolve().parents[1]
+    logs = sorted((REAL / "bullet").glob("*_490g.json"))[:2]
+    rows = ["path,machine,plant,started_at,map"]
+    rows += [f"{logs[0]},wrong,120kg,2025-01-01T10:00:00,{root}/examples/bullet/map.toml"]
+    rows += [f"{logs[1]},bullet,{root}/examples/bullet/plant.toml,2025-01-02T10:00:00,{root}/examples/bullet/map.toml"]
+    (tmp_path / "m.csv").write_text("\n".join(rows) + "\n")
+    code, out, err = cli("fleet", "ingest", "--db", tmp_path / "f.duckdb", "--manifest", tmp_path / "m.csv")
+    assert code == 2 and "1 batch(es) ingested" in out
+    (line,) = [e for e in err.splitlines() if "rejected" in e]
+    assert "line 2:" in line and logs[0].name in line and "0.49 kg batch is far outside 120kg" in line

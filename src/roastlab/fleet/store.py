@@ -331,6 +331,11 @@ class _Machines:
         self._plants[spec] = out
         return out
 
+    def plant(self, spec: str):
+        """The :class:`~roastlab.model.plant.Plant` of a manifest's plant column (ValueError if unknown)."""
+        stored, text, _sha = self._plant(spec)
+        return plant_of(spec, stored, text)
+
     def check(self, name: str, plant_spec: str) -> None:
         """ValueError if the plant is unknown or differs from the one the machine already has."""
         plant, _text, sha = self._plant(plant_spec)
@@ -414,6 +419,11 @@ def ingest(db: str | Path, manifest: str | Path, progress=None, wait_s: float = 
                         batch, map_path, map_sha = read_batch_csv(path), None, None
                     else:
                         batch, map_path, map_sha = import_log(path, None), None, None
+                    try:  # a batch its plant cannot take is refused here, as a model's apply refuses it
+                        if batch.Mb_kg:
+                            machines.plant(row["plant"]).check_batch_mass(batch.Mb_kg)
+                    except InputError as exc:
+                        raise InputError(exc.problem, path) from None
                     mid = machines.resolve(row["machine"], row["plant"])
                 except (InputError, ValueError, OSError) as exc:
                     report.rejected.append(f"{manifest}: {where}: {exc}")
