@@ -314,6 +314,7 @@ class _Machines:
         self.next_id = 1 + max([v[0] for v in self.known.values()], default=0)
         self.new: list[tuple] = []
         self._plants: dict[str, tuple] = {}
+        self._plant_objects: dict = {}
 
     def _plant(self, spec: str) -> tuple[str, str | None, str | None]:
         """(plant as stored, its TOML text or None for a preset, its SHA-256)."""
@@ -332,9 +333,12 @@ class _Machines:
         return out
 
     def plant(self, spec: str):
-        """The :class:`~roastlab.model.plant.Plant` of a manifest's plant column (ValueError if unknown)."""
-        stored, text, _sha = self._plant(spec)
-        return plant_of(spec, stored, text)
+        """The :class:`~roastlab.model.plant.Plant` of a manifest's plant column (ValueError if unknown),
+        read once per column value."""
+        if spec not in self._plant_objects:
+            stored, text, _sha = self._plant(spec)
+            self._plant_objects[spec] = plant_of(spec, stored, text)
+        return self._plant_objects[spec]
 
     def check(self, name: str, plant_spec: str) -> None:
         """ValueError if the plant is unknown or differs from the one the machine already has."""
