@@ -38,7 +38,7 @@ def build_parser() -> argparse.ArgumentParser:
         "  roastlab validate --model model.json --plant 360kg dataset-V/\n"
         "  roastlab simulate --model model.json --inputs batch.csv --out pred.csv --tgi-offset 20\n"
         "  roastlab import roast.alog --map map.toml --out batch.csv\n"
-        "  roastlab init roasts/*.alog --out myroaster   your roaster's map, plant and fit spec from its logs\n"
+        "  roastlab init roasts/*.alog --out myroaster   your roaster's map, plant, fit and fleet specs from its logs\n"
         "  roastlab fit-roaster myroaster roasts/*.alog  fit, hold out, report\n"
         "  roastlab app --data-dir roasts/               the page: curves, live what-if, transfer\n"
         "  roastlab bench                           speed against solve_ivp (about a minute)\n\n"

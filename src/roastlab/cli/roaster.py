@@ -95,23 +95,25 @@ def add_parsers(sub) -> None:
     """Register this module's command(s) on the ``roastlab`` subparsers ``sub``."""
     p = sub.add_parser(
         "init",
-        help="read a roaster's logs and write its column map, plant and fit spec",
+        help="read a roaster's logs and write its column map, plant, fit spec and fleet spec",
         description="Inspect LOG... (Artisan .alog/.csv, RoasTime .json, or plain CSV with a header naming time, BT and "
         "ET, its first row the charge, of one roaster) and write DIR/map.toml "
         "(which channel is BT, the heater, the fan, a second bean reading, ET, the inlet air), DIR/plant.toml (the drum, from its "
-        "dimensions, a catalogue entry or the batch capacity, each estimate stated) and DIR/fit.toml (what these "
-        "logs can determine), each commented with what was detected and what was guessed. A LOG that is a folder "
+        "dimensions, a catalogue entry or the batch capacity, each estimate stated), DIR/fit.toml (what these "
+        "logs can determine) and DIR/fleet.toml (what a fleet fit frees per batch under the fitted model), each "
+        "commented with what was detected and what was guessed. A LOG that is a folder "
         "stands for its logs of one format (.alog where it has any, else .json, RoasTime's files without a suffix, .csv). "
         "A log that cannot be "
         "read as a roast (an empty or aborted recording), is a copy of another (the same recording start), records no "
         "green weight (nor one in its file name) or no setting the others record is named, and fit-roaster leaves it out. Logs are never modified. "
-        "Then 'roastlab fit-roaster DIR LOG...' fits the model (MODEL.json) and writes a report.",
+        "Then 'roastlab fit-roaster DIR LOG...' fits the model (DIR/model.json) and writes a report; 'roastlab fleet "
+        "fit --spec R=DIR/fleet.toml --model R=DIR/model.json' fits each batch of a fleet store under it.",
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog="examples:\n  roastlab init roasts/*.alog --out myroaster\n  roastlab fit-roaster myroaster roasts/*.alog\n"
         "  roastlab init roasts --out myroaster        the logs in the folder roasts",
     )
     p.add_argument("logs", nargs="+", metavar="LOG", help="roast logs of one roaster, or a folder of them")
-    p.add_argument("--out", required=True, metavar="DIR", help="folder for map.toml, plant.toml, fit.toml")
+    p.add_argument("--out", required=True, metavar="DIR", help="folder for map.toml, plant.toml, fit.toml, fleet.toml")
     p.add_argument(
         "--batch-kg",
         type=float_arg("--batch-kg"),
