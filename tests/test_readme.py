@@ -45,3 +45,32 @@ def test_readme_api_example(tmp_path):
     delta = float(lines[-2])
     assert 0.0 < delta < 20.0  # a hotter ET heats the beans, by less than the ET change
     assert lines[-1].startswith("<ValidationResult 2 batch(es) on 360kg")
+
+
+def test_every_roastlab_name_the_docs_give_exists():
+    """A `roastlab.a.b` the README or docs/*.md names (a module, function or constant) resolves:
+    the docs do not point at code that moved or was renamed."""
+    import importlib
+    import warnings
+
+    root = README.parent
+    named = {}
+    for path in [README, *sorted((root / "docs").glob("*.md"))]:
+        for m in re.finditer(r"`(roastlab(?:\.[A-Za-z_]\w*)+)", path.read_text(encoding="utf-8")):
+            named.setdefault(m.group(1), path.name)
+    missing = []
+    for dotted, where in sorted(named.items()):
+        parts = dotted.split(".")
+        for i in range(len(parts), 0, -1):  # the longest importable module, then attributes
+            try:
+                with warnings.catch_warnings():  # a deprecated alias the README names still imports
+                    warnings.simplefilter("ignore", DeprecationWarning)
+                    obj = importlib.import_module(".".join(parts[:i]))
+                break
+            except ImportError:
+                continue
+        for attr in parts[i:]:
+            obj = getattr(obj, attr, None)
+        if obj is None:
+            missing.append(f"{where}: {dotted}")
+    assert len(named) > 50 and not missing, missing
