@@ -74,3 +74,31 @@ def test_every_roastlab_name_the_docs_give_exists():
         if obj is None:
             missing.append(f"{where}: {dotted}")
     assert len(named) > 50 and not missing, missing
+
+
+def test_every_option_the_docs_give_a_command_exists():
+    """`roastlab CMD [SUB] ... --option` in the README or docs/*.md: the option is one of that command's
+    (a renamed or dropped flag, or an error message advising one the command lacks, would fail here)."""
+    import argparse
+
+    from roastlab.cli.main import build_parser
+
+    def commands(parser):
+        return next((a.choices for a in parser._actions if isinstance(a, argparse._SubParsersAction)), {})
+
+    root = README.parent
+    checked, unknown = 0, []
+    for path in [README, *sorted((root / "docs").glob("*.md"))]:
+        for m in re.finditer(
+            r"roastlab ([a-z][a-z-]*)(?: ([a-z][a-z-]*))?([^`\n;|&]*)", path.read_text(encoding="utf-8")
+        ):
+            parser = commands(build_parser()).get(m.group(1))
+            if parser is None:
+                continue
+            parser = commands(parser).get(m.group(2), parser)
+            known = {s for a in parser._actions for s in a.option_strings}
+            for flag in re.findall(r"(?<![\w-])(--[a-z][a-z0-9-]*)", m.group(3)):
+                checked += 1
+                if flag not in known:
+                    unknown.append(f"{path.name}: roastlab {m.group(1)} ... {flag}")
+    assert checked > 150 and not unknown, unknown

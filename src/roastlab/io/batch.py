@@ -311,13 +311,13 @@ def _refuse_raw_log(text: str, path) -> None:
         )
         raise InputError(
             f"{kind} roast log, not a batch CSV: convert it with 'roastlab import LOG --map MAP.toml' "
-            "or pass --map MAP.toml",
+            "or read it with a column map (--map MAP.toml; in a fleet manifest, its map column)",
             path,
         )
     if head.split("\n", 1)[0].lstrip("\ufeff").startswith("Date:") or "Unit:" in head.split("\n", 1)[0]:
         raise InputError(
             "an Artisan CSV export, not a batch CSV: convert it with 'roastlab import LOG --map MAP.toml' "
-            "or pass --map MAP.toml",
+            "or read it with a column map (--map MAP.toml; in a fleet manifest, its map column)",
             path,
         )
 

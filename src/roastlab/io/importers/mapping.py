@@ -567,7 +567,7 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
             )
             default_notes.append(
                 "no map: read as Artisan's defaults, BT = bean probe (Ta), ET = inlet (Tgi), gas flow unknown "
-                "(a 1 kg/s placeholder); give --map for anything else"
+                "(a 1 kg/s placeholder); give a column map for anything else (--map, or a fleet manifest's map column)"
             )
     if not path.exists():
         raise InputError("file not found", path)
@@ -715,7 +715,9 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
         Mb = cmap.batch_kg
     if Mb is None and fmt == "roastime":
         raise InputError(
-            "the log has no green weight (weightGreen 0): set batch_kg = ... in the map, or pass --batch-kg", path
+            "the log has no green weight (weightGreen 0) nor grams in its name (as in roast_500g.json): set batch_kg = "
+            "... in the map",
+            path,
         )
     for k, spec in settings.items():
         if k in ("heater", "fan"):
