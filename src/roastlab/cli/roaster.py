@@ -106,7 +106,7 @@ def add_parsers(sub) -> None:
         "A log that cannot be "
         "read as a roast (an empty or aborted recording), is a copy of another (the same recording start), records no "
         "green weight (nor one in its file name) or no setting the others record is named, and fit-roaster leaves it out. Logs are never modified. "
-        "Then 'roastlab fit-roaster DIR LOG...' fits the model (DIR/model.json) and writes a report; 'roastlab fleet "
+        "Then 'roastlab fit-roaster DIR LOG...' fits the model (its MODEL.json, DIR/model.json) and writes a report; 'roastlab fleet "
         "fit --spec R=DIR/fleet.toml --model R=DIR/model.json' fits each batch of a fleet store under it.",
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog="examples:\n  roastlab init roasts/*.alog --out myroaster\n  roastlab fit-roaster myroaster roasts/*.alog\n"
