@@ -1013,8 +1013,8 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
 
 #: What a fleet fit frees per batch on a roaster ``init`` set up, each the first of its choices that
 #: the fit spec frees: the heater's heat into the drum (a weakening heater) or, without a heater, the
-#: metal-bean coefficient (a fouling drum), and the probe's time constant (a probe fouling with oils),
-#: as the examples' fleet specs do (docs/fleet.md). Everything else comes from the model file.
+#: metal-bean coefficient (a fouling drum), and the probe's time constant (a probe fouling with oils);
+#: the Skywalker's fleet spec frees the same two (docs/fleet.md). Everything else comes from the model file.
 FLEET_FREE = (("Qe_gain_kW", "hbm"), ("Kt",))
 
 
