@@ -172,35 +172,37 @@ def _model_spec(spec, model, **options) -> FleetSpec:
     return dataclasses.replace(base, fixed=(), moisture=model.moisture, hold=model.hold, model=model)
 
 
+def held_model(spec: FleetSpec, plant):
+    """The machine model a spec without a model file holds, as a model file would: theta* but for
+    its [fixed], its [initial] and [bed] laws, its moisture law and hold. Both kinds of spec then
+    reach the batches through :meth:`~roastlab.workflows.model.FittedModel.apply`."""
+    from ..workflows.model import FittedModel
+
+    fixed = dict(spec.fixed)
+    model = FittedModel.paper(plant, [fixed.pop(k, THETA_PAPER.as_dict()[k]) for k in THETA_NAMES])
+    model = model.with_values(**fixed, **dict(spec.initial))
+    model.bed = BedLaws(**dict(spec.bed))
+    model.moisture, model.hold = spec.moisture, spec.hold
+    return model
+
+
 def fit_chunk(batch_ids, batches: list[Batch], plant, spec: FleetSpec, threads: int | None = None) -> dict:
     """Fit each batch of one machine separately; runs in-process or as a Dask task.
 
     Returns arrays keyed ``batch_id, value, stderr, SSR, FIT, MAE, n, sims`` (one row per batch).
     """
     from ..fit.batchfit import identify_each
-    from ..sim.population import pack_batches, run_arrays
-    from ..sim.simulate import InitialState
-    from ..workflows.model import PAPER_INITIAL
+    from ..sim.population import run_arrays
 
     if threads is not None:
         import numba
 
         numba.set_num_threads(threads)
-    if spec.model is not None:  # the machine model as validate applies it: values, bed, initial state
-        applied = spec.model.apply(batches, plant)
-        packed = applied.packed
-        if applied.names:
-            _, packed.x0, packed.PB = run_arrays(packed, applied.names, applied.values)
-    else:
-        fixed = dict(spec.fixed)
-        theta = [fixed.get(k, THETA_PAPER.as_dict()[k]) for k in THETA_NAMES]
-        init = InitialState(**{**PAPER_INITIAL, **dict(spec.initial)})
-        bed = BedLaws(**dict(spec.bed))
-        packed = pack_batches(batches, plant, theta, init, spec.moisture, spec.hold, bed=bed)
-        extra = [k for k in fixed if k not in THETA_NAMES]
-        if extra:  # held values other than theta: the same name-addressed setter as population runs
-            values = np.array([[[fixed[k] for k in extra]] * packed.n_batches])
-            _, packed.x0, packed.PB = run_arrays(packed, extra, values)
+    # the machine model as validate applies it (values, bed laws, initial state), then the free ones per batch
+    applied = (spec.model if spec.model is not None else held_model(spec, plant)).apply(batches, plant)
+    packed = applied.packed
+    if applied.names:
+        _, packed.x0, packed.PB = run_arrays(packed, applied.names, applied.values)
     bounds = {n: (lo, hi) for n, lo, hi in zip(spec.names, spec.lower, spec.upper)}
     r = identify_each(
         packed,
