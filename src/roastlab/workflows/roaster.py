@@ -42,7 +42,6 @@ from __future__ import annotations
 import io
 import math
 import re
-import tomllib
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -1022,9 +1021,9 @@ def fleet_spec_text(fit_text: str) -> str:
     """The fleet spec beside ``fit_text`` (a fit spec's text): :data:`FLEET_FREE`'s names with their
     lines of its [free] table as they are (bounds, start and comment), to fit each batch under the
     model ``fit-roaster`` writes from that spec."""
-    free = tomllib.loads(fit_text)["free"]
-    names = [next(n for n in choice if n in free) for choice in FLEET_FREE if any(n in free for n in choice)]
+    # the [free] table's lines by the name they set (a comment line's key is never a name)
     lines = {ln.split("=", 1)[0].strip(): ln for ln in fit_text.split("[free]", 1)[1].split("\n[", 1)[0].splitlines()}
+    names = [next(n for n in choice if n in lines) for choice in FLEET_FREE if any(n in lines for n in choice)]
     return (
         "\n".join(
             [
