@@ -31,7 +31,7 @@ import numpy as np
 from ..errors import InputError
 from ..io.batch import Batch
 from ..io.fitspec import FitSpec, load_fit_spec
-from ..model.bed import LAWS, PAPER_BED, BedLaws
+from ..model.bed import PAPER_BED, BedLaws
 from ..model.parameters import DEFAULT_WEIGHTS, REGISTRY, THETA_NAMES, THETA_PAPER, THETA_START, FreeParameter
 from .store import SERIES_COLUMNS, filled, open_store, plant_of, store_errors
 
@@ -133,7 +133,7 @@ def fleet_spec(spec: str | FitSpec | None = None, model=None, **options) -> Flee
         free_slots([f.name for f in free])
     except InputError as exc:
         raise InputError(exc.problem, source or None) from None
-    bed = () if spec is None else tuple((k, v) for k, v in spec.bed.as_dict().items() if v != LAWS[k][0])
+    bed = () if spec is None else tuple(spec.bed.changed().items())
     return FleetSpec(
         tuple(f.name for f in free),
         tuple(float(f.lower) for f in free),

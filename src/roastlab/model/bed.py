@@ -68,8 +68,11 @@ class BedLaws:
     @property
     def name(self) -> str:
         """``"paper"`` or the options that differ from it, ``"contact=wall,probe=tumbling"``."""
-        changed = [f"{k}={v}" for k, v in self.as_dict().items() if v != LAWS[k][0]]
-        return ",".join(changed) or "paper"
+        return ",".join(f"{k}={v}" for k, v in self.changed().items()) or "paper"
+
+    def changed(self) -> dict[str, str]:
+        """The options whose law is not the default (the paper's), ``{"probe": "tumbling"}``."""
+        return {k: v for k, v in self.as_dict().items() if v != LAWS[k][0]}
 
     def as_dict(self) -> dict[str, str]:
         return {f.name: getattr(self, f.name) for f in fields(self)}
