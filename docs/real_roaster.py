@@ -306,6 +306,103 @@ def scaling(model, column_map, paths, nominal_val, lines):
     plt.close(fig)
 
 
+def best_drum_start(model, batch, keep, around_C: float, span_C: float = 100.0) -> float:
+    """The drum start Tm0 [degC] whose prediction fits ``batch``'s probe samples ``keep`` best (least
+    squares; the model's own prediction, ``FittedModel.predict`` with the change ``Tm0_C``): a 5 degC
+    grid over ``around_C`` +- ``span_C`` (the SSR need not have one minimum), then Brent's method
+    within a step of the grid's best."""
+    from scipy.optimize import minimize_scalar
+
+    def ssr(tm0):
+        return float(np.sum((model.predict(batch, Tm0_C=tm0).Ta_C[keep] - batch.Ta_C[keep]) ** 2))
+
+    grid = around_C + np.arange(-span_C, span_C + 1e-9, 5.0)
+    g = float(grid[int(np.argmin([ssr(x) for x in grid]))])
+    return float(minimize_scalar(ssr, bounds=(g - 5.0, g + 5.0), method="bounded", options={"xatol": 0.1}).x)
+
+
+def drum_start(model, column_map, paths, lines, early_s: float = 180.0):
+    """How much of each log's error the drum's unlogged heat at CHARGE can explain.
+
+    Per held-out log (the other sizes and the held-out nominal logs): the drum start Tm0 that best
+    fits the whole log, and the one that best fits the probe up to ``early_s`` with the rest of the roast then
+    scored (what a roaster watching the first minutes could know). Every prediction is the model's
+    own (:func:`best_drum_start`); nothing else is refitted."""
+    from roastlab.metrics.profile import crossing_time_s
+
+    nominal_held = set(nominal_logs()[1::2])  # the held-out half of machine()'s split
+    held = [p for p in paths if not nominal_size(p) or p in nominal_held]
+
+    def probe(b, tm0):
+        return model.predict(b, Tm0_C=tm0).Ta_C
+
+    def fit_pct(y, yhat):
+        return 100.0 * (1.0 - np.linalg.norm(y - yhat) / np.linalg.norm(y - y.mean()))
+
+    rows = []
+    for p, b in zip(held, load(held, column_map)):
+        logged = float(b.initial["Tm0_C"])
+        whole = best_drum_start(model, b, np.ones(b.n, bool), logged)
+        late = b.time_s > early_s
+        early = best_drum_start(model, b, ~late, logged)
+        fc_s = b.events.get("FCs")
+        level = None if fc_s is None else float(np.interp(fc_s, b.time_s, b.Ta_C))
+        marked = level is not None and fc_s > early_s
+        rec = {"path": p, "logged": logged, "whole": whole, "early": early, "marked": marked}
+        for key, tm0 in (("at_logged", logged), ("at_whole", whole), ("at_early", early)):
+            ta = probe(b, tm0)
+            rec[key] = fit_pct(b.Ta_C, ta)
+            rec[key + "_late"] = fit_pct(b.Ta_C[late], ta[late])
+            hit = crossing_time_s(b.time_s, ta, level) if marked else None
+            rec[key + "_fc"] = None if hit is None else hit - fc_s
+        rows.append(rec)
+    lines += [
+        "### The drum's heat at CHARGE",
+        "",
+        f"Each held-out log with the drum start that best fits its whole probe curve, and with the one "
+        f"that best fits its first {early_s / 60:g} minutes, the rest of the roast then scored (FIT after "
+        f"{early_s / 60:g} min; first crack: the model's probe reaching the log's reading at its FCs mark, "
+        "error in s, positive late; blank where the log marks no first crack or the model's probe never "
+        "gets there):",
+        "",
+        "| log | unit | preheat °C | best start °C | FIT % at preheat | at best | start from first minutes °C "
+        "| FIT after, at preheat | after, from first minutes | FCs error at preheat s | from first minutes s |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+
+    def s(v):
+        return "" if v is None else f"{v:+.0f}"
+
+    for r in rows:
+        lines.append(
+            f"| {r['path'].stem} | {unit(r['path'])} | {r['logged']:.0f} | {r['whole']:.0f} | {r['at_logged']:.1f} "
+            f"| {r['at_whole']:.1f} | {r['early']:.0f} | {r['at_logged_late']:.1f} | {r['at_early_late']:.1f} "
+            f"| {s(r['at_logged_fc'])} | {s(r['at_early_fc'])} |"
+        )
+
+    def summary(name, group):
+        if not group:
+            return
+        marked = sum(r["marked"] for r in group)
+        fc0 = [abs(r["at_logged_fc"]) for r in group if r["at_logged_fc"] is not None]
+        fc1 = [abs(r["at_early_fc"]) for r in group if r["at_early_fc"] is not None]
+        lines.append(
+            f"- {name} ({len(group)} logs): FIT {np.mean([r['at_logged'] for r in group]):.1f} % at the preheat, "
+            f"{np.mean([r['at_whole'] for r in group]):.1f} % at each log's best start (best minus preheat "
+            f"{min(r['whole'] - r['logged'] for r in group):+.0f} to {max(r['whole'] - r['logged'] for r in group):+.0f} °C); "
+            f"after {early_s / 60:g} min {np.mean([r['at_logged_late'] for r in group]):.1f} % at the preheat, "
+            f"{np.mean([r['at_early_late'] for r in group]):.1f} % from the first minutes; first crack median "
+            f"|error| {np.median(fc0) if fc0 else float('nan'):.0f} s at the preheat (the model reaches it on "
+            f"{len(fc0)} of the {marked} logs that mark it), {np.median(fc1) if fc1 else float('nan'):.0f} s from "
+            f"the first minutes ({len(fc1)} of {marked})"
+        )
+
+    lines += [""]
+    summary(f"held-out {NOMINAL}", [r for r in rows if nominal_size(r["path"])])
+    summary("every other size", [r for r in rows if not nominal_size(r["path"])])
+    lines.append("")
+
+
 def variants_and_bands(column_map, paths, lines):
     """Each bed-law variant (roastlab.model.bed, the probe's depth scale fitted) and the example's
     own spec (its laws, the depth scale held) fitted on the same 490-500 g logs: held-out nominal
@@ -480,6 +577,7 @@ def main() -> int:
         f"Aillio Bullet R1, {NOMINAL} batches", ROOT / "examples" / "bullet", nominal, lines
     )
     scaling(model, column_map, bullet, val, lines)
+    drum_start(model, column_map, bullet, lines)
     variants_and_bands(column_map, bullet, lines)
     spread_against_refits(column_map, bullet, lines)
     (DOCS / "real-roaster-results.md").write_text("\n".join(lines) + "\n", encoding="utf-8")

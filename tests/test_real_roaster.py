@@ -792,3 +792,25 @@ def test_skywalker_logs_whose_et_the_map_drops_say_so_when_et_is_weighed(cli, re
     last = err.strip().splitlines()[-1]
     assert code == 2 and "dropped ET on all 2 log(s)" in last and "--weight ET=0" in last, err
     assert not (tmp_path / "m.json").exists()
+
+
+def test_the_drum_start_that_fits_a_log_is_found_where_it_was_planted(bullet_model, monkeypatch):
+    """docs/real_roaster.py's best_drum_start (how much of a log's error the drum's heat at CHARGE
+    explains, docs/real-roaster.md 'The drum's heat at CHARGE'): on a probe curve the model made from
+    a drum start 37 degC above the log's preheat it finds that start, from the whole curve and from
+    its first three minutes alone, and not the preheat."""
+    import dataclasses
+
+    from roastlab.workflows.model import load_log, load_model
+
+    monkeypatch.syspath_prepend(str(Path(__file__).resolve().parents[1] / "docs"))
+    import real_roaster as rr
+
+    model = load_model(bullet_model)
+    log = load_log(REAL_DATA / "bullet" / "bullet_2020-10-01_2053_500g.json", model.column_map)
+    preheat = float(log.initial["Tm0_C"])
+    planted = model.predict(log, Tm0_C=preheat + 37.0).Ta_C
+    made = dataclasses.replace(log, Ta_C=planted)
+    for keep in (np.ones(log.n, bool), log.time_s <= 180.0):
+        found = rr.best_drum_start(model, made, keep, preheat)
+        assert abs(found - (preheat + 37.0)) < 0.5, found
