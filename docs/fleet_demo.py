@@ -46,8 +46,8 @@ def main() -> int:
     (tmp / "manifest.csv").write_text("\n".join(rows) + "\n")
     exe = str(Path(sys.executable).parent / "roastlab")
     fit_logs = {
-        "skywalker": real_roaster.roasts(sorted((DATA / "skywalker").glob("*.alog")))[0::2],
-        "bullet": real_roaster.nominal_logs()[0::2],
+        "skywalker": real_roaster.split(real_roaster.roasts(sorted((DATA / "skywalker").glob("*.alog"))))[0],
+        "bullet": real_roaster.split(real_roaster.nominal_logs())[0],
     }
     for name, example in (("skywalker", sky), ("bullet", bul)):
         argv = ["identify", "--plant", str(example / "plant.toml"), "--map", str(example / "map.toml")]

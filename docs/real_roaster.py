@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 import roastlab
-from roastlab.evaluate.metrics import average_metrics, mean_gap
+from roastlab.evaluate.metrics import average_metrics, fit_percent, mean_gap
 from roastlab.fit import uncertainty
 from roastlab.fit.baseline import describe, fit_first_order, validate_first_order
 from roastlab.io.fitspec import load_fit_spec
@@ -120,10 +120,15 @@ def paper_probe_variant(example, fit_b, val_b, column_map, lines):
     return model
 
 
+def split(paths) -> tuple[list[Path], list[Path]]:
+    """The logs sorted by name, split alternately: (1st, 3rd, ... fit; 2nd, 4th, ... held out)."""
+    return paths[0::2], paths[1::2]
+
+
 def machine(title, example, paths, lines):
     """Fit, hold out and compare with the baseline; append markdown to ``lines``; return the model."""
     column_map = load_map(example / "map.toml")
-    fit_paths, val_paths = paths[0::2], paths[1::2]
+    fit_paths, val_paths = split(paths)
     fit_b, val_b = load(fit_paths, column_map), load(val_paths, column_map)
     t0 = time.perf_counter()
     result = roastlab.fit(fit_b, example / "plant.toml", example / "fit.toml", column_map=column_map)
@@ -330,14 +335,11 @@ def drum_start(model, column_map, paths, lines, early_s: float = 180.0):
     own (:func:`best_drum_start`); nothing else is refitted."""
     from roastlab.metrics.profile import crossing_time_s
 
-    nominal_held = set(nominal_logs()[1::2])  # the held-out half of machine()'s split
+    nominal_held = set(split(nominal_logs())[1])
     held = [p for p in paths if not nominal_size(p) or p in nominal_held]
 
     def probe(b, tm0):
         return model.predict(b, Tm0_C=tm0).Ta_C
-
-    def fit_pct(y, yhat):
-        return 100.0 * (1.0 - np.linalg.norm(y - yhat) / np.linalg.norm(y - y.mean()))
 
     rows = []
     for p, b in zip(held, load(held, column_map)):
@@ -351,8 +353,8 @@ def drum_start(model, column_map, paths, lines, early_s: float = 180.0):
         rec = {"path": p, "logged": logged, "whole": whole, "early": early, "marked": marked}
         for key, tm0 in (("at_logged", logged), ("at_whole", whole), ("at_early", early)):
             ta = probe(b, tm0)
-            rec[key] = fit_pct(b.Ta_C, ta)
-            rec[key + "_late"] = fit_pct(b.Ta_C[late], ta[late])
+            rec[key] = fit_percent(b.Ta_C, ta)
+            rec[key + "_late"] = fit_percent(b.Ta_C[late], ta[late])
             hit = crossing_time_s(b.time_s, ta, level) if marked else None
             rec[key + "_fc"] = None if hit is None else hit - fc_s
         rows.append(rec)
@@ -415,7 +417,8 @@ def variants_and_bands(column_map, paths, lines):
     example = ROOT / "examples" / "bullet"
     nominal = [p for p in paths if nominal_size(p)]
     others = [p for p in paths if not nominal_size(p)]
-    fit_b, val_b, oth_b = load(nominal[0::2], column_map), load(nominal[1::2], column_map), load(others, column_map)
+    fit_p, val_p = split(nominal)
+    fit_b, val_b, oth_b = load(fit_p, column_map), load(val_p, column_map), load(others, column_map)
     lines += [
         f"### Bed-law variants (fitted on the same {NOMINAL} logs: `fit.toml` with each variant's laws and "
         "h_probe_m free, then the example's `fit.toml` as it is)",
@@ -459,7 +462,7 @@ def spread_against_refits(column_map, paths, lines):
     from roastlab.evaluate.bands import roast_spread
 
     example = ROOT / "examples" / "bullet"
-    fit_b = load([p for p in paths if nominal_size(p)][0::2], column_map)
+    fit_b = load(split([p for p in paths if nominal_size(p)])[0], column_map)
     full = roastlab.fit(fit_b, example / "plant.toml", example / "fit.toml", column_map=column_map)
     held = full.identification.held_out_Ta
     own_v = full.model.validate(fit_b)
