@@ -65,6 +65,30 @@ def test_implausible_states_only_where_the_heat_must_come_through_the_drum():
     assert implausible_states(gas) == [] and implausible_states(hot_metal) == []
 
 
+def test_beans_far_from_where_coffee_cracks_at_the_first_crack_mark_are_implausible():
+    """Where the log marks first crack, the model's beans must be near FIRST_CRACK_BEAN_C then (within
+    FIRST_CRACK_TOLERANCE_C): beans 60 degC colder with the probe in hot air fit a probe curve as well,
+    and are flagged; beans near it, or a log with no mark, are not."""
+    from types import SimpleNamespace
+
+    from roastlab.metrics.profile import FIRST_CRACK_TOLERANCE_C, implausible_states
+    from roastlab.model.constants import FIRST_CRACK_BEAN_C
+
+    t = np.arange(0.0, 601.0, 5.0)
+    ta = 100.0 + 0.15 * np.abs(t - 60.0)
+
+    def roast(beans_at_mark, events):
+        beans = 22.0 + (beans_at_mark - 22.0) * t / 480.0
+        return SimpleNamespace(time_s=t, Ta_C=ta, Tb_C=beans, Tm_C=beans + 40.0, Tgi_C=np.full(t.size, 22.0),
+                               meta={"events": events})  # fmt: skip
+
+    cold = roast(FIRST_CRACK_BEAN_C - FIRST_CRACK_TOLERANCE_C - 15.0, {"FCs": 480.0})
+    assert "at the log's first crack (8:00)" in implausible_states(cold)[0]
+    assert implausible_states(roast(FIRST_CRACK_BEAN_C - 6.0, {"FCs": 480.0})) == []
+    assert implausible_states(roast(140.0, {})) == []  # no mark: nothing to say
+    assert implausible_states(roast(140.0, {"FCs": 900.0})) == []  # a mark past the log's end
+
+
 @pytest.mark.parametrize("seconds", [0.0, 5.0, 59.0, 60.0, 457.0, 3599.0, 3725.0, -5.0, -65.0])
 def test_clock_s_reads_what_mmss_writes(seconds):
     from roastlab.metrics.profile import clock_s, mmss

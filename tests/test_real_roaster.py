@@ -119,7 +119,7 @@ def test_skywalker_fit_on_bt_alone_fails_on_its_states(cli, real_data, tmp_path)
     lines = (EXAMPLE / "fit.toml").read_text().splitlines(keepends=True)
     spec.write_text("".join(ln for ln in lines if not ln.startswith("Gg_fan_kg_s")))
     args = ("identify", *common, "--spec", spec, *fit_logs, "--out", theta, "--starts", "2")
-    code, out, err = cli(*args, "--weight", "ET=0")
+    code, out, err = cli(*args, "--weight", "ET=0", "--weight", "Tb2=0")  # the probe alone
     errors = [line for line in err.splitlines() if line.startswith("error:")]
     assert code == 1 and len(errors) == 1 and "the fit failed, non-physical states" in errors[0], err
     assert str(theta) in errors[0] and "--weight ET=1" in errors[0]
@@ -158,7 +158,9 @@ def test_skywalker_logs_without_et_fit_with_the_heater_into_the_drum(cli, real_d
     code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
     assert code == 0 and "failed" not in err and "drum metal colder" not in err, err
     held = printed_percent(out, "held out: FIT ")
-    assert held >= 80.0, out  # 83.6 % measured on 2026-11-26 with the fan's flow freed (83.3 % before)
+    # 75.2 % measured on 2026-11-27 with each log's first-crack mark read as the beans (init's map); 83.6 %
+    # before it, when the fit put the beans at 125 degC at first crack (docs/real-roaster.md)
+    assert held >= 72.0, out
 
 
 @pytest.mark.slow
@@ -173,9 +175,11 @@ def test_the_global_search_reaches_the_bt_only_fits_corner_of_the_bounds(cli, re
     logs = _skywalker_without_et(real_data, tmp_path)
     assert cli("init", *logs, "--out", tmp_path / "cfg")[0] == 0
     cfg = tmp_path / "cfg"
-    code, out, err = cli("identify", "--plant", cfg / "plant.toml", "--map", cfg / "map.toml",
-                         "--spec", cfg / "fit.toml", *logs, "--out", tmp_path / "m.json")  # fmt: skip
-    assert code == 0, err
+    code, out, err = cli("identify", "--plant", cfg / "plant.toml", "--map", cfg / "map.toml", "--spec",
+                         cfg / "fit.toml", *logs, "--out", tmp_path / "m.json", "--weight", "Tb2=0")  # fmt: skip
+    # the probe alone (the first-crack mark unweighed): this tests the search, and the fit it finds
+    # puts the beans far from where coffee cracks, so it is marked failed (exit 1), its file written
+    assert code in (0, 1) and "Traceback" not in err, err
     doc = json.loads((tmp_path / "m.json").read_text())
     lag = doc["parameters"]["tau_heater_s"]["value"]
     assert doc["fit"]["SSR"] < 0.7 * 39487.4 and lag > 60.0, (doc["fit"]["SSR"], lag)
@@ -202,7 +206,7 @@ def test_skywalker_logs_whose_fan_is_only_a_speed_readout_fit_as_with_its_events
     code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
     assert code == 0, err
     held = printed_percent(out, "held out: FIT ")
-    assert held >= 78.0, out  # 82.0 % measured on 2026-11-26 (82.1 % from the Air events)
+    assert held >= 73.0, out  # 76.6 % measured on 2026-11-27 with the first-crack mark (82.0 % before it)
     code, out, err = cli("whatif", logs[8], "--model", tmp_path / "cfg" / "model.json", "--fan", "+480@5:00")
     assert code == 0 and "fan +480 rpm from 5:00" in out, err
     probe = out.split("probe BT")[1]
@@ -243,8 +247,10 @@ def test_a_log_without_burner_events_is_left_out_and_a_non_physical_fit_refitted
     """Six Skywalker logs (October-November 2025, rewritten in tmp_path), one with its Burner events
     removed, as Artisan writes a roast whose burner never moved while it recorded: init sets up the
     other five's layout and says so, fit-roaster leaves that log out. On the five, with ET weighed by
-    its residuals (init's fit.toml) the fit stands; with ET weighed like BT, the fit with both heater
-    paths free puts the drum below the beans, and fit-roaster refits with the drum's path alone."""
+    its residuals and the first-crack marks read as the beans (init's files), the fit with both heater
+    paths free puts the drum below the beans, and fit-roaster refits with the drum's path alone, which
+    stands. (Until 2026-11-27, with the beans free to sit at 125 degC at first crack, the first fit
+    stood and ET weighed like BT was needed to show the refit.)"""
     names = ["roast_25-10-04_1155", "roast_25-10-04_1229", "roast_25-10-25_1544", "roast_25-10-25_1609",
              "roast_25-11-16_1235", "roast_25-11-16_1259"]  # fmt: skip
     if not all((real_data / f"{n}.alog").is_file() for n in names):
@@ -260,16 +266,12 @@ def test_a_log_without_burner_events_is_left_out_and_a_non_physical_fit_refitted
     code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
     assert code == 0 and "1 log(s) record no Burner (roast_25-10-25_1544.alog)" in out, err
     code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
-    assert code == 0 and "failed" not in err and "refitted" not in out, (out, err)
+    assert code == 0 and "failed" not in err, (out, err)
     assert "left out: roast_25-10-25_1544.alog records no Burner" in out
-    spec = tmp_path / "cfg" / "fit.toml"
-    assert 'ET = "residual"' in spec.read_text()
-    spec.write_text(spec.read_text().replace('ET = "residual"', "ET = 1.0"))
-    code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
-    assert code == 0 and "failed" not in err, err
+    assert 'ET = "residual"' in (tmp_path / "cfg" / "fit.toml").read_text()
     assert "refitted: with the heater free to heat the air and the drum, the fit failed on non-physical" in out
     held, base = printed_percent(out, "held out: FIT "), printed_percent(out, "first-order baseline: ")
-    assert held > base + 10, out  # 71.0 % against 44.4 % measured on 2026-11-26
+    assert held > base + 10, out  # 84.3 % against 44.4 % measured on 2026-11-27
     assert "note: roast_25-10-25_1609.alog: bean temperature jumps" in err  # what the import did, said
     report = (tmp_path / "cfg" / "report.md").read_text()
     assert "Read from the logs:" in report and "- roast_25-10-25_1609.alog: bean temperature jumps" in report
@@ -814,3 +816,57 @@ def test_the_drum_start_that_fits_a_log_is_found_where_it_was_planted(bullet_mod
     for keep in (np.ones(log.n, bool), log.time_s <= 180.0):
         found = rr.best_drum_start(model, made, keep, preheat)
         assert abs(found - (preheat + 37.0)) < 0.5, found
+
+
+def test_coffee_cracks_at_a_bean_temperature_the_ir_reads_on_every_bullet(bullet_data):
+    """FIRST_CRACK_BEAN_C is where the beans are at the roaster's FCs mark: on every weighed RoasTime
+    log (five drums, 200-900 g) the infrared bean reading there lies within 10 degC of it and their
+    median within 1 degC, while the probe reads 10-40 degC lower: the crack is a bean temperature."""
+    from roastlab.io.importers.roastime import read_roastime
+    from roastlab.model.constants import FIRST_CRACK_BEAN_C
+
+    ir, probe = [], []
+    for path in sorted(bullet_data.glob("*_*g.json")):
+        log = read_roastime(path)
+        fc_s = log.events.get("FCs")
+        if fc_s is not None:
+            ir.append(float(np.interp(fc_s, log.time_s, log.channels["drumTemperature"])))
+            probe.append(float(np.interp(fc_s, log.time_s, log.channels["BT"])))
+    assert len(ir) >= 20
+    assert abs(np.median(ir) - FIRST_CRACK_BEAN_C) < 1.0, np.median(ir)
+    assert np.all(np.abs(np.array(ir) - FIRST_CRACK_BEAN_C) < 10.0), ir
+    assert np.all(np.array(ir) - np.array(probe) > 5.0)
+
+
+def test_the_first_crack_mark_read_as_the_beans(real_data, tmp_path):
+    """A map's [Tb2] first_crack reads each log's FCs mark as one bean reading at FIRST_CRACK_BEAN_C
+    (the Skywalker's logs have no bean channel but the probe); the example weighs it at
+    FIRST_CRACK_WEIGHT; init writes both for such logs; and a map that gives it with a column, or
+    not as true, is refused in one line."""
+    from roastlab.errors import InputError
+    from roastlab.io.fitspec import load_fit_spec
+    from roastlab.io.importers.mapping import load_map
+    from roastlab.model.constants import FIRST_CRACK_BEAN_C
+    from roastlab.model.parameters import FIRST_CRACK_WEIGHT
+    from roastlab.workflows.model import load_log
+    from roastlab.workflows.roaster import init_roaster
+
+    cmap = load_map(EXAMPLE / "map.toml")
+    assert cmap.first_crack_as_beans
+    assert load_fit_spec(EXAMPLE / "fit.toml").weights["Tb2"] == FIRST_CRACK_WEIGHT
+    path = sorted(real_data.glob("*.alog"))[5]
+    batch = load_log(path, cmap)
+    marked = np.flatnonzero(np.isfinite(batch.Tb2_C))
+    assert marked.size == 1 and batch.Tb2_C[marked[0]] == FIRST_CRACK_BEAN_C
+    assert abs(batch.time_s[marked[0]] - batch.events["FCs"]) <= 2.5  # the 5 s sample nearest the mark
+    init_roaster(sorted(real_data.glob("*.alog"))[:4], tmp_path / "sky")
+    assert load_map(tmp_path / "sky" / "map.toml").first_crack_as_beans
+    assert load_fit_spec(tmp_path / "sky" / "fit.toml").weights["Tb2"] == FIRST_CRACK_WEIGHT
+    text = (EXAMPLE / "map.toml").read_text()
+    for bad, says in (
+        ("first_crack = true\ncolumn = 'ET'", "give it alone"),
+        ("first_crack = false", "must be true"),
+    ):
+        (tmp_path / "bad.toml").write_text(text.replace("first_crack = true", bad))
+        with pytest.raises(InputError, match=says):
+            load_map(tmp_path / "bad.toml")

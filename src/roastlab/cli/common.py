@@ -231,12 +231,11 @@ def initial_changes(args) -> dict:
 
 def failed_fit_status(failed: str | None, path) -> int:
     """The exit status of a command that fitted: 0, or 1 with one line naming the model file
-    ``path``, why the fit failed (:attr:`FitResult.failed`) and what to try."""
+    ``path``, why the fit failed (:attr:`FitResult.failed`) and what to try (each check of
+    :func:`roastlab.metrics.profile.implausible_states` says it)."""
     if not failed:
         return 0
-    from ..workflows.fitting import FAILED_HINT
-
-    print(f"error: {path}: the fit failed, {failed}; {FAILED_HINT}", file=sys.stderr)
+    print(f"error: {path}: the fit failed, {failed}", file=sys.stderr)
     return 1
 
 

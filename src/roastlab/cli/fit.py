@@ -305,7 +305,8 @@ def add_parsers(sub) -> None:
         action="append",
         metavar="OUTPUT=W",
         help="weight of a fitted output: Ta (the bean probe, default 1), Tb2 (a second bean reading read by the "
-        "map's [Tb2], compared with the model's Tb; default 0) or ET (the logged ET, compared with the model's "
+        "map's [Tb2], or its first_crack: the log's FCs mark as the beans' temperature; compared with the model's "
+        "Tb; default 0) or ET (the logged ET, compared with the model's "
         "outlet gas; default 0), e.g. --weight Tb2=0.25; W = residual sets it from a first fit's residuals "
         "(--weight ET=residual) (repeatable; overrides the spec's [weights])",
     )

@@ -272,6 +272,12 @@ def display_temp_delta(delta_C: float, units: str = "C") -> float:
 #: colder than the beans, see :func:`implausible_states`).
 METAL_BELOW_BEANS_SHARE = 0.5
 
+#: How far a model's beans may read from :data:`roastlab.model.constants.FIRST_CRACK_BEAN_C` at a
+#: log's first-crack mark before its states are called implausible [degC] (:func:`implausible_states`):
+#: seven standard deviations of the crack temperature (3.4 degC); the Bullet example's beans on its
+#: own nine fit logs read within -4 to +6 degC of the infrared reading there.
+FIRST_CRACK_TOLERANCE_C = 25.0
+
 
 #: ET is compared with BT from this long after CHARGE [s], past the charge dip, when the probe
 #: still carries the preheat's heat (:func:`et_minus_bt_C`).
@@ -376,8 +382,37 @@ def implausible_states(result) -> list[str]:
     than the beans for more than :data:`METAL_BELOW_BEANS_SHARE` of the roast after the turning
     point means the fit found another path for the heat than the machine has. (In the paper's
     gas roaster the hot inlet gas heats the beans directly and a heavy drum may lag behind
-    them: no warning there.) ``result`` has ``time_s``, ``Ta_C``, ``Tb_C``, ``Tm_C``, ``Tgi_C``.
+    them: no warning there.) And where the log marks first crack (``result.meta["events"]["FCs"]``),
+    the beans must be near the temperature coffee cracks at
+    (:data:`~roastlab.model.constants.FIRST_CRACK_BEAN_C`, within :data:`FIRST_CRACK_TOLERANCE_C`):
+    a probe curve alone can be fitted as well with beans 60 degC colder and the probe in hot air.
+    ``result`` has ``time_s``, ``Ta_C``, ``Tb_C``, ``Tm_C``, ``Tgi_C`` (and ``meta``).
     """
+    return _metal_below_beans(result) + _beans_at_first_crack(result)
+
+
+def _beans_at_first_crack(result) -> list[str]:
+    """The beans far from :data:`~roastlab.model.constants.FIRST_CRACK_BEAN_C` at the log's FCs mark
+    (``result.meta["events"]``, seconds after CHARGE), by more than :data:`FIRST_CRACK_TOLERANCE_C`."""
+    from ..model.constants import FIRST_CRACK_BEAN_C
+
+    fc_s = ((getattr(result, "meta", None) or {}).get("events") or {}).get("FCs")
+    t = np.asarray(result.time_s, dtype=float)
+    if fc_s is None or not t[0] <= fc_s <= t[-1]:
+        return []
+    tb = float(np.interp(fc_s, t, result.Tb_C))
+    if abs(tb - FIRST_CRACK_BEAN_C) <= FIRST_CRACK_TOLERANCE_C:
+        return []
+    return [
+        f"beans at {tb:.0f} °C at the log's first crack ({mmss(fc_s)}), where coffee cracks at about "
+        f"{FIRST_CRACK_BEAN_C:.0f} °C: the fit has placed the beans' temperature wrong, the probe alone cannot "
+        "tell the beans from the air around it; read the mark as a bean reading ([Tb2] first_crack = true in the "
+        "map, weighed in the fit spec's [weights] as Tb2)"
+    ]
+
+
+def _metal_below_beans(result) -> list[str]:
+    """The drum metal below the beans for most of the roast where the inlet air cannot heat them."""
     t = np.asarray(result.time_s, dtype=float)
     tp_s, _ = turning_point(t, result.Ta_C)
     after = t >= (tp_s or 0.0)
@@ -392,6 +427,8 @@ def implausible_states(result) -> list[str]:
         return [
             f"drum metal colder than the beans for {100 * below.mean():.0f} % of the roast after the turning point "
             f"(metal {tm.min():.0f}-{tm.max():.0f} °C, beans {tb.min():.0f}-{tb.max():.0f} °C): physically "
-            "implausible for a drum roaster, the fit found another path for the heat"
+            "implausible for a drum roaster, the fit found another path for the heat; let the fit tell the heater's "
+            "paths apart: weight the logged ET ([weights] ET = 1 in the fit spec, or --weight ET=1), or, where no ET "
+            "is logged, let the heater heat the drum alone (remove Tgi_gain_C from [free])"
         ]
     return []

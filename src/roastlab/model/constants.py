@@ -60,6 +60,16 @@ RHO0_KG_M3 = 1.275
 #: (:attr:`roastlab.model.plant.Plant.bed_depth_m`).
 GREEN_BULK_DENSITY_KG_M3 = 680.0
 
+#: Bean temperature at first crack [degC]. Coffee cracks when its beans reach a temperature, not
+#: when a probe reads one: roasting guides put it at about 196-205 degC, and on the 27 weighed
+#: RoasTime logs in ../shared/data/real/bullet (five Aillio Bullets, 200-900 g) the infrared bean
+#: reading at the roaster's FCs mark reads a median 199.7 degC (standard deviation 3.4 degC,
+#: 191-207 degC), while the bean probe reads 162-190 degC there (tests/test_real_roaster.py
+#: recomputes it). So a log that marks first crack gives the beans' temperature at one instant even
+#: where it logs no bean reading (a column map's ``[Tb2] first_crack``), and a model whose beans are
+#: far from it at the mark has placed the beans wrong (:func:`roastlab.metrics.profile.implausible_states`).
+FIRST_CRACK_BEAN_C = 200.0
+
 
 @dataclass(frozen=True)
 class ProcessConstants:

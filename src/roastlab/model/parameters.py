@@ -161,6 +161,15 @@ DEFAULT_WEIGHTS = {"Ta": 1.0, "Tb2": 0.0, "ET": 0.0}
 #: A weight given as this word is set from the residuals (:func:`roastlab.fit.identify.residual_weights`):
 #: the probe's residual variance over the output's, both from a first fit with the output at weight 1.
 RESIDUAL_WEIGHT = "residual"
+#: Weight of a log's first-crack mark read as the beans' temperature (a column map's ``[Tb2]
+#: first_crack``: one sample per log at :data:`roastlab.model.constants.FIRST_CRACK_BEAN_C`) against
+#: the probe's samples at weight 1. The mark is one sample against a hundred of the probe's, whose
+#: errors run together for minutes (lag-1 autocorrelation 0.95-0.995 at 5 s: 40-400 samples to one
+#: independent error), so at weight 1 the probe's curve outvotes it: fitted on the Skywalker's logs the
+#: beans read 174-176 degC at the mark at weight 1, 187-199 at 10 and 196-203 at 50, where coffee cracks
+#: at about 200 (spread 3.4 degC), the held-out probe FIT within 1.3 points throughout
+#: (docs/real-roaster.md, "Skywalker: the beans at first crack").
+FIRST_CRACK_WEIGHT = 30.0
 #: The output weights from the residuals are relative to, the bean probe: its own weight is a number.
 RESIDUAL_REFERENCE = "Ta"
 #: Why the reference output cannot be weighed by the residuals (the fit spec's and --weight's error).

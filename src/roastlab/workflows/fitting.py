@@ -38,13 +38,6 @@ from ..sim.population import pack_batches
 from ..sim.simulate import InitialState
 from .model import PAPER_INITIAL, PLACEHOLDER_GG_KG_S, FittedModel, load_log, provenance
 
-#: What to try when a fit fails on non-physical states (printed by the commands that fit).
-FAILED_HINT = (
-    "a drum roaster's metal runs hotter than its beans; let the fit tell the heater's paths apart: weight "
-    "the logged ET ([weights] ET = 1 in the fit spec, or --weight ET=1), or, where no ET is logged, let the "
-    "heater heat the drum alone (remove Tgi_gain_C from [free])"
-)
-
 
 @dataclasses.dataclass
 class FitResult(Result):

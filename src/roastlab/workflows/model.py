@@ -337,7 +337,7 @@ class FittedModel:
             p = PP[i].copy()
             Gg = b.Gg_kg_s * p[P["Gg_scale"]]  # the flow as applied; the result's params then carry 1
             p[P["Gg_scale"]] = 1.0
-            meta = {"notes": list(applied.notes), "plant": applied.plant.name}
+            meta = {"notes": list(applied.notes), "plant": applied.plant.name, "events": dict(b.events)}
             res = SimulationResult(
                 b.time_s.copy(),
                 out[i, :n, :NS].copy(),

@@ -71,8 +71,8 @@ from ..metrics.profile import (
 )
 from ..model.actuators import UNIT_DEFAULTS
 from ..model.bed import CROSS_VALIDATED, PROBE_DEPTH_OVER_DIAMETER
-from ..model.constants import GREEN_BULK_DENSITY_KG_M3
-from ..model.parameters import RESIDUAL_WEIGHT
+from ..model.constants import FIRST_CRACK_BEAN_C, GREEN_BULK_DENSITY_KG_M3
+from ..model.parameters import FIRST_CRACK_WEIGHT, RESIDUAL_WEIGHT
 from ..model.quantities import default, quantity
 
 #: Names of a heater/burner and a fan/air channel in Artisan's languages (lower case, substrings).
@@ -196,6 +196,7 @@ class LogInfo:
     et_before_charge: bool = False  # the log has ET's reading before CHARGE (artisan.ET_BEFORE_CHARGE)
     seen: dict = field(default_factory=dict)  # the heater's and the fan's distinct logged values (their unit: survey)
     inlet: str | None = None  # a temperature channel named as the inlet air (INLET_NAMES)
+    marks_first_crack: bool = False  # the log marks first crack (FCs) within its samples
 
 
 @dataclass
@@ -226,6 +227,8 @@ class Survey:
     inlet: str | None = None  # the inlet-air channel every log records (INLET_NAMES), else None
     et_below_bt: bool = False  # ET reads below BT through every roast: not the drum's air, not used
     fan_at: float | None = None  # the one fan setting of every log, where the fan never moves; else None
+    first_crack: bool = False  # no bean reading but the probe, and most logs mark first crack: the map reads
+    # the mark as the beans' temperature ([Tb2] first_crack, roastlab.model.constants.FIRST_CRACK_BEAN_C)
 
 
 #: A heater logged in watts heats the drum by at most its electric power [kW per W].
@@ -450,6 +453,8 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
         info.et_reads_beans = et_reads_beans(log.time_s, log.channels["ET"], log.channels["BT"], default("T_room_C"))
         info.et_before_charge = ET_BEFORE_CHARGE in log.fields
     info.inlet = inlet
+    fc_s = log.events.get("FCs")
+    info.marks_first_crack = fc_s is not None and bool(log.time_s[0] <= fc_s <= log.time_s[-1])
     for what, channel in (("heater", heater), ("fan", fan)):
         if channel:
             values = log.channels[channel]
@@ -653,6 +658,15 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
             f"ET reads below BT through the roast on {len(odd)} log(s) ({', '.join(odd[:3])}{' ...' if len(odd) > 3 else ''}), "
             "unlike the others: not the drum's air there, so the map drops ET on such logs ([ET] above_BT)"
         )
+    second_bean = first.second_bean or (((first.columns or {}).get("ET") or "ET") if et_is_bean else None)
+    marked = sum(i.marks_first_crack for i in infos)
+    first_crack = second_bean is None and 2 * marked > len(infos)
+    if first_crack:
+        notes.append(
+            f"no bean reading but the probe; {marked} of {len(infos)} log(s) mark first crack, where the beans are at "
+            f"about {FIRST_CRACK_BEAN_C:.0f} degC: the map reads each mark as the beans' temperature then ([Tb2] "
+            "first_crack), so the fit cannot put the beans where coffee does not crack"
+        )
     fan_at = _one_setting(pooled.get("fan")) if fan else None
     if fan_at is not None:
         notes.append(
@@ -667,7 +681,7 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
         heater_unit,
         fan,
         fan_unit,
-        first.second_bean or (((first.columns or {}).get("ET") or "ET") if et_is_bean else None),
+        second_bean,
         all(i.has_et for i in infos) and not et_is_bean and not et_below_bt,
         max(i.heater_max for i in infos),
         max(i.fan_max for i in infos),
@@ -684,6 +698,7 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
         inlet,
         et_below_bt,
         fan_at=fan_at,
+        first_crack=first_crack,
     )
 
 
@@ -861,6 +876,12 @@ def map_text(s: Survey) -> str:
         ]
     elif s.second_bean:
         lines += ["[Tb2]", f'column = "{s.second_bean}"   # a second bean reading (infrared)', "start_s = 10.0", ""]
+    elif s.first_crack:
+        lines += [
+            "[Tb2]",
+            f"first_crack = true   # the first-crack mark (FCs) as the beans at {FIRST_CRACK_BEAN_C:g} degC then",
+            "",
+        ]
     initial = []
     if s.format == "roastime":
         sources = ", ".join(f'"{c}"' for c in DRUM_AT_CHARGE)
@@ -996,6 +1017,11 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
     weights = []
     if s.second_bean:
         weights.append("Tb2 = 1.0                             # the second bean reading vs the model's Tb")
+    elif s.first_crack:
+        weights.append(
+            f"Tb2 = {FIRST_CRACK_WEIGHT:g}".ljust(38) + "# the first-crack mark vs the model's Tb, against the probe's "
+            "samples at 1 (roastlab.model.parameters.FIRST_CRACK_WEIGHT)"
+        )
     if s.has_et and (s.heater or s.inlet):
         # ET is then a reading, not the inlet (map_text): fitted against the outlet gas, it tells the
         # heater's paths (into the air, into the drum) apart, which BT alone cannot, and pins the
@@ -1196,7 +1222,6 @@ def fit_roaster(
     from ..io.fitspec import load_fit_spec
     from ..io.importers.mapping import load_map
     from ..io.modelfile import model_document_text
-    from .fitting import FAILED_HINT
     from .model import load_log
     from .sizes import across_sizes, across_sizes_figure, across_sizes_lines, size_split
 
@@ -1248,11 +1273,7 @@ def fit_roaster(
     lines = [
         f"# {model.plant.name if model.plant else 'roaster'}: fitted by roastlab fit-roaster",
         "",
-        *(
-            [f"**The fit failed**: {result.failed}. {FAILED_HINT[0].upper()}{FAILED_HINT[1:]}.", ""]
-            if result.failed
-            else []
-        ),
+        *([f"**The fit failed**: {result.failed}.", ""] if result.failed else []),
         *([f"**Not usable**: {verdict}.", ""] if verdict else []),
         f"{len(batches)} logs sorted by {by}, split alternately: {len(fit_b)} fit, {len(val_b)} held out "
         f"(the fit never saw them). Fit in {result.identification.wall_s:.1f} s.",

@@ -43,6 +43,8 @@ A map is a TOML file::
     unit = "percent"
     [Tb2]                      # a second bean reading compared with the model's Tb
     column = "drumTemperature" # e.g. the Bullet's infrared channel
+    # first_crack = true       # ... or, with no bean channel: the log's FCs mark read as the beans
+                               # at FIRST_CRACK_BEAN_C (one sample per log that marks first crack)
     [ET]                       # the roaster's ET, drawn beside the model (default: an Artisan
     column = "ET"              # log's ET channel); never an input
     above_BT = true            # drop it on a log where it reads below BT through the roast
@@ -183,6 +185,13 @@ class ColumnMap:
         return (self.Tb2 or {}).get("column") == "ET"
 
     @property
+    def first_crack_as_beans(self) -> bool:
+        """True if the map reads each log's first-crack mark as its one bean reading (``[Tb2]
+        first_crack = true``: the model's Tb at the FCs mark against
+        :data:`~roastlab.model.constants.FIRST_CRACK_BEAN_C`), for logs with no bean channel."""
+        return bool((self.Tb2 or {}).get("first_crack"))
+
+    @property
     def identifies_flow(self) -> bool:
         """True if the map writes a 1 kg/s placeholder flow for the fit to scale (``[Gg] identify``)."""
         return bool(self.Gg.get("identify"))
@@ -198,7 +207,7 @@ TABLE_KEYS = {
     "Tgi": {"column", "unit", "offset_C", "constant_C", "room", "room_unit"},
     "heater": {"column", "unit", "min", "max", "step", "rate_per_min"},
     "fan": {"column", "unit", "min", "max", "step", "rate_per_min"},
-    "Tb2": {"column", "unit", "offset_C", "start_s"},
+    "Tb2": {"column", "unit", "offset_C", "start_s", "first_crack"},
     "ET": {"column", "unit", "offset_C", "above_BT"},
     "initial": set(INITIAL_FROM_LOG),
     "Gg": {"column", "unit", "density_kg_m3", "constant_kg_s", "identify", "pitot"},
@@ -297,6 +306,20 @@ def map_from_mapping(data: dict, path: str | Path) -> ColumnMap:
                 elif "room_unit" in t:
                     raise InputError("room_unit needs room = true", path, "Tgi")
                 continue
+            if key == "Tb2" and "first_crack" in t:
+                if t["first_crack"] is not True:
+                    raise InputError(
+                        f"must be true (or leave it out), got {t['first_crack']!r}", path, "Tb2.first_crack"
+                    )
+                if set(t) != {"first_crack"}:
+                    raise InputError(
+                        "first_crack reads the log's FCs mark as the beans' temperature: give it alone, not with "
+                        f"{', '.join(sorted(set(t) - {'first_crack'}))}",
+                        path,
+                        "Tb2",
+                    )
+                m.Tb2 = {"first_crack": True}
+                continue
             if "room" in t or "room_unit" in t:
                 raise InputError(
                     "room = true needs constant_C (the inlet air where a log records no room)", path, "Tgi"
@@ -312,7 +335,7 @@ def map_from_mapping(data: dict, path: str | Path) -> ColumnMap:
         if not isinstance(flag, bool):
             raise InputError(f"must be true or false, got {flag!r}", path, "ET.above_BT")
         m.ET["above_BT"] = flag
-    if m.Tb2 is not None:
+    if m.Tb2 is not None and not m.first_crack_as_beans:
         start = _check_num(data["Tb2"], "start_s", path, "Tb2", default=0.0)
         if not 0 <= start <= 3600:
             raise InputError(f"must be 0..3600 s, got {start:g}", path, "Tb2.start_s")
@@ -578,7 +601,8 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
     events: dict = {}
     unit = ""
     started_epoch_s = None  # when the recording started (Artisan roastepoch, RoasTime dateTime)
-    settings = {k: spec for k, spec in (("heater", cmap.heater), ("fan", cmap.fan), ("Tb2", cmap.Tb2)) if spec}
+    bean_channel = None if cmap.first_crack_as_beans else cmap.Tb2  # the mark is read after the log, below
+    settings = {k: spec for k, spec in (("heater", cmap.heater), ("fan", cmap.fan), ("Tb2", bean_channel)) if spec}
     et_spec = cmap.ET
     if fmt in ("alog", "artisan-csv", "roastime"):
         if fmt == "alog":
@@ -692,7 +716,7 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
         if "column" in cmap.Tgi:
             temps[cmap.Tgi["column"]] = Tgi
         for k in ("Tb2", "ET"):  # a reading the check above dropped on this log gives no state
-            if getattr(cmap, k):
+            if (getattr(cmap, k) or {}).get("column"):  # (a first-crack mark is no channel)
                 temps[getattr(cmap, k)["column"]] = series.get(k, np.full(len(time_s), np.nan))
         for state, sources in cmap.initial.items():
             names = [sources] if isinstance(sources, str) else sources
@@ -801,8 +825,35 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
         started_epoch_s=started_epoch_s,
     )
     batch.initial.update(initial)
+    if cmap.first_crack_as_beans:
+        batch.Tb2_C, note = first_crack_reading(batch.time_s, events)
+        if note:
+            notes.append(note)
     batch.notes = notes
     return batch.validate()
+
+
+def first_crack_reading(time_s, events: dict) -> tuple[np.ndarray | None, str | None]:
+    """The log's first-crack mark as a bean reading: NaN everywhere but the sample nearest the FCs
+    mark, which reads :data:`~roastlab.model.constants.FIRST_CRACK_BEAN_C` (a map's ``[Tb2]
+    first_crack``), and a note; (None, a note) where the log marks no first crack within its samples.
+
+    >>> tb2, _ = first_crack_reading(np.array([0.0, 5.0, 10.0, 15.0]), {"FCs": 11.0})
+    >>> tb2
+    array([ nan,  nan, 200.,  nan])
+    >>> first_crack_reading(np.array([0.0, 5.0]), {})[1]
+    'no first-crack mark (FCs) in the log: no bean reading on it ([Tb2] first_crack)'
+    """
+    from ...model.constants import FIRST_CRACK_BEAN_C
+
+    t = np.asarray(time_s, dtype=float)
+    fc_s = events.get("FCs")
+    if fc_s is None or not t[0] <= fc_s <= t[-1]:
+        where = "no first-crack mark (FCs) in the log" if fc_s is None else "the first-crack mark lies outside the log"
+        return None, f"{where}: no bean reading on it ([Tb2] first_crack)"
+    tb2 = np.full(t.size, np.nan)
+    tb2[int(np.argmin(np.abs(t - fc_s)))] = FIRST_CRACK_BEAN_C
+    return tb2, None
 
 
 def room_temperature_C(room, bare_unit: str) -> tuple[float | None, str | None]:
