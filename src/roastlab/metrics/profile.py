@@ -35,6 +35,8 @@ import functools
 import numpy as np
 from scipy import sparse
 
+from ..model.constants import FIRST_CRACK_BEAN_C
+
 #: Window of the rate-of-rise estimate [s] (see the module docstring for why 30 s).
 ROR_SPAN_S = 30.0
 #: Window over which a curve that stops short is extended at its rate of rise [s].
@@ -394,8 +396,6 @@ def implausible_states(result) -> list[str]:
 def _beans_at_first_crack(result) -> list[str]:
     """The beans far from :data:`~roastlab.model.constants.FIRST_CRACK_BEAN_C` at the log's FCs mark
     (``result.meta["events"]``, seconds after CHARGE), by more than :data:`FIRST_CRACK_TOLERANCE_C`."""
-    from ..model.constants import FIRST_CRACK_BEAN_C
-
     fc_s = ((getattr(result, "meta", None) or {}).get("events") or {}).get("FCs")
     t = np.asarray(result.time_s, dtype=float)
     if fc_s is None or not t[0] <= fc_s <= t[-1]:

@@ -75,6 +75,7 @@ import numpy as np
 from ...errors import InputError, ParameterError
 from ...metrics.profile import ET_CHECK_FROM_S, et_minus_bt_C
 from ...model.actuators import UNIT_DEFAULTS, Actuator
+from ...model.constants import FIRST_CRACK_BEAN_C
 from ...model.limits import check_value
 from ...model.pitot import gas_flow_pitot_kg_s
 from ..batch import Batch, csv_log_text, read_table
@@ -844,8 +845,6 @@ def first_crack_reading(time_s, events: dict) -> tuple[np.ndarray | None, str | 
     >>> first_crack_reading(np.array([0.0, 5.0]), {})[1]
     'no first-crack mark (FCs) in the log: no bean reading on it ([Tb2] first_crack)'
     """
-    from ...model.constants import FIRST_CRACK_BEAN_C
-
     t = np.asarray(time_s, dtype=float)
     fc_s = events.get("FCs")
     if fc_s is None or not t[0] <= fc_s <= t[-1]:
