@@ -124,3 +124,23 @@ def test_comparison_summary_still_indexes_as_before_with_a_warning():
         old = r.summary()["mean_rmse_C"]
     assert old == r.statistics()["mean_rmse_C"]
     assert any(issubclass(w.category, DeprecationWarning) for w in caught)
+
+
+def test_validation_reports_the_model_beans_at_each_logs_first_crack_mark():
+    """Where a log marks first crack, validation gives the model's bean temperature then (the one
+    check of the beans a probe-only log allows), in its table and its JSON; a log without a mark
+    adds nothing."""
+    import dataclasses
+
+    from roastlab.model.constants import FIRST_CRACK_BEAN_C
+
+    batch = _batch()
+    model = roastlab.FittedModel.paper("120kg")
+    plain = model.validate([batch])
+    assert plain.first_crack_beans_C == {} and "first-crack" not in plain.table()
+    marked = dataclasses.replace(batch, events={"FCs": 400.0})
+    v = model.validate([marked])
+    res = model.predict(marked)
+    assert v.first_crack_beans_C[batch.name] == pytest.approx(float(np.interp(400.0, res.time_s, res.Tb_C)))
+    assert f"coffee cracks at about {FIRST_CRACK_BEAN_C:.0f} °C" in v.table()
+    assert v.to_json_dict()["first_crack_beans_C"] == v.first_crack_beans_C

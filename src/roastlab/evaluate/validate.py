@@ -10,6 +10,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..metrics.profile import beans_at_first_crack
+from ..model.constants import FIRST_CRACK_BEAN_C
 from ..model.parameters import MODEL_OF_OUTPUT
 from ..report.result import Result, draw_curves
 from .metrics import METRIC_NAMES, absolute_error_moments, average_metrics, batch_metrics
@@ -36,6 +38,11 @@ class ValidationResult(Result):
     #: Metrics of further outputs: {"Tb2": {"names": [...], "rows": [...]}}, the model's Tb
     #: against a second measured bean reading, over the batches (and samples) that have one.
     outputs: dict = field(default_factory=dict)
+    #: The model's bean temperature at each log's first-crack mark [degC], by log name, where the log
+    #: marks one (:func:`roastlab.metrics.profile.beans_at_first_crack`): coffee cracks at about
+    #: :data:`roastlab.model.constants.FIRST_CRACK_BEAN_C`, so it shows whether the model has the beans
+    #: where they are, which the probe's metrics cannot.
+    first_crack_beans_C: dict = field(default_factory=dict)
 
     def __repr__(self) -> str:
         a = self.average
@@ -101,6 +108,8 @@ class ValidationResult(Result):
             "average": self.average,
             "absolute_error": self.error_moments,
         }
+        if self.first_crack_beans_C:
+            out["first_crack_beans_C"] = self.first_crack_beans_C
         if self.outputs:  # per output: the probe (the top-level figures) and each further one
             out["outputs"] = {"Ta": {"compared": "model Ta with the measured bean probe", "average": self.average}}
             for name, o in self.outputs.items():
@@ -131,6 +140,13 @@ class ValidationResult(Result):
                 f"{n:<{w}}" + "".join(_fmt(k, row[k]) for k in METRIC_NAMES) for n, row in zip(o["names"], o["rows"])
             ]
             lines += ["-" * len(head), f"{'average':<{w}}" + "".join(_fmt(k, avg[k]) for k in METRIC_NAMES)]
+        if self.first_crack_beans_C:
+            v = np.array(list(self.first_crack_beans_C.values()))
+            lines += [
+                "",
+                f"model beans at the logs' first-crack marks: median {np.median(v):.0f} °C ({v.min():.0f}-{v.max():.0f} °C, "
+                f"{v.size} log{'s' * (v.size > 1)}); coffee cracks at about {FIRST_CRACK_BEAN_C:.0f} °C",
+            ]
         return "\n".join(lines)
 
 
@@ -153,6 +169,7 @@ def score(results, plant_name: str) -> ValidationResult:
         states.append(np.column_stack([r.states, r.Tgo_C]))
     out = ValidationResult([r.name for r in results], times, meas, pred, states, rows, str(plant_name))
     out.results = list(results)
+    out.first_crack_beans_C = {r.name: mark[1] for r in results if (mark := beans_at_first_crack(r)) is not None}
     # further outputs: each measured series (<output>_measured_C) against its model quantity
     for name, compared in (
         ("Tb2", "model Tb (eq. 15a) with the second measured bean reading"),

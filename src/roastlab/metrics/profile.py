@@ -393,14 +393,24 @@ def implausible_states(result) -> list[str]:
     return _metal_below_beans(result) + _beans_at_first_crack(result)
 
 
-def _beans_at_first_crack(result) -> list[str]:
-    """The beans far from :data:`~roastlab.model.constants.FIRST_CRACK_BEAN_C` at the log's FCs mark
-    (``result.meta["events"]``, seconds after CHARGE), by more than :data:`FIRST_CRACK_TOLERANCE_C`."""
+def beans_at_first_crack(result) -> tuple[float, float] | None:
+    """(the log's first-crack mark [s after CHARGE], the model's bean temperature then [degC]) of a
+    simulated log (``result.meta["events"]["FCs"]``, ``result.Tb_C``), or None where the log marks no
+    first crack within its samples."""
     fc_s = ((getattr(result, "meta", None) or {}).get("events") or {}).get("FCs")
     t = np.asarray(result.time_s, dtype=float)
     if fc_s is None or not t[0] <= fc_s <= t[-1]:
+        return None
+    return float(fc_s), float(np.interp(fc_s, t, result.Tb_C))
+
+
+def _beans_at_first_crack(result) -> list[str]:
+    """The beans far from :data:`~roastlab.model.constants.FIRST_CRACK_BEAN_C` at the log's FCs mark
+    (:func:`beans_at_first_crack`), by more than :data:`FIRST_CRACK_TOLERANCE_C`."""
+    mark = beans_at_first_crack(result)
+    if mark is None:
         return []
-    tb = float(np.interp(fc_s, t, result.Tb_C))
+    fc_s, tb = mark
     if abs(tb - FIRST_CRACK_BEAN_C) <= FIRST_CRACK_TOLERANCE_C:
         return []
     return [
