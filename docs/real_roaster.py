@@ -333,7 +333,7 @@ def drum_start(model, column_map, paths, lines, early_s: float = 180.0):
     fits the whole log, and the one that best fits the probe up to ``early_s`` with the rest of the roast then
     scored (what a roaster watching the first minutes could know). Every prediction is the model's
     own (:func:`best_drum_start`); nothing else is refitted."""
-    from roastlab.metrics.profile import crossing_time_s
+    from roastlab.metrics.profile import crossing_time_s, first_crack_s
 
     nominal_held = set(split(nominal_logs())[1])
     held = [p for p in paths if not nominal_size(p) or p in nominal_held]
@@ -347,7 +347,7 @@ def drum_start(model, column_map, paths, lines, early_s: float = 180.0):
         whole = best_drum_start(model, b, np.ones(b.n, bool), logged)
         late = b.time_s > early_s
         early = best_drum_start(model, b, ~late, logged)
-        fc_s = b.events.get("FCs")
+        fc_s = first_crack_s(b.time_s, b.events)
         level = None if fc_s is None else float(np.interp(fc_s, b.time_s, b.Ta_C))
         marked = level is not None and fc_s > early_s
         rec = {"path": p, "logged": logged, "whole": whole, "early": early, "marked": marked}

@@ -393,15 +393,21 @@ def implausible_states(result) -> list[str]:
     return _metal_below_beans(result) + _beans_at_first_crack(result)
 
 
+def first_crack_s(time_s, events: dict) -> float | None:
+    """The log's first-crack mark (``events["FCs"]``, seconds after CHARGE) where it lies within the
+    samples ``time_s`` [s], else None: the one rule of whether a log marks first crack (``roastlab
+    init``, a map's ``[Tb2] first_crack``, the check of the beans there)."""
+    fc_s = (events or {}).get("FCs")
+    t = np.asarray(time_s, dtype=float)
+    return None if fc_s is None or not t[0] <= fc_s <= t[-1] else float(fc_s)
+
+
 def beans_at_first_crack(result) -> tuple[float, float] | None:
     """(the log's first-crack mark [s after CHARGE], the model's bean temperature then [degC]) of a
-    simulated log (``result.meta["events"]["FCs"]``, ``result.Tb_C``), or None where the log marks no
-    first crack within its samples."""
-    fc_s = ((getattr(result, "meta", None) or {}).get("events") or {}).get("FCs")
-    t = np.asarray(result.time_s, dtype=float)
-    if fc_s is None or not t[0] <= fc_s <= t[-1]:
-        return None
-    return float(fc_s), float(np.interp(fc_s, t, result.Tb_C))
+    simulated log (``result.meta["events"]``, ``result.Tb_C``), or None where the log marks no first
+    crack within its samples (:func:`first_crack_s`)."""
+    fc_s = first_crack_s(result.time_s, (getattr(result, "meta", None) or {}).get("events"))
+    return None if fc_s is None else (fc_s, float(np.interp(fc_s, result.time_s, result.Tb_C)))
 
 
 def _beans_at_first_crack(result) -> list[str]:

@@ -67,6 +67,7 @@ from ..metrics.profile import (
     et_minus_bt_C,
     et_not_drum_air,
     et_reads_beans,
+    first_crack_s,
     mmss,
 )
 from ..model.actuators import UNIT_DEFAULTS
@@ -453,8 +454,7 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
         info.et_reads_beans = et_reads_beans(log.time_s, log.channels["ET"], log.channels["BT"], default("T_room_C"))
         info.et_before_charge = ET_BEFORE_CHARGE in log.fields
     info.inlet = inlet
-    fc_s = log.events.get("FCs")
-    info.marks_first_crack = fc_s is not None and bool(log.time_s[0] <= fc_s <= log.time_s[-1])
+    info.marks_first_crack = first_crack_s(log.time_s, log.events) is not None
     for what, channel in (("heater", heater), ("fan", fan)):
         if channel:
             values = log.channels[channel]

@@ -73,7 +73,7 @@ from pathlib import Path
 import numpy as np
 
 from ...errors import InputError, ParameterError
-from ...metrics.profile import ET_CHECK_FROM_S, et_minus_bt_C
+from ...metrics.profile import ET_CHECK_FROM_S, et_minus_bt_C, first_crack_s
 from ...model.actuators import UNIT_DEFAULTS, Actuator
 from ...model.constants import FIRST_CRACK_BEAN_C
 from ...model.limits import check_value
@@ -846,9 +846,11 @@ def first_crack_reading(time_s, events: dict) -> tuple[np.ndarray | None, str | 
     'no first-crack mark (FCs) in the log: no bean reading on it ([Tb2] first_crack)'
     """
     t = np.asarray(time_s, dtype=float)
-    fc_s = events.get("FCs")
-    if fc_s is None or not t[0] <= fc_s <= t[-1]:
-        where = "no first-crack mark (FCs) in the log" if fc_s is None else "the first-crack mark lies outside the log"
+    fc_s = first_crack_s(t, events)
+    if fc_s is None:
+        where = (
+            "the first-crack mark lies outside the log" if "FCs" in events else "no first-crack mark (FCs) in the log"
+        )
         return None, f"{where}: no bean reading on it ([Tb2] first_crack)"
     tb2 = np.full(t.size, np.nan)
     tb2[int(np.argmin(np.abs(t - fc_s)))] = FIRST_CRACK_BEAN_C
