@@ -250,3 +250,45 @@ def test_probe_immersion_reads_the_covered_mix_at_steady_state():
     assert np.array_equal(paper.states, covered.states)  # c = 1 is eq. 17 exactly
     # the probe never feeds back (only the adaptive step, which also watches Ta, differs)
     assert np.allclose(paper.states[:, :4], half.states[:, :4], rtol=0, atol=1e-4)
+
+
+def test_drum_at_charge_from_a_share_of_its_rise():
+    """The drum at CHARGE from a reading that shows a share of its rise over the room
+    (roastlab.model.rhs.drum_at_charge_C), by hand: a probe at 132 degC in a 22 degC room showing
+    0.8 of the drum's rise puts the drum at 22 + 110/0.8 = 159.5 degC; share 1 returns the reading
+    bit for bit (the paper's and the Bullet's Tm0); the inverse gives the reading back; and a
+    simulation from the population path starts there."""
+    from roastlab.io.batch import Batch
+    from roastlab.model.layout import S_TM
+    from roastlab.model.parameters import THETA_START
+    from roastlab.model.rhs import drum_at_charge_C, drum_start_reading_C
+    from roastlab.sim.population import pack_batches, simulate_population
+
+    p = pack_params(load_plant("120kg"), THETA_START)
+    p[P["T_room"]], p[P["Tm0_share"]] = 22.0, 0.8
+    assert drum_at_charge_C(132.0, p) == pytest.approx(159.5, abs=1e-12)
+    assert drum_start_reading_C(159.5, p) == pytest.approx(132.0, abs=1e-12)
+    p[P["Tm0_share"]] = 1.0
+    assert drum_at_charge_C(131.71, p) == 131.71
+    t = np.arange(0.0, 61.0, 5.0)
+    b = Batch("synthetic", t, np.full(t.size, 0.45), np.full(t.size, 400.0), initial={"Tm0_C": 132.0})
+    packed = pack_batches([b], "120kg", THETA_START)
+    out = simulate_population(packed, ["Tm0_share", "T_room_C"], np.array([[[0.8, 22.0]]]))
+    assert out[0, 0, 0, S_TM] == pytest.approx(159.5, abs=1e-9)
+    assert simulate_population(packed)[0, 0, 0, S_TM] == 132.0
+
+
+def test_a_model_with_a_drum_start_share_reads_logs_and_given_drums_apart():
+    """A model whose drum start is a reading (Tm0_share 0.8): a log's reading starts the drum above
+    it, while a drum temperature given as a change (what-if, the page, a scenario) starts the drum
+    there, not above it."""
+    from roastlab import FittedModel
+    from roastlab.io.batch import Batch
+    from roastlab.model.layout import S_TM
+
+    t = np.arange(0.0, 121.0, 5.0)
+    b = Batch("synthetic", t, np.full(t.size, 0.45), np.full(t.size, 400.0), initial={"Tm0_C": 132.0})
+    model = FittedModel.paper().with_values(Tm0_share=0.8, T_room_C=22.0)
+    assert model.predict(b).states[0, S_TM] == pytest.approx(159.5, abs=1e-9)
+    assert model.predict(b, Tm0_C=150.0).states[0, S_TM] == pytest.approx(150.0, abs=1e-9)
+    assert FittedModel.paper().predict(b).states[0, S_TM] == 132.0

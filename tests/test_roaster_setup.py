@@ -185,6 +185,13 @@ def test_init_without_et_lets_the_heater_heat_the_drum_alone(cli, tmp_path):
     fit = (tmp_path / "cfg" / "fit.toml").read_text()
     assert "Qe_gain_kW" in fit and "Tgi_gain_C" not in fit and "heater heats the drum metal alone" in fit
     assert "[weights]" not in fit
+    # the drum at CHARGE is BT then, the probe soaked in the empty drum: the share of the drum's rise it
+    # shows is fitted, within the quantity table's bounds (roastlab.model.rhs.drum_at_charge_C)
+    from roastlab.model.quantities import quantity
+    from roastlab.workflows.roaster import TM0_SHARE_START
+
+    lo, hi = quantity("Tm0_share").bounds
+    assert f"Tm0_share = [{lo:g}, {hi:g}, {TM0_SHARE_START:g}]" in fit
 
 
 def test_a_heater_logged_in_watts_is_read_as_a_power(cli, tmp_path):
@@ -913,6 +920,8 @@ def test_fit_roaster_by_size_on_the_bullet_reads_the_scaling_gap_from_inits_file
         if float(doc.get("weightGreen") or 0) > 0:
             weighed[p.stem] = str(doc.get("serialNumber", ""))
     assert cli("init", bullet, "--out", tmp_path / "cfg")[0] == 0
+    # the drum at CHARGE is the preheat RoasTime held it at (a reading of the drum): no share of it to fit
+    assert "Tm0_share" not in (tmp_path / "cfg" / "fit.toml").read_text()
     code, out, err = cli("fit-roaster", tmp_path / "cfg", bullet, "--by-size")
     assert code == 0, err
     line = out.split("across sizes: ")[1].splitlines()[0]

@@ -286,3 +286,27 @@ def test_outlet_gas_sensitivities_match_central_differences():
         fd = (predict_outputs(packed, names, vp[None], False, True)[2][0, 0]
               - predict_outputs(packed, names, vm[None], False, True)[2][0, 0]) / (2 * h)  # fmt: skip
         assert np.abs(dg[0, :, c] - fd).max() <= 1e-4 * np.abs(fd).max(), c
+
+
+def test_drum_start_share_sensitivities_match_central_differences():
+    """The drum at CHARGE read through a share of its rise over the room (``Tm0_share``): the
+    exact derivatives of the probe with respect to the share, the reading and the room against
+    central differences of the simulated probe."""
+    from roastlab.io.batch import Batch
+    from roastlab.model.parameters import THETA_START
+    from roastlab.sim.population import output_sensitivities, pack_batches, predict_outputs
+
+    t, Gg, Tgi, Q, F, x0, p, _ = _case(False, heater=True)
+    packed = pack_batches([Batch("synthetic", t, Gg, Tgi, heater=Q)], "120kg", THETA_START)
+    names = ["Tm0_share", "Tm0_C", "T_room_C", "Qe_gain_kW"]
+    values = np.array([[0.7, 150.0, 25.0, 3.0]])
+    res = output_sensitivities(packed, names, values, [(j, -1) for j in range(len(names))])
+    ta, dta = res["Ta"]
+    np.testing.assert_allclose(ta[0], predict_outputs(packed, names, values[None], False)[0][0, 0], atol=1e-9)
+    for c, h in enumerate((1e-4, 0.01, 0.01, 1e-4)):
+        vp, vm = values.copy(), values.copy()
+        vp[0, c] += h
+        vm[0, c] -= h
+        fd = (predict_outputs(packed, names, vp[None], False)[0][0, 0]
+              - predict_outputs(packed, names, vm[None], False)[0][0, 0]) / (2 * h)  # fmt: skip
+        assert np.abs(dta[0, :, c] - fd).max() <= 1e-5 * np.abs(fd).max(), names[c]

@@ -167,6 +167,10 @@ _TABLE: tuple[Quantity, ...] = (
     Quantity("k_flight", "-", "extension", 0.0, (0.0, 1000.0),
              "gas-bean area over the bed's free surface, beans in flight included (0: the contact law's Agb)",
              (1.0, 100.0), False, "k_flight"),
+    Quantity("Tm0_share", "-", "extension", 1.0, (0.05, 1.0),
+             "share of the drum's rise over the room at CHARGE that the map's drum-start reading shows "
+             "(1: the reading is the drum's; a probe soaked in the empty drum reads less)",
+             (0.3, 1.0), False, "Tm0_share"),
     # --- closed-loop scenarios (roastlab.io.scenario) --------------------------------------------
     Quantity("mass_factor", "-", "scenario", 1.0, (0.1, 5.0), "batch mass over the reference's"),
     Quantity("Gg_factor", "-", "scenario", 1.0, (0.1, 5.0), "gas flow the plant gets over the flow set"),

@@ -20,9 +20,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..model.layout import S_TA, S_TB
+from ..model.layout import S_TA, S_TB, S_TM
 from ..model.parameters import REGISTRY, STATE0
-from ..model.rhs import P, dry_mass_kg, pack_params
+from ..model.rhs import P, drum_at_charge_C, dry_mass_kg, pack_params
 from . import lanes
 from .kernels import H_MAX_S, I_TGO, N_OUT, NS, simulate_population_kernel, ta_population_kernel
 from .simulate import InitialState, check_hold
@@ -153,7 +153,9 @@ def run_arrays(packed: PackedBatches, names: list[str], values: np.ndarray):
     """Build per-run (batch_of, X0, PP) for ``m`` value sets over all batches.
 
     ``values`` has shape (m, nb, len(names)): the value of each named parameter for each
-    run. Returns arrays for m * nb runs ordered (set, batch).
+    run. Returns arrays for m * nb runs ordered (set, batch). With ``Tm0_share`` among the names,
+    the batch's drum-start value (its log's reading, or ``Tm0_C`` named here) is a reading and the
+    run starts from the drum it implies (:func:`roastlab.model.rhs.drum_at_charge_C`).
     """
     m, nb = values.shape[0], packed.n_batches
     X0 = np.repeat(packed.x0[None, :, :], m, axis=0).copy()
@@ -168,6 +170,8 @@ def run_arrays(packed: PackedBatches, names: list[str], values: np.ndarray):
                 PP[:, :, P["Mbd"]] = dry_mass_kg(packed.Mb[None, :], v)
         else:
             raise KeyError(name)
+    if "Tm0_share" in names:  # the drum at CHARGE from its reading (1, the default, leaves it as read)
+        X0[:, :, S_TM] = drum_at_charge_C(X0[:, :, S_TM], PP)
     batch_of = np.tile(np.arange(nb, dtype=np.int64), m)
     return batch_of, X0.reshape(m * nb, NS), PP.reshape(m * nb, -1)
 
@@ -241,14 +245,21 @@ def output_sensitivities(packed: PackedBatches, names: list[str], values: np.nda
     nb, nmax, m = packed.n_batches, packed.T.shape[1], len(directions)
     batch_of, X0, PP = run_arrays(packed, names, values[None, :, :])
     S0 = np.zeros((nb, NS, m))
+    # the drum at CHARGE, room + (reading - room) / share: d/d reading = 1/share, d/d share = -(drum - room)/share
+    share = PP[:, P["Tm0_share"]] if "Tm0_share" in names else np.ones(nb)
+    room = PP[:, P["T_room"]]
     triplets: list[list] = [[] for _ in range(nb)]
     for col, (j, b) in enumerate(directions):
         name = names[j]
         for bb in range(nb) if b < 0 else (b,):
-            if name in PARAM_SLOTS:
+            if name == "Tm0_share":
+                S0[bb, S_TM, col] = -(X0[bb, S_TM] - room[bb]) / share[bb]
+            elif name in PARAM_SLOTS:
                 triplets[bb].append((PARAM_SLOTS[name], col, 1.0))
+                if name == "T_room_C":  # the drum at CHARGE sits above the room
+                    S0[bb, S_TM, col] = 1.0 - 1.0 / share[bb]
             elif name in STATE0:
-                S0[bb, STATE0[name], col] = 1.0
+                S0[bb, STATE0[name], col] = 1.0 / share[bb] if name == "Tm0_C" else 1.0
                 if name == "X0":  # Mbd = dry_mass_kg(Mb, X0) = Mb / (1 + X0): d Mbd / d X0 = -Mbd / (1 + X0)
                     x0 = X0[bb, STATE0[name]]
                     triplets[bb].append((P["Mbd"], col, -dry_mass_kg(packed.Mb[bb], x0) / (1.0 + x0)))

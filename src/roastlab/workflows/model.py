@@ -38,7 +38,7 @@ from ..model.limits import check_value
 from ..model.parameters import REGISTRY, STATE0, THETA_NAMES, THETA_PAPER, THETA_UNITS, Theta
 from ..model.plant import Plant
 from ..model.quantities import default
-from ..model.rhs import P
+from ..model.rhs import N_PARAMS, P, drum_start_reading_C
 from ..sim.kernels import I_TGO, NS, failure
 from ..sim.population import pack_batches, run_arrays, simulate_population
 from ..sim.simulate import InitialState, SimulationResult
@@ -265,14 +265,18 @@ class FittedModel:
             if "batch_kg" in changes:
                 target.check_batch_mass(b.Mb_kg)
             ready.append(b)
-        for name in STATE0:
-            if name in changes:
-                value = check_value(name, changes[name], name)  # one number in its plausible range
-                for b in ready:
-                    b.initial[name] = value
         for name in REGISTRY:
             if name in changes and name not in STATE0:
                 params[name] = check_value(name, changes[name], name)
+        for name in STATE0:
+            if name in changes:
+                value = check_value(name, changes[name], name)  # one number in its plausible range
+                if name == "Tm0_C" and params.get("Tm0_share", 1.0) != 1.0:
+                    # a drum temperature given here, where the batch holds the reading that implies it
+                    # (roastlab.model.rhs.drum_at_charge_C, applied to it in the population's run_arrays)
+                    value = float(drum_start_reading_C(value, self._share_params(params)))
+                for b in ready:
+                    b.initial[name] = value
         theta = Theta(*(params.pop(k) for k in THETA_NAMES))
         fields = {k: base[k] for k in PAPER_INITIAL}
         if "Ta0_C" in base:
@@ -281,6 +285,14 @@ class FittedModel:
         names = list(params)
         values = np.array([[[params[k] for k in names]] * len(ready)]) if names else np.zeros((1, len(ready), 0))
         return Applied(ready, packed, names, values, target, notes)
+
+    @staticmethod
+    def _share_params(params: dict) -> np.ndarray:
+        """A parameter vector holding the drum-start reading's share and the room (all else unused)."""
+        p = np.zeros(N_PARAMS)
+        p[P["Tm0_share"]] = params["Tm0_share"]
+        p[P["T_room"]] = params.get("T_room_C", default("T_room_C"))
+        return p
 
     def _check_batch(self, b: Batch, params: dict, plant: Plant) -> None:
         """A log that cannot be this plant's: the wrong flow, or a batch far from its size."""

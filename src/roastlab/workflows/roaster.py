@@ -168,6 +168,12 @@ EXOTHERM_LAW = ("A", "Ha_R")
 #: order below the quantity table's fit bounds (made for the paper's industrial drums), inside
 #: its plausible range (the Bullet's gas-metal coefficient ends near it).
 SMALL_COEFF_FLOOR = 0.001
+#: Where a fit starts the share of the drum's rise over the room that the probe soaked in the empty
+#: drum shows (``Tm0_share``, :func:`roastlab.model.rhs.drum_at_charge_C`): between the Bullet's soaked
+#: probe, 0.48-0.69 of the way from the room to its preheated drum, and the drum itself (1); the
+#: Skywalker's fits end at 0.76-0.87 from here (docs/real-roaster.md, "Skywalker: the drum above its
+#: probe at CHARGE").
+TM0_SHARE_START = 0.8
 
 
 @dataclass
@@ -230,6 +236,12 @@ class Survey:
     fan_at: float | None = None  # the one fan setting of every log, where the fan never moves; else None
     first_crack: bool = False  # no bean reading but the probe, and most logs mark first crack: the map reads
     # the mark as the beans' temperature ([Tb2] first_crack, roastlab.model.constants.FIRST_CRACK_BEAN_C)
+
+    @property
+    def drum_start_from_probe(self) -> bool:
+        """The map reads the drum at CHARGE from the bean probe soaked in the empty drum (BT then), not
+        from a reading of the drum itself (RoasTime's preheat, an infrared sensor on the empty drum)."""
+        return self.format != "roastime" and not (self.et_is_bean and any(i.et_before_charge for i in self.logs))
 
 
 #: A heater logged in watts heats the drum by at most its electric power [kW per W].
@@ -981,6 +993,15 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
             )
         rows.append(line("tau_heater_s", 1.0, 300.0, 30.0, "lag of the heater's effect [s]"))
         rows.append(line("U_shell_kW_m2K", 0.0, 0.1, 0.01, "drum shell heat loss to the room [kW/(m2 K)]"))
+    if (
+        s.drum_start_from_probe
+    ):  # the probe in the empty drum reads short of the drum (roastlab.model.rhs.drum_at_charge_C)
+        q = quantity("Tm0_share")
+        rows.append(
+            line(
+                "Tm0_share", *q.bounds, TM0_SHARE_START, "share of the drum's rise over the room BT shows at CHARGE [-]"
+            )
+        )
     if s.fan and s.fan_at is not None:
         # Gg + Gg_fan fan with one fan setting in every log: the two cannot be told apart
         rows.append(
