@@ -77,7 +77,7 @@ def test_skywalker_fit_and_validate(cli, real_data, tmp_path):
     )
     assert code == 0, err
     doc = json.loads(theta.read_text())
-    for key in ("hgm", "hbm", "Pbm", "Gg_kg_s", "Kt", "Qe_gain_kW", "Tgi_gain_C", "tau_heater_s"):
+    for key in ("hgm", "hbm", "Pbm", "Gg_kg_s", "Kt", "Qe_gain_kW", "Tgi_gain_C", "tau_heater_s", "Tm0_share"):
         assert doc["parameters"][key]["how"] == "fitted", key
     assert doc["initial"]["Tm0_C"] == {"how": "from log", "field": ["BT", "ET"]} and doc["map"]["Gg"] == {
         "identify": True

@@ -194,6 +194,20 @@ def test_init_without_et_lets_the_heater_heat_the_drum_alone(cli, tmp_path):
     assert f"Tm0_share = [{lo:g}, {hi:g}, {TM0_SHARE_START:g}]" in fit
 
 
+def test_init_leaves_the_drum_start_as_read_where_et_drives_the_model(cli, tmp_path):
+    """SYNTHETIC logs with BT and ET and no heater setting: ET drives the model as the inlet air, and a
+    free share of the drum's rise at CHARGE would stand in for the heater the logs lack (on six
+    Skywalker logs without their events it ran to its floor, a drum at 389 degC), so init does not
+    free it; with a heater it does (the test above)."""
+    logs = [tmp_path / f"r{k}.alog" for k in range(2)]
+    for p in logs:
+        p.write_text(fake_alog())
+    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
+    assert code == 0, err
+    assert 'column = "ET"' in (tmp_path / "cfg" / "map.toml").read_text()
+    assert "Tm0_share" not in (tmp_path / "cfg" / "fit.toml").read_text()
+
+
 def test_a_heater_logged_in_watts_is_read_as_a_power(cli, tmp_path):
     """SYNTHETIC logs whose heater is an extra device reading 450-900 (a power readout, not a
     percent): the map says W with the logs' top, the fit spec bounds the drum's share of it at all of
