@@ -264,12 +264,9 @@ def test_drum_at_charge_from_a_share_of_its_rise():
     from roastlab.model.rhs import drum_at_charge_C, drum_start_reading_C
     from roastlab.sim.population import pack_batches, simulate_population
 
-    p = pack_params(load_plant("120kg"), THETA_START)
-    p[P["T_room"]], p[P["Tm0_share"]] = 22.0, 0.8
-    assert drum_at_charge_C(132.0, p) == pytest.approx(159.5, abs=1e-12)
-    assert drum_start_reading_C(159.5, p) == pytest.approx(132.0, abs=1e-12)
-    p[P["Tm0_share"]] = 1.0
-    assert drum_at_charge_C(131.71, p) == 131.71
+    assert drum_at_charge_C(132.0, 0.8, 22.0) == pytest.approx(159.5, abs=1e-12)
+    assert drum_start_reading_C(159.5, 0.8, 22.0) == pytest.approx(132.0, abs=1e-12)
+    assert drum_at_charge_C(131.71, 1.0, 22.0) == 131.71
     t = np.arange(0.0, 61.0, 5.0)
     b = Batch("synthetic", t, np.full(t.size, 0.45), np.full(t.size, 400.0), initial={"Tm0_C": 132.0})
     packed = pack_batches([b], "120kg", THETA_START)

@@ -77,7 +77,6 @@ from .layout import (  # noqa: E402, F401
     I_QEO,
     I_TAUH,
     I_TGIG,
-    I_TM0SHARE,
     I_TROOM,
     I_USH,
     I_XEXP,
@@ -221,11 +220,11 @@ def shell_loss_kW(Tm, p):
     return p[I_USH] * p[I_ASH] * (Tm - p[I_TROOM])
 
 
-def drum_at_charge_C(reading_C, p):
+def drum_at_charge_C(reading_C, share, room_C):
     """The drum metal's temperature at CHARGE from the map's drum-start reading [degC].
 
-    Tm(0) = T_room + (reading - T_room) / Tm0_share, with T_room [degC] the room and
-    Tm0_share [-] the share of the drum's rise over the room that the reading shows (the
+    Tm(0) = T_room + (reading - T_room) / Tm0_share, with T_room ``room_C`` [degC] the room and
+    Tm0_share ``share`` [-] the share of the drum's rise over the room that the reading shows (the
     extension's ``Tm0_share``; 1, the default, is a reading of the drum itself: the Bullet's
     preheat, the paper's Tm0, returned unchanged, bit for bit). A bean probe that soaked in the
     empty preheated drum sits in air the drum heats and sees the wall by radiation: it settles
@@ -234,19 +233,15 @@ def drum_at_charge_C(reading_C, p):
     share below 1; on the Bullet, whose infrared sensor reads the preheated drum while its probe
     soaks beside it, the probe reads 0.48-0.69 of the way (docs/real-roaster.md). An extension
     of section 5.1's initial state, not a term of the right-hand side: read once per batch
-    (:func:`roastlab.sim.population.run_arrays`). ``reading_C`` a number or an array; ``p`` one
-    parameter vector, or an array whose last axis is the parameter vector.
+    (:func:`roastlab.sim.population.run_arrays`). Numbers or arrays that broadcast together
+    (a parameter vector's entries ``p[P["Tm0_share"]]``, ``p[P["T_room"]]``).
     """
-    share = p[..., I_TM0SHARE]
-    room = p[..., I_TROOM]
-    return np.where(share == 1.0, reading_C, room + (reading_C - room) / share)
+    return np.where(share == 1.0, reading_C, room_C + (reading_C - room_C) / share)
 
 
-def drum_start_reading_C(drum_C, p):
+def drum_start_reading_C(drum_C, share, room_C):
     """The inverse of :func:`drum_at_charge_C`: the reading a drum at ``drum_C`` [degC] shows."""
-    share = p[..., I_TM0SHARE]
-    room = p[..., I_TROOM]
-    return np.where(share == 1.0, drum_C, room + share * (drum_C - room))
+    return np.where(share == 1.0, drum_C, room_C + share * (drum_C - room_C))
 
 
 @register_jitable

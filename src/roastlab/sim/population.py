@@ -171,7 +171,7 @@ def run_arrays(packed: PackedBatches, names: list[str], values: np.ndarray):
         else:
             raise KeyError(name)
     if "Tm0_share" in names:  # the drum at CHARGE from its reading (1, the default, leaves it as read)
-        X0[:, :, S_TM] = drum_at_charge_C(X0[:, :, S_TM], PP)
+        X0[:, :, S_TM] = drum_at_charge_C(X0[:, :, S_TM], PP[:, :, P["Tm0_share"]], PP[:, :, P["T_room"]])
     batch_of = np.tile(np.arange(nb, dtype=np.int64), m)
     return batch_of, X0.reshape(m * nb, NS), PP.reshape(m * nb, -1)
 

@@ -38,7 +38,7 @@ from ..model.limits import check_value
 from ..model.parameters import REGISTRY, STATE0, THETA_NAMES, THETA_PAPER, THETA_UNITS, Theta
 from ..model.plant import Plant
 from ..model.quantities import default
-from ..model.rhs import N_PARAMS, P, drum_start_reading_C
+from ..model.rhs import P, drum_start_reading_C
 from ..sim.kernels import I_TGO, NS, failure
 from ..sim.population import pack_batches, run_arrays, simulate_population
 from ..sim.simulate import InitialState, SimulationResult
@@ -274,7 +274,8 @@ class FittedModel:
                 if name == "Tm0_C" and params.get("Tm0_share", 1.0) != 1.0:
                     # a drum temperature given here, where the batch holds the reading that implies it
                     # (roastlab.model.rhs.drum_at_charge_C, applied to it in the population's run_arrays)
-                    value = float(drum_start_reading_C(value, self._share_params(params)))
+                    room = params.get("T_room_C", default("T_room_C"))
+                    value = float(drum_start_reading_C(value, params["Tm0_share"], room))
                 for b in ready:
                     b.initial[name] = value
         theta = Theta(*(params.pop(k) for k in THETA_NAMES))
@@ -285,14 +286,6 @@ class FittedModel:
         names = list(params)
         values = np.array([[[params[k] for k in names]] * len(ready)]) if names else np.zeros((1, len(ready), 0))
         return Applied(ready, packed, names, values, target, notes)
-
-    @staticmethod
-    def _share_params(params: dict) -> np.ndarray:
-        """A parameter vector holding the drum-start reading's share and the room (all else unused)."""
-        p = np.zeros(N_PARAMS)
-        p[P["Tm0_share"]] = params["Tm0_share"]
-        p[P["T_room"]] = params.get("T_room_C", default("T_room_C"))
-        return p
 
     def _check_batch(self, b: Batch, params: dict, plant: Plant) -> None:
         """A log that cannot be this plant's: the wrong flow, or a batch far from its size."""

@@ -35,7 +35,7 @@ from ..model.layout import S_TB, S_TM
 from ..model.limits import check_value
 from ..model.plant import Plant
 from ..model.quantities import QUANTITIES
-from ..model.rhs import drum_start_reading_C
+from ..model.rhs import P, drum_start_reading_C
 from ..report.result import Result, draw_curves
 from ..sim.population import PARAM_SLOTS
 
@@ -127,7 +127,8 @@ class TransferResult(Result):
             out.write("## Gg_kg_s is the model's placeholder: the flow is the model's fitted Gg_kg_s\n")
         out.write(f"# Mb_kg = {self.batch_kg:.6g}\n")
         x0 = pr.states[0].copy()  # the charge state the program was optimised for (Tm0 possibly chosen)
-        x0[1] = drum_start_reading_C(x0[1], pr.params)  # a batch file holds the reading that implies the drum
+        # a batch file holds the reading that implies the drum (roastlab.model.rhs.drum_at_charge_C)
+        x0[1] = drum_start_reading_C(x0[1], pr.params[P["Tm0_share"]], pr.params[P["T_room"]])
         for key, j in (("Tm0_C", 1), ("Tb0_C", 0), ("X0", 2), ("Ta0_C", 4)):
             out.write(f"# {key} = {x0[j]:.10g}\n")
         cols = ["time_s", "Gg_kg_s", "Tgi_C"] + (["heater", "fan"] if self.actuators else []) + ["Ta_pred_C"]
