@@ -31,7 +31,7 @@ from ..fit.program import (
 from ..io.batch import Batch
 from ..metrics.profile import DRY_END_C, FIRST_CRACK_C, crossing_or_projected_s, crossing_time_s, mmss
 from ..model.actuators import MIN_HOLD_S, SETTING_GAINS
-from ..model.layout import S_TB, S_TM
+from ..model.layout import S_TB, S_TM, STATE0
 from ..model.limits import check_value
 from ..model.plant import Plant
 from ..model.quantities import QUANTITIES
@@ -128,9 +128,9 @@ class TransferResult(Result):
         out.write(f"# Mb_kg = {self.batch_kg:.6g}\n")
         x0 = pr.states[0].copy()  # the charge state the program was optimised for (Tm0 possibly chosen)
         # a batch file holds the reading that implies the drum (roastlab.model.rhs.drum_at_charge_C)
-        x0[1] = drum_start_reading_C(x0[1], pr.params[P["Tm0_share"]], pr.params[P["T_room"]])
-        for key, j in (("Tm0_C", 1), ("Tb0_C", 0), ("X0", 2), ("Ta0_C", 4)):
-            out.write(f"# {key} = {x0[j]:.10g}\n")
+        x0[S_TM] = drum_start_reading_C(x0[S_TM], pr.params[P["Tm0_share"]], pr.params[P["T_room"]])
+        for key in ("Tm0_C", "Tb0_C", "X0", "Ta0_C"):
+            out.write(f"# {key} = {x0[STATE0[key]]:.10g}\n")
         cols = ["time_s", "Gg_kg_s", "Tgi_C"] + (["heater", "fan"] if self.actuators else []) + ["Ta_pred_C"]
         out.write(",".join(cols) + "\n")
         for i, t in enumerate(pr.time_s):
