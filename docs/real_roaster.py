@@ -457,8 +457,9 @@ def variants_and_bands(column_map, paths, lines):
 
 def spread_against_refits(column_map, paths, lines):
     """The bands' roast-to-roast spread takes each fitted log's error as predicted without it, by the
-    linearised rule (roastlab.fit.uncertainty.held_out_residuals); here against refitting the
-    example without each 490-500 g fit log in turn."""
+    fit's own rule (roastlab.fit.uncertainty.held_out_residuals: the fit redone from its optimum
+    without the log); here against the example fitted anew (global search) without each 490-500 g
+    fit log in turn."""
     from roastlab.evaluate.bands import roast_spread
 
     example = ROOT / "examples" / "bullet"
@@ -467,9 +468,9 @@ def spread_against_refits(column_map, paths, lines):
     held = full.identification.held_out_Ta
     own_v = full.model.validate(fit_b)
     lines += [
-        f"### The bands' roast-to-roast spread: linearised leave-one-log-out against refits (Bullet, {NOMINAL} fit logs)",
+        f"### The bands' roast-to-roast spread: the fit's leave-one-log-out against new fits (Bullet, {NOMINAL} fit logs)",
         "",
-        "| log | RMS error in the fit °C | linearised, left out °C | refit without it °C |",
+        "| log | RMS error in the fit °C | left out, the fit's rule °C | fitted anew without it °C |",
         "|---|---|---|---|",
     ]
     times, refit_errors = [], []
@@ -488,10 +489,10 @@ def spread_against_refits(column_map, paths, lines):
     refit = roast_spread(times, refit_errors)["rms_C"]
     lines += [
         "",
-        f"Median spread over the roast: {np.median(linear):.2f} °C linearised, {np.median(refit):.2f} °C from the refits.",
+        f"Median spread over the roast: {np.median(linear):.2f} °C by the fit's rule, {np.median(refit):.2f} °C from the new fits.",
         "",
     ]
-    print(f"spread: linearised {np.median(linear):.2f} °C, refits {np.median(refit):.2f} °C", file=sys.stderr)
+    print(f"spread: fit's rule {np.median(linear):.2f} °C, new fits {np.median(refit):.2f} °C", file=sys.stderr)
 
 
 def skywalker_et(paths, lines):

@@ -18,9 +18,11 @@ sources of error, each a standard deviation at every instant t:
   At fitting, the root mean square over the fit-set logs of the model's probe error at each time
   since CHARGE, sigma_r(t), is stored in the model file (``fit.spread``, on a
   :data:`SPREAD_GRID_S` grid; held at its last value past the longest log). Each log's error is
-  the one it would have had if it had been left out of the fit (cross-validated, linearised:
-  :func:`roastlab.fit.uncertainty.held_out_residuals`), because a new roast is not in the fit;
-  the fit set's own errors are smaller by what the parameters learnt from each log.
+  the one it would have had if it had been left out of the fit (cross-validated: the fit redone
+  without it from the full fit's optimum, :func:`roastlab.fit.uncertainty.held_out_residuals`;
+  until 2026-11-27 one linearised step, which on three fitted logs could run to a band 329 degC
+  wide), because a new roast is not in the fit; the fit set's own errors are smaller by what the
+  parameters learnt from each log.
 
 The band is prediction +- sqrt((z sigma_p)^2 + (z_n sigma_r)^2), z the standard normal quantile
 of (1 + L)/2 and z_n = t_{(1+L)/2, n} the prediction-interval factor of a new roast when

@@ -73,7 +73,7 @@ class IdentificationResult:
     n_residuals, nfev, wall_s, method, seed, starts : diagnostics;
     outputs : per fitted output {"weight", "n", "SSR" (unweighted, degC^2)};
     held_out_Ta : (nb, nmax) model - measured probe [degC] of each batch as predicted had it been
-    left out of the fit (:func:`roastlab.fit.uncertainty.held_out_residuals`), NaN where no
+    left out of the fit (refitted without it, :func:`roastlab.fit.uncertainty.held_out_residuals`), NaN where no
     probe sample was fitted; None when Ta has no weight.
     """
 
@@ -297,14 +297,20 @@ class Objective:
     def residuals(self, z: np.ndarray) -> np.ndarray:
         return self.residuals_many(z[None, :])[0]
 
-    def held_out_ta(self, r: np.ndarray, J: np.ndarray, determined: np.ndarray) -> np.ndarray | None:
+    def held_out_ta(self, z: np.ndarray, r: np.ndarray, J: np.ndarray, determined: np.ndarray) -> np.ndarray | None:
         """(nb, nmax) probe error (model - measured) [degC] of each batch had it been left out of the
-        fit, from the weighted residuals ``r`` and their Jacobian ``J`` at the optimum
-        (:func:`uncertainty.held_out_residuals`, each batch a group; every fitted output's residuals
-        move the parameters); NaN where no probe sample was fitted, None when the probe has no weight."""
+        fit, from the weighted residuals ``r`` and their Jacobian ``J`` at the optimum ``z``
+        (:func:`uncertainty.held_out_residuals`, each batch a group, the fit redone without it from
+        ``z``; every fitted output's residuals move the parameters); NaN where no probe sample was
+        fitted, None when the probe has no weight."""
         if not self.masks["Ta"].any():
             return None
-        r = uncertainty.held_out_residuals(J, r, self.batch_of_residual, determined) / self.sqrt_w
+        r = (
+            uncertainty.held_out_residuals(
+                J, r, self.batch_of_residual, determined, z, self.lower, self.upper, self.residuals_many, self.jacobian
+            )
+            / self.sqrt_w
+        )
         out = np.full(self.packed.TA.shape, np.nan)
         out[self.masks["Ta"]] = r[self.output_of_residual == OUTPUTS.index("Ta")]
         return out
@@ -628,5 +634,5 @@ def identify(
         batches=list(packed.names),
         outputs=obj.output_ssr(r),
         uncertainty=unc,
-        held_out_Ta=obj.held_out_ta(r, J, unc.determined),
+        held_out_Ta=obj.held_out_ta(z, r, J, unc.determined),
     )

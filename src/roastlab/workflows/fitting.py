@@ -267,7 +267,7 @@ def fit(
         doc["fit"]["warnings"] = ident.warnings
         doc["fit"]["failed"] = f"non-physical states: {summary}"
     # the roast-to-roast part of the prediction bands (evaluate.bands): each log's probe error by time
-    # (each log's error as predicted without it, fit.uncertainty.held_out_residuals; the fit set's own
+    # (each log's error as predicted by the fit redone without it, fit.uncertainty.held_out_residuals; the fit set's own
     # errors when the probe was not fitted)
     held = ident.held_out_Ta
     masses = [b.Mb_kg or plant.Mb_kg for b in batches]  # the green weights the spread was measured at
