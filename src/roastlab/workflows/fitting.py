@@ -231,7 +231,15 @@ def fit(
     if from_residuals:  # a first fit with those outputs at weight 1 sets their weights; the second polishes from it
         at_one = {**weights, **dict.fromkeys(from_residuals, 1.0)}
         first = identify(
-            packed, free, fixed, method=method, seed=seed, n_starts=starts, progress=progress, weights=at_one
+            packed,
+            free,
+            fixed,
+            method=method,
+            seed=seed,
+            n_starts=starts,
+            progress=progress,
+            weights=at_one,
+            held_out=False,  # only its outputs' residuals are used: no refit without each log
         )
         weights = {**weights, **residual_weights(first.outputs, from_residuals)}
         free = [_started_at(f, first.values) for f in free]
