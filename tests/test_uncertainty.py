@@ -170,6 +170,13 @@ def test_held_out_residuals_given_the_model_are_refits_without_each_group():
     assert np.allclose(held_b[far], refit(~far, z, lo_b, hi)[far], atol=1e-4)
     assert not np.allclose(held_b[far], held[far], atol=1e-3)
 
+    # a refit SciPy refuses (it raises ValueError where the products overflow) keeps the step
+    def refused(Z):
+        raise ValueError("overflow")
+
+    kept = uncertainty.held_out_residuals(J, r, groups, det, z, lo, hi, refused, jacobian)
+    assert np.array_equal(kept, linear)
+
 
 def test_held_out_residuals_equal_refits_without_each_group_for_a_linear_model():
     """The linearised leave-one-group-out rule is exact when the model is linear in its parameters:

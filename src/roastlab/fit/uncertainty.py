@@ -292,7 +292,8 @@ def held_out_residuals(
     parameters (SciPy's ``least_squares``, trust-region reflective with the exact Jacobian, at most
     :data:`REFIT_MAX_NFEV` evaluations), and the group's residuals are the model's at that refit:
     the leave-one-out the formula stands in for. A local refit, not a new global search: it finds
-    the optimum nearest the full fit's, as a fit that lost one roast would.
+    the optimum nearest the full fit's, as a fit that lost one roast would. Where SciPy refuses the
+    refit (values whose products overflow), the group keeps the linearised step.
 
     >>> J = np.array([[1.0], [1.0], [1.0], [1.0]])  # a mean fitted to two groups of two
     >>> r = np.array([2.0, 2.0, -2.0, -2.0])
@@ -317,17 +318,20 @@ def held_out_residuals(
         return out
     labels = np.unique(groups)
     rows = {g: groups == g for g in labels}
-    if residuals_many is not None:
-        z = np.asarray(z, dtype=float)
-        lower = np.full(z.shape, -np.inf) if lower is None else np.asarray(lower, dtype=float)
-        upper = np.full(z.shape, np.inf) if upper is None else np.asarray(upper, dtype=float)
-        for g in labels:
-            out[rows[g]] = _refit_without(~rows[g], z, det, lower, upper, residuals_many, jacobian, J)[rows[g]]
-        return out
     A = Jd.T @ Jd
     for g in labels:
         Ji = Jd[rows[g]]
         out[rows[g]] = r[rows[g]] + Ji @ (scaled_pinv(A - Ji.T @ Ji) @ (Ji.T @ r[rows[g]]))
+    if residuals_many is None:
+        return out
+    z = np.asarray(z, dtype=float)
+    lower = np.full(z.shape, -np.inf) if lower is None else np.asarray(lower, dtype=float)
+    upper = np.full(z.shape, np.inf) if upper is None else np.asarray(upper, dtype=float)
+    for g in labels:
+        try:
+            out[rows[g]] = _refit_without(~rows[g], z, det, lower, upper, residuals_many, jacobian, J)[rows[g]]
+        except ValueError:  # SciPy refuses values where the products overflow: the step stands in
+            pass
     return out
 
 
@@ -356,18 +360,22 @@ def _refit_without(held_in, z, det, lower, upper, residuals_many, jacobian, J0) 
         J = J0 if np.array_equal(x, x0) else jacobian(full(x))
         return np.asarray(J, dtype=float)[held_in][:, det]
 
-    sol = least_squares(
-        fun,
-        x0,
-        jac=jac,
-        bounds=(lo, hi),
-        method="trf",
-        x_scale="jac",
-        ftol=REFIT_TOL,
-        xtol=REFIT_TOL,
-        gtol=REFIT_TOL,
-        max_nfev=REFIT_MAX_NFEV,
-    )
+    # far out along a parameter spanning decades (the reaction's A) SciPy's products overflow, as in
+    # the fit's own polish (roastlab.fit.identify._polish): the step is rejected, or SciPy raises
+    # ValueError and held_out_residuals keeps the linearised step for that group
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        sol = least_squares(
+            fun,
+            x0,
+            jac=jac,
+            bounds=(lo, hi),
+            method="trf",
+            x_scale="jac",
+            ftol=REFIT_TOL,
+            xtol=REFIT_TOL,
+            gtol=REFIT_TOL,
+            max_nfev=REFIT_MAX_NFEV,
+        )
     fun(sol.x)
     return seen[sol.x.tobytes()]
 
