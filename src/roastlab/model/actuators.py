@@ -44,14 +44,29 @@ _STEPS_PER_UNIT = {"tens": 0.1}
 SETTING_GAINS: dict[str, tuple[str, ...]] = {"heater": ("Qe_gain_kW", "Tgi_gain_C"), "fan": ("Gg_fan_kg_s",)}
 
 
+#: A gain smaller than this share of its quantity's fit range (:data:`roastlab.model.quantities.QUANTITIES`)
+#: moves nothing a roaster could see: a fit that drives a gain onto its floor of 0 leaves it at about
+#: 1e-44, not 0 (a fan gain of 1e-9 kg/s per % adds 1e-7 kg/s at full fan to a flow near 1e-3 kg/s).
+NEGLIGIBLE_GAIN_SHARE = 1e-9
+
+
 def inert_settings(values: dict, settings) -> list[str]:
     """The ``settings`` ("heater", "fan") that move nothing in a model with these parameter
-    ``values`` (registry names): every gain of :data:`SETTING_GAINS` 0 or absent.
+    ``values`` (registry names): every gain of :data:`SETTING_GAINS` absent, 0 or negligible
+    (below :data:`NEGLIGIBLE_GAIN_SHARE` of its fit range, where a fit leaves a gain it put on its floor).
 
     >>> inert_settings({"Qe_gain_kW": 0.005, "Gg_fan_kg_s": 0.0}, ["heater", "fan"])
     ['fan']
+    >>> inert_settings({"Qe_gain_kW": 0.005, "Gg_fan_kg_s": 1.4e-44}, ["fan"])
+    ['fan']
     """
-    return [s for s in dict.fromkeys(settings) if not any(values.get(k, 0.0) for k in SETTING_GAINS[s])]
+    from .quantities import quantity
+
+    def moves(name: str) -> bool:
+        lo, hi = quantity(name).bounds
+        return abs(values.get(name, 0.0)) > NEGLIGIBLE_GAIN_SHARE * (hi - lo)
+
+    return [s for s in dict.fromkeys(settings) if not any(moves(k) for k in SETTING_GAINS[s])]
 
 
 #: The inlet gas temperature as a decided input (the paper's gas roaster): lowest and highest

@@ -30,7 +30,7 @@ from ..fit.program import (
 )
 from ..io.batch import Batch
 from ..metrics.profile import DRY_END_C, FIRST_CRACK_C, crossing_or_projected_s, crossing_time_s, mmss
-from ..model.actuators import MIN_HOLD_S, SETTING_GAINS
+from ..model.actuators import MIN_HOLD_S, SETTING_GAINS, inert_settings
 from ..model.layout import S_TB, S_TM, STATE0
 from ..model.limits import check_value
 from ..model.plant import Plant
@@ -424,9 +424,9 @@ def transfer(
     res_same = model.predict(grid_b, plant=pb, **changes)
     p_b = res_same.params
     gains = SETTING_GAINS.get(limits.decide, ())
-    if gains and not any(p_b[PARAM_SLOTS[g]] for g in gains):
+    if gains and inert_settings({g: p_b[PARAM_SLOTS[g]] for g in gains}, [limits.decide]):
         raise InputError(
-            f"the {limits.decide} has no effect on {pb.name}: its gains ({', '.join(gains)}) are 0 there "
+            f"the {limits.decide} has no effect on {pb.name}: its gains ({', '.join(gains)}) are 0 or negligible there "
             "(plant-specific values do not carry over to another plant); decide Tgi",
             f"--decide {limits.decide}",
         )

@@ -244,8 +244,9 @@ class WhatIf(Result):
         rows where the change is smaller than the model's own error on this log (the change may be
         real, but this log cannot confirm the model that close)."""
         out = [
-            f"the model does not respond to the {setting} ({' and '.join(gains)} = 0 in this model file: its fit "
-            f"spec held {'them' if len(gains) > 1 else 'it'} at 0, or the fit found no effect), so the change "
+            f"the model does not respond to the {setting} ({' and '.join(gains)} = 0 in this model file, or "
+            f"negligibly above: its fit spec held {'them' if len(gains) > 1 else 'it'} at 0, or the fit found "
+            "no effect), so the change "
             f"to it shows none; free {' or '.join(gains)} in the fit spec and refit to ask this"
             for setting, gains in self.inert.items()
         ]
