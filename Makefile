@@ -75,7 +75,7 @@ real-roaster: $(STAMP)
 	$(PY) docs/band_splits.py
 	$(VENV)/bin/roastlab compare-models --plant examples/skywalker/plant.toml --map examples/skywalker/map.toml \
 	  --spec examples/skywalker/fit.toml $(SKYWALKER)/*.alog --group-by log \
-	  --variant $(BED_EXAMPLE) --variant paper,h_probe_m=0 \
+	  --variant $(BED_EXAMPLE) --variant $(BED_EXAMPLE),h_probe_m=$(SKYWALKER_DEPTH_M) --variant paper,h_probe_m=0 \
 	  --json docs/real-roaster-skywalker.json --plot docs/real-roaster-skywalker.png
 # the two heat paths that grow with the bed's surface, as the code holds them (roastlab.model.bed.SURFACE_HEAT)
 SURFACE_HEAT = $(shell $(PY) -c "from roastlab.model.bed import SURFACE_HEAT as s; print(' '.join(s))")
@@ -91,6 +91,9 @@ PAPER_EXOTHERM = $(shell $(PY) -c "from roastlab.model.quantities import QUANTIT
 # the example's laws until 2026-11-25, held at its depth scale, for comparison
 BED_BEFORE = contact=wall,probe=tumbling,probe_gas=mean
 H_PROBE_PROFILE_M = 0.03 0.1 0.2 0.5 1
+# the Skywalker's probe depth scale held where init holds it (the drum's diameter), the example's until
+# 2026-11-27; the example fits it (examples/skywalker/fit.toml)
+SKYWALKER_DEPTH_M = $(shell $(PY) -c "from roastlab import load_plant; from roastlab.model.bed import PROBE_DEPTH_OVER_DIAMETER as k; print(f'{k * load_plant(\"examples/skywalker/plant.toml\").Dch_m:g}')")
 
 # The page's screenshots for docs/app.md and its measured speed (needs Debian's chromium).
 app-screens: $(STAMP)
