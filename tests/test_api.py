@@ -321,3 +321,27 @@ def test_transfer_deciding_a_heater_the_model_is_deaf_to_says_so(sky_model):
     model = roastlab.load_model(model_path).with_values(Qe_gain_kW=0.0, Tgi_gain_C=0.0)
     with pytest.raises(InputError, match=r"the heater has no effect on .*\(Qe_gain_kW, Tgi_gain_C\) are 0"):
         transfer(model, roastlab.load_log(log, model.column_map), None, None)
+
+
+def test_whatif_figure_shows_the_first_crack_mark_and_no_mark_past_the_curves(sky_model):
+    """The Skywalker's one bean reading, its FCs mark read as the beans at FIRST_CRACK_BEAN_C, is drawn
+    as a marker at the mark and named so (a single dot among a channel's went unseen), and an event
+    well past the curves (COOL, minutes after DROP) gets no label outside the axes."""
+    from matplotlib.text import Annotation
+
+    from roastlab.model.constants import FIRST_CRACK_BEAN_C
+    from roastlab.report.figures import plot_whatif
+    from roastlab.workflows.whatif import parse_setting_change, whatif
+
+    model_path, log = sky_model
+    model = roastlab.load_model(model_path)
+    batch = roastlab.load_log(log, model.column_map)
+    batch.events["COOL"] = batch.time_s[-1] + 120.0
+    fig = plot_whatif(whatif(model, batch, [parse_setting_change("heater", "+5@3:00")]))
+    ax = fig.axes[0]
+    (mark,) = [ln for ln in ax.get_lines() if ln.get_label().startswith("beans at first crack")]
+    assert mark.get_ydata().tolist() == [FIRST_CRACK_BEAN_C] and mark.get_marker() == "D"
+    assert abs(mark.get_xdata()[0] * 60.0 - batch.events["FCs"]) <= 2.5
+    labels = [c.get_text() for c in ax.get_children() if isinstance(c, Annotation)]
+    assert any(s.startswith("FCs ") for s in labels) and any(s.startswith("DRY ") for s in labels)
+    assert not any(s.startswith("COOL ") for s in labels)

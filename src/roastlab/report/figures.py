@@ -14,6 +14,7 @@ import numpy as np
 from ..errors import InputError
 from ..io.files import Outputs
 from ..metrics.profile import ROR_SPAN_S, implausible_states, mmss, rate_of_rise_C_per_min, turning_point
+from ..model.constants import FIRST_CRACK_BEAN_C
 from ..model.layout import S_TB, S_TM
 from ..model.parameters import REGISTRY
 
@@ -70,6 +71,8 @@ def _events(ax, events: dict | None, color="0.55") -> None:
     last_x, level = -np.inf, 0
     for t, name in marks:
         x = t / 60.0
+        if ax.has_data() and not lo - 0.02 * span <= x <= hi + 0.02 * span:
+            continue  # well past the curves (COOL after DROP): a label there would sit outside the axes
         level = (level + 1) % 3 if x - last_x < 0.06 * span else 0
         ax.axvline(x, color=color, lw=0.8, ls=":")
         right = x > lo + 0.88 * span  # a mark near the right edge is labelled on its left
@@ -306,7 +309,13 @@ def plot_whatif(w, path=None, outputs=None):
     if b.Ta_C is not None:
         ax.plot(t_min, b.Ta_C, ".", ms=3, color="0.3", label="BT measured (probe)")
     if b.Tb2_C is not None:
-        ax.plot(t_min, b.Tb2_C, ".", ms=2, color="tab:brown", alpha=0.5, label="beans measured (second reading)")
+        marked = np.isfinite(b.Tb2_C)
+        if np.count_nonzero(marked) > 3:
+            ax.plot(t_min, b.Tb2_C, ".", ms=2, color="tab:brown", alpha=0.5, label="beans measured (second reading)")
+        else:  # a few readings, such as the first-crack mark read as the beans ([Tb2] first_crack): visible
+            at_crack = np.all(b.Tb2_C[marked] == FIRST_CRACK_BEAN_C) and "FCs" in b.events
+            label = f"beans at first crack ({FIRST_CRACK_BEAN_C:g} °C, the FCs mark)" if at_crack else "beans measured"
+            ax.plot(t_min[marked], b.Tb2_C[marked], "D", ms=6, mfc="none", color="tab:brown", label=label)
     if b.ET_C is not None:
         ax.plot(t_min, b.ET_C, ".", ms=2, color="tab:purple", alpha=0.6, label="ET measured (log)")
     change = "; ".join(w.changes) or "no change"
