@@ -312,7 +312,7 @@ def plot_whatif(w, path=None, outputs=None):
         marked = np.isfinite(b.Tb2_C)
         if np.count_nonzero(marked) > 3:
             ax.plot(t_min, b.Tb2_C, ".", ms=2, color="tab:brown", alpha=0.5, label="beans measured (second reading)")
-        else:  # a few readings, such as the first-crack mark read as the beans ([Tb2] first_crack): visible
+        elif marked.any():  # a few readings, such as the first-crack mark read as the beans ([Tb2] first_crack)
             at_crack = np.all(b.Tb2_C[marked] == FIRST_CRACK_BEAN_C) and "FCs" in b.events
             label = f"beans at first crack ({FIRST_CRACK_BEAN_C:g} °C, the FCs mark)" if at_crack else "beans measured"
             ax.plot(t_min[marked], b.Tb2_C[marked], "D", ms=6, mfc="none", color="tab:brown", label=label)
