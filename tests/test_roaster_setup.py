@@ -1146,3 +1146,28 @@ def test_the_examples_fit_specs_bound_the_gas_flow_as_init_does():
         spec = load_fit_spec(Path(__file__).resolve().parents[1] / "examples" / machine / "fit.toml")
         gg = next(p for p in spec.free if p.name == "Gg_kg_s")
         assert (gg.lower, gg.upper) == (GAS_FLOW_MIN_KG_S, GAS_FLOW_MAX_FLOOR_KG_S), machine
+
+
+def test_init_says_how_to_fit_the_probe_depth_where_the_logs_span_batch_sizes(cli, tmp_path):
+    """SYNTHETIC logs of 200 and 300 g: init holds the probe's depth scale at the drum's diameter and,
+    because these sizes could determine it, writes the line that frees it (the quantity table's bounds,
+    started where it is held), which the fit spec reads; logs of one size get no such line."""
+    import re
+
+    from roastlab.io.fitspec import load_fit_spec
+    from roastlab.model.quantities import quantity
+
+    logs = [tmp_path / f"r{k}.alog" for k in range(3)]
+    for k, p in enumerate(logs):
+        p.write_text(fake_alog(extra=dict(_BURNER_AIR, **({"weight": [300, 0, "g"]} if k == 1 else {}))))
+    assert cli("init", *logs, "--out", tmp_path / "cfg")[0] == 0
+    text = (tmp_path / "cfg" / "fit.toml").read_text()
+    held = float(re.search(r"\n\[fixed\]\nh_probe_m = ([0-9.]+)", text).group(1))
+    hint = re.search(r"# these logs span 200-300 g, .* as (h_probe_m = \[[^\]]*\])", text)
+    assert hint, text
+    freed = text.replace("[free]\n", f"[free]\n{hint.group(1)}\n").replace(f"h_probe_m = {held:g} ", "# ")
+    (tmp_path / "freed.toml").write_text(freed)
+    (h,) = [f for f in load_fit_spec(tmp_path / "freed.toml").free if f.name == "h_probe_m"]
+    assert (h.lower, h.upper) == quantity("h_probe_m").bounds and h.start == held
+    assert cli("init", *logs[::2], "--out", tmp_path / "one")[0] == 0
+    assert "these logs span" not in (tmp_path / "one" / "fit.toml").read_text()

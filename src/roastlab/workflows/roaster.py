@@ -49,6 +49,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
+from ..evaluate.metrics import size_labels
 from ..io.batch import first_of_each_roast
 from ..io.importers.artisan import DRUM_AT_CHARGE as ARTISAN_DRUM_AT_CHARGE
 from ..io.importers.artisan import ET_BEFORE_CHARGE, WEIGHT_UNITS, RoomReading, read_alog, read_artisan_csv
@@ -1033,6 +1034,15 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
         f"h_probe_m = {PROBE_DEPTH_OVER_DIAMETER * diameter_m:.4g}".ljust(38)
         + "# bed depth that covers the probe [m]: the drum's diameter; only other batch sizes determine it",
     ]
+    masses = [i.batch_kg for i in s.logs if i.batch_kg]
+    if masses and len(set(size_labels(masses)[0])) > 1:  # several batch sizes (compare-models' groups)
+        lo, hi = quantity("h_probe_m").bounds
+        rows += [
+            f"# these logs span {min(masses) * 1e3:.0f}-{max(masses) * 1e3:.0f} g, which can determine it: to fit it, move it "
+            f"to [free] as h_probe_m = [{lo:g}, {hi:g}, {PROBE_DEPTH_OVER_DIAMETER * diameter_m:.4g}]",
+            "# and compare the two with 'roastlab compare-models --group-by log' (the Skywalker example fits it;",
+            '# on init\'s files it predicted no better: docs/real-roaster.md, "Skywalker: the probe half in the bed")',
+        ]
     weights = []
     if s.second_bean:
         weights.append("Tb2 = 1.0                             # the second bean reading vs the model's Tb")
