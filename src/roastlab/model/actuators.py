@@ -21,6 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .quantities import quantity
+
 #: Per unit: (lowest, highest, step or None for continuous, fastest change per minute).
 #: A percentage slider moves in 5 % steps; a level knob in whole steps; kW is continuous.
 UNIT_DEFAULTS: dict[str, tuple[float, float, float | None, float]] = {
@@ -60,7 +62,6 @@ def inert_settings(values: dict, settings) -> list[str]:
     >>> inert_settings({"Qe_gain_kW": 0.005, "Gg_fan_kg_s": 1.4e-44}, ["fan"])
     ['fan']
     """
-    from .quantities import quantity
 
     def moves(name: str) -> bool:
         lo, hi = quantity(name).bounds

@@ -1023,6 +1023,9 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
         rows.append(line("Gg_fan_kg_s", 0.0, hi, start, f"air flow per {per} of the fan [kg/s]"))
     rows += ["", "[initial]", "Tb0_C = 22.0                          # green beans at room temperature",
              "X0 = 0.11                             # typical green-coffee moisture [kg/kg dry]"]  # fmt: skip
+    depth_m = (
+        f"{PROBE_DEPTH_OVER_DIAMETER * diameter_m:.4g}"  # the probe's depth scale, held (and where freed, started)
+    )
     rows += [  # the probe's immersion in the bed: the laws and depth scale cross-validation chose
         "",
         "# The probe in a tumbling bed, its uncovered part in the bed's air: the laws chosen by",
@@ -1031,7 +1034,7 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
         *(f'{k} = "{v}"' for k, v in CROSS_VALIDATED.as_dict().items()),
         "",
         "[fixed]",
-        f"h_probe_m = {PROBE_DEPTH_OVER_DIAMETER * diameter_m:.4g}".ljust(38)
+        f"h_probe_m = {depth_m}".ljust(38)
         + "# bed depth that covers the probe [m]: the drum's diameter; only other batch sizes determine it",
     ]
     masses = [i.batch_kg for i in s.logs if i.batch_kg]
@@ -1039,7 +1042,7 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
         lo, hi = quantity("h_probe_m").bounds
         rows += [
             f"# these logs span {min(masses) * 1e3:.0f}-{max(masses) * 1e3:.0f} g, which can determine it: to fit it, move it "
-            f"to [free] as h_probe_m = [{lo:g}, {hi:g}, {PROBE_DEPTH_OVER_DIAMETER * diameter_m:.4g}]",
+            f"to [free] as h_probe_m = [{lo:g}, {hi:g}, {depth_m}]",
             "# and compare the two with 'roastlab compare-models --group-by log' (the Skywalker example fits it;",
             '# on init\'s files it predicted no better: docs/real-roaster.md, "Skywalker: the probe half in the bed")',
         ]
