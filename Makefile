@@ -49,7 +49,8 @@ wheel-check:
 # Then every bed-law variant, the probe depth scale's profile and the two surface-scaled heat paths
 # cross-validated by batch size on the Bullet (14 variants x 9 fits), then by roaster (3 variants x 6
 # fits). Then the band's calibration: the example leave-one-log-out on the 17 nominal logs (18 fits)
-# and on 16 splits of them into 9 fit and 8 held out (docs/band_splits.py). Last, the Skywalker's 16
+# and on 16 splits of them into 9 fit and 8 held out, and the Skywalker's held-out FIT on 16 halves of
+# its logs, with and without the fan (docs/band_splits.py, 4 + 4 min). Last, the Skywalker's 16
 # logs one by one, the example's bed laws against the paper's probe (2 x 17 fits). All of it: 29 min
 # on 2 cores on 2026-11-27 (on 2026-11-26, with 12 variants: docs/real_roaster.py 5 min, the variants
 # 13, the roasters 3, the bands 5, the Skywalker 2).
