@@ -32,7 +32,7 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 
 # run as a script from docs/, whose folder Python puts first on the path
-from real_roaster import DATA, DOCS, NOMINAL, ROOT, nominal_logs, roasts, split
+from real_roaster import DATA, DOCS, NOMINAL, ROOT, nominal_logs, skywalker_logs, split
 
 import roastlab
 from roastlab.evaluate.bands import BAND_LEVEL, band_coverage, roast_spread, share_inside
@@ -151,10 +151,6 @@ def skywalker_fit(args) -> dict:
         "width_C": float(np.median([r["median_width_C"] for r in cov])),
         "h_probe_m": model.values.get("h_probe_m", float("nan")),
     }
-
-
-def skywalker_logs():
-    return roasts(sorted((DATA / "skywalker").glob("*.alog")))
 
 
 def skywalker_lines() -> list[str]:
