@@ -13,12 +13,15 @@ $(STAMP): pyproject.toml
 	$(PY) -m pip install --quiet -e '.[test]'
 	touch $(STAMP)
 
+# The suite runs on every core (pytest-xdist): on CI's 2 cores 7.4 min against 13 min in one process on
+# 2026-11-27. `make test TEST_WORKERS=0` runs it in one process.
+TEST_WORKERS ?= auto
 test: $(STAMP)
-	$(PY) -m pytest
+	$(PY) -m pytest -n $(TEST_WORKERS)
 
 # The inner loop: every test but those marked slow (make test, which CI runs, has them all).
 test-fast: $(STAMP)
-	$(PY) -m pytest -m "not slow"
+	$(PY) -m pytest -n $(TEST_WORKERS) -m "not slow"
 
 reproduce: $(STAMP)
 	$(VENV)/bin/roastlab reproduce --out out/reproduce
