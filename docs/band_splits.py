@@ -22,7 +22,6 @@ time on 2 cores, 32 fits in 4-6 min.
 
 from __future__ import annotations
 
-import dataclasses
 import multiprocessing
 import os
 import sys
@@ -71,6 +70,21 @@ def held_out_rms(validation) -> float:
     return float(np.median(spread["rms_C"])) if spread else float("nan")
 
 
+def held_out(model, held) -> tuple[dict, object]:
+    """A fitted model's scores on the held-out batches: ``({"FIT", "MAE", "inside", "per_log",
+    "width_C"}, validation)``, the probe's mean FIT and MAE, the share of held-out samples inside the
+    band (overall and per log) and the median over the logs of each log's median band width [degC]."""
+    cov, v = band_coverage(model, held), model.validate(held)
+    scores = {
+        "FIT": v.average["FIT"],
+        "MAE": v.average["MAE"],
+        "inside": share_inside(cov),
+        "per_log": [r["inside"] for r in cov],
+        "width_C": float(np.median([r["median_width_C"] for r in cov])),
+    }
+    return scores, v
+
+
 def bullet_lines() -> list[str]:
     """The Bullet's splits: markdown lines (the band of the example fitted on nine nominal logs)."""
     example = ROOT / "examples" / "bullet"
@@ -88,15 +102,12 @@ def bullet_lines() -> list[str]:
         fit_b = [logs[i] for i in fit_i]
         held = [b for i, b in enumerate(logs) if i not in fit_i]
         model = roastlab.fit(fit_b, example / "plant.toml", example / "fit.toml", column_map=column_map).model
-        cov, v = band_coverage(model, held), model.validate(held)
+        scores, v = held_out(model, held)
         rows.append(
             {
                 "split": k,
                 "fit": fit_i,
-                "inside": share_inside(cov),
-                "per_log": [r["inside"] for r in cov],
-                "width_C": float(np.median([r["median_width_C"] for r in cov])),
-                "FIT": v.average["FIT"],
+                **scores,
                 "spread_C": float(np.median(model.doc["fit"]["spread"]["rms_C"])),
                 "held_rms_C": held_out_rms(v),
             }
@@ -149,20 +160,12 @@ def skywalker_fit(args) -> dict:
     column_map = load_map(example / "map.toml")
     paths = skywalker_logs()
     spec = load_fit_spec(example / "fit.toml")
-    spec = dataclasses.replace(Variant(spec.bed, tuple(overrides)).spec(spec), bed=spec.bed)
+    spec = Variant(spec.bed, tuple(overrides)).spec(spec)  # the overrides over the example's spec, its bed kept
     fit_b = [roastlab.load_log(paths[i], column_map) for i in fit_i]
     held = [roastlab.load_log(p, column_map) for i, p in enumerate(paths) if i not in fit_i]
     model = roastlab.fit(fit_b, example / "plant.toml", spec, column_map=column_map).model
-    cov, v = band_coverage(model, held), model.validate(held)
-    return {
-        "variant": name,
-        "fit": list(fit_i),
-        "FIT": v.average["FIT"],
-        "MAE": v.average["MAE"],
-        "inside": share_inside(cov),
-        "width_C": float(np.median([r["median_width_C"] for r in cov])),
-        "h_probe_m": model.values.get("h_probe_m", float("nan")),
-    }
+    scores, _ = held_out(model, held)
+    return {"variant": name, "fit": list(fit_i), **scores, "h_probe_m": model.values.get("h_probe_m", float("nan"))}
 
 
 def skywalker_lines() -> list[str]:
