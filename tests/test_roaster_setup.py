@@ -1171,3 +1171,51 @@ def test_init_says_how_to_fit_the_probe_depth_where_the_logs_span_batch_sizes(cl
     assert (h.lower, h.upper) == quantity("h_probe_m").bounds and h.start == held
     assert cli("init", *logs[::2], "--out", tmp_path / "one")[0] == 0
     assert "these logs span" not in (tmp_path / "one" / "fit.toml").read_text()
+
+
+def test_logs_of_unit_keeps_one_drums_logs_and_says_the_others_in_one_line():
+    """``fit-roaster --unit``: the logs of one roaster unit (RoasTime's serial number), the others left
+    out in one line with their units; no log of the unit, or only one, is bad input naming what there is."""
+    from types import SimpleNamespace
+
+    def info(name, unit):
+        return SimpleNamespace(path=Path(name), unit=unit)
+
+    infos = [info("a.json", "2779"), info("b.json", "2054"), info("c.json", "2779"), info("d.json", "2054")]
+    infos += [info("e.json", "2779"), info("f.alog", "")]
+    mine, why = roaster.logs_of_unit(infos, "2779")
+    assert [i.path.name for i in mine] == ["a.json", "c.json", "e.json"]
+    assert why == {"--unit": "3 log(s) of other units (2054: 2, (none named): 1), by --unit 2779"}
+    assert roaster.logs_of_unit([infos[0], infos[2]], "2779")[1] == {}  # none left out, nothing said
+    for unit, given, words in [
+        ("9999", infos, "no log was recorded by unit 9999: the logs name units 2779: 3, 2054: 2 (serial number: logs)"),
+        ("9999", [infos[5], info("g.alog", "")], "the logs name no unit"),
+        ("2054", infos[:3], "unit 2054 recorded only b.json: fit-roaster needs two of its logs"),
+    ]:
+        with pytest.raises(InputError, match=re.escape(words)):
+            roaster.logs_of_unit(given, unit)
+
+
+@pytest.mark.slow
+def test_fit_roaster_unit_fits_one_drums_logs_and_leaves_the_others_out(cli, tmp_path):
+    """Five Bullet logs of one drum, written to tmp_path as two units (the copies' serial numbers set to
+    111 and 222; the shared logs are read, never changed): init names both units and the option, and
+    ``fit-roaster --unit 222`` fits and holds out 222's two logs alone, the other three said in one line."""
+    bullet = REAL_DATA / "bullet"
+    if not bullet.is_dir():
+        pytest.skip("../shared/data/real is absent")
+    logs = sorted(bullet.glob("bullet_*_49?g.json"))[:5]
+    folder = tmp_path / "logs"
+    folder.mkdir()
+    for k, p in enumerate(logs):
+        doc = json.loads(p.read_text())
+        doc["serialNumber"] = 222 if k in (1, 3) else 111
+        (folder / p.name).write_text(json.dumps(doc))
+    code, out, _ = cli("init", folder, "--out", tmp_path / "cfg")
+    assert code == 0 and "(serial number: logs; 111: 3, 222: 2)" in out and "fit-roaster --unit 111" in out, out
+    code, out, err = cli("fit-roaster", tmp_path / "cfg", folder, "--unit", "222")
+    assert code == 0, err
+    assert "left out: 3 log(s) of other units (111: 3), by --unit 222" in out, out
+    report = (tmp_path / "cfg" / "report.md").read_text()
+    assert "2 logs sorted by date, split alternately: 1 fit, 1 held out" in report
+    assert "Left out: 3 log(s) of other units (111: 3), by --unit 222." in report

@@ -59,6 +59,7 @@ def cmd_fit_roaster(args) -> int:
         every_log=args.every_log,
         by_size=args.by_size,
         fit_size_kg=args.fit_size_kg,
+        unit=args.unit,
     )
     f, h, b = r["fit"], r["held_out"], r["baseline_held_out"]
     for line in grouped_notes(r["notes"]):
@@ -139,7 +140,8 @@ def add_parsers(sub) -> None:
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog="examples:\n  roastlab fit-roaster myroaster roasts/*.alog\n"
         "  roastlab fit-roaster myroaster roasts/*.alog --every-log   each log also held out once (minutes)\n"
-        "  roastlab fit-roaster myroaster roasts/*.alog --by-size     fitted at one batch size, the others predicted",
+        "  roastlab fit-roaster myroaster roasts/*.alog --by-size     fitted at one batch size, the others predicted\n"
+        "  roastlab fit-roaster mybullet roasts/ --unit 2779           the logs of one unit of the make alone",
     )
     p.add_argument("dir", metavar="DIR", help="the folder 'roastlab init' wrote")
     p.add_argument("logs", nargs="+", metavar="LOG", help="the roaster's logs, or a folder of them")
@@ -164,5 +166,12 @@ def add_parsers(sub) -> None:
         type=float_arg("--fit-size-kg"),
         metavar="KG",
         help="with --by-size (implied): the batch size to fit on [kg], e.g. 0.5 (default: the size with the most logs)",
+    )
+    p.add_argument(
+        "--unit",
+        metavar="SERIAL",
+        help="fit only the logs recorded by this roaster unit (its serial number, as 'init' lists them; RoasTime "
+        "logs carry it): one drum's model, the other units' logs left out and said. Units of one make differ by more "
+        "than a batch size does",
     )
     p.set_defaults(func=cmd_fit_roaster)

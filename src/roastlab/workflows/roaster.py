@@ -625,10 +625,9 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
     serials = Counter(i.unit for i in infos if i.unit)
     if len(serials) > 1:
         notes.append(
-            f"the logs come from {len(serials)} units of this roaster (serial number: logs; "
-            + ", ".join(f"{u}: {k}" for u, k in serials.most_common())
-            + "): one fit treats them as one drum, so the differences between units count as its error; "
-            "fit one unit's logs for that unit's model"
+            f"the logs come from {len(serials)} units of this roaster (serial number: logs; {unit_counts([i for i in infos if i.unit])}): "
+            "one fit treats them as one drum, so the differences between units count as its error; "
+            f"fit one unit's logs for that unit's model (fit-roaster --unit {serials.most_common(1)[0][0]})"
         )
     inlets = {i.inlet for i in infos}
     inlet = inlets.pop() if len(inlets) == 1 else None  # every log records it, under one name
@@ -1155,6 +1154,43 @@ def grouped_notes(notes: dict[str, list[str]], at_least: int = 3) -> list[str]:
     return lines
 
 
+def unit_counts(infos) -> str:
+    """The roaster units the logs name and each one's number of logs, the most first: "2779: 22, 2054: 2"
+    (RoasTime's serial number, :attr:`LogInfo.unit`; a log that names none counts as "(none named)")."""
+    return ", ".join(f"{u}: {k}" for u, k in Counter(i.unit or "(none named)" for i in infos).most_common())
+
+
+def logs_of_unit(infos, unit: str) -> tuple[list, dict[str, str]]:
+    """The logs recorded by the roaster unit ``unit`` (its serial number, :attr:`LogInfo.unit`), and
+    one line of why the others are left out (``{"--unit": why}``, empty when there are none).
+
+    Units of one make differ by more than a batch size does (docs/real-roaster.md, "Batch-size
+    scaling on the Bullet"), so a drum's model is fitted on that drum's logs. ``InputError`` when no
+    log names the unit (with the units the logs do name) or only one does.
+    """
+    mine = [i for i in infos if i.unit == unit]
+    if not mine:
+        named = [i for i in infos if i.unit]
+        raise InputError(
+            f"no log was recorded by unit {unit}: "
+            + (
+                f"the logs name units {unit_counts(named)} (serial number: logs)"
+                if named
+                else "the logs name no unit (RoasTime logs carry the roaster's serial number; Artisan's do not)"
+            ),
+            "--unit",
+        )
+    if len(mine) < 2:
+        raise InputError(
+            f"unit {unit} recorded only {mine[0].path.name}: fit-roaster needs two of its logs (one to fit, one to "
+            "hold out)",
+            "--unit",
+        )
+    others = [i for i in infos if i.unit != unit]
+    why = f"{len(others)} log(s) of other units ({unit_counts(others)}), by --unit {unit}"
+    return mine, ({"--unit": why} if others else {})
+
+
 def logs_without_weight(infos) -> dict[str, str]:
     """The logs whose green weight is unknown (none in the log, its file name or ``--batch-kg``),
     each with why; ``{name: why}``. The model scales with the batch, so a log of unknown batch cannot
@@ -1222,6 +1258,7 @@ def fit_roaster(
     every_log: bool = False,
     by_size: bool = False,
     fit_size_kg: float | None = None,
+    unit: str | None = None,
 ) -> dict:
     """Fit, validate and report a roaster set up by :func:`init_roaster`.
 
@@ -1246,6 +1283,9 @@ def fit_roaster(
     alone and predict every other size with nothing refitted, the paper's scaling claim on this
     roaster (:mod:`roastlab.workflows.sizes`; one more fit), written to the report and
     ``config_dir``/sizes.png.
+
+    ``unit``: fit only the logs of that roaster unit (its serial number; :func:`logs_of_unit`), the
+    others left out and said in one line.
     """
     from ..evaluate.bands import held_out_band
     from ..evaluate.metrics import average_metrics
@@ -1270,6 +1310,9 @@ def fit_roaster(
         )
     cmap = load_map(d / "map.toml")
     infos, unreadable = readable_logs(paths, cmap.batch_kg)
+    if unit is not None:
+        infos, other_units = logs_of_unit(infos, unit)
+        unreadable = {**unreadable, **other_units}
     paths = [i.path for i in infos]
     unusable = {
         **logs_without_weight(infos),
