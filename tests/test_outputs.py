@@ -30,6 +30,7 @@ VALUES = {
     "--every-log",
     "--by-size",
     "--fit-size-kg",
+    "--unit",
     "--batch-capacity-kg",
     "--drum-diameter-m",
     "--drum-length-m",
