@@ -1219,3 +1219,5 @@ def test_fit_roaster_unit_fits_one_drums_logs_and_leaves_the_others_out(cli, tmp
     report = (tmp_path / "cfg" / "report.md").read_text()
     assert "2 logs sorted by date, split alternately: 1 fit, 1 held out" in report
     assert "Left out: 3 log(s) of other units (111: 3), by --unit 222." in report
+    code, out, err = cli("fit-roaster", tmp_path / "cfg", folder, "--unit", "333")  # bad input: one line, exit 2
+    assert code == 2 and len(err.strip().splitlines()) == 1 and "the logs name units 111: 3, 222: 2" in err, err
