@@ -10,7 +10,7 @@ docs/real-roaster-scaling.png. Needs ../shared/data/real beside the repository.
 from __future__ import annotations
 
 import dataclasses
-import re
+import functools
 import sys
 import time
 from pathlib import Path
@@ -32,9 +32,14 @@ DATA = ROOT.parent / "shared" / "data" / "real"
 DOCS = ROOT / "docs"
 
 
+@functools.cache
 def grams(path: Path) -> int | None:
-    m = re.search(r"_(\d+)g\.json$", path.name)
-    return int(m.group(1)) if m else None
+    """A Bullet log's green batch [g] as ``roastlab init`` reads it: the weight the log records, else
+    the grams in its file name (roastlab.workflows.roaster.inspect_log); None if neither."""
+    from roastlab.workflows.roaster import inspect_log
+
+    kg = inspect_log(path).batch_kg
+    return None if kg is None else round(kg * 1000)
 
 
 #: The Bullet's fit batch sizes [g]: the roaster's nominal 0.5 kg as its owner weighed it.
@@ -61,8 +66,8 @@ def roasts(paths) -> list[Path]:
 
 
 def bullet_logs() -> list[Path]:
-    """The weighed Bullet logs (a green weight in the name) that are roasts (:func:`roasts`), by name."""
-    return roasts(sorted(p for p in (DATA / "bullet").glob("*.json") if grams(p) is not None))
+    """The Bullet logs that are roasts (:func:`roasts`) and record their green weight (:func:`grams`), by name."""
+    return [p for p in roasts(sorted((DATA / "bullet").glob("*.json"))) if grams(p) is not None]
 
 
 def skywalker_logs() -> list[Path]:
