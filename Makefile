@@ -64,7 +64,7 @@ SKYWALKER = ../shared/data/real/skywalker
 real-roaster: $(STAMP)
 	$(PY) docs/real_roaster.py
 	$(VENV)/bin/roastlab compare-models --plant examples/bullet/plant.toml --map examples/bullet/map.toml \
-	  --spec examples/bullet/fit.toml $$(ls $(BULLET)/*_*g.json) \
+	  --spec examples/bullet/fit.toml $(BULLET_WEIGHED) \
 	  --variant $(BED_EXAMPLE) \
 	  $(foreach v,$(BED_VARIANTS),--variant $(v),h_probe_m=free,$(PAPER_EXOTHERM)) \
 	  $(foreach h,$(H_PROBE_PROFILE_M),--variant $(BED_EXAMPLE),h_probe_m=$(h),$(PAPER_EXOTHERM)) \
@@ -72,7 +72,7 @@ real-roaster: $(STAMP)
 	  $(foreach x,$(SURFACE_HEAT),--variant $(BED_EXAMPLE),$(x)) \
 	  --json docs/real-roaster-compare.json --plot docs/real-roaster-compare.png
 	$(VENV)/bin/roastlab compare-models --plant examples/bullet/plant.toml --map examples/bullet/map.toml \
-	  --spec examples/bullet/fit.toml $$(ls $(BULLET)/*_*g.json) --group-by unit \
+	  --spec examples/bullet/fit.toml $(BULLET_WEIGHED) --group-by unit \
 	  --variant $(BED_EXAMPLE) --variant $(BED_EXAMPLE),$(PAPER_EXOTHERM) --variant paper,h_probe_m=free,$(PAPER_EXOTHERM) \
 	  --json docs/real-roaster-roasters.json --plot docs/real-roaster-roasters.png
 	$(VENV)/bin/roastlab compare-models --plant examples/bullet/plant.toml --map examples/bullet/map.toml \
@@ -89,6 +89,8 @@ SURFACE_HEAT = $(shell $(PY) -c "from roastlab.model.bed import SURFACE_HEAT as 
 BED_VARIANTS = paper probe=tumbling contact=wall probe=tumbling,probe_gas=mean contact=wall,probe=tumbling,probe_gas=mean
 # the laws cross-validation chose, as the code holds them (roastlab.model.bed.CROSS_VALIDATED)
 BED_EXAMPLE = $(shell $(PY) -c "from roastlab.model.bed import CROSS_VALIDATED as b; print(b.name)")
+# the Bullet's logs that record their green weight (docs/real_roaster.py's bullet_logs, as init reads a batch)
+BULLET_WEIGHED = $(shell cd docs && ../$(PY) -c "from real_roaster import bullet_logs; print(*bullet_logs())")
 # the Bullet's logs of the fit's batch size (docs/real_roaster.py's NOMINAL_G)
 BULLET_NOMINAL = $(shell cd docs && ../$(PY) -c "from real_roaster import nominal_logs; print(*nominal_logs())")
 # the paper's exothermic rate law (Schwartzberg's A and Ha/R, the quantity table's defaults), held in the
