@@ -622,10 +622,11 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
             + f" [deg{c['temp_unit']}], by their names; each log's first row is taken as CHARGE"
             + (f"; not read (not numbers): {', '.join(c['not read'])}" if c.get("not read") else "")
         )
-    serials = Counter(i.unit for i in infos if i.unit)
+    named = [i for i in infos if i.unit]
+    serials = Counter(i.unit for i in named)
     if len(serials) > 1:
         notes.append(
-            f"the logs come from {len(serials)} units of this roaster (serial number: logs; {unit_counts([i for i in infos if i.unit])}): "
+            f"the logs come from {len(serials)} units of this roaster (serial number: logs; {unit_counts(named)}): "
             "one fit treats them as one drum, so the differences between units count as its error; "
             f"fit one unit's logs for that unit's model (fit-roaster --unit {serials.most_common(1)[0][0]})"
         )
@@ -1310,15 +1311,13 @@ def fit_roaster(
         )
     cmap = load_map(d / "map.toml")
     infos, unreadable = readable_logs(paths, cmap.batch_kg)
-    if unit is not None:
-        infos, other_units = logs_of_unit(infos, unit)
-        unreadable = {**unreadable, **other_units}
+    infos, other_units = logs_of_unit(infos, unit) if unit is not None else (infos, {})
     paths = [i.path for i in infos]
     unusable = {
         **logs_without_weight(infos),
         **logs_without_controls(infos, {k: (getattr(cmap, k) or {}).get("column") for k in ("heater", "fan")}),
     }
-    left_out = {**unreadable, **unusable}
+    left_out = {**unreadable, **other_units, **unusable}
     if left_out:
         keep = [k for k, i in enumerate(infos) if i.path.name not in unusable]
         paths, infos = [paths[k] for k in keep], [infos[k] for k in keep]
