@@ -1209,15 +1209,44 @@ def test_fit_roaster_unit_fits_one_drums_logs_and_leaves_the_others_out(cli, tmp
     folder.mkdir()
     for k, p in enumerate(logs):
         doc = json.loads(p.read_text())
-        doc["serialNumber"] = 222 if k in (1, 3) else 111
+        doc["serialNumber"] = 222 if k in (1, 2) else 111
         (folder / p.name).write_text(json.dumps(doc))
     code, out, _ = cli("init", folder, "--out", tmp_path / "cfg")
     assert code == 0 and "(serial number: logs; 111: 3, 222: 2)" in out and "fit-roaster --unit 111" in out, out
+    # without --unit: one fit of both, its held-out logs (the 2nd and 4th by date, one of each unit) by unit
+    code, out, err = cli("fit-roaster", tmp_path / "cfg", folder)
+    assert code == 0, err
+    line = next(x for x in out.splitlines() if x.startswith("held out by unit: "))
+    assert line.count(" % (1 log)") == 2 and "222 " in line and "111 " in line, line
+    table = (tmp_path / "cfg" / "report.md").read_text().split("Held out by roaster unit")[1]
+    assert sum(r.startswith(("| 111 | 1 |", "| 222 | 1 |")) for r in table.splitlines()) == 2, table
     code, out, err = cli("fit-roaster", tmp_path / "cfg", folder, "--unit", "222")
     assert code == 0, err
+    assert "held out by unit" not in out  # one unit: nothing to tell apart
     assert "left out: 3 log(s) of other units (111: 3), by --unit 222" in out, out
     report = (tmp_path / "cfg" / "report.md").read_text()
     assert "2 logs sorted by date, split alternately: 1 fit, 1 held out" in report
     assert "Left out: 3 log(s) of other units (111: 3), by --unit 222." in report
     code, out, err = cli("fit-roaster", tmp_path / "cfg", folder, "--unit", "333")  # bad input: one line, exit 2
     assert code == 2 and len(err.strip().splitlines()) == 1 and "the logs name units 111: 3, 222: 2" in err, err
+
+
+def test_held_out_by_unit_says_which_drum_a_shared_fit_serves():
+    """Per unit the held-out logs' paper Average FIT and MAE and the sample-weighted share inside the
+    band; nothing where the logs name one unit (or none)."""
+    from types import SimpleNamespace
+
+    batches = [SimpleNamespace(unit=u) for u in ("2779", "2054", "2779", "")]
+    from roastlab.evaluate.metrics import METRIC_NAMES
+
+    rows = [
+        {**dict.fromkeys(METRIC_NAMES, 0.0), "FIT": fit, "MAE": mae}
+        for fit, mae in ((90.0, 2.0), (30.0, 20.0), (80.0, 4.0), (70.0, 5.0))
+    ]
+    band = [{"n": 100, "inside": 1.0}, {"n": 50, "inside": 0.1}, {"n": 300, "inside": 0.8}, {"n": 10, "inside": 0.5}]
+    got = roaster.held_out_by_unit(batches, rows, band)
+    assert [(g["unit"], g["logs"]) for g in got] == [("2779", 2), ("2054", 1), ("(none named)", 1)]
+    assert got[0]["FIT"] == pytest.approx(85.0) and got[0]["MAE"] == pytest.approx(3.0)
+    assert got[0]["inside"] == pytest.approx((100 * 1.0 + 300 * 0.8) / 400)
+    assert roaster.held_out_by_unit(batches, rows)[1]["inside"] is None  # no band: no share
+    assert roaster.held_out_by_unit(batches[:1] + batches[2:], rows[:1] + rows[2:]) == []  # one unit named

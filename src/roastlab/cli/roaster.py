@@ -78,6 +78,14 @@ def cmd_fit_roaster(args) -> int:
         print(f"band:     {band_sentence(r['band'])}")
         if r["band"]["note"]:
             print(f"note: {r['band']['note']}")
+    if r["held_out_by_unit"]:
+        print(
+            "held out by unit: "
+            + ", ".join(
+                f"{g['unit']} {g['FIT']:.1f} % ({g['logs']} log{'s' if g['logs'] > 1 else ''})"
+                for g in r["held_out_by_unit"]
+            )
+        )
     e = r["every_log"]
     if e:
         print(f"each log held out once: {every_log_sentence(e['FIT'], e['band_inside'], e['band_median_width_C'])}")

@@ -1192,6 +1192,28 @@ def logs_of_unit(infos, unit: str) -> tuple[list, dict[str, str]]:
     return mine, ({"--unit": why} if others else {})
 
 
+def held_out_by_unit(batches, rows, band_rows=None) -> list[dict]:
+    """The held-out logs' figures by the roaster unit each records (``Batch.unit``, RoasTime's serial
+    number), most logs first: ``[{"unit", "logs", "FIT", "MAE" (the paper's Average over the unit's
+    logs, :func:`roastlab.evaluate.metrics.average_metrics`), "inside" (the share of its samples
+    inside the band, :func:`roastlab.evaluate.bands.share_inside`; None without a band)}]``. Empty
+    unless the logs name more than one unit: where they do, one fit treats the drums as one, and
+    this says which drum it serves."""
+    from ..evaluate.bands import share_inside
+    from ..evaluate.metrics import average_metrics
+
+    units = [b.unit or "(none named)" for b in batches]
+    if len({b.unit for b in batches if b.unit}) < 2:
+        return []
+    out = []
+    for unit, k in Counter(units).most_common():
+        mine = [i for i, u in enumerate(units) if u == unit]
+        mean = average_metrics([rows[i] for i in mine])
+        inside = None if band_rows is None else share_inside([band_rows[i] for i in mine])
+        out.append({"unit": unit, "logs": k, "FIT": mean["FIT"], "MAE": mean["MAE"], "inside": inside})
+    return out
+
+
 def logs_without_weight(infos) -> dict[str, str]:
     """The logs whose green weight is unknown (none in the log, its file name or ``--batch-kg``),
     each with why; ``{name: why}``. The model scales with the batch, so a log of unknown batch cannot
@@ -1405,6 +1427,21 @@ def fit_roaster(
         if band["by_size"]:
             lines += ["", "| batch size | held-out logs | inside the band |", "|---|---|---|"]
             lines += [f"| {g['size']} | {g['logs']} | {100 * g['inside']:.0f} % |" for g in band["by_size"]]
+    by_unit = held_out_by_unit(val_b, v_val.rows, band["batches"] if band else None)
+    if by_unit:
+        lines += [
+            "",
+            "Held out by roaster unit (the serial number the logs record; one fit treats the units as one drum):",
+            "",
+            "| unit | held-out logs | FIT % | MAE °C | inside the band |",
+            "|---|---|---|---|---|",
+        ]
+        lines += [
+            f"| {g['unit']} | {g['logs']} | {g['FIT']:.1f} | {g['MAE']:.2f} | "
+            + ("-" if g["inside"] is None else f"{100 * g['inside']:.0f} %")
+            + " |"
+            for g in by_unit
+        ]
     every = held_out_one_by_one(batches, d, cmap, seed, progress, spec) if every_log else None
     if every is not None:
         lines += every_log_lines(every, len(batches))
@@ -1436,6 +1473,7 @@ def fit_roaster(
         "refit": refit,
         "notes": {p.name: list(b.notes) for p, b in zip(paths, batches) if b.notes},
         "band": band,
+        "held_out_by_unit": by_unit,
         "every_log": every
         and {
             "FIT": every.cv_FIT,
