@@ -180,6 +180,6 @@ def add_parsers(sub) -> None:
         metavar="SERIAL",
         help="fit only the logs recorded by this roaster unit (its serial number, as 'init' lists them; RoasTime "
         "logs carry it): one drum's model, the other units' logs left out and said. Units of one make differ by more "
-        "than a batch size does",
+        "than a batch size does; without --unit, held-out logs of several units are also reported by unit",
     )
     p.set_defaults(func=cmd_fit_roaster)
