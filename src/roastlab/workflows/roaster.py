@@ -1155,10 +1155,14 @@ def grouped_notes(notes: dict[str, list[str]], at_least: int = 3) -> list[str]:
     return lines
 
 
+#: How the per-unit lines name the logs that record no roaster unit (an Artisan log among RoasTime's).
+UNNAMED_UNIT = "(none named)"
+
+
 def unit_counts(infos) -> str:
     """The roaster units the logs name and each one's number of logs, the most first: "2779: 22, 2054: 2"
-    (RoasTime's serial number, :attr:`LogInfo.unit`; a log that names none counts as "(none named)")."""
-    return ", ".join(f"{u}: {k}" for u, k in Counter(i.unit or "(none named)" for i in infos).most_common())
+    (RoasTime's serial number, :attr:`LogInfo.unit`; a log that names none counts as :data:`UNNAMED_UNIT`)."""
+    return ", ".join(f"{u}: {k}" for u, k in Counter(i.unit or UNNAMED_UNIT for i in infos).most_common())
 
 
 def logs_of_unit(infos, unit: str) -> tuple[list, dict[str, str]]:
@@ -1202,7 +1206,7 @@ def held_out_by_unit(batches, rows, band_rows=None) -> list[dict]:
     from ..evaluate.bands import share_inside
     from ..evaluate.metrics import average_metrics
 
-    units = [b.unit or "(none named)" for b in batches]
+    units = [b.unit or UNNAMED_UNIT for b in batches]
     if len({b.unit for b in batches if b.unit}) < 2:
         return []
     out = []
