@@ -59,7 +59,6 @@ wheel-check:
 # logs one by one, the example's bed laws against the paper's probe (2 x 17 fits). All of it: 29 min
 # on 2 cores on 2026-11-27 (on 2026-11-26, with 12 variants: docs/real_roaster.py 5 min, the variants
 # 13, the roasters 3, the bands 5, the Skywalker 2).
-BULLET = ../shared/data/real/bullet
 SKYWALKER = ../shared/data/real/skywalker
 real-roaster: $(STAMP)
 	$(PY) docs/real_roaster.py
