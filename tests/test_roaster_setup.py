@@ -648,6 +648,7 @@ def test_init_and_fit_roaster_reach_the_hand_written_examples_on_the_shared_logs
         base = printed_percent(out, "baseline: ")
         inside[cfg] = printed_percent(out, "band:")
         width[cfg] = float(out.split("median width ")[1].split(" °C")[0])
+        assert out.splitlines()[-1].endswith(f"{tmp_path / cfg / 'heldout.png'}")  # the figure is said with the files
     assert abs(held["cfg"] - held["example"]) <= 2.0 and held["cfg"] > base + 20, held
     # the 90 % band on the held-out logs: about its level and not uselessly wide (measured
     # 2026-11-25: Skywalker 96 %, 34.5 °C, since 2026-11-26 92 %, 14.5 °C; Bullet 94 %, 19.0 °C;
@@ -917,6 +918,7 @@ def test_fit_roaster_by_size_carries_a_synthetic_drum_over_to_other_batches(cli,
     right, report = _across_sizes(cli, tmp_path / "right", logs)
     assert "fitted on 3 kg (3 logs)" in right["out"], right["out"]
     assert (tmp_path / "right" / "cfg" / "sizes.png").stat().st_size > 10_000
+    assert right["out"].splitlines()[-1].endswith("sizes.png"), right["out"]
     held = float(right["rows"]["3 kg, held out"].split("|")[3])
     other = float(right["rows"]["**every other size**"].split("|")[3])
     assert held > 90.0 and abs(other - held) < 3.0, right["section"]

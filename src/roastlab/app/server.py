@@ -459,10 +459,8 @@ def create_app(data_dir: str | Path):
                     every_log=r["every_log"] and {"FIT": r["every_log"]["FIT"]},
                     across_sizes=r["across_sizes"] and across_sizes_sentence(r["across_sizes"]),
                     figures={  # the report's figures, drawn under it on the page
-                        name: "data:image/png;base64,"
-                        + base64.b64encode((folder / f"{name}.png").read_bytes()).decode()
-                        for name, made in (("heldout", True), ("sizes", r["across_sizes"] is not None))
-                        if made
+                        f.stem: "data:image/png;base64," + base64.b64encode(f.read_bytes()).decode()
+                        for f in r["figures"]
                     },
                 )
             except RoastlabError as exc:

@@ -96,7 +96,7 @@ def cmd_fit_roaster(args) -> int:
             print(f"warning: the fit on {a['fit_size']} alone failed: {a['failed']}", file=sys.stderr)
     for w in r["warnings"]:
         print(f"warning: {w}", file=sys.stderr)
-    print(f"wrote {r['model']}, {r['report']}")
+    print(f"wrote {', '.join(str(f) for f in [r['model'], r['report'], *r['figures']])}")
     return failed_fit_status(r["failed"], r["model"])
 
 

@@ -1490,6 +1490,7 @@ def fit_roaster(
         "failed": result.failed,
         "model": d / "model.json",
         "report": d / "report.md",
+        "figures": [d / "heldout.png"] + ([d / "sizes.png"] if across is not None else []),
     }
 
 
