@@ -1252,3 +1252,52 @@ def test_held_out_by_unit_says_which_drum_a_shared_fit_serves():
     assert got[0]["inside"] == pytest.approx((100 * 1.0 + 300 * 0.8) / 400)
     assert roaster.held_out_by_unit(batches, rows)[1]["inside"] is None  # no band: no share
     assert roaster.held_out_by_unit(batches[:1] + batches[2:], rows[:1] + rows[2:]) == []  # one unit named
+
+
+def _as_fahrenheit(src: Path, dst: Path) -> Path:
+    """A copy of the Artisan log ``src`` as Artisan writes it in Fahrenheit mode (``mode`` "F"):
+    BT, ET, the room and the phase limits in degF, -1 (no sample) and 0 (no room entered) kept.
+    Read with ``ast.literal_eval`` (data only)."""
+    import ast
+
+    def f(v):
+        return v if v in (-1, -1.0) else round(v * 9.0 / 5.0 + 32.0, 4)
+
+    d = ast.literal_eval(src.read_text(encoding="utf-8"))
+    d["mode"] = "F"
+    d["temp1"], d["temp2"] = [f(v) for v in d["temp1"]], [f(v) for v in d["temp2"]]
+    if d.get("ambientTemp"):
+        d["ambientTemp"] = f(d["ambientTemp"])
+    d["phases"] = [f(v) for v in d.get("phases", [])]
+    out = dst / src.name
+    out.write_text(repr(d), encoding="utf-8")
+    return out
+
+
+@pytest.mark.slow
+def test_a_roaster_logging_in_fahrenheit_gets_the_fit_it_gets_in_celsius(cli, tmp_path):
+    """The same eight Skywalker roasts as Artisan writes them in Fahrenheit mode: init writes the
+    same map, plant and fit spec, and fit-roaster (the inlet air taken from the room each log
+    records) the same held-out figures: the importer reads every temperature, the room among
+    them, in the profile's unit (the copies round to 1e-4 degF)."""
+    folder = REAL_DATA / "skywalker"
+    if not folder.is_dir():
+        pytest.skip("../shared/data/real is absent")
+    logs = sorted(folder.glob("*.alog"))[:8]
+    (tmp_path / "F").mkdir()
+    logs_F = [_as_fahrenheit(p, tmp_path / "F") for p in logs]
+    held, mae = {}, {}
+    for unit, paths in (("C", logs), ("F", logs_F)):
+        assert cli("init", *paths, "--out", tmp_path / f"cfg{unit}")[0] == 0
+        map_toml = tmp_path / f"cfg{unit}" / "map.toml"  # the inlet air from the room each log records
+        assert "# room = true" in map_toml.read_text()
+        map_toml.write_text(map_toml.read_text().replace("# room = true", "room = true"))
+        code, out, err = cli("fit-roaster", tmp_path / f"cfg{unit}", *paths)
+        assert code == 0, err
+        held[unit] = printed_percent(out, "held out: FIT ")
+        mae[unit] = float(out.split("held out: FIT")[1].split("MAE ")[1].split(" °C")[0])
+    for name in ("plant.toml", "fit.toml"):
+        assert (tmp_path / "cfgC" / name).read_text() == (tmp_path / "cfgF" / name).read_text(), name
+    # the map names the files it was written from, the same names in both folders
+    assert (tmp_path / "cfgC" / "map.toml").read_text() == (tmp_path / "cfgF" / "map.toml").read_text()
+    assert abs(held["C"] - held["F"]) < 0.2 and abs(mae["C"] - mae["F"]) < 0.05, (held, mae)
