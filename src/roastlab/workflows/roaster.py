@@ -1461,13 +1461,14 @@ def fit_roaster(
             lines += ["", f"**The fit on {sizes.fit_size} alone failed**: {size_fit.failed}."]
     from ..report.figures import figure_bytes
 
-    fig = v_val.plot()
+    figures = {d / "heldout.png": v_val.plot()}
+    if across is not None:
+        figures[d / "sizes.png"] = across_sizes_figure(across)
     with Outputs(paths) as out:
         out.write_text(d / "model.json", model_document_text(model.to_document()))
         out.write_text(d / "report.md", "\n".join(lines) + "\n")
-        out.write_bytes(d / "heldout.png", figure_bytes(fig, d / "heldout.png"))
-        if across is not None:
-            out.write_bytes(d / "sizes.png", figure_bytes(across_sizes_figure(across), d / "sizes.png"))
+        for path, fig in figures.items():
+            out.write_bytes(path, figure_bytes(fig, path))
     return {
         "fit": {"FIT": v_fit.average["FIT"], "MAE": v_fit.average["MAE"]},
         "held_out": {"FIT": v_val.average["FIT"], "MAE": v_val.average["MAE"]},
@@ -1490,7 +1491,7 @@ def fit_roaster(
         "failed": result.failed,
         "model": d / "model.json",
         "report": d / "report.md",
-        "figures": [d / "heldout.png"] + ([d / "sizes.png"] if across is not None else []),
+        "figures": list(figures),
     }
 
 
