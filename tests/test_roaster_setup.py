@@ -1260,8 +1260,8 @@ def _as_fahrenheit(src: Path, dst: Path) -> Path:
     Read with ``ast.literal_eval`` (data only)."""
     import ast
 
-    def f(v):
-        return v if v in (-1, -1.0) else round(v * 9.0 / 5.0 + 32.0, 4)
+    def f(v):  # written here, not taken from roastlab: the test checks the importer's inverse
+        return v if v == -1 else round(v * 9.0 / 5.0 + 32.0, 4)
 
     d = ast.literal_eval(src.read_text(encoding="utf-8"))
     d["mode"] = "F"
