@@ -1155,6 +1155,9 @@ def grouped_notes(notes: dict[str, list[str]], at_least: int = 3) -> list[str]:
     return lines
 
 
+#: The figures fit-roaster writes beside report.md, by file name (the report links them by it).
+HELD_OUT_FIGURE, SIZES_FIGURE = "heldout.png", "sizes.png"
+
 #: How the per-unit lines name the logs that record no roaster unit (an Artisan log among RoasTime's).
 UNNAMED_UNIT = "(none named)"
 
@@ -1410,7 +1413,7 @@ def fit_roaster(
         "",
         "Held-out logs, measured and predicted BT, and their rate of rise (right axis):",
         "",
-        "![held out](heldout.png)",
+        f"![held out]({HELD_OUT_FIGURE})",
         "",
     ]
     band = held_out_band(model, val_b)
@@ -1454,16 +1457,16 @@ def fit_roaster(
         size_fit, _, size_refit = fit_checked([batches[k] for k in sizes.fit], d, spec, cmap, seed, progress)
         across = across_sizes(size_fit.model, batches, sizes)
         across["failed"], across["refit"] = size_fit.failed, size_refit
-        lines += across_sizes_lines(across, "sizes.png")
+        lines += across_sizes_lines(across, SIZES_FIGURE)
         if size_refit:
             lines += ["", f"Refitted (the fit on {sizes.fit_size} alone): {size_refit}."]
         if size_fit.failed:
             lines += ["", f"**The fit on {sizes.fit_size} alone failed**: {size_fit.failed}."]
     from ..report.figures import figure_bytes
 
-    figures = {d / "heldout.png": v_val.plot()}
+    figures = {d / HELD_OUT_FIGURE: v_val.plot()}
     if across is not None:
-        figures[d / "sizes.png"] = across_sizes_figure(across)
+        figures[d / SIZES_FIGURE] = across_sizes_figure(across)
     with Outputs(paths) as out:
         out.write_text(d / "model.json", model_document_text(model.to_document()))
         out.write_text(d / "report.md", "\n".join(lines) + "\n")
