@@ -571,6 +571,34 @@ def test_roastime_drum_at_charge_is_the_preheat_else_the_ir_reading_then(tmp_pat
     assert import_log(p, m).initial["Tm0_C"] == (preheat or 221.5)
 
 
+def test_a_roastime_log_without_a_map_is_read_as_a_bullet(tmp_path):
+    """SYNTHETIC RoasTime log imported with no map: the bean probe, the heater and fan levels over the
+    room air (the quantity table's room), the IR from SECOND_BEAN_START_S, the drum at the preheat,
+    with a note that says so; before, it stopped on a map for CSV columns ('no channel Ta_C')."""
+    from roastlab.io.importers.mapping import SECOND_BEAN_START_S
+    from roastlab.model.quantities import default
+
+    n = 200
+    d = {
+        "sampleRate": 1,
+        "weightGreen": "480",
+        "preheatTemperature": 235,
+        "beanTemperature": [150.0 - 2 * i if i < 30 else 90 + i for i in range(n)],
+        "drumTemperature": [300.0 - i for i in range(n)],
+        "actions": {"actionTimeList": [{"index": 0, "value": 6, "ctrlType": 0}, {"index": 0, "value": 2, "ctrlType": 1},
+                                       {"index": 100, "value": 4, "ctrlType": 0}]},
+    }  # fmt: skip
+    p = tmp_path / "rt.json"
+    p.write_text(json.dumps(d))
+    b = import_log(p, None)
+    assert b.Mb_kg == pytest.approx(0.48) and b.initial["Tm0_C"] == 235.0
+    assert np.all(b.Tgi_C == default("T_room_C")) and b.Ta_C[0] == 150.0
+    assert b.heater[0] == 6 and b.heater[-1] == 4 and np.all(b.fan == 2)
+    ir = b.Tb2_C
+    assert np.all(np.isnan(ir[b.time_s < SECOND_BEAN_START_S])) and ir[b.time_s >= SECOND_BEAN_START_S][0] < 300.0
+    assert any(note.startswith("no map: read as a Bullet's defaults") for note in b.notes)
+
+
 def test_an_unmarked_charge_and_drop_are_read_from_bt(tmp_path):
     """SYNTHETIC BT: 30 s of preheated drum at 200 degC, the charge (a dip to a turning point near 90 degC),
     a rise to 205 degC at 10:00 after CHARGE, then the discharge; no CHARGE or DROP marked (-1, 0)."""

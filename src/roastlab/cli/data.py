@@ -66,15 +66,20 @@ def add_parsers(sub) -> None:
 
     p = sub.add_parser(
         "import",
-        help="convert a roast log (Artisan .alog/.csv, CSV, Parquet) into a batch CSV",
+        help="convert a roast log (Artisan .alog/.csv, RoasTime .json, CSV, Parquet) into a batch CSV",
         description="Read a log with a column map and write the canonical batch CSV time_s,Gg_kg_s,Tgi_C,Ta_C "
-        "(Artisan logs: time 0 at CHARGE, cut after DROP, °F converted, green weight kept as '# Mb_kg').",
+        "(Artisan and RoasTime logs: time 0 at CHARGE, cut after DROP, °F converted, green weight kept as '# Mb_kg').",
         epilog="example: roastlab import roast.alog --map examples/skywalker/map.toml --out batch.csv\n"
         "then: roastlab simulate --model MODEL.json --inputs batch.csv --out pred.csv (a model fitted with a map also "
         "reads the raw log itself)",
     )
     p.add_argument("log", metavar="LOG", help="the roast log")
-    p.add_argument("--map", metavar="MAP.toml", help="column map (default: canonical column names)")
+    p.add_argument(
+        "--map",
+        metavar="MAP.toml",
+        help="column map (default: Artisan's BT and ET for an Artisan log, a Bullet's channels for a RoasTime "
+        "log, the canonical column names for a CSV or Parquet table; `roastlab init` writes one from your logs)",
+    )
     p.add_argument("--out", required=True, metavar="BATCH.csv", help="where to write the batch CSV")
     p.add_argument("--name", help="batch name (default: the log's file name)")
     p.set_defaults(func=cmd_import)

@@ -54,6 +54,7 @@ from ..io.batch import first_of_each_roast
 from ..io.importers.artisan import DRUM_AT_CHARGE as ARTISAN_DRUM_AT_CHARGE
 from ..io.importers.artisan import ET_BEFORE_CHARGE, WEIGHT_UNITS, RoomReading, read_alog, read_artisan_csv
 from ..io.importers.mapping import (
+    SECOND_BEAN_START_S,
     bare_room_unit,
     detect_format,
     grams_in_name,
@@ -818,7 +819,10 @@ def map_text(s: Survey) -> str:
     room_air = bool(s.heater)
     inlet_unit = f'\nunit = "{cols["temp_unit"]}"' if cols else ""
     if room_air:
-        lines += ["[Tgi]", "constant_C = 22.0     # room air drawn into the drum: the heat comes from the heater"]
+        lines += [
+            "[Tgi]",
+            f"constant_C = {default('T_room_C'):.1f}     # room air drawn into the drum: the heat comes from the heater",
+        ]
         if s.inlet:  # an option: the heater is what a program decides
             lines += [
                 f"# the logs also record the inlet air ({s.inlet!r}); to take it as the paper's input in place of "
@@ -884,11 +888,16 @@ def map_text(s: Survey) -> str:
             "[Tb2]",
             f'column = "{s.second_bean}"   # ET reads the beans: it falls to the green beans at CHARGE (infrared)'
             + et_unit,
-            "start_s = 10.0",
+            f"start_s = {SECOND_BEAN_START_S:g}",
             "",
         ]
     elif s.second_bean:
-        lines += ["[Tb2]", f'column = "{s.second_bean}"   # a second bean reading (infrared)', "start_s = 10.0", ""]
+        lines += [
+            "[Tb2]",
+            f'column = "{s.second_bean}"   # a second bean reading (infrared)',
+            f"start_s = {SECOND_BEAN_START_S:g}",
+            "",
+        ]
     elif s.first_crack:
         lines += [
             "[Tb2]",
@@ -1021,7 +1030,7 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
         per = "%" if s.fan_unit == "percent" else "rpm"
         hi, start = (float(f"{x:.3g}") for x in (gg_hi / span, gg_hi / span / 10))
         rows.append(line("Gg_fan_kg_s", 0.0, hi, start, f"air flow per {per} of the fan [kg/s]"))
-    rows += ["", "[initial]", "Tb0_C = 22.0                          # green beans at room temperature",
+    rows += ["", "[initial]", f"Tb0_C = {default('T_room_C'):.1f}                          # green beans at room temperature",
              "X0 = 0.11                             # typical green-coffee moisture [kg/kg dry]"]  # fmt: skip
     depth_m = (
         f"{PROBE_DEPTH_OVER_DIAMETER * diameter_m:.4g}"  # the probe's depth scale, held (and where freed, started)

@@ -78,10 +78,11 @@ from ...model.actuators import UNIT_DEFAULTS, Actuator
 from ...model.constants import FIRST_CRACK_BEAN_C
 from ...model.limits import check_value
 from ...model.pitot import gas_flow_pitot_kg_s
+from ...model.quantities import default
 from ..batch import Batch, csv_log_text, read_table
 from ..files import as_path, finite_number, read_input_bytes, read_toml
 from .artisan import f_to_c, read_alog, read_artisan_csv
-from .roastime import read_roastime
+from .roastime import DRUM_AT_CHARGE, read_roastime
 
 FORMATS = ("auto", "alog", "artisan-csv", "roastime", "csv", "parquet")
 #: Units a logged setting may be given in, and the plausible range of each (the actuator table's).
@@ -93,6 +94,10 @@ TIME_UNITS = {"s": 1.0, "min": 60.0, "ms": 1e-3, "m:ss": 1.0}
 TEMP_UNITS = ("C", "F", "K")
 FLOW_UNITS = {"kg/s": 1.0, "kg/h": 1.0 / 3600.0, "g/s": 1e-3, "m3/h": None}
 DROP_BT_LIMIT_C = 300.0
+#: A second, infrared bean reading counts from this long after CHARGE [s]: while the beans fall in
+#: it still reads the hot drum (``bullet_2020-11-05_1536_500g``: 195, 183, 171 degC over the first
+#: 2 s, then the beans).
+SECOND_BEAN_START_S = 10.0
 
 
 def probe_fault(bt_C: np.ndarray) -> int | None:
@@ -575,6 +580,30 @@ def _drop_et_not_drum_air(time_s, Ta, drop_s, settings: dict, series: dict, note
     return {spec["column"]}
 
 
+def roastime_default_map() -> ColumnMap:
+    """The map a RoasTime log is read with when none is given: the channels every Bullet logs.
+
+    The bean probe is Ta; the heat comes from the heater's levels into room air drawn through the
+    drum (the quantity table's room temperature, ``T_room_C``); the fan's levels move the air; the
+    infrared channel is a second bean reading from :data:`SECOND_BEAN_START_S`; the drum at charge
+    is the preheat (:data:`~roastlab.io.importers.roastime.DRUM_AT_CHARGE`). ``roastlab init``
+    writes the same map with the settings' ranges its logs use.
+    """
+    return map_from_mapping(
+        {
+            "format": "roastime",
+            "Ta": {"column": "BT"},
+            "Tgi": {"constant_C": default("T_room_C")},
+            "Gg": {"identify": True},
+            "heater": {"column": "heater", "unit": "level"},
+            "fan": {"column": "fan", "unit": "level"},
+            "Tb2": {"column": "drumTemperature", "start_s": SECOND_BEAN_START_S},
+            "initial": {"Tm0_C": list(DRUM_AT_CHARGE)},
+        },
+        "default RoasTime map",
+    )
+
+
 def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None) -> Batch:
     """Read any supported log with a column map into a validated canonical :class:`Batch`."""
     path = as_path(path, "path")
@@ -592,6 +621,14 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
             default_notes.append(
                 "no map: read as Artisan's defaults, BT = bean probe (Ta), ET = inlet (Tgi), gas flow unknown "
                 "(a 1 kg/s placeholder); give a column map for anything else (--map, or a fleet manifest's map column)"
+            )
+        elif path.exists() and detect_format(path, "auto") == "roastime":
+            cmap = roastime_default_map()
+            default_notes.append(
+                f"no map: read as a Bullet's defaults, BT = bean probe (Ta), the heater and fan levels over room air "
+                f"at {cmap.Tgi['constant_C']:g} degC (Tgi), the IR as a second bean reading, the drum at charge from "
+                "the preheat, gas flow unknown (a 1 kg/s placeholder); `roastlab init LOGS --out DIR` writes a map "
+                "fitted to your logs"
             )
     if not path.exists():
         raise InputError("file not found", path)
