@@ -135,7 +135,9 @@ def add_parsers(sub) -> None:
         help="green batch on B [kg] (default: B's nominal batch; the reference's when B = A)",
     )
     p.add_argument(
-        "--tb0", type=float_arg("--tb0"), help="bean temperature at CHARGE on B [degC] (default: the model's, else 30)"
+        "--tb0",
+        type=float_arg("--tb0"),
+        help=f"bean temperature at CHARGE on B [degC] (default: the model's, else {default('Tb0_C'):g})",
     )
     p.add_argument(
         "--tm0",
