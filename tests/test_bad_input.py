@@ -172,6 +172,13 @@ CASES = {
         "key temp2: has 2 values but timex has 3",
     ),
     "alog not a dict": (lambda d: import_with(d, "n.alog", "[1, 2, 3]"), "n.alog", "not an Artisan profile"),
+    "alog DROP before CHARGE": (
+        lambda d: import_with(
+            d, "x.alog", GOOD_ALOG.replace("[2, 0, 0, 0, 0, 0, 75, 0]", "[60, 0, 0, 0, 0, 0, 20, 0]")
+        ),
+        "x.alog",
+        "key timeindex: DROP (sample 20, 30 s) is marked at or before CHARGE (sample 60, 90 s)",
+    ),
     "map unknown key": (
         lambda d: import_with(d, "g.alog", GOOD_ALOG, "colour = 'red'\n" + SKY_MAP),
         "map.toml",

@@ -504,6 +504,13 @@ def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: boo
     if not isinstance(ti, list) or not all(isinstance(q, int) and not isinstance(q, bool) for q in ti):
         raise InputError("timeindex must be a list of integers", path, "key timeindex")
     ti = (ti + [0] * 8)[:8]
+    if 0 <= ti[0] < n and 0 < ti[6] < n and ti[6] <= ti[0]:
+        raise InputError(
+            f"DROP (sample {ti[6]}, {timex[ti[6]]:.0f} s) is marked at or before CHARGE (sample {ti[0]}, "
+            f"{timex[ti[0]]:.0f} s): mark them again in Artisan",
+            path,
+            "key timeindex",
+        )
     charge, drop, notes = marks_or_bt(
         timex,
         channels["BT"],
