@@ -122,3 +122,19 @@ def test_a_whatif_time_is_read_by_the_same_clock():
     assert parse_setting_change("heater", "+1@4:30").from_s == 270.0
     with pytest.raises(ParameterError, match="not a time"):
         parse_setting_change("heater", "+1@4:75")  # was read as 5:15
+
+
+def test_a_whatif_change_from_after_the_log_ends_is_refused():
+    """SYNTHETIC 10-minute batch with a heater series: a change from 12:00 on changes nothing, and
+    says so instead of printing a table of zeros; one from the last sample on still runs."""
+    from roastlab import FittedModel
+    from roastlab.errors import ParameterError
+    from roastlab.io.batch import Batch
+    from roastlab.workflows.whatif import parse_setting_change, whatif
+
+    t = np.arange(0.0, 601.0, 5.0)
+    b = Batch("synthetic", t, np.full(t.size, 0.4), np.full(t.size, 450.0), 30 + t / 5, heater=np.full(t.size, 6.0))
+    model = FittedModel.paper()
+    with pytest.raises(ParameterError, match=r"12:00 is after the log ends \(10:00 after CHARGE\)"):
+        whatif(model, b, [parse_setting_change("heater", "+1@12:00")])
+    assert whatif(model, b, [parse_setting_change("heater", "+1@10:00")]).changes == ["heater +1 from 10:00"]

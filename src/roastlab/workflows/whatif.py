@@ -350,6 +350,12 @@ def whatif(
                 f"{c}: the log has no {c.setting} setting (its map reads none), so it cannot change",
                 batch.source or batch.name,
             )
+        if c.from_s > batch.time_s[-1] and not np.isfinite(c.until_s):  # a step of a drawn program may run off
+            raise ParameterError(
+                f"{c}: {mmss(c.from_s)} is after the log ends ({mmss(batch.time_s[-1])} after CHARGE), so it changes "
+                "nothing",
+                batch.source or batch.name,
+            )
         new = c.apply(batch.time_s, series)
         act = (actuators or {}).get(c.setting)
         if act is None and actuators is None and model.column_map is not None and getattr(model.column_map, c.setting):
