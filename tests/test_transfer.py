@@ -86,6 +86,25 @@ def test_unreachable_target_returns_the_best_program_and_says_why():
     assert r.program.Tgi_C.max() <= 330.0 + 1e-9
 
 
+def test_a_miss_is_also_said_from_the_targets_turning_point_on():
+    """SYNTHETIC reference with a charge dip the probe cannot follow (40 degC above the model's run at
+    CHARGE, fading in 10 s): the verdict stays on the whole roast, and the miss from the target's turning
+    point on (metrics.profile.turning_point) is said apart, recomputed here from the program's curve."""
+    import dataclasses
+
+    from roastlab.metrics.profile import turning_point
+
+    model, ref = random_reference(np.random.default_rng(1), "120kg")
+    ref = dataclasses.replace(ref, Ta_C=ref.Ta_C + 40.0 * np.exp(-ref.time_s / 10.0))
+    r = transfer(model, ref, "120kg", "120kg")
+    m, t = r.metrics, r.time_s
+    tp = turning_point(t, r.target_C)[0]
+    after = np.abs(r.program.Ta_pred_C - r.target_C)[t >= tp].max()
+    assert not m["feasible"] and 0 < tp == m["turning_point_s"] < 60
+    assert m["max_abs_from_turning_point_C"] == pytest.approx(after) and after <= m["max_abs_C"]
+    assert f"from the target's turning point (0:{tp:02.0f}) on: max |e| {after:.1f} °C" in r.summary()
+
+
 def test_limit_spans_name_levels_and_rates():
     t = np.arange(0.0, 60.0, 5.0)
     u = np.array([150, 150, 160, 170, 180, 180, 180, 550, 550, 550, 540, 540], dtype=float)
