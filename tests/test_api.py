@@ -119,6 +119,23 @@ def test_transfer_to_another_plant_names_what_carried_over():
     assert "carried over hgm, hbm, Pbm" in note and "dropped plant-specific Tm0_C" in note
 
 
+def test_a_log_outside_a_per_batch_fit_runs_from_its_own_drum_reading_and_says_only_what_it_uses():
+    """SYNTHETIC dataset-I: the drum start fitted per batch on two batches. A third batch with no
+    reading of its own runs from the fitted batches' median and a note says so; with its own reading
+    (what a map's [initial] gives) it runs from that, as a change to it would, and no note claims the median."""
+    import dataclasses
+
+    ds = roastlab.read_dataset(DATA / "dataset-I")
+    model = roastlab.fit(ds.batches[:2], "120kg", estimate_tm0=True, seed=0, starts=1).model
+    assert model.initial["Tm0_C"]["how"] == "fitted per batch"
+    new = ds.batches[2]
+    assert any("median of the fitted batches" in n for n in model.validate([new]).notes)
+    own = dataclasses.replace(new, initial={**new.initial, "Tm0_C": 150.0})
+    v = model.validate([own])
+    assert not any("median of the fitted batches" in n for n in v.notes)
+    np.testing.assert_allclose(model.predict(own).Ta_C, model.predict(new, Tm0_C=150.0).Ta_C, atol=1e-9)
+
+
 def test_results_display_and_plot_without_pyplot():
     import matplotlib.pyplot as plt
 

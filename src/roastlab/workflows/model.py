@@ -256,7 +256,7 @@ class FittedModel:
             for name, vals in per_batch.items():
                 if b.name in vals:
                     b.initial[name] = vals[b.name]
-                elif name not in changes:
+                elif name not in changes and name not in b.initial:  # else the log's own reading (its map)
                     notes.append(
                         f"{b.name}: not in the fit set, {name} = {base[name]:.4g} (median of the fitted batches)"
                     )
