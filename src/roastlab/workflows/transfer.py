@@ -113,19 +113,17 @@ class TransferResult(Result):
             f"solved in {m['solve_s']:.2f} s ({m['simulations']} simulations)"
         )
         rows += [f"  {s}" for s in m["explanation"]]
-        after = m.get("max_abs_from_turning_point_C")
-        if not m["feasible"] and after is not None:
-            within = after <= m["tolerance_C"]
-            rows.append(
-                f"  from the target's turning point ({mmss(m['turning_point_s'])}) on: max |e| {after:.1f} °C"
-                + (
-                    ", within the tolerance: the misses are the charge's dip, which the drum and the probe at CHARGE "
-                    "set more than the program does"
-                    + ("" if m.get("Tm0_chosen") else " (--tm0 free lets the optimiser choose the drum at CHARGE)")
-                    if within
-                    else ""
+        after, tp_s = m.get("max_abs_from_turning_point_C"), m.get("turning_point_s")
+        if not m["feasible"] and after is not None and tp_s:  # a turning point at CHARGE says nothing new
+            line = f"  from the target's turning point ({mmss(tp_s)}) on: max |e| {after:.1f} °C"
+            if after <= m["tolerance_C"]:
+                line += (
+                    ", within the tolerance: the misses are the charge's dip, which the drum and the probe at "
+                    "CHARGE set more than the program does"
                 )
-            )
+                if not m.get("Tm0_chosen"):
+                    line += " (--tm0 free lets the optimiser choose the drum at CHARGE)"
+            rows.append(line)
         if m.get("Tm0_chosen"):
             rows.append(f"drum at CHARGE (chosen by the optimiser): {m['Tm0_C']:.0f} °C")
         if "runnable" in m:
@@ -507,7 +505,7 @@ def transfer(
     # the curve before the target's turning point is the charge's (the probe falling from its soak
     # to the beans, the drum's heat at CHARGE) more than the program's: said apart, judged as a whole
     tp_s = turning_point(t, target)[0]
-    from_tp = _errors(program.Ta_pred_C[t >= tp_s], target[t >= tp_s]) if tp_s else None
+    from_tp = _errors(program.Ta_pred_C[t >= tp_s], target[t >= tp_s]) if tp_s is not None else None
     explanation = _explain(t, program.Ta_pred_C - target, spans, tolerance_C, pb.name, mass_b, feasible)
     baselines_best = min((b["rmse_C"] for b in (base_same, base_ret) if b["rmse_C"] is not None), default=None)
     metrics = {
