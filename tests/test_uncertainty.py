@@ -60,6 +60,29 @@ def test_bound_flat_and_no_dof_get_no_standard_error():
     assert "upper bound" in words and "no effect" in words
 
 
+def test_several_values_on_bounds_and_several_correlated_pairs_are_one_line_each():
+    """Five parameters, two held by their bounds and two pairs nearly collinear: two warnings, each
+    naming every parameter or pair (a fit-roaster's terminal read seven lines for these before)."""
+    rng = np.random.default_rng(0)
+    a, b = rng.normal(size=40), rng.normal(size=40)
+    J = np.column_stack([a, a + 1e-3 * rng.normal(size=40), b, b - 1e-3 * rng.normal(size=40), rng.normal(size=40)])
+    J = np.column_stack([J, rng.normal(size=(40, 2))])
+    lo, hi = np.zeros(7), np.ones(7)
+    names = ["p", "q", "r", "s", "t", "low", "high"]
+    u = uncertainty.from_jacobian(J, [0.5] * 5 + [1e-7, 1.0 - 1e-7], lo, hi, 2.0, names)
+    w = u.warnings()
+    assert len(w) == 2, w
+    assert w[0].startswith("2 values are on a bound: low (its lower bound 0), high (its upper bound 1)")
+    assert w[1].startswith("2 pairs are correlated: p and q (-1.000), r and s (-1.000); the data pin down")
+    one = uncertainty.from_jacobian(
+        J[:, [0, 1, 4, 5]], [0.5, 0.5, 0.5, 1e-7], lo[:4], hi[:4], 2.0, ["p", "q", "t", "low"]
+    )
+    assert [x.split(":")[0] for x in one.warnings()] == [
+        "low = 1e-07 is on its lower bound 0",
+        "p and q are correlated (-1.000)",
+    ]
+
+
 def test_a_range_over_decades_is_judged_near_its_bound_in_the_logarithm():
     """A rate factor in [1e5, 1e10] at 1e6, a decade above its floor, is determined by the data; in
     the value it lay within 1e-4 of the span (1e6) of the floor and got no standard error."""

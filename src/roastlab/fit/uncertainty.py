@@ -192,30 +192,42 @@ class Uncertainty:
         return self.at_lower | self.at_upper
 
     def warnings(self) -> list[str]:
-        """Plain-words warnings: parameters on a bound, without effect, or strongly correlated."""
+        """Plain-words warnings: parameters on a bound, without effect, or strongly correlated; the
+        parameters on a bound in one line, the correlated pairs in another."""
         out = []
+        held = []
         for k, lab in enumerate(self.names):
-            z = self.values[k]
-            if self.at_lower[k]:
-                out.append(
-                    f"{lab} = {z:.6g} is on its lower bound {self.lower[k]:g}: the optimum may lie outside; no standard error (held by the bound, not the data)"
-                )
-            elif self.at_upper[k]:
-                out.append(
-                    f"{lab} = {z:.6g} is on its upper bound {self.upper[k]:g}: the optimum may lie outside; no standard error (held by the bound, not the data)"
-                )
+            if self.at_lower[k] or self.at_upper[k]:
+                side, bound = ("lower", self.lower[k]) if self.at_lower[k] else ("upper", self.upper[k])
+                held.append((lab, self.values[k], side, bound))
             elif self.flat[k]:
                 out.append(
-                    f"{lab} = {z:.6g} has no effect on the fit there (its term is off or saturated): the data do not "
-                    "determine it; no standard error (try more starts or another start value)"
+                    f"{lab} = {self.values[k]:.6g} has no effect on the fit there (its term is off or saturated): the "
+                    "data do not determine it; no standard error (try more starts or another start value)"
                 )
+        why = "the optimum may lie outside; no standard error (held by the bound, not the data)"
+        if len(held) == 1:
+            lab, z, side, bound = held[0]
+            out.insert(0, f"{lab} = {z:.6g} is on its {side} bound {bound:g}: {why}")
+        elif held:
+            listed = ", ".join(f"{lab} (its {side} bound {bound:g})" for lab, _, side, bound in held)
+            out.insert(0, f"{len(held)} values are on a bound: {listed}; for each, {why}")
         c = self.correlation
-        for a in range(self.k_free):
-            for b in range(a + 1, self.k_free):
-                if np.isfinite(c[a, b]) and abs(c[a, b]) > CORRELATION_WARN:
-                    out.append(
-                        f"{self.names[a]} and {self.names[b]} are correlated ({c[a, b]:+.3f}): the data pin down a combination of them, not each"
-                    )
+        pairs = [
+            f"{self.names[a]} and {self.names[b]} ({c[a, b]:+.3f})"
+            for a in range(self.k_free)
+            for b in range(a + 1, self.k_free)
+            if np.isfinite(c[a, b]) and abs(c[a, b]) > CORRELATION_WARN
+        ]
+        if len(pairs) == 1:
+            out.append(
+                f"{pairs[0].replace(' (', ' are correlated (', 1)}: the data pin down a combination of them, not each"
+            )
+        elif pairs:
+            out.append(
+                f"{len(pairs)} pairs are correlated: {', '.join(pairs)}; the data pin down a combination of each pair, "
+                "not each"
+            )
         return out
 
     def to_dict(self) -> dict:
