@@ -136,6 +136,16 @@ def test_a_log_outside_a_per_batch_fit_runs_from_its_own_drum_reading_and_says_o
     np.testing.assert_allclose(model.predict(own).Ta_C, model.predict(new, Tm0_C=150.0).Ta_C, atol=1e-9)
 
 
+def test_a_value_left_on_its_bound_to_rounding_reads_as_the_bound_in_the_table():
+    """A fitted value 1e-16 on a floor of 0 (the Bullet's shell loss in fit-roaster's table read
+    1.0803e-16) reads 0; one a step inside its bound keeps its digits."""
+    doc = roastlab.FittedModel.paper().to_document()
+    doc["parameters"]["U_shell_kW_m2K"] = {"value": 1.08e-16, "how": "fitted", "stderr": None, "bounds": [0.0, 0.1]}
+    doc["parameters"]["hgm"] = {"value": 0.0010004, "how": "fitted", "stderr": None, "bounds": [0.001, 1.0]}
+    rows = {r[0]: r[1] for r in roastlab.FittedModel(doc).table()}
+    assert rows["U_shell_kW_m2K"] == "0" and rows["hgm"] == "0.0010004"
+
+
 def test_results_display_and_plot_without_pyplot():
     import matplotlib.pyplot as plt
 

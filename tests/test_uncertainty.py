@@ -78,7 +78,7 @@ def test_several_values_on_bounds_and_several_correlated_pairs_are_one_line_each
         J[:, [0, 1, 4, 5]], [0.5, 0.5, 0.5, 1e-7], lo[:4], hi[:4], 2.0, ["p", "q", "t", "low"]
     )
     assert [x.split(":")[0] for x in one.warnings()] == [
-        "low = 1e-07 is on its lower bound 0",
+        "low is on its lower bound 0",
         "p and q are correlated (-1.000)",
     ]
 

@@ -199,7 +199,7 @@ class Uncertainty:
         for k, lab in enumerate(self.names):
             if self.at_lower[k] or self.at_upper[k]:
                 side, bound = ("lower", self.lower[k]) if self.at_lower[k] else ("upper", self.upper[k])
-                held.append((lab, self.values[k], side, bound))
+                held.append((lab, side, bound))
             elif self.flat[k]:
                 out.append(
                     f"{lab} = {self.values[k]:.6g} has no effect on the fit there (its term is off or saturated): the "
@@ -207,26 +207,25 @@ class Uncertainty:
                 )
         why = "the optimum may lie outside; no standard error (held by the bound, not the data)"
         if len(held) == 1:
-            lab, z, side, bound = held[0]
-            out.insert(0, f"{lab} = {z:.6g} is on its {side} bound {bound:g}: {why}")
+            lab, side, bound = held[0]
+            out.insert(0, f"{lab} is on its {side} bound {bound:g}: {why}")
         elif held:
-            listed = ", ".join(f"{lab} (its {side} bound {bound:g})" for lab, _, side, bound in held)
+            listed = ", ".join(f"{lab} (its {side} bound {bound:g})" for lab, side, bound in held)
             out.insert(0, f"{len(held)} values are on a bound: {listed}; for each, {why}")
         c = self.correlation
         pairs = [
-            f"{self.names[a]} and {self.names[b]} ({c[a, b]:+.3f})"
+            (f"{self.names[a]} and {self.names[b]}", f"{c[a, b]:+.3f}")
             for a in range(self.k_free)
             for b in range(a + 1, self.k_free)
             if np.isfinite(c[a, b]) and abs(c[a, b]) > CORRELATION_WARN
         ]
         if len(pairs) == 1:
-            out.append(
-                f"{pairs[0].replace(' (', ' are correlated (', 1)}: the data pin down a combination of them, not each"
-            )
+            ((both, r),) = pairs
+            out.append(f"{both} are correlated ({r}): the data pin down a combination of them, not each")
         elif pairs:
+            listed = ", ".join(f"{both} ({r})" for both, r in pairs)
             out.append(
-                f"{len(pairs)} pairs are correlated: {', '.join(pairs)}; the data pin down a combination of each pair, "
-                "not each"
+                f"{len(pairs)} pairs are correlated: {listed}; the data pin down a combination of each pair, not each"
             )
         return out
 

@@ -424,9 +424,20 @@ class FittedModel:
         """Rows (name, value, std. error, unit, how) of every value the model applies."""
         rows = []
         for name, e in self.parameters.items():
-            se = e.get("stderr")
+            se, value = e.get("stderr"), e["value"]
+            bounds = e.get("bounds")
+            if se is None and isinstance(bounds, list) and len(bounds) == 2:
+                # a value the fit left on a bound to rounding (1.08e-16 on a floor of 0) reads as that bound
+                value = next(
+                    (
+                        b
+                        for b in bounds
+                        if math.isclose(value, b, rel_tol=1e-9, abs_tol=1e-9 * abs(bounds[1] - bounds[0]))
+                    ),
+                    value,
+                )
             rows.append(
-                (name, f"{e['value']:.5g}", "" if se is None else f"{se:.2g}", REGISTRY[name].unit, e.get("how", ""))
+                (name, f"{value:.5g}", "" if se is None else f"{se:.2g}", REGISTRY[name].unit, e.get("how", ""))
             )
         for name, e in self.initial.items():
             if e["how"] == "fitted per batch":
