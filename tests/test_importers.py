@@ -597,6 +597,15 @@ def test_a_roastime_log_without_a_map_is_read_as_a_bullet(tmp_path):
     ir = b.Tb2_C
     assert np.all(np.isnan(ir[b.time_s < SECOND_BEAN_START_S])) and ir[b.time_s >= SECOND_BEAN_START_S][0] < 300.0
     assert any(note.startswith("no map: read as a Bullet's defaults") for note in b.notes)
+    # a log with no fan change, no IR channel and no reading of the drum at charge: read without them
+    for key in ("drumTemperature", "preheatTemperature"):
+        del d[key]
+    d["actions"]["actionTimeList"] = [a for a in d["actions"]["actionTimeList"] if a["ctrlType"] == 0]
+    p.write_text(json.dumps(d))
+    b = import_log(p, None)
+    assert b.fan is None and b.Tb2_C is None and "Tm0_C" not in b.initial and b.heater[-1] == 4
+    (note,) = [n for n in b.notes if n.startswith("no map")]
+    assert "the heater levels over room air" in note and "the IR" not in note and "drum at charge" not in note
 
 
 def test_an_unmarked_charge_and_drop_are_read_from_bt(tmp_path):

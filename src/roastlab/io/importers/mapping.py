@@ -81,7 +81,7 @@ from ...model.pitot import gas_flow_pitot_kg_s
 from ...model.quantities import default
 from ..batch import Batch, csv_log_text, read_table
 from ..files import as_path, finite_number, read_input_bytes, read_toml
-from .artisan import f_to_c, read_alog, read_artisan_csv
+from .artisan import ArtisanLog, f_to_c, read_alog, read_artisan_csv
 from .roastime import DRUM_AT_CHARGE, read_roastime
 
 FORMATS = ("auto", "alog", "artisan-csv", "roastime", "csv", "parquet")
@@ -580,25 +580,30 @@ def _drop_et_not_drum_air(time_s, Ta, drop_s, settings: dict, series: dict, note
     return {spec["column"]}
 
 
-def roastime_default_map() -> ColumnMap:
-    """The map a RoasTime log is read with when none is given: the channels every Bullet logs.
+def roastime_default_map(log: ArtisanLog | None = None) -> ColumnMap:
+    """The map a RoasTime log is read with when none is given: the channels a Bullet logs.
 
     The bean probe is Ta; the heat comes from the heater's levels into room air drawn through the
     drum (the quantity table's room temperature, ``T_room_C``); the fan's levels move the air; the
     infrared channel is a second bean reading from :data:`SECOND_BEAN_START_S`; the drum at charge
-    is the preheat (:data:`~roastlab.io.importers.roastime.DRUM_AT_CHARGE`). ``roastlab init``
-    writes the same map with the settings' ranges its logs use.
+    is the preheat (:data:`~roastlab.io.importers.roastime.DRUM_AT_CHARGE`). Given the parsed
+    ``log``, only what it holds is mapped (a log with no fan change, no IR channel or no drum reading
+    at charge is read without them). ``roastlab init`` writes the same map with the settings' ranges
+    its logs use.
     """
+    has = (lambda name: name in log.channels) if log is not None else (lambda name: True)
+    at_charge = [f for f in DRUM_AT_CHARGE if log is None or f in log.fields]
     return map_from_mapping(
         {
             "format": "roastime",
             "Ta": {"column": "BT"},
             "Tgi": {"constant_C": default("T_room_C")},
             "Gg": {"identify": True},
-            "heater": {"column": "heater", "unit": "level"},
-            "fan": {"column": "fan", "unit": "level"},
-            "Tb2": {"column": "drumTemperature", "start_s": SECOND_BEAN_START_S},
-            "initial": {"Tm0_C": list(DRUM_AT_CHARGE)},
+            **{k: {"column": k, "unit": "level"} for k in ("heater", "fan") if has(k)},
+            **(
+                {"Tb2": {"column": "drumTemperature", "start_s": SECOND_BEAN_START_S}} if has("drumTemperature") else {}
+            ),
+            **({"initial": {"Tm0_C": at_charge}} if at_charge else {}),
         },
         "default RoasTime map",
     )
@@ -608,6 +613,7 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
     """Read any supported log with a column map into a validated canonical :class:`Batch`."""
     path = as_path(path, "path")
     default_notes = []
+    preread = None  # a log read to choose its default map, read once
     if cmap is None:
         cmap = ColumnMap(source="default map")
         if path.exists() and detect_format(path, "auto") in ("alog", "artisan-csv"):
@@ -623,11 +629,20 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
                 "(a 1 kg/s placeholder); give a column map for anything else (--map, or a fleet manifest's map column)"
             )
         elif path.exists() and detect_format(path, "auto") == "roastime":
-            cmap = roastime_default_map()
+            preread = read_roastime(path)
+            cmap = roastime_default_map(preread)
+            settings = " and ".join(k for k in ("heater", "fan") if getattr(cmap, k))
+            read = [
+                "BT = bean probe (Ta)",
+                f"the {settings} levels over room air at {cmap.Tgi['constant_C']:g} degC (Tgi)"
+                if settings
+                else f"room air at {cmap.Tgi['constant_C']:g} degC (Tgi) and no heater (the log records none)",
+                *(["the IR as a second bean reading"] if cmap.Tb2 else []),
+                *([f"the drum at charge from {' else '.join(cmap.initial['Tm0_C'])}"] if cmap.initial else []),
+                "gas flow unknown (a 1 kg/s placeholder)",
+            ]
             default_notes.append(
-                f"no map: read as a Bullet's defaults, BT = bean probe (Ta), the heater and fan levels over room air "
-                f"at {cmap.Tgi['constant_C']:g} degC (Tgi), the IR as a second bean reading, the drum at charge from "
-                "the preheat, gas flow unknown (a 1 kg/s placeholder); `roastlab init LOGS --out DIR` writes a map "
+                f"no map: read as a Bullet's defaults, {', '.join(read)}; `roastlab init LOGS --out DIR` writes a map "
                 "fitted to your logs"
             )
     if not path.exists():
@@ -646,7 +661,7 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
         if fmt == "alog":
             log = read_alog(path, keep_after_drop=cmap.keep_after_drop)
         elif fmt == "roastime":
-            log = read_roastime(path, keep_after_drop=cmap.keep_after_drop)
+            log = preread or read_roastime(path, keep_after_drop=cmap.keep_after_drop)
         else:
             log = read_artisan_csv(path, cmap.keep_after_drop)
         time_s = log.time_s
