@@ -144,6 +144,8 @@ def test_a_value_left_on_its_bound_to_rounding_reads_as_the_bound_in_the_table()
     doc["parameters"]["hgm"] = {"value": 0.0010004, "how": "fitted", "stderr": None, "bounds": [0.001, 1.0]}
     rows = {r[0]: r[1] for r in roastlab.FittedModel(doc).table()}
     assert rows["U_shell_kW_m2K"] == "0" and rows["hgm"] == "0.0010004"
+    doc["parameters"]["U_shell_kW_m2K"]["bounds"] = ["a", None]  # a user's file: bounds are not trusted
+    assert {r[0]: r[1] for r in roastlab.FittedModel(doc).table()}["U_shell_kW_m2K"] == "1.08e-16"
 
 
 def test_results_display_and_plot_without_pyplot():

@@ -425,8 +425,13 @@ class FittedModel:
         rows = []
         for name, e in self.parameters.items():
             se, value = e.get("stderr"), e["value"]
-            bounds = e.get("bounds")
-            if se is None and isinstance(bounds, list) and len(bounds) == 2:
+            bounds = e.get("bounds")  # a user's file: used only where it is a pair of finite numbers
+            if (
+                se is None
+                and isinstance(bounds, list)
+                and len(bounds) == 2
+                and all(isinstance(b, (int, float)) and not isinstance(b, bool) and math.isfinite(b) for b in bounds)
+            ):
                 # a value the fit left on a bound to rounding (1.08e-16 on a floor of 0) reads as that bound
                 value = next(
                     (
