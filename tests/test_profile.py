@@ -138,3 +138,20 @@ def test_a_whatif_change_from_after_the_log_ends_is_refused():
     with pytest.raises(ParameterError, match=r"12:00 is after the log ends \(10:00 after CHARGE\)"):
         whatif(model, b, [parse_setting_change("heater", "+1@12:00")])
     assert whatif(model, b, [parse_setting_change("heater", "+1@10:00")]).changes == ["heater +1 from 10:00"]
+
+
+def test_whatif_changes_within_the_models_own_error_are_one_note():
+    """SYNTHETIC straight-line BT against the paper's model (far from it): a 1 degC warmer inlet moves
+    every milestone less than the model misses them on this log, and the note names them all in one line."""
+    from roastlab import FittedModel
+    from roastlab.io.batch import Batch
+    from roastlab.workflows.whatif import whatif
+
+    t = np.arange(0.0, 901.0, 5.0)
+    b = Batch("synthetic", t, np.full(t.size, 0.4), np.full(t.size, 450.0), 30 + t / 4.5)
+    w = whatif(FittedModel.paper(), b, Tgi_offset_C=1.0)
+    small = [r for r in w.rows if r["changed"] is not None and r["measured"] is not None and not r["key"].startswith("TP")
+             and 1e-6 < abs(r["changed"] - r["as_run"]) < abs(r["as_run"] - r["measured"])]  # fmt: skip
+    notes = [n for n in w.warnings() if n.startswith("within the model's own error")]
+    assert len(small) >= 2 and len(notes) == 1
+    assert notes[0].split("): ", 1)[1].count(" against ") == len(small) and f"{small[0]['reading']} {small[0]['what']} " in notes[0]

@@ -258,15 +258,19 @@ class WhatIf(Result):
                     f"{r['reading']}: {who} reaches the first-crack temperature ({level:.1f} °C) only after the "
                     f"logged DROP (at {mmss(r[col])}, projected){': it runs cooler than this log late in the roast' if col == 'as_run' else ''}"
                 )
+        small = []
+        for r in self.rows:
             a, c, m = r["as_run"], r["changed"], r["measured"]
             if a is None or c is None or m is None or r["key"].startswith("TP"):
                 continue
             if 1e-6 < abs(c - a) < abs(a - m):  # a change there is, smaller than the model's own error
                 unit = {"time": "s", "temp": "°C", "pct": "points"}[r["kind"]]
-                out.append(
-                    f"{r['reading']} {r['what']}: the change ({c - a:+.1f} {unit}) is within the model's own error "
-                    f"on this log ({a - m:+.1f} {unit})"
-                )
+                small.append(f"{r['reading']} {r['what']} {c - a:+.1f} {unit} against {a - m:+.1f} {unit}")
+        if small:  # one line for them all: a roaster reads which, not the same sentence eight times
+            out.append(
+                "within the model's own error on this log, so this log cannot confirm "
+                f"{'it' if len(small) == 1 else 'them'} (the change against the model's error): " + "; ".join(small)
+            )
         return out
 
     def summary(self) -> str:
