@@ -407,7 +407,14 @@ def optimise_program(
     tgi, q = (u, q) if which == 0 else (T_in, u)
     out = _run(t, gg, tgi + Tgi_bias_C if Tgi_bias_C else tgi, q, F, x, p, zoh)
     counter["sims"] += 1
-    notes = [] if sol.success else [f"optimiser stopped: {sol.message}"]
+    if sol.success:
+        notes = []
+    elif getattr(sol, "status", None) == 0:  # SciPy's least_squares: max_nfev reached
+        notes = [
+            f"the optimiser used all {max_iterations} of its evaluations before it settled: the program is the best it found"
+        ]
+    else:
+        notes = [f"optimiser stopped: {sol.message}"]
     return ProgramResult(
         time_s=t,
         Tgi_C=np.array(tgi),
