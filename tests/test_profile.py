@@ -154,4 +154,7 @@ def test_whatif_changes_within_the_models_own_error_are_one_note():
              and 1e-6 < abs(r["changed"] - r["as_run"]) < abs(r["as_run"] - r["measured"])]  # fmt: skip
     notes = [n for n in w.warnings() if n.startswith("within the model's own error")]
     assert len(small) >= 2 and len(notes) == 1
-    assert notes[0].split("): ", 1)[1].count(" against ") == len(small) and f"{small[0]['reading']} {small[0]['what']} " in notes[0]
+    assert (
+        notes[0].split("): ", 1)[1].count(" against ") == len(small)
+        and f"{small[0]['reading']} {small[0]['what']} " in notes[0]
+    )

@@ -262,6 +262,21 @@ def test_program_optimiser_exact_and_fd_agree():
     assert res["exact"].simulations < res["fd"].simulations
 
 
+def test_a_program_optimiser_out_of_evaluations_says_so_in_plain_words():
+    """SYNTHETIC target as above, two evaluations allowed: the program is returned with a note in the
+    roaster's words, not SciPy's message; with enough evaluations there is none."""
+    from roastlab.fit.program import ProgramLimits, optimise_program
+
+    t, Gg, Tgi, Q, F, x0, p, _ = _case(False)
+    target = _ta(t, Gg, Tgi + 15.0 * np.cos(t / 100.0), Q, F, x0, p, False)[:, S_TA]
+    limits = ProgramLimits(low=150.0, high=550.0, rate_per_min=60.0)
+    short = optimise_program(t, target, x0, p, Gg, Tgi, limits, max_iterations=2)
+    assert short.notes == [
+        "the optimiser used all 2 of its evaluations before it settled: the program is the best it found"
+    ]
+    assert optimise_program(t, target, x0, p, Gg, Tgi, limits, max_iterations=60).notes == []
+
+
 def test_outlet_gas_sensitivities_match_central_differences():
     """ET fitted against the outlet gas Tgo: its exact derivative (the generated outlet Jacobian
     applied to the state sensitivities) against central differences of the simulated Tgo."""
