@@ -13,7 +13,6 @@ times the first baseline gives on B, as a person does with Artisan's Transposer.
 from __future__ import annotations
 
 import dataclasses
-import datetime as _dt
 import io
 import math
 
@@ -161,108 +160,60 @@ class TransferResult(Result):
         return out.getvalue()
 
     def background_events(self) -> list[tuple[int, str, float, str]]:
-        """The program as Artisan special events: ``(sample index, type, value, label)`` with
-        Artisan's types (``Burner`` for the heater or the decided inlet temperature, ``Air`` for
-        the fan or a chosen gas flow) and values in the machine's units (a level as the level,
-        the inlet temperature and a flow as % of their range in 5 % steps), one event per real
-        change, at most one every :data:`~roastlab.model.actuators.MIN_HOLD_S` seconds for what
-        the optimiser decided (a held, logged setting keeps its own changes)."""
+        """The program as Artisan special events (:func:`roastlab.io.background.setting_events`):
+        ``Burner`` for the heater or the decided inlet temperature, ``Air`` for the fan or a chosen
+        gas flow, in the machine's units (a level as the level, the inlet temperature and a flow as %
+        of their range in 5 % steps); what the optimiser decided at most one change every
+        :data:`~roastlab.model.actuators.MIN_HOLD_S` seconds, a held, logged setting with its own."""
+        from ..io.background import setting_events
         from ..model.actuators import Actuator
 
         pr, lim = self.program, self.limits
-        t = pr.time_s
-        series = []  # (type, values, actuator for labels, thin?)
+        series = []  # (setting, values, actuator for labels, thin?)
         if lim.decide == "heater":
             act = lim.actuator or Actuator("heater", "percent", lim.low, lim.high)
-            series.append(("Burner", pr.heater, act, lim.actuator is None or not lim.actuator.stepped))
+            series.append(("heater", pr.heater, act, lim.actuator is None or not lim.actuator.stepped))
         else:
             pct = Actuator("heater", "percent", 0.0, 100.0, 5.0)
-            series.append(("Burner", pct.quantise(100.0 * (pr.Tgi_C - lim.low) / (lim.high - lim.low)), pct, True))
+            series.append(("heater", pct.quantise(100.0 * (pr.Tgi_C - lim.low) / (lim.high - lim.low)), pct, True))
         if self.actuators and np.any(pr.fan != 0):
             fan = self.fan_actuator or Actuator("fan", "percent", 0.0, 100.0)
-            series.append(("Air", pr.fan, fan, False))
+            series.append(("fan", pr.fan, fan, False))
         elif lim.gg_free:
             pct = Actuator("fan", "percent", 0.0, 100.0, 5.0)
             span = lim.Gg_max_kg_s - lim.Gg_min_kg_s
-            series.append(("Air", pct.quantise(100.0 * (pr.Gg_kg_s - lim.Gg_min_kg_s) / span), pct, True))
-        out = []
-        for etype, values, act, thin in series:
-            last_v, last_t = None, -np.inf
-            for i, v in enumerate(np.asarray(values, dtype=float)):
-                if thin:
-                    v = float(act.quantise(v))
-                if last_v is not None and (v == last_v or (thin and t[i] - last_t < MIN_HOLD_S)):
-                    continue
-                out.append((i, etype, v, act.label(v) if act.unit in ("level", "tens") else f"{etype} {v:g}"))
-                last_v, last_t = v, t[i]
-        return sorted(out, key=lambda e: e[0])
+            series.append(("fan", pct.quantise(100.0 * (pr.Gg_kg_s - lim.Gg_min_kg_s) / span), pct, True))
+        return setting_events(pr.time_s, series)
 
     def alog_text(self) -> str:
-        """An Artisan profile (Python-literal .alog, as Artisan writes) to load as a background:
-        BT the predicted probe, ET the model's ET (the inlet gas or the drum, as the machine's
-        map defines ET), the reference's event marks (CHARGE, DRY, FCs, ..., DROP) and the
-        program as events (:meth:`background_events`) in Artisan's value encoding."""
-        from ..io.importers.artisan import EVENT_NAMES
+        """An Artisan profile (Python-literal .alog, as Artisan writes) to load as a background
+        (:func:`roastlab.io.background.background_alog_text`): BT the predicted probe, ET the model's
+        ET (the inlet gas or the drum, as the machine's map defines ET), the reference's event marks
+        (CHARGE, DRY, FCs, ..., DROP) and the program as events (:meth:`background_events`)."""
+        from ..io.background import background_alog_text
 
-        pr = self.program
-        lim = self.limits
-        t = pr.time_s
-        etypes = ["Air", "Drum", "Damper", "Burner", "--"]
-        events = self.background_events()
-        n = len(t)
-        timeindex = [0] * 8
-        for k, name in enumerate(EVENT_NAMES):
-            at = self.events.get(name)
-            if at is not None and t[0] <= at <= t[-1] and name != "CHARGE":
-                timeindex[k] = int(np.argmin(np.abs(t - at)))
-        timeindex[EVENT_NAMES.index("DROP")] = n - 1
+        pr, lim = self.program, self.limits
         et = {"Tm": pr.states[:, S_TM], "Tb": pr.states[:, S_TB]}.get(self.et_source, pr.Tgi_C)
-        now = _dt.datetime.now(_dt.UTC)
         decided = (
             lim.actuator.describe()
             if lim.actuator is not None
             else f"{lim.decide} {lim.low:g}..{lim.high:g} {lim.unit}"
         )
-        profile = {
-            "recording_version": "roastlab",
-            "version": "2.8.4",
-            "revision": "",
-            "build": "",
-            "artisan_os": "roastlab",
-            "mode": "C",
-            "title": f"roastlab transfer: {self.reference} on {self.plant_to} (predicted)",
-            "roastertype": self.plant_to,
-            "operator": "",
-            "beans": "",
-            "roastingnotes": (
+        return background_alog_text(
+            pr.time_s,
+            pr.Ta_pred_C,
+            et,
+            self.events,
+            self.background_events(),
+            title=f"roastlab transfer: {self.reference} on {self.plant_to} (predicted)",
+            notes=(
                 f"Computed by roastlab transfer from {self.reference} ({self.plant_from} -> {self.plant_to}, "
-                f"{self.batch_kg:g} kg). BT is the model's prediction, ET the model's "
-                f"{ET_CURVE[self.et_source]}; "
+                f"{self.batch_kg:g} kg). BT is the model's prediction, ET the model's {ET_CURVE[self.et_source]}; "
                 f"Burner events = the decided {decided}."
             ),
-            "roastdate": now.strftime("%a %b %d %Y"),
-            "roastisodate": now.strftime("%Y-%m-%d"),
-            "roasttime": now.strftime("%H:%M:%S"),
-            "roastepoch": int(now.timestamp()),
-            "samplinginterval": float(t[1] - t[0]),
-            "timex": [round(float(v), 3) for v in t],
-            "temp1": [round(float(v), 2) for v in et],
-            "temp2": [round(float(v), 2) for v in pr.Ta_pred_C],
-            "timeindex": timeindex,
-            "specialevents": [int(e[0]) for e in events],
-            "specialeventstype": [etypes.index(e[1]) for e in events],
-            "specialeventsvalue": [round(float(e[2]) / 10.0 + 1.0, 4) for e in events],  # Artisan's encoding
-            "specialeventsStrings": [e[3] for e in events],
-            "etypes": etypes,
-            "weight": [round(self.batch_kg, 6), 0.0, "Kg"],
-            "extradevices": [],
-            "extratimex": [],
-            "extratemp1": [],
-            "extratemp2": [],
-            "extraname1": [],
-            "extraname2": [],
-        }
-        return repr(profile) + "\n"
+            roaster=self.plant_to,
+            batch_kg=self.batch_kg,
+        )
 
     def to_frame(self):
         """The program on its knots: time, the inputs, the target and the predicted probe."""

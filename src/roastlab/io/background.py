@@ -1,0 +1,111 @@
+"""Artisan background profiles: a predicted roast written as Artisan writes ``.alog`` files.
+
+One writer for every prediction a roaster may roast against (``roastlab transfer --alog``, ``roastlab
+whatif --alog``): a Python literal (Artisan's own format, read back by
+:func:`roastlab.io.importers.artisan.read_alog`) with BT the predicted probe, ET the model's curve for
+what the machine's ET measures, the roast's marks in ``timeindex`` and the settings as Artisan special
+events of its default types (``Burner`` for the heater, ``Air`` for the fan), in Artisan's value
+encoding (internal value = 1 + value/10).
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+
+import numpy as np
+
+from ..model.actuators import MIN_HOLD_S
+from .importers.artisan import EVENT_NAMES
+
+#: Artisan's default special-event types, in its order (the index is what ``specialeventstype`` holds).
+ETYPES = ("Air", "Drum", "Damper", "Burner", "--")
+#: The event type each setting is written as.
+SETTING_ETYPES = {"heater": "Burner", "fan": "Air"}
+
+
+def setting_events(time_s, series) -> list[tuple[int, str, float, str]]:
+    """Step series as Artisan special events ``(sample index, type, value, label)``, one per real
+    change. ``series``: ``(setting, values, actuator, thin)`` with ``setting`` "heater" or "fan" and
+    the values in the actuator's units; ``thin``: the values are an optimiser's, quantised to the
+    actuator's steps and held at least :data:`~roastlab.model.actuators.MIN_HOLD_S` (a logged
+    setting keeps its own changes). The label is the machine's (``P7``, ``F3``) for levels, else
+    the type and the value."""
+    t = np.asarray(time_s, dtype=float)
+    out = []
+    for setting, values, act, thin in series:
+        etype = SETTING_ETYPES[setting]
+        last_v, last_t = None, -np.inf
+        for i, v in enumerate(np.asarray(values, dtype=float)):
+            if thin:
+                v = float(act.quantise(v))
+            if last_v is not None and (v == last_v or (thin and t[i] - last_t < MIN_HOLD_S)):
+                continue
+            out.append((i, etype, float(v), act.label(v) if act.unit in ("level", "tens") else f"{etype} {v:g}"))
+            last_v, last_t = v, t[i]
+    return sorted(out, key=lambda e: e[0])
+
+
+def background_alog_text(
+    time_s,
+    bt_C,
+    et_C,
+    marks_s: dict,
+    events: list,
+    *,
+    title: str,
+    notes: str,
+    roaster: str,
+    batch_kg: float,
+) -> str:
+    """The ``.alog`` text of a predicted roast from CHARGE (``time_s[0]``) to DROP (its last sample).
+
+    ``bt_C``, ``et_C``: the curves Artisan draws as BT and ET [degC]; ``marks_s``: event name
+    (:data:`~roastlab.io.importers.artisan.EVENT_NAMES`: DRY, FCs, ...) -> time [s] on ``time_s``,
+    each written at its nearest sample (CHARGE is the first sample, DROP the last); ``events``: from
+    :func:`setting_events`; ``title``, ``notes`` (Artisan's roasting notes), ``roaster`` (its
+    machine name) and ``batch_kg`` (the green weight) describe the prediction.
+    """
+    t = np.asarray(time_s, dtype=float)
+    n = len(t)
+    timeindex = [0] * 8
+    for k, name in enumerate(EVENT_NAMES):
+        at = marks_s.get(name)
+        if at is not None and name != "CHARGE" and t[0] <= at <= t[-1]:
+            timeindex[k] = int(np.argmin(np.abs(t - at)))
+    timeindex[EVENT_NAMES.index("DROP")] = n - 1
+    now = _dt.datetime.now(_dt.UTC)
+    profile = {
+        "recording_version": "roastlab",
+        "version": "2.8.4",
+        "revision": "",
+        "build": "",
+        "artisan_os": "roastlab",
+        "mode": "C",
+        "title": title,
+        "roastertype": roaster,
+        "operator": "",
+        "beans": "",
+        "roastingnotes": notes,
+        "roastdate": now.strftime("%a %b %d %Y"),
+        "roastisodate": now.strftime("%Y-%m-%d"),
+        "roasttime": now.strftime("%H:%M:%S"),
+        "roastepoch": int(now.timestamp()),
+        "samplinginterval": float(t[1] - t[0]),
+        "timex": [round(float(v), 3) for v in t],
+        "temp1": [round(float(v), 2) for v in et_C],
+        "temp2": [round(float(v), 2) for v in bt_C],
+        "timeindex": timeindex,
+        "specialevents": [int(e[0]) for e in events],
+        "specialeventstype": [ETYPES.index(e[1]) for e in events],
+        "specialeventsvalue": [round(float(e[2]) / 10.0 + 1.0, 4) for e in events],  # Artisan's encoding
+        "specialeventsStrings": [e[3] for e in events],
+        "etypes": list(ETYPES),
+        "weight": [round(batch_kg, 6), 0.0, "Kg"],
+        "extradevices": [],
+        "extratimex": [],
+        "extratemp1": [],
+        "extratemp2": [],
+        "extraname1": [],
+        "extraname2": [],
+    }
+    return repr(profile) + "\n"
