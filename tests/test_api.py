@@ -374,3 +374,27 @@ def test_whatif_figure_shows_the_first_crack_mark_and_no_mark_past_the_curves(sk
     labels = [c.get_text() for c in ax.get_children() if isinstance(c, Annotation)]
     assert any(s.startswith("FCs ") for s in labels) and any(s.startswith("DRY ") for s in labels)
     assert not any(s.startswith("COOL ") for s in labels)
+
+
+def test_whatif_writes_the_changed_roast_as_an_artisan_background(cli, sky_model, tmp_path):
+    """whatif --alog: Artisan's format read back by the project's own importer gives the changed
+    probe prediction as BT, the model's drum (the Skywalker's ET) as ET, the changed heater as Burner
+    events, DRY and first crack where the table's changed probe reaches them, DROP at the log's."""
+    from roastlab.io.importers.artisan import read_alog
+    from roastlab.workflows.whatif import parse_setting_change, whatif
+
+    model_path, log = sky_model
+    bg = tmp_path / "next.alog"
+    code, out, err = cli("whatif", log, "--model", model_path, "--heater", "+10@4:00", "--alog", bg)
+    assert code == 0, err
+    model = roastlab.load_model(model_path)
+    w = whatif(model, roastlab.load_log(log, model.column_map), [parse_setting_change("heater", "+10@4:00", "percent")])
+    back = read_alog(bg)
+    assert np.max(np.abs(back.channels["BT"] - w.changed.Ta_C)) <= 0.005
+    assert np.max(np.abs(back.channels["ET"] - w.changed.Tm_C)) <= 0.005
+    np.testing.assert_allclose(back.channels["Burner"], w.changed.heater, atol=1e-9)
+    probe = {r["key"]: r["changed"] for r in w.rows if r["reading"] == "probe"}
+    t = w.changed.time_s
+    step = float(np.max(np.diff(t)))
+    assert abs(back.events["FCs"] - probe["FCs_s"]) <= step and abs(back.events["DRY"] - probe["DRY_s"]) <= step
+    assert back.events["DROP"] == pytest.approx(t[-1] - t[0]) and back.weight_in_kg == pytest.approx(w.batch_kg)

@@ -25,7 +25,7 @@ def cmd_whatif(args) -> int:
     from ..workflows.whatif import parse_set, parse_setting_change, whatif
 
     outputs = Outputs([args.log, args.model, args.map])
-    check_targets(outputs, args.json, plot=args.plot)
+    check_targets(outputs, args.json, args.alog, plot=args.plot)
     model = load_model(args.model)
     warn_if_failed(model, args.model)
     cmap = load_map(args.map) if args.map else model.column_map
@@ -52,6 +52,8 @@ def cmd_whatif(args) -> int:
     print(result.table(units=args.units))
     with outputs as out:
         write_json_and_plot(out, args, result.to_json_dict(), result)
+        if args.alog:
+            out.write_text(args.alog, result.alog_text())
     return 0
 
 
@@ -74,7 +76,8 @@ def add_parsers(sub) -> None:
         "  roastlab whatif roast.json --model bullet.json --heater +1@4:00    # one step more from 4:00 on\n"
         "  roastlab whatif roast.json --model bullet.json --set heater=6@2:00 --fan -2\n"
         "  roastlab whatif roast.json --model bullet.json --batch-kg 0.8 --tm0 260 --units F\n"
-        "  roastlab whatif roast.json --model bullet.json --heater -1@5:00 --band    # with the 90 % band",
+        "  roastlab whatif roast.json --model bullet.json --heater -1@5:00 --band    # with the 90 % band\n"
+        "  roastlab whatif roast.json --model bullet.json --heater -1@5:00 --alog next.alog   # to roast against",
     )
     p.add_argument("log", metavar="LOG", help="the roast log (read with the model's map, or --map)")
     p.add_argument("--model", required=True, metavar="MODEL.json", help=MODEL_HELP)
@@ -101,4 +104,10 @@ def add_parsers(sub) -> None:
     p.add_argument("--units", choices=("C", "F"), default="C", help="temperatures in the table in C or F (default C)")
     p.add_argument("--json", metavar="WHATIF.json", help="write the table as JSON (temperatures in degC, times in s)")
     p.add_argument("--plot", metavar="FIG.png", help="overlay measured BT and both predictions (.png/.svg/.pdf)")
+    p.add_argument(
+        "--alog",
+        metavar="BACKGROUND.alog",
+        help="write the changed roast as an Artisan background to roast against: BT and ET predicted, DRY and first "
+        "crack where the predicted BT reaches the log's marks, the changed heater and fan as events",
+    )
     p.set_defaults(func=cmd_whatif)

@@ -186,6 +186,13 @@ class WhatIf(Result):
     #: the changed settings the model does not respond to (its gains for them are 0:
     #: :func:`roastlab.model.actuators.inert_settings`), with the gains' names
     inert: dict = field(default_factory=dict)
+    #: the settings' actuators (name -> :class:`~roastlab.model.actuators.Actuator`), for the background's events
+    actuators: dict = field(default_factory=dict)
+    #: what the machine's ET measures (:func:`roastlab.workflows.transfer.et_source`): the background's ET curve
+    et_source: str = "Tgi"
+    #: the machine's name and the changed roast's green batch [kg], for the background
+    roaster: str = ""
+    batch_kg: float | None = None
 
     def band_line(self, units: str = "C") -> str | None:
         """The changed probe BT's band in one line: its level, median width and BT at DROP."""
@@ -297,6 +304,44 @@ class WhatIf(Result):
             "DROP_upper_C": round(float(b.upper_C[-1]), 2),
             **({"note": self.band_note} if self.band_note else {}),
         }
+
+    def alog_text(self) -> str:
+        """The changed roast as an Artisan background (:func:`roastlab.io.background.background_alog_text`):
+        BT the changed probe prediction, ET the model's curve for what the machine's ET measures, DRY
+        and first crack where the changed probe reaches the log's marks (none past DROP), DROP at the
+        log's, and the changed heater and fan settings as Burner and Air events."""
+        from ..io.background import background_alog_text, setting_events
+        from .transfer import ET_CURVE
+
+        ch = self.changed
+        et = {"Tm": ch.Tm_C, "Tb": ch.Tb_C}.get(self.et_source, ch.Tgi_C)
+        probe = {r["key"]: r for r in self.rows if r["reading"] == "probe"}
+        marks = {
+            name: probe[key]["changed"]
+            for name, key in (("DRY", "DRY_s"), ("FCs", "FCs_s"))
+            if key in probe and probe[key]["changed"] is not None and "changed" not in probe[key]["projected"]
+        }
+        series = [
+            (k, getattr(ch, k), self.actuators[k], False)
+            for k in ("heater", "fan")
+            if getattr(ch, k) is not None and k in self.actuators
+        ]
+        what = "; ".join(self.changes) or "no change"
+        return background_alog_text(
+            ch.time_s,
+            ch.Ta_C,
+            et,
+            marks,
+            setting_events(ch.time_s, series),
+            title=f"roastlab whatif: {self.batch.name} ({what}, predicted)",
+            notes=(
+                f"Computed by roastlab whatif from {self.batch.name} with {what}. BT is the model's prediction of "
+                f"the changed roast, ET the model's {ET_CURVE[self.et_source]}; DRY and FCs where the predicted "
+                "BT reaches the log's marks; Burner and Air events = the changed heater and fan settings."
+            ),
+            roaster=self.roaster,
+            batch_kg=self.batch_kg or 0.0,
+        )
 
     def to_frame(self):
         """One row per milestone and reading: measured, as run, changed, change, model error."""
@@ -422,4 +467,23 @@ def whatif(
         band = prediction_bands(model, [changed_batch], band_level, **changes)[0]
         note = band_note(model, [changed_batch], changes.get("batch_kg"))
     inert = {s: SETTING_GAINS[s] for s in inert_settings(model.values, [c.setting for c in setting_changes])}
-    return WhatIf(batch, as_run, changed, labels, rows, levels, band, note, inert)
+    cmap = model.column_map
+    if actuators is None:
+        actuators = {k: cmap.actuator(k) for k in ("heater", "fan") if cmap is not None and getattr(cmap, k)}
+    from .transfer import et_source
+
+    return WhatIf(
+        batch,
+        as_run,
+        changed,
+        labels,
+        rows,
+        levels,
+        band,
+        note,
+        inert,
+        actuators=dict(actuators),
+        et_source=et_source(cmap),
+        roaster=model.plant.name if model.plant is not None else "",
+        batch_kg=changes.get("batch_kg") or batch.Mb_kg or (model.plant.Mb_kg if model.plant is not None else None),
+    )
