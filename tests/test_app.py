@@ -337,6 +337,34 @@ def test_the_page_runs_a_transfer_and_its_downloads_load(page, tmp_path):
 
 
 @pytest.mark.slow
+def test_the_page_saves_the_what_if_as_an_artisan_background(page, tmp_path):
+    """The button under the what-if writes the changed roast as an Artisan background and links it;
+    the file downloads and loads; a further change takes the link away (it would be another roast's)."""
+    from roastlab.io.importers.artisan import read_alog
+
+    _open(page, "batch1.csv", "paper-model.json")
+    updates = page.evaluate("Number(document.body.dataset.updates || 0)")
+    page.fill("#tgi", "20")
+    page.dispatch_event("#tgi", "change")
+    page.wait_for_function(f"Number(document.body.dataset.updates || 0) > {updates}")
+    page.click("#whatif-background")
+    page.wait_for_function("document.body.dataset.background === 'done'")
+    link = page.locator("#whatif_downloads a")
+    assert link.count() == 1
+    with page.expect_download() as info:
+        link.click()
+    path = tmp_path / info.value.suggested_filename
+    info.value.save_as(path)
+    changed = np.array(_traces(page)["BT model, changed"], dtype=float)
+    assert np.max(np.abs(read_alog(path).channels["BT"] - changed)) < 0.01
+    updates = page.evaluate("Number(document.body.dataset.updates || 0)")
+    page.fill("#tgi", "10")
+    page.dispatch_event("#tgi", "change")
+    page.wait_for_function(f"Number(document.body.dataset.updates || 0) > {updates}")
+    assert page.locator("#whatif_downloads a").count() == 0
+
+
+@pytest.mark.slow
 def test_a_bad_upload_shows_a_message_and_the_page_keeps_working(page, tmp_path):
     _open(page, "batch1.csv", "paper-model.json")
     bad = tmp_path / "broken.alog"
@@ -437,3 +465,27 @@ def test_the_file_list_takes_a_roastime_file_without_a_suffix_for_a_log(tmp_path
     (tmp_path / "zl9ZdStWgBkMIm5TrsOR").write_text(json.dumps({"beanTemperature": [20.0, 21.0], "sampleRate": 2}))
     (tmp_path / "LICENSE").write_text("MIT License\n")
     assert list_files(tmp_path)["logs"] == ["zl9ZdStWgBkMIm5TrsOR"]
+
+
+def test_the_what_ifs_changed_roast_is_written_as_an_artisan_background(client, data_dir, tmp_path):
+    """SYNTHETIC paper batch: the page's background of a 20 degC hotter inlet is the what-if's changed
+    curve (BT) and the inlet the model sees (ET, the paper model's), read back with the project's Artisan
+    importer; it is served from the tab's downloads folder."""
+    from roastlab.io.importers.artisan import read_alog
+
+    assert (
+        "error"
+        not in client.post("/api/open", json={"log": "batch1.csv", "model": "paper-model.json"}, headers=H).json()
+    )
+    w = client.post("/api/whatif", json={"tgi": 20}, headers=H).json()
+    r = client.post("/api/whatif-background", json={"tgi": 20}, headers=H).json()
+    assert "error" not in r, r
+    assert r["download"].startswith("/downloads/") and r["download"].endswith("-whatif-background.alog")
+    got = client.get(r["download"])
+    assert got.status_code == 200
+    (tmp_path / "bg.alog").write_bytes(got.content)
+    log = read_alog(tmp_path / "bg.alog")
+    np.testing.assert_allclose(log.channels["BT"], np.array(w["curves"]["BT_model"], dtype=float), atol=0.006)
+    np.testing.assert_allclose(log.channels["ET"], np.array(w["curves"]["ET_model"], dtype=float), atol=0.006)
+    assert "Tgi +20" in r["changes"][0]
+    assert client.post("/api/whatif-background", json={}, headers={"X-Session": "no-log-open"}).json()["error"]

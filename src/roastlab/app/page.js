@@ -261,6 +261,7 @@ async function whatif() {
     const t0 = performance.now();
     const body = changes();
     const r = await api("/api/whatif", body);
+    $("whatif_downloads").innerHTML = "";  // a background written before these changes is not this roast's
     state.changed = r.curves;
     state.changedBand = null;
     state.table = r.table;
@@ -278,8 +279,20 @@ async function whatif() {
   }
 }
 
+async function whatifBackground() {
+  try {
+    const r = await api("/api/whatif-background", changes());
+    $("whatif_downloads").innerHTML = `<a href="${r.download}" download>${r.download.split("/").pop()}</a>`;
+    say("");
+    document.body.dataset.background = "done";
+  } catch (e) {
+    say(e.message);
+  }
+}
+
 async function openLog() {
   say("opening ...");
+  $("whatif_downloads").innerHTML = "";
   try {
     const r = await api("/api/open", { log: $("log").value, model: $("model").value });
     state.open = r;
@@ -425,6 +438,7 @@ window.addEventListener("DOMContentLoaded", async () => {
   $("units").addEventListener("change", () => { draw(); drawTable(); });
   $("reset").addEventListener("click", openLog);
   $("run-transfer").addEventListener("click", runTransfer);
+  $("whatif-background").addEventListener("click", whatifBackground);
   $("run-fit").addEventListener("click", runFit);
   link("Tm0_C", "Tm0_C_range");
   link("batch_kg", "batch_kg_range");

@@ -379,6 +379,21 @@ def create_app(data_dir: str | Path):
             "server_ms": round((time.perf_counter() - t0) * 1e3, 2),
         }
 
+    def whatif_background(session: Session, body: dict) -> dict:
+        """The what-if's changed roast as an Artisan background (the page's changes, the same call as
+        ``roastlab whatif --alog``), written under the tab's downloads folder."""
+        from ..workflows.whatif import whatif
+
+        need(session)
+        setting_changes, changes = _changes(body, session)
+        w = whatif(session.model, session.batch, setting_changes, **changes)
+        folder = data / "downloads" / session.sid
+        name = re.sub(r"[^A-Za-z0-9_.-]", "_", f"{session.batch.name}-whatif-background.alog")
+        with Outputs([data / session.log]) as out:
+            out.folder(folder)
+            out.write_text(folder / name, w.alog_text())
+        return {"download": f"/{folder.relative_to(data).as_posix()}/{name}", "changes": w.changes}
+
     def transfer_(session: Session, body: dict) -> dict:
         from ..model.limits import check_value
         from ..model.plant import preset_names
@@ -527,6 +542,7 @@ def create_app(data_dir: str | Path):
         Route("/api/files", handler(files), methods=["GET"]),
         Route("/api/open", handler(open_log), methods=["POST"]),
         Route("/api/whatif", handler(whatif_), methods=["POST"]),
+        Route("/api/whatif-background", handler(whatif_background), methods=["POST"]),
         Route("/api/transfer", handler(transfer_), methods=["POST"]),
         Route("/api/upload", upload, methods=["POST"]),
         Route("/api/fit", handler(fit_start), methods=["POST"]),

@@ -314,7 +314,7 @@ class WhatIf(Result):
         from .transfer import ET_CURVE
 
         ch = self.changed
-        et = {"Tm": ch.Tm_C, "Tb": ch.Tb_C}.get(self.et_source, ch.Tgi_C)
+        et = ch.Tm_C if self.et_source == "Tm" else ch.Tb_C if self.et_source == "Tb" else ch.gas_seen()[1]
         probe = {r["key"]: r for r in self.rows if r["reading"] == "probe"}
         marks = {
             name: probe[key]["changed"]
