@@ -144,12 +144,14 @@ def curves(batch, result, et: str = "Tm") -> dict:
     reads the machine's map), the settings and the rate of rise [degC/min] (the one RoR of
     :mod:`roastlab.metrics.profile`); with ``batch`` the measured BT, ET and a second bean
     reading too."""
+    from ..workflows.transfer import model_et_C
+
     t = result.time_s
     out = {
         "time_s": _series(t),
         "BT_model": _series(result.Ta_C),
         "beans_model": _series(result.Tb_C),
-        "ET_model": _series(result.Tm_C if et == "Tm" else result.Tb_C if et == "Tb" else result.gas_seen()[1]),
+        "ET_model": _series(model_et_C(result, et)),
         "RoR_model": _series(rate_of_rise_C_per_min(t, result.Ta_C)),
         "heater": _series(result.heater),
         "fan": _series(result.fan),

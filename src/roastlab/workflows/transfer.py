@@ -272,6 +272,17 @@ def et_source(cmap) -> str:
     return "Tm" if cmap is not None and cmap.inlet_is_constant else "Tgi"
 
 
+def model_et_C(result, source: str) -> np.ndarray:
+    """The model's curve for what the machine's ET measures (``source`` from :func:`et_source`) on a
+    :class:`~roastlab.sim.simulate.SimulationResult`: the drum (Tm), the beans (Tb), or the inlet gas
+    the model sees (after the heater's air path, :meth:`~roastlab.sim.simulate.SimulationResult.gas_seen`)."""
+    if source == "Tm":
+        return result.Tm_C
+    if source == "Tb":
+        return result.Tb_C
+    return result.gas_seen()[1]
+
+
 def _grid_batch(ref: Batch, interval_s: float) -> Batch:
     """The reference on the program's knots: inputs and probe interpolated, settings held."""
     t_end = float(ref.time_s[-1])

@@ -311,10 +311,10 @@ class WhatIf(Result):
         and first crack where the changed probe reaches the log's marks (none past DROP), DROP at the
         log's, and the changed heater and fan settings as Burner and Air events."""
         from ..io.background import background_alog_text, setting_events
-        from .transfer import ET_CURVE
+        from .transfer import ET_CURVE, model_et_C
 
         ch = self.changed
-        et = ch.Tm_C if self.et_source == "Tm" else ch.Tb_C if self.et_source == "Tb" else ch.gas_seen()[1]
+        et = model_et_C(ch, self.et_source)
         probe = {r["key"]: r for r in self.rows if r["reading"] == "probe"}
         marks = {
             name: probe[key]["changed"]
