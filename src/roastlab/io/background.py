@@ -5,7 +5,7 @@ whatif --alog``): a Python literal (Artisan's own format, read back by
 :func:`roastlab.io.importers.artisan.read_alog`) with BT the predicted probe, ET the model's curve for
 what the machine's ET measures, the roast's marks in ``timeindex`` and the settings as Artisan special
 events of its default types (``Burner`` for the heater, ``Air`` for the fan), in Artisan's value
-encoding (internal value = 1 + value/10).
+encoding (:func:`~roastlab.io.importers.artisan.events_external_to_internal`).
 """
 
 from __future__ import annotations
@@ -15,10 +15,8 @@ import datetime as _dt
 import numpy as np
 
 from ..model.actuators import MIN_HOLD_S
-from .importers.artisan import EVENT_NAMES
+from .importers.artisan import DEFAULT_ETYPES, EVENT_NAMES, events_external_to_internal
 
-#: Artisan's default special-event types, in its order (the index is what ``specialeventstype`` holds).
-ETYPES = ("Air", "Drum", "Damper", "Burner", "--")
 #: The event type each setting is written as.
 SETTING_ETYPES = {"heater": "Burner", "fan": "Air"}
 
@@ -96,10 +94,10 @@ def background_alog_text(
         "temp2": [round(float(v), 2) for v in bt_C],
         "timeindex": timeindex,
         "specialevents": [int(e[0]) for e in events],
-        "specialeventstype": [ETYPES.index(e[1]) for e in events],
-        "specialeventsvalue": [round(float(e[2]) / 10.0 + 1.0, 4) for e in events],  # Artisan's encoding
+        "specialeventstype": [DEFAULT_ETYPES.index(e[1]) for e in events],
+        "specialeventsvalue": [events_external_to_internal(float(e[2])) for e in events],
         "specialeventsStrings": [e[3] for e in events],
-        "etypes": list(ETYPES),
+        "etypes": list(DEFAULT_ETYPES),
         "weight": [round(batch_kg, 6), 0.0, "Kg"],
         "extradevices": [],
         "extratimex": [],

@@ -70,6 +70,20 @@ def f_to_c(values):
     return (np.asarray(values, dtype=float) - 32.0) * 5.0 / 9.0
 
 
+#: Artisan's default special-event types, in its order (a log's ``specialeventstype`` indexes them).
+DEFAULT_ETYPES = ("Air", "Drum", "Damper", "Burner", "--")
+
+
+def events_external_to_internal(x: float) -> float:
+    """The inverse of :func:`events_internal_to_external`: an external value in [-100, 100] as
+    Artisan stores it, 1 + x/10 (and -(1 + |x|/10) below 0).
+
+    >>> events_external_to_internal(70.0), events_internal_to_external(events_external_to_internal(70.0))
+    (8.0, 70.0)
+    """
+    return round(1.0 + x / 10.0, 4) if x >= 0 else -round(1.0 + abs(x) / 10.0, 4)
+
+
 def events_internal_to_external(v: float) -> float:
     """Artisan's event-value encoding: internal v in [-11, 11] -> external in [-100, 100].
 
@@ -459,7 +473,7 @@ def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: boo
 
     channels = {"ET": et.copy(), "BT": bt.copy()}
     temps = {"ET", "BT"}
-    etypes = _as_list(data.get("etypes")) or ["Air", "Drum", "Damper", "Burner", "--"]
+    etypes = _as_list(data.get("etypes")) or list(DEFAULT_ETYPES)
     events = _special_events(data, etypes, n, path)
     with_events = {name for _, name, _ in events}
     # extra devices: each has a time base and two channels with names
