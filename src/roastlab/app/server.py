@@ -389,12 +389,20 @@ def create_app(data_dir: str | Path):
         need(session)
         setting_changes, changes = _changes(body, session)
         w = whatif(session.model, session.batch, setting_changes, **changes)
+        (url,) = downloads(session, {f"{session.batch.name}-whatif-background.alog": w.alog_text()})
+        return {"download": url, "changes": w.changes}
+
+    def downloads(session: Session, files: dict[str, str]) -> list[str]:
+        """Write ``files`` (name -> text) under the tab's downloads folder, atomically and never over
+        the open log; their URLs, in order."""
         folder = data / "downloads" / session.sid
-        name = re.sub(r"[^A-Za-z0-9_.-]", "_", f"{session.batch.name}-whatif-background.alog")
+        names = [re.sub(r"[^A-Za-z0-9_.-]", "_", name) for name in files]
         with Outputs([data / session.log]) as out:
             out.folder(folder)
-            out.write_text(folder / name, w.alog_text())
-        return {"download": f"/{folder.relative_to(data).as_posix()}/{name}", "changes": w.changes}
+            for name, text in zip(names, files.values()):
+                out.write_text(folder / name, text)
+        rel = folder.relative_to(data).as_posix()
+        return [f"/{rel}/{name}" for name in names]
 
     def transfer_(session: Session, body: dict) -> dict:
         from ..model.limits import check_value
@@ -416,13 +424,10 @@ def create_app(data_dir: str | Path):
             batch_kg=None if kg in (None, "") else check_value("batch_kg", kg, "to batch"),
             tm0_free=tm0_free,
         )
-        folder = data / "downloads" / session.sid
-        stem = re.sub(r"[^A-Za-z0-9_.-]", "_", f"{session.batch.name}-{r.batch_kg:g}kg")
-        with Outputs([data / session.log]) as out:
-            out.folder(folder)
-            out.write_text(folder / f"{stem}-program.csv", r.program_csv_text())
-            out.write_text(folder / f"{stem}-background.alog", r.alog_text())
-        rel = folder.relative_to(data).as_posix()
+        stem = f"{session.batch.name}-{r.batch_kg:g}kg"
+        urls = downloads(
+            session, {f"{stem}-program.csv": r.program_csv_text(), f"{stem}-background.alog": r.alog_text()}
+        )
         pr = r.program
         return {
             "summary": r.summary(),
@@ -437,7 +442,7 @@ def create_app(data_dir: str | Path):
             "low": r.limits.low,
             "high": r.limits.high,
             "step": r.limits.actuator.step if r.limits.actuator is not None and r.limits.actuator.stepped else None,
-            "downloads": [f"/{rel}/{stem}-program.csv", f"/{rel}/{stem}-background.alog"],
+            "downloads": urls,
         }
 
     def fit_start(session: Session, body: dict) -> dict:
