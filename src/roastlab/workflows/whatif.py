@@ -390,6 +390,9 @@ def whatif(
 
         band_level = check_level(band_level)
         require_band(model)
+    cmap = model.column_map
+    if actuators is None:  # the machine's ranges, as the model's map declares them
+        actuators = {k: cmap.actuator(k) for k in ("heater", "fan") if cmap is not None and getattr(cmap, k)}
     changed_batch = batch
     labels = [str(c) for c in setting_changes]
     for c in setting_changes:
@@ -406,9 +409,7 @@ def whatif(
                 batch.source or batch.name,
             )
         new = c.apply(batch.time_s, series)
-        act = (actuators or {}).get(c.setting)
-        if act is None and actuators is None and model.column_map is not None and getattr(model.column_map, c.setting):
-            act = model.column_map.actuator(c.setting)
+        act = actuators.get(c.setting)
         if act is not None and (new.min() < act.low - 1e-9 or new.max() > act.high + 1e-9):
             if c.how == "set":
                 raise ParameterError(
@@ -467,9 +468,6 @@ def whatif(
         band = prediction_bands(model, [changed_batch], band_level, **changes)[0]
         note = band_note(model, [changed_batch], changes.get("batch_kg"))
     inert = {s: SETTING_GAINS[s] for s in inert_settings(model.values, [c.setting for c in setting_changes])}
-    cmap = model.column_map
-    if actuators is None:
-        actuators = {k: cmap.actuator(k) for k in ("heater", "fan") if cmap is not None and getattr(cmap, k)}
     from .transfer import et_source
 
     return WhatIf(

@@ -580,19 +580,18 @@ def _drop_et_not_drum_air(time_s, Ta, drop_s, settings: dict, series: dict, note
     return {spec["column"]}
 
 
-def roastime_default_map(log: ArtisanLog | None = None) -> ColumnMap:
-    """The map a RoasTime log is read with when none is given: the channels a Bullet logs.
+def roastime_default_map(log: ArtisanLog) -> ColumnMap:
+    """The map the parsed RoasTime ``log`` is read with when none is given: the channels a Bullet logs.
 
     The bean probe is Ta; the heat comes from the heater's levels into room air drawn through the
     drum (the quantity table's room temperature, ``T_room_C``); the fan's levels move the air; the
     infrared channel is a second bean reading from :data:`SECOND_BEAN_START_S`; the drum at charge
-    is the preheat (:data:`~roastlab.io.importers.roastime.DRUM_AT_CHARGE`). Given the parsed
-    ``log``, only what it holds is mapped (a log with no fan change, no IR channel or no drum reading
-    at charge is read without them). ``roastlab init`` writes the same map with the settings' ranges
-    its logs use.
+    is the preheat (:data:`~roastlab.io.importers.roastime.DRUM_AT_CHARGE`). Only what the log holds
+    is mapped (a log with no fan change, no IR channel or no drum reading at charge is read without
+    them). ``roastlab init`` writes the same map with the settings' ranges its logs use.
     """
-    has = (lambda name: name in log.channels) if log is not None else (lambda name: True)
-    at_charge = [f for f in DRUM_AT_CHARGE if log is None or f in log.fields]
+    has = log.channels.__contains__
+    at_charge = [f for f in DRUM_AT_CHARGE if f in log.fields]
     return map_from_mapping(
         {
             "format": "roastime",
