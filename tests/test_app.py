@@ -99,6 +99,7 @@ def test_open_gives_phases_band_fit_figures_and_the_machines_controls(client, da
     assert 0 < r["metrics"]["FIT_pct"] <= 100 and r["metrics"]["MAE_C"] > 0
     assert r["actuators"]["heater"]["unit"] == "level" and r["actuators"]["heater"]["step"] == 1
     assert r["metrics"]["fitted_on"] is False
+    assert r["model"] == "bullet-model.json"  # the page names the model its figures are from
     # a roast the model was fitted on, under another name: its figures are said not to be held out
     f = client.post("/api/open", json={"log": "logs/renamed-fitted-490g.json", "model": "bullet-model.json"}, headers=H)
     assert f.json()["metrics"]["fitted_on"] is True
@@ -273,6 +274,7 @@ def test_the_page_draws_a_real_log_and_follows_a_what_if(page, data_dir, tmp_pat
     upper = np.array(now["90 % band, changed"], dtype=float)
     assert np.all(upper >= np.array(now["BT model, changed"], dtype=float) - 1e-6)
     assert "changed:" in page.inner_text("#figures")
+    assert page.inner_text("#figures").startswith("model bullet-model.json as run against this log")
     page.screenshot(path=str(tmp_path / "whatif.png"), full_page=True)
     assert (tmp_path / "whatif.png").stat().st_size > 20_000
 

@@ -211,7 +211,9 @@ function drawTable() {
   }
   $("table").innerHTML = html;
   const m = state.open && state.open.metrics, b = state.open && state.open.band;
-  $("figures").textContent = (m ? `model as run against this log${m.fitted_on ? " (it was fitted on this roast: not held out)" : ""}: FIT ${m.FIT_pct.toFixed(1)} %, MAE ${dtemp(m.MAE_C).toFixed(2)} ${unit()}` : "") +
+  // named: after a fit the model list selects the new model, which the open log shows only once opened again
+  const which = state.open ? `${state.open.model} ` : "";
+  $("figures").textContent = (m ? `model ${which}as run against this log${m.fitted_on ? " (it was fitted on this roast: not held out)" : ""}: FIT ${m.FIT_pct.toFixed(1)} %, MAE ${dtemp(m.MAE_C).toFixed(2)} ${unit()}` : "") +
     (b && b.lower ? `; ${Math.round(b.level * 100)} % band median width ${dtemp(b.median_width_C).toFixed(1)} ${unit()}` : b && b.why ? `; ${b.why}` : "") +
     (state.changed && state.changedBand ? `; changed: ${dtemp(state.changedBand.median_width_C).toFixed(1)} ${unit()}` : "");
   const bandNotes = [b && b.note, state.changed && state.changedBand && state.changedBand.note];
@@ -370,6 +372,7 @@ async function runFit() {
         (st.across_sizes ? `; across sizes: ${st.across_sizes}` : "");
       if (st.verdict) say(`not usable: ${st.verdict}`);
       pickModel = st.model;
+      $("fit_text").textContent += ` — ${st.model} is selected under "model": Open shows it on a log`;
       await refreshFiles($("log").value);
       document.body.dataset.fitted = st.model;
     };

@@ -340,6 +340,7 @@ def create_app(data_dir: str | Path):
                                    "label": act.describe()}  # fmt: skip
         return {
             "log": batch.name,
+            "model": body["model"],  # the model file the curves and figures are from, as chosen
             "batch_kg": batch.Mb_kg,
             "Tm0_C": round(float(w.as_run.Tm_C[0]), 1),  # the drum at CHARGE the model starts from
             "X0": round(float(w.as_run.X_kg_kg[0]), 4),
