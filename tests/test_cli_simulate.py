@@ -195,3 +195,22 @@ def test_every_subcommand_help_names_the_model_file():
         for inner in (a for a in p._actions if a.dest == "what"):
             text += "".join(q.format_help() for q in inner.choices.values())
         assert "MODEL.json" in text, name
+
+
+def test_a_signed_change_is_read_as_the_value_of_its_option():
+    # "--heater -1@5:00", as the whatif help writes it, failed with "expected one argument"
+    from roastlab.cli import build_parser
+
+    parser = build_parser()
+    args = parser.parse_args(
+        ["whatif", "roast.json", "--model", "m.json", "--heater", "-1@5:00", "--fan", "-2", "--tgi", "-3.5"]
+    )
+    assert (args.heater, args.fan, args.tgi) == ("-1@5:00", "-2", -3.5)
+    args = parser.parse_args(
+        ["whatif", "roast.json", "--model", "m.json", "--set", "heater=-1@2:00", "--set", "-1@3:00"]
+    )
+    assert args.set == ["heater=-1@2:00", "-1@3:00"]
+    # a dash-led word that is not a signed number is still an option: a missing value says so
+    with pytest.raises(SystemExit) as e:
+        parser.parse_args(["whatif", "roast.json", "--model", "m.json", "--heater", "--band"])
+    assert e.value.code == 2

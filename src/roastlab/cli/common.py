@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import re
 import sys
 from pathlib import Path
 
@@ -14,11 +15,41 @@ from ..errors import InputError, ParameterError, RoastlabError
 MODEL_HELP = "fitted model file from 'roastlab identify' (roastlab-model/1; a THETA.json of roastlab 0.1 also loads)"
 
 
+#: A value that starts with a minus and a digit: a signed change such as ``-1@5:00`` or ``-2.5``. No option
+#: of roastlab starts so, but argparse takes any dash-led word but a plain number for an option and
+#: ``--heater -1@5:00`` failed with "expected one argument".
+SIGNED_VALUE = re.compile(r"^-\.?\d")
+
+
 class Parser(argparse.ArgumentParser):
-    """argparse with one-line errors (exit 2) instead of a usage block."""
+    """argparse with one-line errors (exit 2) instead of a usage block, and a signed value taken as
+    the value of the option before it (``--heater -1@5:00`` read as ``--heater=-1@5:00``)."""
 
     def error(self, message: str):  # noqa: D102
         self.exit(2, f"{self.prog}: error: {message} (see --help)\n")
+
+    def parse_known_args(self, args=None, namespace=None):  # noqa: D102
+        args = list(sys.argv[1:] if args is None else args)
+        return super().parse_known_args(self._attach_signed_values(args), namespace)
+
+    def _attach_signed_values(self, args: list[str]) -> list[str]:
+        """``OPTION VALUE`` as ``OPTION=VALUE`` where the option takes one value and the value is
+        signed (:data:`SIGNED_VALUE`); everything after ``--`` as it is."""
+        out: list[str] = []
+        i = 0
+        while i < len(args):
+            word = args[i]
+            if word == "--":
+                return out + args[i:]
+            action = self._option_string_actions.get(word)
+            takes_one = action is not None and action.nargs is None and word.startswith("--")
+            if takes_one and i + 1 < len(args) and SIGNED_VALUE.match(args[i + 1]):
+                out.append(f"{word}={args[i + 1]}")
+                i += 2
+                continue
+            out.append(word)
+            i += 1
+        return out
 
 
 def float_arg(name: str):
