@@ -235,3 +235,18 @@ def test_transfer_limits_are_checked_against_the_plausible_table(cli, tmp_path, 
     )  # fmt: skip
     assert code == 2 and words in err and "plausible range" in err and err.count("\n") == 1, err
     assert not (tmp_path / "p.csv").exists()
+
+
+def test_a_feasible_programs_limits_are_summed_up_by_limit():
+    # a stepped program meets its rate limit at every step: said once per limit, not once per step
+    from roastlab.workflows.transfer import _spans_in_words
+
+    rising = [{"limit": "heater rising at its 6 levels/min rate limit", "from_s": 60.0 * k, "to_s": 60.0 * k + 10.0}
+              for k in range(1, 6)]  # fmt: skip
+    ceiling = [{"limit": "heater at its P9 ceiling", "from_s": 90.0, "to_s": 150.0}]
+    text = _spans_in_words(sorted(rising + ceiling, key=lambda s: s["from_s"]))
+    assert text == (
+        "heater rising at its 6 levels/min rate limit 5 times from 1:00 to 5:10 (0:50 in all); "
+        "heater at its P9 ceiling 1:30-2:30"
+    )
+    assert _spans_in_words(rising[:2]) == "heater rising at its 6 levels/min rate limit 1:00-1:10, 2:00-2:10"

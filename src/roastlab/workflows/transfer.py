@@ -539,6 +539,24 @@ def transfer(
     )
 
 
+def _spans_in_words(spans, listed: int = 3) -> str:
+    """The spans a program sits on its limits, by limit: each span where a limit holds up to
+    ``listed`` times, else how often, from when to when and for how long in all (a stepped program
+    meets its rate limit at every step)."""
+    words = []
+    for limit in dict.fromkeys(s["limit"] for s in spans):
+        own = [s for s in spans if s["limit"] == limit]
+        if len(own) <= listed:
+            words.append(f"{limit} " + ", ".join(f"{mmss(s['from_s'])}-{mmss(s['to_s'])}" for s in own))
+        else:
+            total = sum(s["to_s"] - s["from_s"] for s in own)
+            words.append(
+                f"{limit} {len(own)} times from {mmss(own[0]['from_s'])} to {mmss(own[-1]['to_s'])} "
+                f"({mmss(total)} in all)"
+            )
+    return "; ".join(words)
+
+
 def _explain(t, e, spans, tol, plant, mass, feasible) -> list[str]:
     """Where the program misses the target by more than ``tol`` and the limits that hold it back
     in the direction of the miss (below the target: a ceiling or a rising rate; above it: a
@@ -547,7 +565,7 @@ def _explain(t, e, spans, tol, plant, mass, feasible) -> list[str]:
     bad = np.abs(e) > tol
     if feasible:
         if spans:
-            out.append("on a limit: " + "; ".join(f"{s['limit']} {mmss(s['from_s'])}-{mmss(s['to_s'])}" for s in spans))
+            out.append("on a limit: " + _spans_in_words(spans))
         return out
     for i, j in true_runs(bad):
         worst = int(i + np.argmax(np.abs(e[i : j + 1])))
