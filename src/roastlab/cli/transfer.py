@@ -94,7 +94,8 @@ def add_parsers(sub) -> None:
     p = sub.add_parser(
         "transfer",
         help="compute the input program that reproduces a roast on another plant or batch size",
-        description="Find the inlet-gas program (or, with --decide heater, the heater program) that makes the "
+        description="Find the heater program (where the model's map reads a heater and the inlet is room air), "
+        "else the inlet-gas program (--decide chooses), that makes the "
         "model's bean probe on plant B (--to) follow the reference roast's BT from CHARGE to DROP on plant A "
         "(--from), within level and rate limits. The model's carried-over values (theta, process constants) are "
         "applied on B. Prints the fit of the program against two baselines computed in the same run: B with A's "
@@ -113,6 +114,8 @@ def add_parsers(sub) -> None:
         f"at least {MIN_HOLD_S:g} s between changes: the runnable program; the continuous one's error is printed "
         "beside it.\n\n"
         "examples:\n"
+        "  roastlab transfer --model myroaster/model.json --reference roast.alog --batch-kg 0.25 --out program.csv \\\n"
+        "      --plot transfer.png --alog next.alog    # your roaster's log at another batch size\n"
         "  roastlab transfer --model model.json --from 120kg --to 360kg --reference batch1.csv --out program.csv\n"
         "  roastlab transfer --model model.json --from 120kg --to 120kg --batch-kg 84 --reference batch1.csv \\\n"
         "      --out program.csv --tm0 free --plot transfer.png --alog background.alog",
