@@ -147,6 +147,12 @@ def test_transfer_limits_and_charge_state_from_the_page(client, data_dir):
     assert "error" not in held, held
     assert max(free["program"]) > 6 >= max(held["program"])  # the ceiling the page gave is the program's
     assert held["metrics"]["rmse_C"] > free["metrics"]["rmse_C"]
+    # the heater program as Artisan alarms, beside the program and the background: P6 moves the slider to 60
+    (alrm,) = [u for u in held["downloads"] if u.endswith("-program.alrm")]
+    alarms = client.get(alrm).json()
+    assert alarms["alarmactions"] and set(alarms["alarmactions"]) <= {3, 6}  # Air, Burner sliders
+    burner = [float(v.split(" # ")[0]) for v, a in zip(alarms["alarmstrings"], alarms["alarmactions"]) if a == 6]
+    assert max(burner) <= 60 and all(v % 10 == 0 for v in burner)
     bad = client.post("/api/transfer", json={"limit_low": 7, "limit_high": 3}, headers=H)
     assert bad.status_code == 400 and "inverted" in bad.json()["error"]
     out = client.post("/api/transfer", json={"plant_to": "../plant.toml"}, headers=H)

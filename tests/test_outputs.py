@@ -21,7 +21,7 @@ from roastlab.cli import build_parser
 from test_bad_input import GOOD_ALOG, GOOD_ROWS, HEADER, PLANT
 
 #: Options that name a file or folder the command writes.
-OUTPUTS = {"--out", "--json", "--plot", "--predictions", "--save", "--alog", "--db"}
+OUTPUTS = {"--out", "--json", "--plot", "--predictions", "--save", "--alog", "--alarms", "--db"}
 #: Options that name a file or folder the command reads.
 INPUTS = {"--model", "--theta", "--plant", "--inputs", "--map", "--spec", "--data", "batches", "log", "plant"}
 INPUTS |= {"--from", "--to", "--reference", "--scenario", "--scenarios", "--manifest", "--data-dir", "logs", "dir"}

@@ -7,6 +7,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from roastlab.errors import InputError
 from roastlab.fit.program import ProgramLimits, limit_spans
 from roastlab.io.batch import read_batch_csv, write_batch_csv
 from roastlab.io.importers.artisan import read_alog
@@ -158,6 +159,7 @@ def test_cli_program_file_reproduces_with_simulate_and_alog_loads(cli, tmp_path)
         (["--tm0", "hot"], "'free'"),
         (["--tm0", "free", "--tm0-range", "300:100"], "LO < HI"),
         (["--decide", "heater"], "heater setting"),
+        (["--alarms", "never-written.alrm"], "heater slider"),  # an inlet-temperature program moves no slider
     ],
 )
 def test_bad_transfer_input_is_one_line_and_exit_2(cli, tmp_path, extra, needle):
@@ -250,3 +252,37 @@ def test_a_feasible_programs_limits_are_summed_up_by_limit():
         "heater at its P9 ceiling 1:30-2:30"
     )
     assert _spans_in_words(rising[:2]) == "heater rising at its 6 levels/min rate limit 1:00-1:10, 2:00-2:10"
+
+
+def test_a_heater_program_in_levels_becomes_artisan_alarms_that_move_the_burner_slider():
+    """transfer --alarms: one alarm per change of the runnable program, at its time after CHARGE, moving
+    the Burner slider to the level in tens (Artisan's Aillio setups: P6 is 60); Artisan's table layout."""
+    from roastlab.io.background import ALARM_FROM_CHARGE, ALARM_NO_SOURCE, alarm_slider_action, setting_events
+    from roastlab.io.batch import Batch
+    from roastlab.model.actuators import Actuator
+    from roastlab.workflows.model import FittedModel
+
+    model = FittedModel.paper("120kg").with_values(Qe_gain_kW=40.0, tau_heater_s=20.0)
+    t = np.arange(0.0, 601.0, 5.0)
+    heater = np.where(t < 240, 6.0, np.where(t < 420, 4.0, 5.0))
+    ref0 = Batch("levels", t, np.full(len(t), 0.4), np.full(len(t), 300.0), heater=heater, fan=np.zeros(len(t)))
+    ref = Batch("levels", t, ref0.Gg_kg_s, ref0.Tgi_C, model.predict(ref0, Ta0_C=25.0).Ta_C, heater=heater,
+                fan=np.zeros(len(t)))  # fmt: skip
+    act = Actuator("heater", "level", 0.0, 9.0, 1.0, 12.0)
+    r = transfer(model, ref, "120kg", "120kg", limits=ProgramLimits.for_actuator(act), batch_kg=100.0)
+    alarms = json.loads(r.alarms_text())
+    n = len(alarms["alarmflags"])
+    assert n >= 2 and all(len(v) == n for v in alarms.values())
+    events = setting_events(r.program.time_s, r._setting_series())
+    assert [e[1] for e in events] == ["Burner"] * n  # the fan is no machine slider here: not moved
+    assert alarms["alarmactions"] == [alarm_slider_action("Burner")] * n == [6] * n
+    assert alarms["alarmoffsets"] == [max(1, round(r.program.time_s[e[0]])) for e in events]
+    assert alarms["alarmoffsets"][0] == 1  # the setting at CHARGE: 0:00 would be no time condition
+    assert set(alarms["alarmtimes"]) == {ALARM_FROM_CHARGE} and set(alarms["alarmsources"]) == {ALARM_NO_SOURCE}
+    for (_, _, level, label), text in zip(events, alarms["alarmstrings"]):
+        value, comment = text.split(" # ", 1)
+        assert float(value) == 10.0 * level and comment.startswith(label) and label == f"P{level:g}"
+    # the same program from a model whose inlet temperature is decided moves no slider: refused
+    model_t, ref_t = random_reference(np.random.default_rng(6), "120kg", minutes=3.0)
+    with pytest.raises(InputError, match="heater slider"):
+        transfer(model_t, ref_t, "120kg", "120kg", limits=ProgramLimits(150.0, 550.0, 120.0)).alarms_text()

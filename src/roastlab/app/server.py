@@ -426,9 +426,10 @@ def create_app(data_dir: str | Path):
             tm0_free=tm0_free,
         )
         stem = f"{session.batch.name}-{r.batch_kg:g}kg"
-        urls = downloads(
-            session, {f"{stem}-program.csv": r.program_csv_text(), f"{stem}-background.alog": r.alog_text()}
-        )
+        files = {f"{stem}-program.csv": r.program_csv_text(), f"{stem}-background.alog": r.alog_text()}
+        if r.limits.decide == "heater":  # a heater program runs in Artisan as its alarms (transfer --alarms)
+            files[f"{stem}-program.alrm"] = r.alarms_text()
+        urls = downloads(session, files)
         pr = r.program
         return {
             "summary": r.summary(),

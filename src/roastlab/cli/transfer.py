@@ -25,7 +25,7 @@ def cmd_transfer(args) -> int:
     from ..workflows.transfer import default_limits, transfer
 
     outputs = Outputs([args.reference, args.model, args.map, args.plant_from, args.plant_to])
-    check_targets(outputs, args.out, args.json, args.alog, plot=args.plot)
+    check_targets(outputs, args.out, args.json, args.alog, args.alarms, plot=args.plot)
     if args.gg is not None and (args.gg_min is not None or args.gg_max is not None):
         raise InputError(
             "--gg fixes the flow; --gg-min/--gg-max let the optimiser choose it: give one or the other", "command line"
@@ -82,6 +82,8 @@ def cmd_transfer(args) -> int:
         write_json_and_plot(out, args, result.to_json_dict(), result)
         if args.alog:
             out.write_text(args.alog, result.alog_text())
+        if args.alarms:
+            out.write_text(args.alarms, result.alarms_text())
     return 0
 
 
@@ -109,13 +111,15 @@ def add_parsers(sub) -> None:
         "                lines: 'roastlab simulate --model M --plant B --inputs PROGRAM.csv' reproduces Ta_pred_C\n"
         "  METRICS.json  rmse_C, max_abs_C, feasible, solve_s, the baselines, the limits the program sits on\n"
         "  BACKGROUND.alog  an Artisan profile to load as background: BT predicted, ET the model's, the\n"
-        "                reference's CHARGE/DRY/FCs/DROP marks, the program as Burner/Air events\n\n"
+        "                reference's CHARGE/DRY/FCs/DROP marks, the program as Burner/Air events\n"
+        "  PROGRAM.alrm  Artisan alarms that run the program: at each change, the Burner (Air) slider moved to\n"
+        "                it (a level in tens, as Artisan's Aillio setups: P6 = 60), the setting at CHARGE at 0:01\n\n"
         "A heater program is rounded to the machine's settings (the map's [heater] min, max, step) and held\n"
         f"at least {MIN_HOLD_S:g} s between changes: the runnable program; the continuous one's error is printed "
         "beside it.\n\n"
         "examples:\n"
         "  roastlab transfer --model myroaster/model.json --reference roast.alog --batch-kg 0.25 --out program.csv \\\n"
-        "      --plot transfer.png --alog next.alog    # your roaster's log at another batch size\n"
+        "      --plot transfer.png --alog next.alog --alarms next.alrm   # your roaster's log at another batch size\n"
         "  roastlab transfer --model model.json --from 120kg --to 360kg --reference batch1.csv --out program.csv\n"
         "  roastlab transfer --model model.json --from 120kg --to 120kg --batch-kg 84 --reference batch1.csv \\\n"
         "      --out program.csv --tm0 free --plot transfer.png --alog background.alog",
@@ -222,5 +226,11 @@ def add_parsers(sub) -> None:
     )
     p.add_argument(
         "--alog", metavar="BACKGROUND.alog", help="write an Artisan background profile of the prediction and program"
+    )
+    p.add_argument(
+        "--alarms",
+        metavar="PROGRAM.alrm",
+        help="write the heater program (and the logged fan) as an Artisan alarm set that moves the Burner and Air "
+        "sliders at its changes after CHARGE (Config > Alarms > Load; a machine Artisan controls)",
     )
     p.set_defaults(func=cmd_transfer)

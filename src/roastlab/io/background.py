@@ -11,14 +11,29 @@ encoding (:func:`~roastlab.io.importers.artisan.events_external_to_internal`).
 from __future__ import annotations
 
 import datetime as _dt
+import json
 
 import numpy as np
 
+from ..metrics.profile import mmss
 from ..model.actuators import MIN_HOLD_S
 from .importers.artisan import DEFAULT_ETYPES, EVENT_NAMES, events_external_to_internal
 
 #: The event type each setting is written as.
 SETTING_ETYPES = {"heater": "Burner", "fan": "Air"}
+
+#: Artisan's alarm table (Config > Alarms; an ``.alrm`` file is its export): "From" CHARGE is alarm time 0;
+#: an empty "Source" (no temperature condition) is source -3; the action "Slider <event type k>" is 3 + k
+#: for Artisan's four event types (:data:`~roastlab.io.importers.artisan.DEFAULT_ETYPES`: Air, Drum,
+#: Damper, Burner); no "If Alarm" / "But Not" guard is -1.
+ALARM_FROM_CHARGE = 0
+ALARM_NO_SOURCE = -3
+ALARM_NO_GUARD = -1
+
+
+def alarm_slider_action(etype: str) -> int:
+    """Artisan's alarm action that moves the slider of event type ``etype`` (Air 3 ... Burner 6)."""
+    return 3 + DEFAULT_ETYPES.index(etype)
 
 
 def setting_events(time_s, series) -> list[tuple[int, str, float, str]]:
@@ -107,3 +122,36 @@ def background_alog_text(
         "extraname2": [],
     }
     return repr(profile) + "\n"
+
+
+def alarms_text(time_s, series, *, note: str) -> str:
+    """An Artisan alarm set (``.alrm``, Config > Alarms > Load) that runs a program: for each change of
+    :func:`setting_events` on ``series``, an alarm at its time after CHARGE that moves the setting's
+    slider (Burner, Air) to the value Artisan's slider takes for it
+    (:meth:`~roastlab.model.actuators.Actuator.artisan_slider`); its description is that value, then
+    a comment (after ``#``, which Artisan ignores) with the setting as the roaster reads it and ``note``.
+
+    An alarm whose time is 0:00 has no time condition in Artisan, so a setting at CHARGE is moved at
+    0:01 (set it before charging). Each alarm fires once per roast, as Artisan's alarms do."""
+    t = np.asarray(time_s, dtype=float)
+    units = {SETTING_ETYPES[setting]: act for setting, _, act, _ in series}
+    rows = []
+    for i, etype, value, label in setting_events(t, series):
+        at_s = max(1, int(round(t[i] - t[0])))
+        slider = units[etype].artisan_slider(value)
+        rows.append((at_s, alarm_slider_action(etype), f"{slider:g} # {label} at {mmss(at_s)}, {note}"))
+    n = len(rows)
+    alarms = {
+        "alarmflags": [1] * n,
+        "alarmguards": [ALARM_NO_GUARD] * n,
+        "alarmnegguards": [ALARM_NO_GUARD] * n,
+        "alarmtimes": [ALARM_FROM_CHARGE] * n,
+        "alarmoffsets": [r[0] for r in rows],
+        "alarmconds": [1] * n,
+        "alarmsources": [ALARM_NO_SOURCE] * n,
+        "alarmtemperatures": [500.0] * n,  # Artisan's default; no source, so never compared
+        "alarmactions": [r[1] for r in rows],
+        "alarmbeep": [0] * n,
+        "alarmstrings": [r[2] for r in rows],
+    }
+    return json.dumps(alarms, ensure_ascii=True) + "\n"

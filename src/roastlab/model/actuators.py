@@ -124,6 +124,12 @@ class Actuator:
             return f"{prefix}{value * _STEPS_PER_UNIT.get(self.unit, 1.0):g}"
         return f"{value:g} %" if self.unit == "percent" else f"{value:g} {self.unit}"
 
+    def artisan_slider(self, value: float) -> float:
+        """The value Artisan's slider for this control takes for the setting ``value``: a machine's level
+        in tens, as Artisan's Aillio setups have it (P6 is 60, :data:`UNIT_DEFAULTS` "tens"); every other
+        unit as it is (a percentage, a level already logged in tens, a power)."""
+        return value / _STEPS_PER_UNIT["tens"] if self.unit == "level" else value
+
     def describe(self) -> str:
         """``heater P0-P9 in steps of 1`` / ``fan 0-100 % in 5 % steps``."""
         if self.stepped:

@@ -166,6 +166,29 @@ class TransferResult(Result):
         of their range in 5 % steps); what the optimiser decided at most one change every
         :data:`~roastlab.model.actuators.MIN_HOLD_S` seconds, a held, logged setting with its own."""
         from ..io.background import setting_events
+
+        return setting_events(self.program.time_s, self._setting_series())
+
+    def alarms_text(self) -> str:
+        """The heater program (and the fan, where it is the machine's) as an Artisan alarm set
+        (:func:`roastlab.io.background.alarms_text`): loaded in Artisan (Config > Alarms > Load), it
+        moves the Burner and Air sliders at the program's changes after CHARGE, on a machine Artisan
+        controls. Only a program that sets the machine's heater: an inlet temperature or a gas flow has
+        no slider of the machine's to move."""
+        from ..io.background import alarms_text
+
+        if self.limits.decide != "heater":
+            raise InputError(
+                "Artisan alarms move the machine's heater slider: this program sets the inlet gas temperature "
+                "(a model whose map reads a heater decides the heater)",
+                "--alarms",
+            )
+        series = [s for s in self._setting_series() if s[0] == "heater" or self.fan_actuator is not None]
+        return alarms_text(self.program.time_s, series, note="roastlab transfer")
+
+    def _setting_series(self) -> list:
+        """The program's settings for :func:`roastlab.io.background.setting_events`:
+        ``(setting, values, actuator for labels, thin?)`` (see :meth:`background_events`)."""
         from ..model.actuators import Actuator
 
         pr, lim = self.program, self.limits
@@ -183,7 +206,7 @@ class TransferResult(Result):
             pct = Actuator("fan", "percent", 0.0, 100.0, 5.0)
             span = lim.Gg_max_kg_s - lim.Gg_min_kg_s
             series.append(("fan", pct.quantise(100.0 * (pr.Gg_kg_s - lim.Gg_min_kg_s) / span), pct, True))
-        return setting_events(pr.time_s, series)
+        return series
 
     def alog_text(self) -> str:
         """An Artisan profile (Python-literal .alog, as Artisan writes) to load as a background
