@@ -398,3 +398,30 @@ def test_whatif_writes_the_changed_roast_as_an_artisan_background(cli, sky_model
     step = float(np.max(np.diff(t)))
     assert abs(back.events["FCs"] - probe["FCs_s"]) <= step and abs(back.events["DRY"] - probe["DRY_s"]) <= step
     assert back.events["DROP"] == pytest.approx(t[-1] - t[0]) and back.weight_in_kg == pytest.approx(w.batch_kg)
+
+
+def test_whatif_writes_the_changed_settings_as_artisan_alarms(cli, sky_model, tmp_path):
+    """whatif --alarms: an alarm per change of the changed heater and fan, at its time after CHARGE (a
+    setting at CHARGE at 0:01), moving the Burner or Air slider to the percentage; replayed step by step
+    the alarms give back the changed settings the prediction ran with."""
+    import json
+
+    from roastlab.io.background import alarm_slider_action
+    from roastlab.workflows.whatif import parse_setting_change, whatif
+
+    model_path, log = sky_model
+    alrm = tmp_path / "next.alrm"
+    code, _, err = cli("whatif", log, "--model", model_path, "--heater", "-10@4:00", "--alarms", alrm)
+    assert code == 0, err
+    model = roastlab.load_model(model_path)
+    w = whatif(model, roastlab.load_log(log, model.column_map), [parse_setting_change("heater", "-10@4:00", "percent")])
+    alarms = json.loads(alrm.read_text())
+    t = w.changed.time_s - w.changed.time_s[0]
+    for setting, etype in (("heater", "Burner"), ("fan", "Air")):
+        rows = [(s, v) for s, a, v in zip(alarms["alarmoffsets"], alarms["alarmactions"], alarms["alarmstrings"])
+                if a == alarm_slider_action(etype)]  # fmt: skip
+        assert rows, etype
+        replay = np.full(len(t), np.nan)
+        for at_s, text in rows:
+            replay[t >= (0 if at_s == 1 else at_s)] = float(text.split(" # ")[0])
+        np.testing.assert_allclose(replay, getattr(w.changed, setting), atol=1e-9, err_msg=setting)

@@ -496,4 +496,23 @@ def test_the_what_ifs_changed_roast_is_written_as_an_artisan_background(client, 
     np.testing.assert_allclose(log.channels["BT"], np.array(w["curves"]["BT_model"], dtype=float), atol=0.006)
     np.testing.assert_allclose(log.channels["ET"], np.array(w["curves"]["ET_model"], dtype=float), atol=0.006)
     assert "Tgi +20" in r["changes"][0]
+    assert r["alarms"] is None  # the paper's plant has no heater or fan slider to move
     assert client.post("/api/whatif-background", json={}, headers={"X-Session": "no-log-open"}).json()["error"]
+
+
+def test_the_what_ifs_changed_settings_are_written_as_artisan_alarms(client, data_dir):
+    """A Bullet log with the heater one step lower from 4:00: beside the background, the changed settings
+    as Artisan alarms; the Burner slider's last value before 4:00 is one step (10, in tens) above the
+    first after it."""
+    if not (data_dir / "bullet-model.json").exists():
+        pytest.skip("../shared/data/real is absent")
+    client.post("/api/open", json={"log": "logs/bullet-500g.json", "model": "bullet-model.json"}, headers=H)
+    r = client.post("/api/whatif-background", json={"heater": "-1@4:00"}, headers=H).json()
+    assert "error" not in r, r
+    assert r["alarms"].startswith("/downloads/") and r["alarms"].endswith("-whatif-settings.alrm")
+    alarms = client.get(r["alarms"]).json()
+    burner = [(s, float(v.split(" # ")[0])) for s, a, v in
+              zip(alarms["alarmoffsets"], alarms["alarmactions"], alarms["alarmstrings"]) if a == 6]  # fmt: skip
+    assert all(v % 10 == 0 for _, v in burner)
+    before = [v for s, v in burner if s < 240][-1]
+    assert [v for s, v in burner if s == 240] == [before - 10]

@@ -284,7 +284,8 @@ async function whatif() {
 async function whatifBackground() {
   try {
     const r = await api("/api/whatif-background", changes());
-    $("whatif_downloads").innerHTML = `<a href="${r.download}" download>${r.download.split("/").pop()}</a>`;
+    $("whatif_downloads").innerHTML = [r.download, r.alarms].filter(Boolean)
+      .map((u) => `<a href="${u}" download>${u.split("/").pop()}</a>`).join("<br>");
     say("");
     document.body.dataset.background = "done";
   } catch (e) {

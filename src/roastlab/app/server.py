@@ -384,14 +384,19 @@ def create_app(data_dir: str | Path):
 
     def whatif_background(session: Session, body: dict) -> dict:
         """The what-if's changed roast as an Artisan background (the page's changes, the same call as
-        ``roastlab whatif --alog``), written under the tab's downloads folder."""
+        ``roastlab whatif --alog``) and, where the machine has settings, its changed settings as Artisan
+        alarms (``--alarms``), written under the tab's downloads folder."""
         from ..workflows.whatif import whatif
 
         need(session)
         setting_changes, changes = _changes(body, session)
         w = whatif(session.model, session.batch, setting_changes, **changes)
-        (url,) = downloads(session, {f"{session.batch.name}-whatif-background.alog": w.alog_text()})
-        return {"download": url, "changes": w.changes}
+        stem = f"{session.batch.name}-whatif"
+        files = {f"{stem}-background.alog": w.alog_text()}
+        if w._setting_series():
+            files[f"{stem}-settings.alrm"] = w.alarms_text()
+        url, *alarms = downloads(session, files)
+        return {"download": url, "alarms": alarms[0] if alarms else None, "changes": w.changes}
 
     def downloads(session: Session, files: dict[str, str]) -> list[str]:
         """Write ``files`` (name -> text) under the tab's downloads folder, atomically and never over

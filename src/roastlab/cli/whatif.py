@@ -25,7 +25,7 @@ def cmd_whatif(args) -> int:
     from ..workflows.whatif import parse_set, parse_setting_change, whatif
 
     outputs = Outputs([args.log, args.model, args.map])
-    check_targets(outputs, args.json, args.alog, plot=args.plot)
+    check_targets(outputs, args.json, args.alog, args.alarms, plot=args.plot)
     model = load_model(args.model)
     warn_if_failed(model, args.model)
     cmap = load_map(args.map) if args.map else model.column_map
@@ -54,6 +54,8 @@ def cmd_whatif(args) -> int:
         write_json_and_plot(out, args, result.to_json_dict(), result)
         if args.alog:
             out.write_text(args.alog, result.alog_text())
+        if args.alarms:
+            out.write_text(args.alarms, result.alarms_text())
     return 0
 
 
@@ -77,7 +79,8 @@ def add_parsers(sub) -> None:
         "  roastlab whatif roast.json --model bullet.json --set heater=6@2:00 --fan -2\n"
         "  roastlab whatif roast.json --model bullet.json --batch-kg 0.8 --tm0 260 --units F\n"
         "  roastlab whatif roast.json --model bullet.json --heater -1@5:00 --band    # with the 90 % band\n"
-        "  roastlab whatif roast.json --model bullet.json --heater -1@5:00 --alog next.alog   # to roast against",
+        "  roastlab whatif roast.json --model bullet.json --heater -1@5:00 --alog next.alog   # to roast against\n"
+        "  roastlab whatif roast.alog --model model.json --heater -10@4:00 --alarms next.alrm  # for Artisan to run",
     )
     p.add_argument("log", metavar="LOG", help="the roast log (read with the model's map, or --map)")
     p.add_argument("--model", required=True, metavar="MODEL.json", help=MODEL_HELP)
@@ -109,5 +112,11 @@ def add_parsers(sub) -> None:
         metavar="BACKGROUND.alog",
         help="write the changed roast as an Artisan background to roast against: BT and ET predicted, DRY and first "
         "crack where the predicted BT reaches the log's marks, the changed heater and fan as events",
+    )
+    p.add_argument(
+        "--alarms",
+        metavar="SETTINGS.alrm",
+        help="write the changed heater and fan settings as an Artisan alarm set that moves the Burner and Air "
+        "sliders at each change after CHARGE (Config > Alarms > Load; a machine Artisan controls)",
     )
     p.set_defaults(func=cmd_whatif)

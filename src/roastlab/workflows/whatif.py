@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import InputError, ParameterError
 from ..io.batch import Batch
 from ..metrics.profile import (  # noqa: F401  (re-exported)
     clock_s,
@@ -321,18 +321,13 @@ class WhatIf(Result):
             for name, key in (("DRY", "DRY_s"), ("FCs", "FCs_s"))
             if key in probe and probe[key]["changed"] is not None and "changed" not in probe[key]["projected"]
         }
-        series = [
-            (k, getattr(ch, k), self.actuators[k], False)
-            for k in ("heater", "fan")
-            if getattr(ch, k) is not None and k in self.actuators
-        ]
         what = "; ".join(self.changes) or "no change"
         return background_alog_text(
             ch.time_s,
             ch.Ta_C,
             et,
             marks,
-            setting_events(ch.time_s, series),
+            setting_events(ch.time_s, self._setting_series()),
             title=f"roastlab whatif: {self.batch.name} ({what}, predicted)",
             notes=(
                 f"Computed by roastlab whatif from {self.batch.name} with {what}. BT is the model's prediction of "
@@ -342,6 +337,29 @@ class WhatIf(Result):
             roaster=self.roaster,
             batch_kg=self.batch_kg or 0.0,
         )
+
+    def alarms_text(self) -> str:
+        """The changed heater and fan settings as an Artisan alarm set (:func:`roastlab.io.background.alarms_text`):
+        loaded in Artisan (Config > Alarms > Load), it moves the Burner and Air sliders at each change of
+        the settings after CHARGE, on a machine Artisan controls, to roast the change as predicted."""
+        from ..io.background import alarms_text
+
+        series = self._setting_series()
+        if not series:
+            raise InputError(
+                "Artisan alarms move the machine's sliders: the model's map reads no heater or fan", "--alarms"
+            )
+        return alarms_text(self.changed.time_s, series, note="roastlab whatif")
+
+    def _setting_series(self) -> list:
+        """The changed settings for :func:`roastlab.io.background.setting_events`: ``(setting, values,
+        actuator, thin=False)``, each the machine's (its map's) and logged."""
+        ch = self.changed
+        return [
+            (k, getattr(ch, k), self.actuators[k], False)
+            for k in ("heater", "fan")
+            if getattr(ch, k) is not None and k in self.actuators
+        ]
 
     def to_frame(self):
         """One row per milestone and reading: measured, as run, changed, change, model error."""
