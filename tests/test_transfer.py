@@ -273,7 +273,7 @@ def test_a_heater_program_in_levels_becomes_artisan_alarms_that_move_the_burner_
     alarms = json.loads(r.alarms_text())
     n = len(alarms["alarmflags"])
     assert n >= 2 and all(len(v) == n for v in alarms.values())
-    events = setting_events(r.program.time_s, r._setting_series())
+    events = setting_events(r.program.time_s, r.setting_series())
     assert [e[1] for e in events] == ["Burner"] * n  # the fan is no machine slider here: not moved
     assert alarms["alarmactions"] == [alarm_slider_action("Burner")] * n == [6] * n
     assert alarms["alarmoffsets"] == [max(1, round(r.program.time_s[e[0]])) for e in events]

@@ -393,7 +393,7 @@ def create_app(data_dir: str | Path):
         w = whatif(session.model, session.batch, setting_changes, **changes)
         stem = f"{session.batch.name}-whatif"
         files = {f"{stem}-background.alog": w.alog_text()}
-        if w._setting_series():
+        if w.setting_series():
             files[f"{stem}-settings.alrm"] = w.alarms_text()
         url, *alarms = downloads(session, files)
         return {"download": url, "alarms": alarms[0] if alarms else None, "changes": w.changes}

@@ -167,7 +167,7 @@ class TransferResult(Result):
         :data:`~roastlab.model.actuators.MIN_HOLD_S` seconds, a held, logged setting with its own."""
         from ..io.background import setting_events
 
-        return setting_events(self.program.time_s, self._setting_series())
+        return setting_events(self.program.time_s, self.setting_series())
 
     def alarms_text(self) -> str:
         """The heater program (and the fan, where it is the machine's) as an Artisan alarm set
@@ -183,10 +183,11 @@ class TransferResult(Result):
                 "(a model whose map reads a heater decides the heater)",
                 "--alarms",
             )
-        series = [s for s in self._setting_series() if s[0] == "heater" or self.fan_actuator is not None]
+        # the heater, and the fan where it is the machine's own (not a chosen flow as % of its range)
+        series = [s for s in self.setting_series() if s[0] == "heater" or s[2] is self.fan_actuator]
         return alarms_text(self.program.time_s, series, note="roastlab transfer")
 
-    def _setting_series(self) -> list:
+    def setting_series(self) -> list:
         """The program's settings for :func:`roastlab.io.background.setting_events`:
         ``(setting, values, actuator for labels, thin?)`` (see :meth:`background_events`)."""
         from ..model.actuators import Actuator

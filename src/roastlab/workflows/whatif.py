@@ -327,7 +327,7 @@ class WhatIf(Result):
             ch.Ta_C,
             et,
             marks,
-            setting_events(ch.time_s, self._setting_series()),
+            setting_events(ch.time_s, self.setting_series()),
             title=f"roastlab whatif: {self.batch.name} ({what}, predicted)",
             notes=(
                 f"Computed by roastlab whatif from {self.batch.name} with {what}. BT is the model's prediction of "
@@ -344,14 +344,14 @@ class WhatIf(Result):
         the settings after CHARGE, on a machine Artisan controls, to roast the change as predicted."""
         from ..io.background import alarms_text
 
-        series = self._setting_series()
+        series = self.setting_series()
         if not series:
             raise InputError(
                 "Artisan alarms move the machine's sliders: the model's map reads no heater or fan", "--alarms"
             )
         return alarms_text(self.changed.time_s, series, note="roastlab whatif")
 
-    def _setting_series(self) -> list:
+    def setting_series(self) -> list:
         """The changed settings for :func:`roastlab.io.background.setting_events`: ``(setting, values,
         actuator, thin=False)``, each the machine's (its map's) and logged."""
         ch = self.changed
