@@ -220,3 +220,23 @@ def test_a_band_of_a_model_fitted_on_one_log_says_it_holds_no_spread(fitted):
         SimpleNamespace(doc={"fit": {}}, plant=None), [SimpleNamespace(Mb_kg=0.2, unit="2054")]
     )  # no spread, so no sizes or units to compare either
     assert three.startswith("the model was fitted on one log") and "nor" not in three
+
+
+def test_a_transfer_programs_band_is_around_its_predicted_curve(fitted):
+    """transfer --band: the program's batch (TransferResult.program_batch, what PROGRAM.csv holds) applied
+    by the model gives the program's predicted BT as the band's centre; the band is the model's, on plant B."""
+    from roastlab.fit.program import ProgramLimits
+    from roastlab.workflows.transfer import transfer
+
+    model, batches, _ = fitted
+    ref = batches[-1]  # held out of the fit
+    r = transfer(model, ref, "120kg", "120kg", limits=ProgramLimits(150.0, 550.0, 120.0), batch_kg=100.0,
+                 interval_s=10.0, band_level=0.9)  # fmt: skip
+    b = r.band
+    np.testing.assert_allclose(b.predicted_C, r.program.Ta_pred_C, atol=1e-6)
+    assert np.all(b.lower_C <= b.predicted_C) and np.all(b.predicted_C <= b.upper_C) and b.median_width_C > 0.1
+    assert r.metrics["band"]["level"] == 0.9 and r.metrics["band"]["median_width_C"] == round(b.median_width_C, 2)
+    assert "90 % prediction band of the predicted BT" in r.summary()
+    # a model file with neither covariance nor spread carries no band: said before any work
+    with pytest.raises(ParameterError, match="no band"):
+        transfer(roastlab.FittedModel.paper("120kg"), ref, "120kg", "120kg", batch_kg=100.0, band_level=0.9)

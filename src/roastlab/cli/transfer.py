@@ -7,6 +7,7 @@ import argparse
 from ..errors import InputError
 from .common import (
     MODEL_HELP,
+    add_band_option,
     check_targets,
     float_arg,
     range_arg,
@@ -74,6 +75,7 @@ def cmd_transfer(args) -> int:
         tm0_free=tm0_free,
         tolerance_C=args.tolerance,
         initial=initial,
+        band_level=args.band,
     )
     say(result.metrics["notes"])
     print(result.summary())
@@ -220,6 +222,8 @@ def add_parsers(sub) -> None:
         default=2.0,
         help="feasible when max |predicted - target| <= this [degC] (default 2)",
     )
+    add_band_option(p, "the predicted BT's prediction band", "its median width and BT at DROP in the output, "
+                    "shaded in --plot, in --json: where a roast run with the program is expected")  # fmt: skip
     p.add_argument("--json", metavar="METRICS.json", help="write the metrics, baselines and limits as JSON")
     p.add_argument(
         "--plot", metavar="FIG.png", help="target vs predicted BT, the program with its limits, the baselines"

@@ -277,6 +277,31 @@ class Band:
         return float(np.median(self.width_C))
 
 
+def band_summary(band: Band, note: str | None = None) -> dict:
+    """A band in a result's JSON: its level, median width and BT at DROP between its bounds [degC],
+    and ``note`` (:func:`band_note`) where there is one."""
+    return {
+        "level": band.level,
+        "median_width_C": round(band.median_width_C, 2),
+        "DROP_lower_C": round(float(band.lower_C[-1]), 2),
+        "DROP_upper_C": round(float(band.upper_C[-1]), 2),
+        **({"note": note} if note else {}),
+    }
+
+
+def band_words(band: Band, what: str, units: str = "C") -> str:
+    """A band in one line: its level, what it is the band of (``what``: "the changed probe BT"), its
+    median width and BT at DROP between its bounds, in ``units`` ("C" or "F")."""
+    from ..metrics.profile import display_temp, display_temp_delta
+
+    u = "°F" if units == "F" else "°C"
+    return (
+        f"{band.level * 100:g} % prediction band of {what} (parameter covariance and roast-to-roast spread): "
+        f"median width {display_temp_delta(band.median_width_C, units):.1f} {u}; BT at DROP "
+        f"{display_temp(band.lower_C[-1], units):.1f} to {display_temp(band.upper_C[-1], units):.1f} {u}"
+    )
+
+
 def prediction_bands(model, batches, level: float = BAND_LEVEL, plant=None, **changes) -> list[Band]:
     """The level-``level`` band of the probe prediction for each batch (module docstring); ``plant``
     and ``changes`` as :meth:`roastlab.workflows.model.FittedModel.apply` (a what-if's band)."""

@@ -380,6 +380,9 @@ def plot_transfer(r, path=None, outputs=None):
         label=f"predicted on {r.plant_to}, {'runnable' if 'runnable' in m else 'optimised'} program "
         f"(RMSE {m['rmse_C']:.2f} °C)",
     )
+    if r.band is not None:  # where a roast run with the program is expected (transfer --band)
+        ax.fill_between(t_min, r.band.lower_C, r.band.upper_C, color="tab:blue", alpha=0.12, lw=0,
+                        label=f"{r.band.level * 100:g} % prediction band")  # fmt: skip
     styles = {"A's inputs unchanged": ("tab:orange", "--"), "A's inputs retimed": ("tab:green", ":")}
     keys = {"A's inputs unchanged": "baseline_same_inputs", "A's inputs retimed": "baseline_retimed"}
     for name, ta in r.baselines.items():

@@ -82,6 +82,10 @@ class TransferResult(Result):
     et_source: str = "Tgi"
     #: the machine's fan (for the background's Air events), when the map declares one
     fan_actuator: object = None
+    #: the predicted probe BT's prediction band (:class:`roastlab.evaluate.bands.Band`) when asked for
+    band: object | None = None
+    #: why the band may hold fewer samples than its level (:func:`roastlab.evaluate.bands.band_note`)
+    band_note: str | None = None
 
     # ------------------------------------------------------------------ text outputs
     def summary(self) -> str:
@@ -125,6 +129,16 @@ class TransferResult(Result):
             rows.append(line)
         if m.get("Tm0_chosen"):
             rows.append(f"drum at CHARGE (chosen by the optimiser): {m['Tm0_C']:.0f} °C")
+        if self.band is not None:
+            from ..evaluate.bands import band_words
+
+            rows.append(band_words(self.band, "the predicted BT"))
+            rows.append(
+                "  (a roast run with the program is expected inside it; the tolerance above is the model against "
+                "the target, not the roast against the model)"
+            )
+            if self.band_note:
+                rows.append(f"note: {self.band_note}")
         if "runnable" in m:
             r = m["runnable"]
             rows.append(f"program ({r['what']}):")
@@ -134,28 +148,44 @@ class TransferResult(Result):
     def to_json_dict(self) -> dict:
         return self.metrics
 
-    def program_csv_text(self) -> str:
-        """PROGRAM.csv: the knots, the inputs and the predicted probe; metadata lines carry the
-        charge state and batch mass, so ``roastlab simulate --inputs`` reproduces ``Ta_pred_C``."""
+    def program_batch(self) -> Batch:
+        """The program as a batch on plant B: its inputs, the batch mass and the charge state it was
+        optimised for, so that the model applied to it (``model.predict(batch, plant=B)``) gives
+        ``Ta_pred_C``; what PROGRAM.csv holds (:meth:`program_csv_text`). A model that fitted a constant
+        flow gets its 1 kg/s placeholder (it applies its own). The drum at CHARGE is the reading that
+        implies it (:func:`roastlab.model.rhs.drum_at_charge_C`), as a log gives it."""
         pr = self.program
+        x0 = pr.states[0].copy()  # the charge state the program was optimised for (Tm0 possibly chosen)
+        x0[S_TM] = drum_start_reading_C(x0[S_TM], pr.params[P["Tm0_share"]], pr.params[P["T_room"]])
+        return Batch(
+            f"{self.reference} program",
+            pr.time_s.copy(),
+            np.ones_like(pr.Gg_kg_s) if self.model_fits_flow else pr.Gg_kg_s.copy(),
+            pr.Tgi_C.copy(),
+            initial={key: float(x0[STATE0[key]]) for key in ("Tm0_C", "Tb0_C", "X0", "Ta0_C")},
+            Mb_kg=self.batch_kg,
+            heater=pr.heater.copy() if self.actuators else None,
+            fan=pr.fan.copy() if self.actuators else None,
+        )
+
+    def program_csv_text(self) -> str:
+        """PROGRAM.csv: :meth:`program_batch` and the predicted probe; metadata lines carry the charge
+        state and batch mass, so ``roastlab simulate --inputs`` reproduces ``Ta_pred_C``."""
+        b = self.program_batch()
         out = io.StringIO()
         out.write(f"## roastlab transfer program: {self.plant_from} -> {self.plant_to}\n")
         if self.model_fits_flow:
             out.write("## Gg_kg_s is the model's placeholder: the flow is the model's fitted Gg_kg_s\n")
-        out.write(f"# Mb_kg = {self.batch_kg:.6g}\n")
-        x0 = pr.states[0].copy()  # the charge state the program was optimised for (Tm0 possibly chosen)
-        # a batch file holds the reading that implies the drum (roastlab.model.rhs.drum_at_charge_C)
-        x0[S_TM] = drum_start_reading_C(x0[S_TM], pr.params[P["Tm0_share"]], pr.params[P["T_room"]])
-        for key in ("Tm0_C", "Tb0_C", "X0", "Ta0_C"):
-            out.write(f"# {key} = {x0[STATE0[key]]:.10g}\n")
+        out.write(f"# Mb_kg = {b.Mb_kg:.6g}\n")
+        for key, value in b.initial.items():
+            out.write(f"# {key} = {value:.10g}\n")
         cols = ["time_s", "Gg_kg_s", "Tgi_C"] + (["heater", "fan"] if self.actuators else []) + ["Ta_pred_C"]
         out.write(",".join(cols) + "\n")
-        for i, t in enumerate(pr.time_s):
-            gg = 1.0 if self.model_fits_flow else pr.Gg_kg_s[i]
-            vals = [f"{t:.6g}", f"{gg:.10g}", f"{pr.Tgi_C[i]:.10g}"]
+        for i, t in enumerate(b.time_s):
+            vals = [f"{t:.6g}", f"{b.Gg_kg_s[i]:.10g}", f"{b.Tgi_C[i]:.10g}"]
             if self.actuators:
-                vals += [f"{pr.heater[i]:.10g}", f"{pr.fan[i]:.10g}"]
-            vals.append(f"{pr.Ta_pred_C[i]:.6f}")
+                vals += [f"{b.heater[i]:.10g}", f"{b.fan[i]:.10g}"]
+            vals.append(f"{self.program.Ta_pred_C[i]:.6f}")
             out.write(",".join(vals) + "\n")
         return out.getvalue()
 
@@ -358,6 +388,7 @@ def transfer(
     tm0_free: tuple[float, float] | None = None,
     tolerance_C: float = 2.0,
     initial: dict | None = None,
+    band_level: float | None = None,
 ) -> TransferResult:
     """Compute the program that reproduces ``reference``'s probe curve on ``plant_to``.
 
@@ -376,8 +407,16 @@ def transfer(
     tm0_free : (lo, hi) [degC] to make the drum temperature at CHARGE a decision
     tolerance_C : the program is ``feasible`` when max |Ta_pred - target| is at most this
     initial : charge state changes on B (``Tb0_C``, ``Tm0_C``, ``X0``)
+    band_level : e.g. 0.9: also the predicted probe BT's prediction band, the program's batch
+        (:meth:`TransferResult.program_batch`) through :func:`roastlab.evaluate.bands.prediction_bands`
     """
     from ..io.plants import load_plant
+
+    if band_level is not None:
+        from ..evaluate.bands import check_level, require_band
+
+        band_level = check_level(band_level)
+        require_band(model)
 
     limits = limits or default_limits(model, plant_from, plant_to)
     src = reference.source or reference.name
@@ -542,7 +581,7 @@ def transfer(
             **_errors(continuous.Ta_pred_C, target),
             "what": "the optimiser's continuous program, before rounding to the machine's settings",
         }
-    return TransferResult(
+    result = TransferResult(
         reference=reference.name,
         plant_from=pa.name,
         plant_to=pb.name,
@@ -561,6 +600,14 @@ def transfer(
         et_source=et_source(cmap),
         fan_actuator=cmap.actuator("fan") if cmap is not None and cmap.fan else None,
     )
+    if band_level is not None:
+        from ..evaluate.bands import band_note, band_summary, prediction_bands
+
+        run = result.program_batch()
+        result.band = prediction_bands(model, [run], band_level, plant=pb)[0]
+        result.band_note = band_note(model, [run], mass_b)
+        metrics["band"] = band_summary(result.band, result.band_note)
+    return result
 
 
 def _spans_in_words(spans, listed: int = 3) -> str:

@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, ParameterError
+from ..evaluate import bands
 from ..io.batch import Batch
 from ..metrics.profile import (  # noqa: F401  (re-exported)
     clock_s,
@@ -196,16 +197,9 @@ class WhatIf(Result):
 
     def band_line(self, units: str = "C") -> str | None:
         """The changed probe BT's band in one line: its level, median width and BT at DROP."""
-        b = self.band
-        if b is None:
-            return None
-        u = "°F" if units == "F" else "°C"
-        width = display_temp_delta(b.median_width_C, units)
-        return (
-            f"{b.level * 100:g} % prediction band of the changed probe BT (parameter covariance and roast-to-roast "
-            f"spread): median width {width:.1f} {u}; BT at DROP {display_temp(b.lower_C[-1], units):.1f} to "
-            f"{display_temp(b.upper_C[-1], units):.1f} {u}"
-        )
+        from ..evaluate.bands import band_words
+
+        return None if self.band is None else band_words(self.band, "the changed probe BT", units)
 
     def table(self, units: str = "C") -> str:
         """The milestone table as text; ``units`` "C" or "F" for temperatures."""
@@ -292,17 +286,7 @@ class WhatIf(Result):
             "levels_C": self.levels,
             "rows": self.rows,
             "warnings": self.warnings(),
-            **({"band": self._band_dict()} if self.band is not None else {}),
-        }
-
-    def _band_dict(self) -> dict:
-        b = self.band
-        return {
-            "level": b.level,
-            "median_width_C": round(b.median_width_C, 2),
-            "DROP_lower_C": round(float(b.lower_C[-1]), 2),
-            "DROP_upper_C": round(float(b.upper_C[-1]), 2),
-            **({"note": self.band_note} if self.band_note else {}),
+            **({"band": bands.band_summary(self.band, self.band_note)} if self.band is not None else {}),
         }
 
     def alog_text(self) -> str:
