@@ -630,6 +630,17 @@ def test_an_unmarked_charge_and_drop_are_read_from_bt(tmp_path):
                            extra={"timex": t.tolist(), "timeindex": [10, 0, 0, 0, 0, 0, 400, 0]}))  # fmt: skip
     log = read_alog(p)
     assert log.charge_index == 10 and log.time_s[-1] == t[400] - t[10] and not log.notes
+    # marks past the last sample (a template whose marks are seconds, a file cut short): said, read as unmarked
+    p.write_text(fake_alog(bt=bt.tolist(), et=[220.0] * len(t), n=len(t),
+                           extra={"timex": t.tolist(), "timeindex": [10, 600, 0, 0, 0, 0, 700, 0]}))  # fmt: skip
+    log = read_alog(p)
+    assert log.notes[0] == f"DRY (sample 600), DROP (sample 700) marked past the log's last sample ({len(t) - 1}): " \
+        "read as unmarked"  # fmt: skip
+    assert (
+        "DRY" not in log.events
+        and log.notes[1].startswith("no DROP marked")
+        and abs(log.time_s[-1] - (630.0 - t[10])) <= 3.0
+    )
 
 
 @pytest.mark.parametrize("drop_marked", [True, False])

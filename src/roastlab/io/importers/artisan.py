@@ -532,6 +532,10 @@ def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: boo
         ti[6] if 0 < ti[6] < n else None,  # DROP unmarked: 0
         keep_after_drop,
     )
+    # a mark past the last sample does not belong to these samples (a template, a file cut short)
+    beyond = [f"{name} (sample {k})" for name, k in zip(EVENT_NAMES, ti) if k >= n]
+    if beyond:
+        notes.insert(0, f"{', '.join(beyond)} marked past the log's last sample ({n - 1}): read as unmarked")
     ti[0], ti[6] = charge, drop or 0
     events = {}
     for name, k in zip(EVENT_NAMES, ti):
