@@ -24,7 +24,18 @@ from test_bad_input import GOOD_ALOG, GOOD_ROWS, HEADER, PLANT
 OUTPUTS = {"--out", "--json", "--plot", "--predictions", "--save", "--alog", "--alarms", "--db"}
 #: Options that name a file or folder the command reads.
 INPUTS = {"--model", "--theta", "--plant", "--inputs", "--map", "--spec", "--data", "batches", "log", "plant"}
-INPUTS |= {"--from", "--to", "--reference", "--scenario", "--scenarios", "--manifest", "--data-dir", "logs", "dir"}
+INPUTS |= {
+    "--from",
+    "--to",
+    "--reference",
+    "--target",
+    "--scenario",
+    "--scenarios",
+    "--manifest",
+    "--data-dir",
+    "logs",
+    "dir",
+}
 #: Options that take no path: numbers, names, choices and flags.
 VALUES = {
     "--every-log",

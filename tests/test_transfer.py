@@ -286,3 +286,33 @@ def test_a_heater_program_in_levels_becomes_artisan_alarms_that_move_the_burner_
     model_t, ref_t = random_reference(np.random.default_rng(6), "120kg", minutes=3.0)
     with pytest.raises(InputError, match="heater slider"):
         transfer(model_t, ref_t, "120kg", "120kg", limits=ProgramLimits(150.0, 550.0, 120.0)).alarms_text()
+
+
+def test_a_target_from_another_roast_is_followed_from_the_references_inputs(cli, tmp_path):
+    """transfer --target: the curve is the target's BT over the target's span (SYNTHETIC: a 12-minute roast
+    the model made with other inputs); the reference (15 minutes) gives the start and the charge state; the
+    reference's own inputs as the baseline are held where the target runs past them."""
+    from roastlab.workflows.transfer import aim_at
+
+    model, ref = random_reference(np.random.default_rng(5), "120kg")
+    _, other = random_reference(np.random.default_rng(11), "120kg", minutes=12.0)
+    aimed = aim_at(ref, other)
+    assert aimed.time_s[-1] == 720.0 and aimed.Ta_C is not other.Ta_C
+    np.testing.assert_array_equal(aimed.Ta_C, other.Ta_C)
+    np.testing.assert_allclose(aimed.Tgi_C, np.interp(other.time_s, ref.time_s, ref.Tgi_C))
+    assert aimed.Mb_kg == ref.Mb_kg and aimed.initial == ref.initial and "curve to follow" in aimed.notes[0]
+    model.save(tmp_path / "model.json")
+    write_batch_csv(tmp_path / "ref.csv", ref, comment="SYNTHETIC reference for a test")
+    write_batch_csv(tmp_path / "target.csv", other, comment="SYNTHETIC target for a test")
+    code, out, err = cli(
+        "transfer", "--model", tmp_path / "model.json", "--reference", tmp_path / "ref.csv",
+        "--target", tmp_path / "target.csv", "--out", tmp_path / "p.csv", "--json", tmp_path / "m.json",
+    )  # fmt: skip
+    assert code == 0, err
+    assert "the curve to follow is target's BT (12:00 from CHARGE to DROP)" in err
+    prog = pd.read_csv(tmp_path / "p.csv", comment="#")
+    assert prog["time_s"].iloc[-1] == pytest.approx(720.0)
+    assert json.loads((tmp_path / "m.json").read_text())["rmse_C"] < 2.0  # the model's own curve: reachable
+    code, _, err = cli("transfer", "--model", tmp_path / "model.json", "--reference", tmp_path / "ref.csv",
+                       "--target", tmp_path / "none.csv", "--out", tmp_path / "q.csv")  # fmt: skip
+    assert code == 2 and "none.csv" in err and err.count("\n") == 1

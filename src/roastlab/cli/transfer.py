@@ -25,7 +25,7 @@ def cmd_transfer(args) -> int:
     from ..workflows.model import load_model
     from ..workflows.transfer import default_limits, transfer
 
-    outputs = Outputs([args.reference, args.model, args.map, args.plant_from, args.plant_to])
+    outputs = Outputs([args.reference, args.target, args.model, args.map, args.plant_from, args.plant_to])
     check_targets(outputs, args.out, args.json, args.alog, args.alarms, plot=args.plot)
     if args.gg is not None and (args.gg_min is not None or args.gg_max is not None):
         raise InputError(
@@ -35,6 +35,13 @@ def cmd_transfer(args) -> int:
     warn_if_failed(model, args.model)
     reference = read_inputs(args.reference, args.map, model)
     say(reference.notes)
+    if args.target:
+        from ..io.importers import import_log
+        from ..workflows.transfer import aim_at
+
+        # any log's BT, read with its format's own channels (another machine's map is not this model's)
+        reference = aim_at(reference, import_log(args.target, None))
+        say(reference.notes)
     initial = {}
     for opt, name in (("tb0", "Tb0_C"), ("x0", "X0")):
         if getattr(args, opt) is not None:
@@ -122,6 +129,8 @@ def add_parsers(sub) -> None:
         "examples:\n"
         "  roastlab transfer --model myroaster/model.json --reference roast.alog --batch-kg 0.25 --out program.csv \\\n"
         "      --plot transfer.png --alog next.alog --alarms next.alrm   # your roaster's log at another batch size\n"
+        "  roastlab transfer --model myroaster/model.json --reference roast.alog --target bullet.json --out program.csv\n"
+        "                                          # another machine's roast on yours\n"
         "  roastlab transfer --model model.json --from 120kg --to 360kg --reference batch1.csv --out program.csv\n"
         "  roastlab transfer --model model.json --from 120kg --to 120kg --batch-kg 84 --reference batch1.csv \\\n"
         "      --out program.csv --tm0 free --plot transfer.png --alog background.alog",
@@ -137,6 +146,13 @@ def add_parsers(sub) -> None:
         "--reference", required=True, metavar="REF", help="batch CSV (time_s,Gg_kg_s,Tgi_C,Ta_C) or a log (with --map)"
     )
     p.add_argument("--map", metavar="MAP.toml", help="column map for a raw-log reference (default: the model's own)")
+    p.add_argument(
+        "--target",
+        metavar="TARGET",
+        help="follow this log's BT instead of the reference's: another machine's roast, a profile drawn in Artisan's "
+        "Designer (any .alog, RoasTime .json or batch CSV, read with its format's own channels); the reference, a "
+        "log of the model's machine, then gives the program's start, the batch and the charge state",
+    )
     p.add_argument("--out", required=True, metavar="PROGRAM.csv", help="where to write the program")
     p.add_argument(
         "--batch-kg",

@@ -337,6 +337,43 @@ def model_et_C(result, source: str) -> np.ndarray:
     return result.gas_seen()[1]
 
 
+def aim_at(reference: Batch, target: Batch) -> Batch:
+    """``reference`` (a log of the model's machine: its inputs, batch and charge state) with ``target``'s
+    probe curve as the one to follow: a roast of another machine, one drawn in Artisan's Designer, a
+    competitor's. On the target's time from its CHARGE to its DROP, with its marks; the reference's inputs
+    interpolated there (settings held, the last value held past the reference's end) as the program's
+    start and the baselines' inputs."""
+    if target.Ta_C is None:
+        raise InputError("the target has no bean-probe curve (BT): nothing to follow", target.source or target.name)
+    t = np.asarray(target.time_s, dtype=float) - float(target.time_s[0])
+    tr = np.asarray(reference.time_s, dtype=float) - float(reference.time_s[0])
+
+    def held(series):
+        if series is None:
+            return None
+        return np.asarray(series, dtype=float)[np.clip(np.searchsorted(tr, t, side="right") - 1, 0, len(tr) - 1)]
+
+    return dataclasses.replace(
+        reference,
+        name=target.name,
+        source=target.source or target.name,
+        time_s=t,
+        Gg_kg_s=np.interp(t, tr, reference.Gg_kg_s),
+        Tgi_C=np.interp(t, tr, reference.Tgi_C),
+        Ta_C=np.asarray(target.Ta_C, dtype=float).copy(),
+        heater=held(reference.heater),
+        fan=held(reference.fan),
+        Tb2_C=None,
+        ET_C=None,
+        events=dict(target.events),
+        initial=dict(reference.initial),
+        notes=[
+            f"the curve to follow is {target.name}'s BT ({mmss(t[-1])} from CHARGE to DROP); the program starts "
+            f"from {reference.name}'s inputs, batch and charge state"
+        ],
+    )
+
+
 def _grid_batch(ref: Batch, interval_s: float) -> Batch:
     """The reference on the program's knots: inputs and probe interpolated, settings held."""
     t_end = float(ref.time_s[-1])
