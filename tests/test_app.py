@@ -162,6 +162,26 @@ def test_transfer_limits_and_charge_state_from_the_page(client, data_dir):
     assert rows["beans", "DRY_s"]["changed"] < rows["beans", "DRY_s"]["as_run"]  # warmer beans dry sooner
 
 
+def test_the_page_transfers_another_logs_curve_with_the_programs_band(client, data_dir):
+    """The page's "follow the curve of": another log's BT (unit 2054's 800 g roast) from the open log's
+    settings and charge state (transfer --target), with the predicted BT's band around its prediction."""
+    if not (data_dir / "bullet-model.json").exists():
+        pytest.skip("../shared/data/real is absent")
+    client.post("/api/open", json={"log": "logs/bullet-500g.json", "model": "bullet-model.json"}, headers=H)
+    own = client.post("/api/transfer", json={"batch_kg": 0.5}, headers=H).json()
+    other = client.post("/api/transfer", json={"batch_kg": 0.5, "target": "logs/bullet-800g-unit2054.json"},
+                        headers=H).json()  # fmt: skip
+    assert "error" not in other, other
+    assert len(other["target"]) != len(own["target"])  # the other roast's span, not the open log's
+    assert "bullet-800g-unit2054" in other["summary"].splitlines()[0]
+    assert all(u.split("/")[-1].startswith("bullet-800g-unit2054-0.5kg") for u in other["downloads"])
+    lower, upper, pred = (np.array(x, dtype=float) for x in (other["band"]["lower"], other["band"]["upper"],
+                                                              other["predicted"]))  # fmt: skip
+    assert np.all(lower <= pred + 0.01) and np.all(pred <= upper + 0.01) and other["band"]["median_width_C"] > 1
+    out = client.post("/api/transfer", json={"target": "../../etc/passwd"}, headers=H)
+    assert out.status_code == 400 and "data folder" in out.json()["error"]
+
+
 def test_tabs_do_not_share_state(client):
     client.post("/api/open", json={"log": "batch1.csv", "model": "paper-model.json"}, headers=H)
     other = client.post("/api/whatif", json={"tgi": 10}, headers={"X-Session": "test-session-b"}).json()

@@ -343,6 +343,8 @@ async function refreshFiles(selectLog) {
   fill("log", f.logs, selectLog);
   fill("model", f.models, pickModel);
   fill("fit_logs", f.logs);
+  $("tr_target").innerHTML = `<option value="">(this log)</option>` +
+    f.logs.map((p) => `<option value="${p}">${p}</option>`).join("");
 }
 let pickModel = null;
 
@@ -405,11 +407,17 @@ async function runTransfer() {
   $("transfer_progress").removeAttribute("value");  // indeterminate: the solve reports no steps
   $("transfer-summary").textContent = "running the transfer ...";
   try {
-    const r = await api("/api/transfer", { batch_kg: $("tr_batch_kg").value, plant_to: $("tr_plant").value.trim(), tm0_free: $("tr_tm0_free").checked, limit_low: $("tr_low").value, limit_high: $("tr_high").value });
+    const r = await api("/api/transfer", { batch_kg: $("tr_batch_kg").value, plant_to: $("tr_plant").value.trim(), tm0_free: $("tr_tm0_free").checked, limit_low: $("tr_low").value, limit_high: $("tr_high").value, target: $("tr_target").value });
     $("transfer-summary").textContent = r.summary;
     $("downloads").innerHTML = r.downloads.map((u) => `<a href="${u}" download>${u.split("/").pop()}</a>`).join("");
     const x = minutes(r.time_s);
+    const band = r.band ? [  // where a roast run with the program is expected (transfer --band)
+      { x, y: r.band.upper.map(temp), line: { width: 0 }, showlegend: false, hoverinfo: "skip" },
+      { x, y: r.band.lower.map(temp), fill: "tonexty", fillcolor: "rgba(31,119,180,0.15)", line: { width: 0 },
+        name: `${Math.round(r.band.level * 100)} % band of the predicted BT` },
+    ] : [];
     Plotly.react("transfer-plot", [
+      ...band,
       { x, y: r.target.map(temp), name: "target BT", line: { color: "#333", width: 2 } },
       { x, y: r.predicted.map(temp), name: "predicted BT with the program", line: { color: "#1f77b4" } },
       { x, y: r.program, name: `program: ${r.decide} [${shownUnit(r.unit)}]`, yaxis: "y2", line: { shape: "hv", color: "#d62728" } },

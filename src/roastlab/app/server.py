@@ -411,9 +411,11 @@ def create_app(data_dir: str | Path):
         return [f"/{rel}/{name}" for name in names]
 
     def transfer_(session: Session, body: dict) -> dict:
+        from ..evaluate.bands import BAND_LEVEL, why_no_band
+        from ..io.importers import import_log
         from ..model.limits import check_value
         from ..model.plant import preset_names
-        from ..workflows.transfer import TM0_FREE_RANGE_C, transfer
+        from ..workflows.transfer import TM0_FREE_RANGE_C, aim_at, transfer
 
         need(session)
         kg = body.get("batch_kg")
@@ -421,16 +423,20 @@ def create_app(data_dir: str | Path):
         plant_to = body.get("plant_to") or None
         if plant_to is not None and not any(plant_to == p for p in preset_names()):
             plant_to = inside(data, plant_to)  # a PLANT.toml in the data folder, never outside it
+        reference = session.batch
+        if body.get("target"):  # another log's BT from this log's settings and charge state (transfer --target)
+            reference = aim_at(reference, import_log(inside(data, body["target"]), None))
         r = transfer(
             session.model,
-            session.batch,
+            reference,
             None,
             plant_to,
             limits=_limits(body, session.model, plant_to),
             batch_kg=None if kg in (None, "") else check_value("batch_kg", kg, "to batch"),
             tm0_free=tm0_free,
+            band_level=None if why_no_band(session.model) else BAND_LEVEL,
         )
-        stem = f"{session.batch.name}-{r.batch_kg:g}kg"
+        stem = f"{reference.name}-{r.batch_kg:g}kg"  # the followed curve's name (a --target's)
         files = {f"{stem}-program.csv": r.program_csv_text(), f"{stem}-background.alog": r.alog_text()}
         if r.limits.decide == "heater":  # a heater program runs in Artisan as its alarms (transfer --alarms)
             files[f"{stem}-program.alrm"] = r.alarms_text()
@@ -450,6 +456,7 @@ def create_app(data_dir: str | Path):
             "high": r.limits.high,
             "step": r.limits.actuator.step if r.limits.actuator is not None and r.limits.actuator.stepped else None,
             "downloads": urls,
+            "band": band_dict(r.band) if r.band is not None else None,
         }
 
     def fit_start(session: Session, body: dict) -> dict:
