@@ -349,9 +349,7 @@ def aim_at(reference: Batch, target: Batch) -> Batch:
     tr = np.asarray(reference.time_s, dtype=float) - float(reference.time_s[0])
 
     def held(series):
-        if series is None:
-            return None
-        return np.asarray(series, dtype=float)[np.clip(np.searchsorted(tr, t, side="right") - 1, 0, len(tr) - 1)]
+        return _held(series, tr, t)
 
     return dataclasses.replace(
         reference,
@@ -374,16 +372,22 @@ def aim_at(reference: Batch, target: Batch) -> Batch:
     )
 
 
+def _held(series, time_s, at_s):
+    """A setting logged at ``time_s`` as held between its changes, at the times ``at_s`` (the first
+    value before the log, the last after it); None for no series."""
+    if series is None:
+        return None
+    j = np.clip(np.searchsorted(time_s, at_s, side="right") - 1, 0, len(time_s) - 1)
+    return np.asarray(series, dtype=np.float64)[j]
+
+
 def _grid_batch(ref: Batch, interval_s: float) -> Batch:
     """The reference on the program's knots: inputs and probe interpolated, settings held."""
     t_end = float(ref.time_s[-1])
     t = np.arange(0.0, t_end + 1e-9, interval_s) + float(ref.time_s[0])
 
     def held(series):
-        if series is None:
-            return None
-        j = np.clip(np.searchsorted(ref.time_s, t, side="right") - 1, 0, ref.n - 1)
-        return series[j].astype(np.float64)
+        return _held(series, ref.time_s, t)
 
     return dataclasses.replace(
         ref,
