@@ -1150,29 +1150,43 @@ def test_the_examples_fit_specs_bound_the_gas_flow_as_init_does():
         assert (gg.lower, gg.upper) == (GAS_FLOW_MIN_KG_S, GAS_FLOW_MAX_FLOOR_KG_S), machine
 
 
-def test_init_says_how_to_fit_the_probe_depth_where_the_logs_span_batch_sizes(cli, tmp_path):
-    """SYNTHETIC logs of 200 and 300 g: init holds the probe's depth scale at the drum's diameter and,
-    because these sizes could determine it, writes the line that frees it (the quantity table's bounds,
-    started where it is held), which the fit spec reads; logs of one size get no such line."""
+def test_init_fits_the_probe_depth_where_the_logs_span_batch_sizes_without_a_bean_reading(cli, tmp_path):
+    """SYNTHETIC logs of 200 and 300 g with the probe alone: init frees the probe's depth scale (the
+    quantity table's bounds, started at the drum's diameter), which only a change of batch size determines
+    and which alone tells the probe from the beans. With a bean reading beside the probe it holds it at
+    the diameter and writes the line that frees it; logs of one size: held, no such line."""
     import re
 
     from roastlab.io.fitspec import load_fit_spec
+    from roastlab.io.plants import load_plant
+    from roastlab.model.bed import PROBE_DEPTH_OVER_DIAMETER
     from roastlab.model.quantities import quantity
 
-    logs = [tmp_path / f"r{k}.alog" for k in range(3)]
-    for k, p in enumerate(logs):
-        p.write_text(fake_alog(extra=dict(_BURNER_AIR, **({"weight": [300, 0, "g"]} if k == 1 else {}))))
-    assert cli("init", *logs, "--out", tmp_path / "cfg")[0] == 0
-    text = (tmp_path / "cfg" / "fit.toml").read_text()
+    def spec_of(name, extra):
+        logs = [tmp_path / f"{name}{k}.alog" for k in range(3)]
+        for k, p in enumerate(logs):
+            p.write_text(fake_alog(extra=dict(extra, **({"weight": [300, 0, "g"]} if k == 1 else {}))))
+        assert cli("init", *logs, "--out", tmp_path / name)[0] == 0
+        return logs, (tmp_path / name / "fit.toml").read_text(), load_fit_spec(tmp_path / name / "fit.toml")
+
+    logs, text, spec = spec_of("probe", _BURNER_AIR)
+    (h,) = [f for f in spec.free if f.name == "h_probe_m"]
+    assert (h.lower, h.upper) == quantity("h_probe_m").bounds and "h_probe_m" not in spec.fixed
+    assert "these logs span 200-300 g and no bean reading runs beside the probe" in text
+    plant = load_plant(tmp_path / "probe" / "plant.toml")
+    assert h.start == pytest.approx(PROBE_DEPTH_OVER_DIAMETER * plant.Dch_m, rel=1e-3)  # started at the diameter
+    _, text, spec = spec_of("ir", dict(_BURNER_AIR, **_ir_as_et()))  # a bean reading beside the probe
     held = float(re.search(r"\n\[fixed\]\nh_probe_m = ([0-9.]+)", text).group(1))
+    assert spec.fixed["h_probe_m"] == held
     hint = re.search(r"# these logs span 200-300 g, .* as (h_probe_m = \[[^\]]*\])", text)
     assert hint, text
     freed = text.replace("[free]\n", f"[free]\n{hint.group(1)}\n").replace(f"h_probe_m = {held:g} ", "# ")
     (tmp_path / "freed.toml").write_text(freed)
-    (h,) = [f for f in load_fit_spec(tmp_path / "freed.toml").free if f.name == "h_probe_m"]
-    assert (h.lower, h.upper) == quantity("h_probe_m").bounds and h.start == held
+    (f,) = [f for f in load_fit_spec(tmp_path / "freed.toml").free if f.name == "h_probe_m"]
+    assert (f.lower, f.upper) == quantity("h_probe_m").bounds and f.start == held
     assert cli("init", *logs[::2], "--out", tmp_path / "one")[0] == 0
-    assert "these logs span" not in (tmp_path / "one" / "fit.toml").read_text()
+    one = (tmp_path / "one" / "fit.toml").read_text()
+    assert "these logs span" not in one and "\n[fixed]\nh_probe_m = " in one
 
 
 def test_logs_of_unit_keeps_one_drums_logs_and_says_the_others_in_one_line():
