@@ -119,10 +119,11 @@ CROSS_VALIDATED = BedLaws(probe="tumbling", probe_gas="mean")
 #: The probe's depth scale ``h_probe_m`` over the drum diameter under :data:`CROSS_VALIDATED`: only a
 #: change of batch size determines it, and its leave-one-size-out profile on the Bullet rises to a
 #: plateau that starts at the drum's diameter (72.9 % at 0.15 D, 73.4 % at 1 D, 73.5 % at 5 D), so it
-#: is held there rather than fitted on one batch size (the Bullet example, ``roastlab init``). The
-#: Skywalker example fits it on logs of 150-250 g: 0.17 D (0.026 m), leave-one-log-out FIT 84.1 % against
-#: 83.8 % at 1 D, with the metal-bean coefficient off its ceiling (docs/real-roaster.md, "Skywalker: the
-#: probe half in the bed").
+#: is held there rather than fitted on one batch size (the Bullet example, ``roastlab init`` where a bean
+#: reading runs beside the probe or the logs are of one size). The Skywalker example, and ``roastlab init``
+#: on logs like its own (several sizes, the probe alone), fit it from there: 0.17 D (0.026 m) on logs of
+#: 150-250 g, leave-one-log-out FIT 84.1 % against 83.8 % at 1 D, with the metal-bean coefficient off its
+#: ceiling (docs/real-roaster.md, "Skywalker: the probe half in the bed").
 PROBE_DEPTH_OVER_DIAMETER = 1.0
 
 #: The variants ``roastlab compare-models`` fits by default, by name: the paper's bed and each law

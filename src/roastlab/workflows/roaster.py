@@ -29,7 +29,8 @@ the paper's three coefficients and the probe constant always; the gas flow when 
 logged; the heater's gains and lag when a heater is logged (into the drum metal, and into the
 air unless the machine heats the drum itself or no ET is logged to tell the two paths apart); the fan's share of the flow when a fan is
 logged; a shell loss when the inlet is room air; the probe's immersion under the bed laws
-cross-validation chose, its depth scale held at the drum's diameter (for every roaster); the
+cross-validation chose (for every roaster), its depth scale held at the drum's diameter, or fitted from
+there where the logs span batch sizes and no bean reading runs beside the probe (:func:`fit_spec_text`); the
 second reading's weight and the beans' exothermic rate law (:data:`EXOTHERM_LAW`) when the log has
 a second bean reading; ET's weight (against the outlet
 gas) when ET is logged beside a heater, because a fit on BT alone can heat the beans by a path the machine does
