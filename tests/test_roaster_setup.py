@@ -1315,3 +1315,21 @@ def test_a_roaster_logging_in_fahrenheit_gets_the_fit_it_gets_in_celsius(cli, tm
     # the map names the files it was written from, the same names in both folders
     assert (tmp_path / "cfgC" / "map.toml").read_text() == (tmp_path / "cfgF" / "map.toml").read_text()
     assert abs(held["C"] - held["F"]) < 0.2 and abs(mae["C"] - mae["F"]) < 0.05, (held, mae)
+
+
+def test_a_fit_on_one_batch_size_holds_the_probe_depth_the_spec_frees():
+    """fit-roaster --by-size fits on one size: the probe's depth scale, which only a change of batch size
+    determines, is held at its start there (and said); a fit on several sizes keeps it free."""
+    from types import SimpleNamespace
+
+    from roastlab.io.fitspec import FitSpec, FreeParameter
+
+    spec = FitSpec([FreeParameter("hbm", 0.001, 1.0, 0.02), FreeParameter("h_probe_m", 0.0, 0.5, 0.155)], {"Kt": 0.02})
+    one = [SimpleNamespace(Mb_kg=m) for m in (0.15, 0.152, 0.15)]
+    held, said = roaster.depth_held_on_one_size(spec, one)
+    assert [f.name for f in held.free] == ["hbm"] and held.fixed == {"Kt": 0.02, "h_probe_m": 0.155}
+    assert said == "holds the probe's depth scale at 0.155 m: logs of one batch size cannot determine it"
+    several = one + [SimpleNamespace(Mb_kg=0.25)]
+    assert roaster.depth_held_on_one_size(spec, several) == (spec, None)
+    no_depth = FitSpec([FreeParameter("hbm", 0.001, 1.0, 0.02)], {"h_probe_m": 0.155})
+    assert roaster.depth_held_on_one_size(no_depth, one) == (no_depth, None)

@@ -1015,7 +1015,7 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
         f"{PROBE_DEPTH_OVER_DIAMETER * diameter_m:.4g}"  # the probe's depth scale, held (and where freed, started)
     )
     masses = [i.batch_kg for i in s.logs if i.batch_kg]
-    spans_sizes = bool(masses) and len(set(size_labels(masses)[0])) > 1  # several of compare-models' size groups
+    spans_sizes = spans_batch_sizes(masses)
     # Only a change of batch size determines the probe's depth scale. Where no bean reading runs beside the
     # probe, it is also what tells the probe from the beans: held at the diameter, the Skywalker's probe reads
     # mostly air and the fit lumps beans and metal (hbm on its ceiling, the beans at 108 degC 5 s after
@@ -1397,7 +1397,8 @@ def fit_roaster(
     batches = [load_log(p, cmap) for p in paths]
     sizes = size_split(batches, fit_size_kg) if (by_size or fit_size_kg is not None) else None
     fit_b, val_b = batches[0::2], batches[1::2]
-    result, spec, refit = fit_checked(fit_b, d, load_fit_spec(d / "fit.toml"), cmap, seed, progress)
+    spec, depth_held = depth_held_on_one_size(load_fit_spec(d / "fit.toml"), fit_b)
+    result, spec, refit = fit_checked(fit_b, d, spec, cmap, seed, progress)
     model = result.model
     v_fit, v_val = model.validate(fit_b), model.validate(val_b)
     base = fit_first_order(fit_b)
@@ -1416,6 +1417,7 @@ def fit_roaster(
         "",
         *(line for why in left_out.values() for line in (f"Left out: {why}.", "")),
         *([f"Refitted: {refit}.", ""] if refit else []),
+        *([f"The fit {depth_held}.", ""] if depth_held else []),
         *(
             [
                 "Read from the logs:",
@@ -1487,10 +1489,14 @@ def fit_roaster(
         lines += every_log_lines(every, len(batches))
     across = None
     if sizes is not None:
-        size_fit, _, size_refit = fit_checked([batches[k] for k in sizes.fit], d, spec, cmap, seed, progress)
+        size_b = [batches[k] for k in sizes.fit]
+        size_spec, size_depth = depth_held_on_one_size(spec, size_b)
+        size_fit, _, size_refit = fit_checked(size_b, d, size_spec, cmap, seed, progress)
         across = across_sizes(size_fit.model, batches, sizes)
         across["failed"], across["refit"] = size_fit.failed, size_refit
         lines += across_sizes_lines(across, SIZES_FIGURE)
+        if size_depth:
+            lines += ["", f"The fit on {sizes.fit_size} alone {size_depth}."]
         if size_refit:
             lines += ["", f"Refitted (the fit on {sizes.fit_size} alone): {size_refit}."]
         if size_fit.failed:
@@ -1529,6 +1535,29 @@ def fit_roaster(
         "report": d / "report.md",
         "figures": list(figures),
     }
+
+
+def spans_batch_sizes(masses) -> bool:
+    """Whether green batch masses [kg] fall in more than one of ``compare-models``' size groups
+    (:func:`roastlab.evaluate.metrics.size_labels`)."""
+    masses = [m for m in masses if m]
+    return bool(masses) and len(set(size_labels(masses)[0])) > 1
+
+
+def depth_held_on_one_size(spec, batches):
+    """``spec`` with the probe's depth scale held at its start where it frees it and ``batches`` are all
+    of one batch size (one of ``compare-models``' size groups): only a change of batch size determines it
+    (:func:`fit_spec_text` frees it where the logs span sizes; a fit on one of them, as ``--by-size``'s,
+    cannot). Returns ``(spec, sentence or None)``."""
+    import dataclasses
+
+    depth = next((f for f in spec.free if f.name == "h_probe_m"), None)
+    if depth is None or spans_batch_sizes([b.Mb_kg for b in batches]):
+        return spec, None
+    held = dataclasses.replace(
+        spec, free=[f for f in spec.free if f is not depth], fixed={**spec.fixed, "h_probe_m": depth.start}
+    )
+    return held, f"holds the probe's depth scale at {depth.start:g} m: logs of one batch size cannot determine it"
 
 
 def fit_checked(batches, config_dir: Path, spec, column_map, seed: int, progress=None):
