@@ -683,16 +683,18 @@ def test_a_band_fitted_on_three_logs_stays_usable_with_the_drum_start_share_free
 
 
 def _truth_of_init(cfg: Path, **values):
-    """The model ``roastlab init``'s files describe (its plant, map, bed laws and held probe depth),
-    with chosen heater and flow values: the truth the SYNTHETIC logs below are drawn from, so that
-    the fit they test can reach it. The drum at CHARGE comes from the log, as the map reads it."""
+    """The model ``roastlab init``'s files describe (its plant, map, bed laws and probe depth: held, or
+    where the logs span batch sizes the start of its fit), with chosen heater and flow values: the truth
+    the SYNTHETIC logs below are drawn from, so that the fit they test can reach it. The drum at CHARGE
+    comes from the log, as the map reads it."""
     import roastlab
     from roastlab.io.fitspec import load_fit_spec
     from roastlab.io.importers import load_map
     from roastlab.workflows.model import FittedModel
 
     spec = load_fit_spec(cfg / "fit.toml")
-    truth = FittedModel.paper(roastlab.load_plant(cfg / "plant.toml")).with_values(**spec.fixed, **values)
+    depth = {f.name: f.start for f in spec.free if f.name == "h_probe_m"}
+    truth = FittedModel.paper(roastlab.load_plant(cfg / "plant.toml")).with_values(**spec.fixed, **depth, **values)
     truth.bed = spec.bed
     truth.doc["map"] = load_map(cfg / "map.toml").to_mapping()
     return FittedModel(truth.doc)
