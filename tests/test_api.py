@@ -376,19 +376,26 @@ def test_whatif_figure_shows_the_first_crack_mark_and_no_mark_past_the_curves(sk
     assert not any(s.startswith("COOL ") for s in labels)
 
 
+def _whatif_written(cli, sky_model, heater: str, option: str, path):
+    """``roastlab whatif LOG --heater HEATER OPTION PATH`` on the Skywalker model (exit 0), and the same
+    what-if as a library call, to compare the written file with."""
+    from roastlab.workflows.whatif import parse_setting_change, whatif
+
+    model_path, log = sky_model
+    code, _, err = cli("whatif", log, "--model", model_path, "--heater", heater, option, path)
+    assert code == 0, err
+    model = roastlab.load_model(model_path)
+    return whatif(model, roastlab.load_log(log, model.column_map), [parse_setting_change("heater", heater, "percent")])
+
+
 def test_whatif_writes_the_changed_roast_as_an_artisan_background(cli, sky_model, tmp_path):
     """whatif --alog: Artisan's format read back by the project's own importer gives the changed
     probe prediction as BT, the model's drum (the Skywalker's ET) as ET, the changed heater as Burner
     events, DRY and first crack where the table's changed probe reaches them, DROP at the log's."""
     from roastlab.io.importers.artisan import read_alog
-    from roastlab.workflows.whatif import parse_setting_change, whatif
 
-    model_path, log = sky_model
     bg = tmp_path / "next.alog"
-    code, out, err = cli("whatif", log, "--model", model_path, "--heater", "+10@4:00", "--alog", bg)
-    assert code == 0, err
-    model = roastlab.load_model(model_path)
-    w = whatif(model, roastlab.load_log(log, model.column_map), [parse_setting_change("heater", "+10@4:00", "percent")])
+    w = _whatif_written(cli, sky_model, "+10@4:00", "--alog", bg)
     back = read_alog(bg)
     assert np.max(np.abs(back.channels["BT"] - w.changed.Ta_C)) <= 0.005
     assert np.max(np.abs(back.channels["ET"] - w.changed.Tm_C)) <= 0.005
@@ -407,14 +414,9 @@ def test_whatif_writes_the_changed_settings_as_artisan_alarms(cli, sky_model, tm
     import json
 
     from roastlab.io.background import alarm_slider_action
-    from roastlab.workflows.whatif import parse_setting_change, whatif
 
-    model_path, log = sky_model
     alrm = tmp_path / "next.alrm"
-    code, _, err = cli("whatif", log, "--model", model_path, "--heater", "-10@4:00", "--alarms", alrm)
-    assert code == 0, err
-    model = roastlab.load_model(model_path)
-    w = whatif(model, roastlab.load_log(log, model.column_map), [parse_setting_change("heater", "-10@4:00", "percent")])
+    w = _whatif_written(cli, sky_model, "-10@4:00", "--alarms", alrm)
     alarms = json.loads(alrm.read_text())
     t = w.changed.time_s - w.changed.time_s[0]
     for setting, etype in (("heater", "Burner"), ("fan", "Air")):

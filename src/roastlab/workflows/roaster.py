@@ -1016,6 +1016,7 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
     )
     masses = [i.batch_kg for i in s.logs if i.batch_kg]
     spans_sizes = spans_batch_sizes(masses)
+    span_g = f"{min(masses) * 1e3:.0f}-{max(masses) * 1e3:.0f} g" if masses else ""
     # Only a change of batch size determines the probe's depth scale. Where no bean reading runs beside the
     # probe, it is also what tells the probe from the beans: held at the diameter, the Skywalker's probe reads
     # mostly air and the fit lumps beans and metal (hbm on its ceiling, the beans at 108 degC 5 s after
@@ -1031,8 +1032,8 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
                 lo,
                 hi,
                 float(depth_m),
-                f"bed depth that covers the probe [m], from the drum's diameter: these logs span "
-                f"{min(masses) * 1e3:.0f}-{max(masses) * 1e3:.0f} g and no bean reading runs beside the probe",
+                f"bed depth that covers the probe [m], from the drum's diameter: these logs span {span_g} "
+                "and no bean reading runs beside the probe",
             )
         )
     if s.fan and s.fan_at is not None:
@@ -1074,7 +1075,7 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
     if spans_sizes and not fit_depth:
         lo, hi = quantity("h_probe_m").bounds
         rows += [
-            f"# these logs span {min(masses) * 1e3:.0f}-{max(masses) * 1e3:.0f} g, which can determine it: to fit it, move it "
+            f"# these logs span {span_g}, which can determine it: to fit it, move it "
             f"to [free] as h_probe_m = [{lo:g}, {hi:g}, {depth_m}]",
             "# and compare the two with 'roastlab compare-models --group-by log' (with the bean reading beside the probe",
             '# it predicted worse on the Bullet: docs/real-roaster.md, "Skywalker: the probe half in the bed")',
