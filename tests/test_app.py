@@ -440,8 +440,12 @@ def test_a_model_is_fitted_on_the_page_in_the_background(client, data_dir):
     assert "held out" in st["report"] and st["held_out"]["FIT"] > 0
     assert st["model"] in client.get("/api/files", headers=H).json()["models"]
     assert st["every_log"] is None and "Every log held out once" not in st["report"]
-    # the report's figure comes with it, drawn under the report on the page
-    assert set(st["figures"]) == {"heldout"} and st["figures"]["heldout"].startswith("data:image/png;base64,")
+    # the report as the page shows it: its tables as tables, its figure in place, embedded
+    html = st["report_html"]
+    assert "<table>" in html and "| set |" not in html and html.count('<img src="data:image/png;base64,') == 1
+    # Open on the model the fit wrote shows the same report
+    opened = client.post("/api/open", json={"log": logs[0], "model": st["model"]}, headers=H).json()
+    assert opened["report_html"] == html
     assert st["verdict"] is None and "Not usable" not in st["report"]  # it beats the first-order baseline
     # the page's "also hold each log out once": fit-roaster --every-log behind it
     assert client.post("/api/fit", json={"logs": logs, "name": "sky", "every_log": True}, headers=H).json()["started"]
@@ -468,7 +472,7 @@ def test_a_model_is_fitted_on_the_page_in_the_background(client, data_dir):
         time.sleep(0.2)
     assert "error" not in st, st
     assert "## Across batch sizes" in st["report"] and "fitted on 0.15-0.152 kg (3 logs)" in st["across_sizes"]
-    assert set(st["figures"]) == {"heldout", "sizes"}
+    assert st["report_html"].count('<img src="data:image/png;base64,') == 2  # held out, FIT by batch size
     # logs with no heater or fan setting: ET drives the model, worse than the baseline here, and the page says so
     (data_dir / "bare").mkdir(exist_ok=True)
     bare = []
@@ -483,6 +487,53 @@ def test_a_model_is_fitted_on_the_page_in_the_background(client, data_dir):
     assert "no heater setting is logged" in st["verdict"] and st["report"].count("**Not usable**") == 1
     one = client.post("/api/fit", json={"logs": logs[:1]}, headers=H)
     assert one.status_code == 400 and "at least two logs" in one.json()["error"]
+
+
+def test_the_fit_report_is_html_with_its_figures_in_place_and_the_logs_text_escaped(tmp_path):
+    """report.md on the page: tables become tables, a figure beside the report is embedded, a
+    picture naming anything else is dropped, HTML quoted from a log is shown as text; Open gives the
+    report only for a model fit-roaster wrote, and not where the model was written after it."""
+    import base64
+    import os
+
+    from starlette.testclient import TestClient
+
+    from roastlab.app.server import report_html
+
+    data = tmp_path / "data"
+    folder = data / "roasters" / "r"
+    folder.mkdir(parents=True)
+    assert report_html(folder) is None
+    png = b"\x89PNG\r\n\x1a\n" + b"figure"
+    (folder / "heldout.png").write_bytes(png)
+    (data / "roasters" / "outside.png").write_bytes(png)
+    (folder / "report.md").write_text(
+        "# r\n\nLeft out: <script>alert(1)</script>.json\n\n| log | FIT % |\n|---|---|\n| a | 90.0 |\n\n"
+        "![held out](heldout.png)\n\n![x](../outside.png) ![y](report.md)\n",
+        encoding="utf-8",
+    )
+    html = report_html(folder)
+    assert "<script>" not in html and "&lt;script&gt;alert(1)&lt;/script&gt;" in html
+    assert "<td>a</td>" in html and "<td>90.0</td>" in html
+    assert html.count("<img") == 1 and f'src="data:image/png;base64,{base64.b64encode(png).decode()}"' in html
+    assert "outside" not in html and 'src="report.md"' not in html
+    # through Open: beside model.json, as fit-roaster writes them
+    shutil.copy(SYNTHETIC / "dataset-I" / "batch1.csv", data / "batch1.csv")
+    FittedModel.paper("120kg").save(folder / "model.json")
+    FittedModel.paper("120kg").save(data / "paper-model.json")
+    stamp = (folder / "model.json").stat().st_mtime
+    os.utime(folder / "report.md", (stamp, stamp))
+    client = TestClient(create_app(data))
+
+    def shown(model):
+        r = client.post("/api/open", json={"log": "batch1.csv", "model": model}, headers=H).json()
+        assert "error" not in r, r
+        return r["report_html"]
+
+    assert shown("roasters/r/model.json") == html
+    assert shown("paper-model.json") is None  # not a model fit-roaster wrote
+    os.utime(folder / "report.md", (stamp - 60, stamp - 60))  # the model written again after its report
+    assert shown("roasters/r/model.json") is None
 
 
 def test_the_file_list_takes_a_roastime_file_without_a_suffix_for_a_log(tmp_path):

@@ -293,6 +293,12 @@ async function whatifBackground() {
   }
 }
 
+// The fit report (fit-roaster's report.md), rendered by the server with raw HTML in it escaped.
+function showReport(html) {
+  if (html) $("fit-report").innerHTML = html;
+  else $("fit-report").textContent = "(this model has no fit report: fit a model on your logs here, or with roastlab init + fit-roaster)";
+}
+
 async function openLog() {
   say("opening ...");
   $("whatif_downloads").innerHTML = "";
@@ -325,6 +331,7 @@ async function openLog() {
     for (const id of ["heater", "fan"]) $(id).value = "";
     $("tgi").value = 0;
     $("notes").textContent = (r.notes || []).join("\n");
+    showReport(r.report_html);
     draw();
     drawTable();
     say("");
@@ -351,7 +358,6 @@ let pickModel = null;
 async function runFit() {
   const logs = Array.from($("fit_logs").selectedOptions).map((o) => o.value);
   say("");
-  $("fit-figures").replaceChildren();
   try {
     await api("/api/fit", {
       logs, name: $("fit_name").value, every_log: $("fit_every_log").checked, by_size: $("fit_by_size").checked,
@@ -363,13 +369,7 @@ async function runFit() {
       $("fit_text").textContent = st.text || "";
       if (st.running) { setTimeout(poll, 300); return; }
       if (st.error) { say(st.error); return; }
-      $("fit-report").textContent = st.report;
-      $("fit-figures").replaceChildren(...Object.entries(st.figures || {}).map(([name, src]) => {
-        const img = document.createElement("img");  // the report's figures: held-out curves, FIT by batch size
-        Object.assign(img, { src, alt: name, title: `${name}.png` });
-        img.style.maxWidth = "100%";
-        return img;
-      }));
+      showReport(st.report_html);
       $("fit_text").textContent = `held out: FIT ${st.held_out.FIT.toFixed(1)} %, MAE ${st.held_out.MAE.toFixed(2)} °C` +
         (st.every_log ? `; each log held out once: FIT ${st.every_log.FIT.toFixed(1)} %` : "") +
         (st.across_sizes ? `; across sizes: ${st.across_sizes}` : "");

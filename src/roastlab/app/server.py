@@ -15,7 +15,8 @@ repository); the page talks JSON to a handful of endpoints, each a thin call int
 * ``POST /api/fit``       fit a model on chosen logs in the background (``roastlab init`` +
   ``fit-roaster`` into ``<data>/roasters/<name>/``; ``every_log``: each log also held out once;
   ``by_size``: fitted at one batch size, the others predicted);
-  ``GET /api/fit-status`` its progress and report
+  ``GET /api/fit-status`` its progress and report (report.md, and as HTML with its figures in place;
+  ``/api/open`` gives the same HTML for a model fit-roaster wrote)
 * ``GET  /downloads/...`` what a transfer wrote
 
 Safety: the server binds 127.0.0.1 unless told otherwise; every path a request names is
@@ -37,6 +38,7 @@ from importlib import resources
 from pathlib import Path
 
 import numpy as np
+from markdown_it import MarkdownIt
 
 from ..errors import InputError, RoastlabError
 from ..io.files import Outputs
@@ -206,6 +208,46 @@ def _fit_figures(batch, result, fitted: bool = False) -> dict | None:
     return {"FIT_pct": round(m["FIT"], 1), "MAE_C": round(m["MAE"], 2), "fitted_on": fitted}
 
 
+def report_html(folder: Path) -> str | None:
+    """``folder``/report.md (``roastlab fit-roaster``'s report) as HTML for the page, or None where
+    there is none.
+
+    CommonMark with tables (markdown-it-py), raw HTML in the text shown as text (the report quotes
+    log names and notes from the logs), each figure the report draws (``![...](heldout.png)``) embedded
+    from the same folder as a data URL so the page needs no file route; a picture that is not a PNG
+    beside the report is dropped.
+    """
+    path = folder / "report.md"
+    if not path.is_file():
+        return None
+    md = MarkdownIt("commonmark", {"html": False}).enable("table")
+    tokens = md.parse(path.read_text(encoding="utf-8"))
+    root = folder.resolve()
+    for token in tokens:
+        kept = []
+        for child in token.children or []:
+            if child.type == "image":
+                png = (folder / str(child.attrGet("src") or "")).resolve()
+                if png.suffix.lower() != ".png" or png.parent != root or not png.is_file():
+                    continue
+                child.attrSet("src", "data:image/png;base64," + base64.b64encode(png.read_bytes()).decode())
+            kept.append(child)
+        if token.children is not None:
+            token.children = kept
+    return md.renderer.render(tokens, md.options, {})
+
+
+def _report_beside(model_path: Path) -> str | None:
+    """The fit report of a model ``fit-roaster`` wrote (``model.json`` with ``report.md`` beside it,
+    written with or after it), as HTML (:func:`report_html`); None for any other model file."""
+    report = model_path.parent / "report.md"
+    if model_path.name != "model.json" or not report.is_file():
+        return None
+    if report.stat().st_mtime < model_path.stat().st_mtime:
+        return None  # the model was written again after the report: the report is not its
+    return report_html(model_path.parent)
+
+
 def _program_sets(body: dict, units: dict) -> list:
     """Steps dragged on the page's program plot: ``[{"setting", "value", "from_s", "until_s"}]``
     -> :class:`~roastlab.workflows.whatif.SettingChange` "set" changes, in the order given."""
@@ -320,7 +362,8 @@ def create_app(data_dir: str | Path):
         from ..workflows.transfer import default_limits, et_source
         from ..workflows.whatif import whatif
 
-        model = load_model(inside(data, body.get("model", "")))
+        model_path = inside(data, body.get("model", ""))
+        model = load_model(model_path)
         log_path = inside(data, body.get("log", ""))
         batch = load_log(log_path, model.column_map) if model.column_map else load_log(log_path)
         w = whatif(model, batch)
@@ -358,6 +401,7 @@ def create_app(data_dir: str | Path):
             "table": w.to_json_dict(),
             "settings": model.column_map.setting_units() if model.column_map else {},
             "actuators": actuators,
+            "report_html": _report_beside(model_path),  # the fit report, where fit-roaster wrote the model
         }
 
     def need(session: Session):
@@ -490,14 +534,11 @@ def create_app(data_dir: str | Path):
                     running=False,
                     model=(folder / "model.json").relative_to(data).as_posix(),
                     report=(folder / "report.md").read_text(encoding="utf-8"),
+                    report_html=report_html(folder),  # the same as the page shows it, its figures in place
                     held_out=r["held_out"],
                     verdict=r["below_baseline"],
                     every_log=r["every_log"] and {"FIT": r["every_log"]["FIT"]},
                     across_sizes=r["across_sizes"] and across_sizes_sentence(r["across_sizes"]),
-                    figures={  # the report's figures, drawn under it on the page
-                        f.stem: "data:image/png;base64," + base64.b64encode(f.read_bytes()).decode()
-                        for f in r["figures"]
-                    },
                 )
             except RoastlabError as exc:
                 session.fit.update(running=False, error=str(exc))
