@@ -16,7 +16,9 @@ $(STAMP): pyproject.toml
 # The suite runs on every core (pytest-xdist). On 2 cores, back to back on 2026-11-27, the fast suite took
 # 159 s against 221 s in one process (1.4 times faster); the clean-clone CI run's whole suite 452 s, where
 # one process had taken 779 s an hour before on the same busy machine. `make test TEST_WORKERS=0` runs it
-# in one process.
+# in one process. Each worker runs numba's parallel loops on its share of the cores (tests/conftest.py):
+# with a thread per core in each of 2 workers the suite took 703 s in a warm clone on 2026-11-28, with one
+# thread per worker 569 s, back to back.
 TEST_WORKERS ?= auto
 test: $(STAMP)
 	$(PY) -m pytest -n $(TEST_WORKERS)

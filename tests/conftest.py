@@ -11,6 +11,19 @@ SHARED = REPO.parent / "shared"
 REAL_DATA = SHARED / "data" / "real"
 
 
+def pytest_configure(config):
+    """Under pytest-xdist, each worker's numba loops on its share of the cores: ``make test`` runs a
+    worker per core, and each worker's parallel loops would otherwise start a thread per core too, so
+    2 workers on 2 cores ran 4 busy threads (four fitting tests together took 98 s against 54 s with a
+    thread per worker, 2026-11-28). Set in each worker's main thread, where the tests run; a test that
+    asks for threads (``fleet --threads``) still gets them."""
+    workers = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1"))
+    if workers > 1:
+        import numba
+
+        numba.set_num_threads(max(1, numba.config.NUMBA_NUM_THREADS // workers))
+
+
 #: Artisan's special-event lists (one entry per event).
 EVENT_KEYS = ("specialevents", "specialeventstype", "specialeventsvalue", "specialeventsStrings")
 
