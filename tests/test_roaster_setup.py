@@ -868,6 +868,11 @@ def test_an_unseen_gas_drum_with_burner_events_is_fitted_with_no_hand_edits(cli,
     held = printed_percent(out, "held out: FIT ")
     base = printed_percent(out, "baseline: ")
     assert held > 80.0 and held > base + 10.0, out
+    # the report also as one page a browser opens: its tables as tables, its figure inside it
+    page = (tmp_path / "cfg" / "report.html").read_text(encoding="utf-8")
+    assert page.startswith("<!doctype html>") and "report.html" in out.splitlines()[-1]
+    assert page.count("<table>") == (tmp_path / "cfg" / "report.md").read_text().count("\n|---") > 1
+    assert page.count('<img src="data:image/png;base64,') == 1 and 'src="heldout.png"' not in page
     # and as a fleet, with init's fleet spec under fit-roaster's model: still no hand-written file
     pytest.importorskip("duckdb")
     cfg = tmp_path / "cfg"

@@ -29,7 +29,6 @@ so two tabs do not share or overwrite state. A bad file or an infeasible request
 
 from __future__ import annotations
 
-import base64
 import re
 import threading
 import time
@@ -38,7 +37,6 @@ from importlib import resources
 from pathlib import Path
 
 import numpy as np
-from markdown_it import MarkdownIt
 
 from ..errors import InputError, RoastlabError
 from ..io.files import Outputs
@@ -210,31 +208,16 @@ def _fit_figures(batch, result, fitted: bool = False) -> dict | None:
 
 def report_html(folder: Path) -> str | None:
     """``folder``/report.md (``roastlab fit-roaster``'s report) as HTML for the page, or None where
-    there is none.
+    there is none: :func:`roastlab.report.markdown.markdown_html`, its figures the PNGs beside it that
+    it names (a picture naming anything else, a path out of the folder included, is dropped)."""
+    from ..report.markdown import markdown_html
 
-    CommonMark with tables (markdown-it-py), raw HTML in the text shown as text (the report quotes
-    log names and notes from the logs), each figure the report draws (``![...](heldout.png)``) embedded
-    from the same folder as a data URL so the page needs no file route; a picture that is not a PNG
-    beside the report is dropped.
-    """
     path = folder / "report.md"
     if not path.is_file():
         return None
-    md = MarkdownIt("commonmark", {"html": False}).enable("table")
-    tokens = md.parse(path.read_text(encoding="utf-8"))
-    root = folder.resolve()
-    for token in tokens:
-        kept = []
-        for child in token.children or []:
-            if child.type == "image":
-                png = (folder / str(child.attrGet("src") or "")).resolve()
-                if png.suffix.lower() != ".png" or png.parent != root or not png.is_file():
-                    continue
-                child.attrSet("src", "data:image/png;base64," + base64.b64encode(png.read_bytes()).decode())
-            kept.append(child)
-        if token.children is not None:
-            token.children = kept
-    return md.renderer.render(tokens, md.options, {})
+    root = folder.resolve()  # a link out of the folder is not read
+    pictures = {p.name: p.read_bytes() for p in folder.glob("*.png") if p.resolve().parent == root and p.is_file()}
+    return markdown_html(path.read_text(encoding="utf-8"), pictures)
 
 
 def _report_beside(model_path: Path) -> str | None:

@@ -96,7 +96,7 @@ def cmd_fit_roaster(args) -> int:
             print(f"warning: the fit on {a['fit_size']} alone failed: {a['failed']}", file=sys.stderr)
     for w in r["warnings"]:
         print(f"warning: {w}", file=sys.stderr)
-    print(f"wrote {', '.join(str(f) for f in [r['model'], r['report'], *r['figures']])}")
+    print(f"wrote {', '.join(str(f) for f in [r['model'], r['report'], r['report_html'], *r['figures']])}")
     return failed_fit_status(r["failed"], r["model"])
 
 
@@ -140,7 +140,8 @@ def add_parsers(sub) -> None:
         description="With DIR from 'roastlab init': sort LOG... by when they were roasted (by name when a log has no date) and split them alternately (1st, 3rd, ... fit; "
         "2nd, 4th, ... held out), identify the model, validate it on the held-out logs, fit the first-order "
         "baseline on the same inputs, and write DIR/model.json (MODEL.json for every other command), "
-        "DIR/report.md and DIR/heldout.png. A log that cannot be read as a roast, is a copy of another, records no green weight or "
+        "DIR/report.md (the same as DIR/report.html, one page any browser opens, its figures inside) and "
+        "DIR/heldout.png. A log that cannot be read as a roast, is a copy of another, records no green weight or "
         "no setting the map drives the model with is left out; a fit whose drum runs below the beans with the heater free to heat the air is refitted with the "
         "heater heating the drum alone; a model worse than the baseline on the held-out logs is called not "
         "usable; each is said. Exit status 1 when the fit failed (states the machine cannot have, "

@@ -1329,8 +1329,9 @@ def fit_roaster(
     The logs, sorted by when they were roasted (Artisan ``roastepoch``, RoasTime ``dateTime``;
     by name when a log has no date), are split alternately: the 1st, 3rd, ... fit, the 2nd,
     4th, ... are held out. Writes
-    ``config_dir``/model.json, report.md and heldout.png (measured vs predicted BT of the
-    held-out logs); returns the figures of the report.
+    ``config_dir``/model.json, report.md, the same report as report.html (one file a browser opens,
+    its figures inside it) and heldout.png (measured vs predicted BT of the held-out logs); returns
+    the figures of the report.
 
     Logs that do not record a setting the map drives the model with, or their green weight, are
     left out (:func:`logs_without_controls`, :func:`logs_without_weight`). A fit that fails on its states with both of the heater's paths
@@ -1503,15 +1504,21 @@ def fit_roaster(
         if size_fit.failed:
             lines += ["", f"**The fit on {sizes.fit_size} alone failed**: {size_fit.failed}."]
     from ..report.figures import figure_bytes
+    from ..report.markdown import html_document
 
     figures = {d / HELD_OUT_FIGURE: v_val.plot()}
     if across is not None:
         figures[d / SIZES_FIGURE] = across_sizes_figure(across)
+    pngs = {path: figure_bytes(fig, path) for path, fig in figures.items()}
+    report = "\n".join(lines) + "\n"
+    title = f"{model.plant.name if model.plant else 'roaster'}: fit report"
     with Outputs(paths) as out:
         out.write_text(d / "model.json", model_document_text(model.to_document()))
-        out.write_text(d / "report.md", "\n".join(lines) + "\n")
-        for path, fig in figures.items():
-            out.write_bytes(path, figure_bytes(fig, path))
+        out.write_text(d / "report.md", report)
+        # the same report as one page that opens in any browser, its figures inside it
+        out.write_text(d / "report.html", html_document(title, report, {p.name: b for p, b in pngs.items()}))
+        for path, png in pngs.items():
+            out.write_bytes(path, png)
     return {
         "fit": {"FIT": v_fit.average["FIT"], "MAE": v_fit.average["MAE"]},
         "held_out": {"FIT": v_val.average["FIT"], "MAE": v_val.average["MAE"]},
@@ -1534,6 +1541,7 @@ def fit_roaster(
         "failed": result.failed,
         "model": d / "model.json",
         "report": d / "report.md",
+        "report_html": d / "report.html",
         "figures": list(figures),
     }
 
