@@ -1409,8 +1409,9 @@ def fit_roaster(
     bf, bv = average_metrics(b_fit), average_metrics(b_val)
     verdict = below_baseline(v_val.average["FIT"], bv["FIT"], cmap)
     weighed = [f"{line[0].upper()}{line[1:]}." for line in model.residual_weight_lines()]
+    roaster_name = model.plant.name if model.plant else "roaster"
     lines = [
-        f"# {model.plant.name if model.plant else 'roaster'}: fitted by roastlab fit-roaster",
+        f"# {roaster_name}: fitted by roastlab fit-roaster",
         "",
         *([f"**The fit failed**: {result.failed}.", ""] if result.failed else []),
         *([f"**Not usable**: {verdict}.", ""] if verdict else []),
@@ -1511,7 +1512,7 @@ def fit_roaster(
         figures[d / SIZES_FIGURE] = across_sizes_figure(across)
     pngs = {path: figure_bytes(fig, path) for path, fig in figures.items()}
     report = "\n".join(lines) + "\n"
-    title = f"{model.plant.name if model.plant else 'roaster'}: fit report"
+    title = f"{roaster_name}: fit report"
     with Outputs(paths) as out:
         out.write_text(d / "model.json", model_document_text(model.to_document()))
         out.write_text(d / "report.md", report)
