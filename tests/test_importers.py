@@ -367,6 +367,26 @@ def test_a_map_names_et_where_the_log_calls_it_something_else(tmp_path):
         import_log(p, load_map(write_map(tmp_path, ROOM_AIR_MAP + '[ET]\ncolumn = "Nope"\n')))
 
 
+def test_a_list_of_control_names_is_checked_and_serves_logs_not_csv(tmp_path):
+    """A ``[heater]`` column may list the names a roaster's logs give it; a list repeating a name is
+    refused, and a CSV map names its one column."""
+    from roastlab.errors import InputError
+    from roastlab.io.importers.mapping import map_from_mapping
+
+    base = {"Ta": {"column": "BT"}, "Tgi": {"constant_C": 22.0}, "Gg": {"identify": True}}
+    cmap = map_from_mapping({**base, "heater": {"column": ["Burner", "Power"]}}, "m.toml")
+    assert cmap.heater["column"] == ["Burner", "Power"]
+    with pytest.raises(InputError, match="distinct names"):
+        map_from_mapping({**base, "heater": {"column": ["Burner", "Burner"]}}, "m.toml")
+    csv = tmp_path / "r.csv"
+    csv.write_text("time_s,BT,Burner\n0,20,50\n1,21,50\n")
+    csv_map = map_from_mapping(
+        {**base, "time": {"column": "time_s"}, "heater": {"column": ["Burner", "Power"]}}, "m.toml"
+    )
+    with pytest.raises(InputError, match="a CSV or Parquet map names its one column"):
+        import_log(csv, csv_map)
+
+
 def test_et_below_bt_through_the_roast_is_dropped_when_the_map_asks(tmp_path):
     """[ET] above_BT: a log whose ET reads below BT from 1:00 on loses ET (with a note) and its drum
     at charge falls back to the next source; a log whose ET runs above BT keeps both; without the

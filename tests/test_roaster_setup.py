@@ -563,6 +563,35 @@ def test_a_log_that_records_no_burner_is_named_and_the_others_set_up(cli, tmp_pa
     )
 
 
+def test_a_control_the_logs_name_differently_is_one_control_read_by_each_logs_name(cli, tmp_path):
+    """SYNTHETIC: a roaster's event types renamed between roasts (Artisan's Burner and Air, later
+    Power and Fan, as after a change of machine setup) are one heater and one fan: the map lists the
+    names, the most used first, and each log reads by the name it has. A heater in percent under one
+    name and in watts under the other is two layouts, refused as before."""
+    from roastlab.io.importers.mapping import import_log, load_map
+
+    renamed = {**_BURNER_AIR, "etypes": ["Fan", "Drum", "Damper", "Power", "--"]}
+    logs = [tmp_path / f"r{k}.alog" for k in range(3)]
+    for k, p in enumerate(logs):
+        p.write_text(fake_alog(extra=_BURNER_AIR if k < 2 else renamed))
+    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
+    assert code == 0, err
+    assert "heater: Burner/Power (percent); fan: Air/Fan (percent)" in out
+    assert "the logs name the heater differently (Burner: 2 log(s), Power: 1 log(s))" in out
+    text = (tmp_path / "cfg" / "map.toml").read_text()
+    assert 'column = ["Burner", "Power"]' in text and 'column = ["Air", "Fan"]' in text
+    cmap = load_map(tmp_path / "cfg" / "map.toml")
+    a, b = import_log(logs[0], cmap), import_log(logs[2], cmap)
+    for what in ("heater", "fan"):  # the same events under either name: the same setting
+        assert np.array_equal(getattr(a, what), getattr(b, what)) and np.nanmax(getattr(a, what)) > 0
+    watts = {"extratimex": [[1.5 * i for i in range(120)]], "extraname1": ["Power"], "extratemp1": [[900.0] * 120],
+             "extraNoneTempHint1": [True]}  # fmt: skip
+    logs[2].write_text(fake_alog(extra=watts))
+    code, _, err = cli("init", *logs, "--out", tmp_path / "cfg2")
+    assert code == 2 and "disagree on heater channels (Burner in percent, Power in W)" in err, err
+    assert err.count("\n") == 1 and not (tmp_path / "cfg2").exists()
+
+
 def test_a_model_below_the_baseline_is_called_not_usable_with_what_the_logs_lack():
     from roastlab.io.importers.mapping import ColumnMap
 

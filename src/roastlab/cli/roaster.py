@@ -23,7 +23,8 @@ def cmd_init(args) -> int:
     aside = f" (and {len(s.unweighed)} without a green weight, below)" if s.unweighed else ""
     print(f"{len(s.logs)} log(s){aside}, format {s.format}, roaster {s.machine or '(not named)'}")
     print(
-        f"  bean probe BT; heater: {s.heater or 'none'} ({s.heater_unit or '-'}); fan: {s.fan or 'none'} ({s.fan_unit or '-'})"
+        f"  bean probe BT; heater: {'/'.join(s.renamed.get('heater', [s.heater or 'none']))} ({s.heater_unit or '-'}); "
+        f"fan: {'/'.join(s.renamed.get('fan', [s.fan or 'none']))} ({s.fan_unit or '-'})"
     )
     et = (
         "yes"

@@ -41,6 +41,7 @@ from the quantity table.
 from __future__ import annotations
 
 import io
+import json
 import math
 import re
 from collections import Counter
@@ -61,6 +62,7 @@ from ..io.importers.mapping import (
     grams_in_name,
     hot_drop,
     is_log_by_content,
+    names_of,
     probe_fault,
 )
 from ..io.importers.roastime import DRUM_AT_CHARGE, read_roastime
@@ -239,6 +241,8 @@ class Survey:
     fan_at: float | None = None  # the one fan setting of every log, where the fan never moves; else None
     first_crack: bool = False  # no bean reading but the probe, and most logs mark first crack: the map reads
     # the mark as the beans' temperature ([Tb2] first_crack, roastlab.model.constants.FIRST_CRACK_BEAN_C)
+    renamed: dict = field(default_factory=dict)  # {"heater": [names, the most used first]} where the logs
+    # name a control differently; the heater or fan field above is the first of them
 
     @property
     def drum_start_from_probe(self) -> bool:
@@ -537,21 +541,21 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
         raise InputError("give the roast logs of one roaster", "init")
     infos, unreadable = readable_logs(paths, batch_kg)
     first = infos[0]
-    for key, what in (("format", "formats"), ("heater", "heater channels"), ("fan", "fan channels")):
-        kinds = {getattr(i, key) for i in infos} - {None}  # a log without a control: below
-        if len(kinds) > 1:
-            one = next(i for i in infos if getattr(i, key) is not None)
-            odd = next(i for i in infos if getattr(i, key) not in (None, getattr(one, key)))
-            raise InputError(
-                f"the logs disagree on {what} ({', '.join(sorted(map(str, kinds)))}): {one.path.name} vs "
-                f"{odd.path.name}. Set up one roaster (one layout) at a time",
-                odd.path,
-            )
-    # a log without a control's events (the setting never moved while Artisan recorded) does not
-    # say what the setting was: the map keeps the channel the other logs name, fit-roaster leaves
-    # that log out (logs_without_controls)
-    heater = next((i.heater for i in infos if i.heater), None)
-    fan = next((i.fan for i in infos if i.fan), None)
+    kinds = {i.format for i in infos}
+    if len(kinds) > 1:
+        odd = next(i for i in infos if i.format != first.format)
+        raise InputError(
+            f"the logs disagree on formats ({', '.join(sorted(kinds))}): {first.path.name} vs {odd.path.name}. "
+            "Set up one roaster (one layout) at a time",
+            odd.path,
+        )
+    # a control the logs name differently (an Artisan event type renamed between roasts) is one
+    # control if every name reads in one unit: the map lists its names, the most used first, and each
+    # log is read by the first it has. A log without a control's events (the setting never moved while
+    # Artisan recorded) does not say what the setting was: the map keeps the channel the other logs
+    # name, fit-roaster leaves that log out (logs_without_controls)
+    control_names = {what: _control_names(infos, what) for what in ("heater", "fan")}
+    heater, fan = (control_names[what][0] if control_names[what] else None for what in ("heater", "fan"))
     layout = ("time", "time_unit", "BT", "temp_unit")  # ET may be unreadable on some logs (has_et says)
     if first.columns is not None and any(
         [i.columns[k] for k in layout] != [first.columns[k] for k in layout] for i in infos
@@ -579,6 +583,20 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
         if (seen := [i.seen[what] for i in infos if what in i.seen])
     }
     heater_unit, fan_unit = (_unit_of(pooled[what]) if what in pooled else None for what in ("heater", "fan"))
+    renamed = {what: n for what, n in control_names.items() if len(n) > 1}
+    for what, n in renamed.items():
+        by_name = {
+            name: _unit_of(np.concatenate(v))
+            for name in n
+            if (v := [i.seen[what] for i in infos if getattr(i, what) == name and what in i.seen])
+        }
+        if len(set(by_name.values())) > 1:
+            one, odd = (next(i for i in infos if getattr(i, what) == name) for name in n[:2])
+            raise InputError(
+                f"the logs disagree on {what} channels ({', '.join(f'{k} in {u}' for k, u in by_name.items())}): "
+                f"{one.path.name} vs {odd.path.name}. Set up one roaster (one layout) at a time",
+                odd.path,
+            )
     in_tens = {what: _in_whole_tens(v) for what, v in pooled.items()}
     if first.format in ("alog", "artisan-csv") and len(machines) == 1 and artisan_shows_tens(next(iter(machines))):
         # Artisan's setup for this machine shows its levels in tens: a percent in whole tens is those levels
@@ -587,6 +605,12 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
             for unit, what in ((heater_unit, "heater"), (fan_unit, "fan"))
         )
     notes = [f"left out: {why}" for why in unreadable.values()]
+    for what, n in renamed.items():
+        counts = Counter(getattr(i, what) for i in infos if getattr(i, what))
+        notes.append(
+            f"the logs name the {what} differently ({', '.join(f'{k}: {counts[k]} log(s)' for k in n)}): read as "
+            f"one {what}, each log by the name it has; if these are two roasters, set them up apart"
+        )
     if unweighed:
         names = list(unweighed)
         notes.append(
@@ -605,12 +629,12 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
             f"no fan channel: the {fan} sets the air flow through the drum, so the map takes it as the fan "
             "(the model's flow rises with it)"
         )
-    lacking = {what: list(logs_without_controls(infos, {what: ch})) for what, ch in (("heater", heater), ("fan", fan))}
-    for (what, names), channel in zip(lacking.items(), (heater, fan)):
-        if names:
+    lacking = {what: list(logs_without_controls(infos, {what: control_names[what]})) for what in ("heater", "fan")}
+    for what, logs in lacking.items():
+        if logs:
             notes.append(
-                f"{len(names)} log(s) record no {channel} ({', '.join(names[:3])}{' ...' if len(names) > 3 else ''}): "
-                f"their {what} setting is unknown, so fit-roaster leaves them out"
+                f"{len(logs)} log(s) record no {' or '.join(control_names[what])} ({', '.join(logs[:3])}"
+                f"{' ...' if len(logs) > 3 else ''}): their {what} setting is unknown, so fit-roaster leaves them out"
             )
     if lacking["heater"] and len(infos) - len(lacking["heater"]) < 2:
         raise InputError(
@@ -714,7 +738,21 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
         et_below_bt,
         fan_at=fan_at,
         first_crack=first_crack,
+        renamed=renamed,
     )
+
+
+def toml_string(text: str) -> str:
+    """``text`` as a TOML basic string (JSON's escapes are TOML's): a channel name from a log may hold a
+    quote or a backslash."""
+    return json.dumps(text, ensure_ascii=False)
+
+
+def _control_names(infos, what: str) -> list[str]:
+    """The names the logs give the ``heater`` or the ``fan`` (:attr:`LogInfo.heater`), the most used
+    first (a tie: the first log's first); empty where no log records it."""
+    counts = Counter(getattr(i, what) for i in infos if getattr(i, what))
+    return sorted(counts, key=lambda name: -counts[name])
 
 
 def _one_setting(values) -> float | None:
@@ -866,9 +904,15 @@ def map_text(s: Survey) -> str:
                 "W": "above 100: a power in watts",
                 "rpm": "above 100: the fan's speed",
             }[unit]
+            column = (
+                f"column = [{', '.join(map(toml_string, s.renamed[name]))}]      # detected by name; the logs name it "
+                "differently: each log is read by the first name it has"
+                if name in s.renamed
+                else f"column = {toml_string(col)}      # detected by name"
+            )
             lines += [
                 f"[{name}]",
-                f'column = "{col}"      # detected by name',
+                column,
                 f'unit = "{unit}"       # by the logged values ({why})',
             ]
             if unit in ("level", "tens", "W", "rpm"):
@@ -1266,17 +1310,18 @@ def logs_without_weight(infos) -> dict[str, str]:
     }
 
 
-def logs_without_controls(infos, controls: dict[str, str | None]) -> dict[str, str]:
+def logs_without_controls(infos, controls: dict) -> dict[str, str]:
     """The logs that do not record a setting the model is driven with (``controls``: ``{"heater":
-    channel, "fan": channel}``, None for none; a channel with no events: Artisan logs a setting only
-    when it moves), each with why; ``{name: why}``. ``init`` names them, ``fit-roaster`` leaves them out."""
+    channel, "fan": channel}``, a channel a name or a list of names (:func:`names_of`), None or empty
+    for none; a channel with no events: Artisan logs a setting only when it moves), each with why;
+    ``{name: why}``. ``init`` names them, ``fit-roaster`` leaves them out."""
     out = {}
     for info in infos:
         for what, channel in controls.items():
-            if channel and channel not in info.channels:
+            if channel and not set(names_of(channel)) & set(info.channels):
                 out[info.path.name] = (
-                    f"{info.path.name} records no {channel} (its {what} setting is unknown: Artisan "
-                    "logs a setting only when it moves)"
+                    f"{info.path.name} records no {' or '.join(names_of(channel))} (its {what} setting is unknown: "
+                    "Artisan logs a setting only when it moves)"
                 )
                 break
     return out

@@ -36,7 +36,8 @@ A map is a TOML file::
     # --- the actuator extension (optional; the paper's model uses none of these) ---
     batch_kg = 0.5             # green weight of a log that records none, nor in its file name [kg]
     [heater]                   # a logged heater/burner setting, held between changes
-    column = "Burner"          # Artisan event type, RoasTime "heater" (P1-P9), or a CSV column
+    column = "Burner"          # Artisan event type, RoasTime "heater" (P1-P9), or a CSV column;
+                               # ["Burner", "Power"]: logs that name it differently, the first a log has
     unit = "percent"           # percent | level | tens (levels shown x10) | kW | W
     [fan]                      # a logged fan/air setting
     column = "Air"             # Artisan event type, RoasTime "fan" (F0-F12), or a CSV column
@@ -232,14 +233,20 @@ def _table(data: dict, key: str, src) -> dict:
     return value
 
 
-def _initial_sources(table: dict, key: str, src) -> str | list[str]:
-    """An ``[initial]`` entry: one field or channel name, or a list of them tried in order."""
+def _names(table: dict, key: str, src, where: str) -> str | list[str]:
+    """One field or channel name, or a list of them tried in order (an ``[initial]`` entry; a
+    ``[heater]`` or ``[fan]`` column whose name differs between a roaster's logs)."""
     v = table.get(key)
     if isinstance(v, list):
-        if not v or not all(isinstance(x, str) and x for x in v):
-            raise InputError(f"must be a name or a list of names, got {v!r}", src, f"initial.{key}")
+        if not v or not all(isinstance(x, str) and x for x in v) or len(set(v)) < len(v):
+            raise InputError(f"must be a name or a list of distinct names, got {v!r}", src, f"{where}.{key}")
         return list(v)
-    return _check_str(table, key, src, "initial")
+    return _check_str(table, key, src, where)
+
+
+def names_of(column: str | list[str]) -> list[str]:
+    """A map entry's names, tried in order: ``"Burner"`` or ``["Burner", "Power"]``."""
+    return [column] if isinstance(column, str) else list(column)
 
 
 def _check_str(table: dict, key: str, src, where: str, required: bool = True, choices=None):
@@ -350,14 +357,14 @@ def map_from_mapping(data: dict, path: str | Path) -> ColumnMap:
         if key in data:
             t = _table(data, key, path)
             spec = {
-                "column": _check_str(t, "column", path, key),
+                "column": _names(t, "column", path, key),
                 "unit": _check_str(t, "unit", path, key, required=False, choices=tuple(SETTING_UNITS)) or "percent",
             }
             spec.update(_actuator_levels(t, spec["unit"], path, key))
             setattr(m, key, spec)
     if "initial" in data:
         t = _table(data, "initial", path)
-        m.initial = {k: _initial_sources(t, k, path) for k in t}
+        m.initial = {k: _names(t, k, path, "initial") for k in t}
     if "batch_kg" in data:
         m.batch_kg = check_value("batch_kg", _check_num(data, "batch_kg", path, "map"), str(path))
     if "Gg" in data:
@@ -668,9 +675,11 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
         default_notes.extend(log.notes)
 
         def channel(spec: dict, what: str) -> np.ndarray:
-            col = spec["column"]
-            if col not in available:
-                raise InputError(f"{what}: no channel {col!r} in the log (has: {', '.join(sorted(available))})", path)
+            names = names_of(spec["column"])  # a control the logs name differently: the first this log has
+            col = next((n for n in names if n in available), None)
+            if col is None:
+                wanted = " or ".join(map(repr, names))
+                raise InputError(f"{what}: no channel {wanted} in the log (has: {', '.join(sorted(available))})", path)
             return np.array(available[col], dtype=float)  # log temperatures already in degC
 
         Ta = channel(cmap.Ta, "Ta") + (cmap.Ta.get("offset_C") or 0.0)
@@ -727,6 +736,13 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
             needed += [gg["pitot"]["dp_column"], gg["pitot"]["T_column"]]
         if et_spec is not None:
             settings["ET"] = et_spec
+        for k, spec in settings.items():
+            if not isinstance(spec["column"], str):
+                raise InputError(
+                    f"[{k}] column: a list of names serves Artisan and RoasTime logs, whose controls a roaster may "
+                    "rename; a CSV or Parquet map names its one column",
+                    cmap.source,
+                )
         needed += [spec["column"] for spec in settings.values()]
         needed = list(dict.fromkeys(needed))
         # an empty cell is a sample not taken: NaN here, its row dropped below with a note
