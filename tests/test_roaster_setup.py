@@ -570,16 +570,16 @@ def test_a_control_the_logs_name_differently_is_one_control_read_by_each_logs_na
     name and in watts under the other is two layouts, refused as before."""
     from roastlab.io.importers.mapping import import_log, load_map
 
-    renamed = {**_BURNER_AIR, "etypes": ["Fan", "Drum", "Damper", "Power", "--"]}
+    renamed = {**_BURNER_AIR, "etypes": ["Fan", "Drum", "Damper", 'Power "2"', "--"]}  # a quote: TOML escapes it
     logs = [tmp_path / f"r{k}.alog" for k in range(3)]
     for k, p in enumerate(logs):
         p.write_text(fake_alog(extra=_BURNER_AIR if k < 2 else renamed))
     code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
     assert code == 0, err
-    assert "heater: Burner/Power (percent); fan: Air/Fan (percent)" in out
-    assert "the logs name the heater differently (Burner: 2 log(s), Power: 1 log(s))" in out
+    assert 'heater: Burner/Power "2" (percent); fan: Air/Fan (percent)' in out
+    assert 'the logs name the heater differently (Burner: 2 log(s), Power "2": 1 log(s))' in out
     text = (tmp_path / "cfg" / "map.toml").read_text()
-    assert 'column = ["Burner", "Power"]' in text and 'column = ["Air", "Fan"]' in text
+    assert 'column = ["Burner", "Power \\"2\\""]' in text and 'column = ["Air", "Fan"]' in text
     cmap = load_map(tmp_path / "cfg" / "map.toml")
     a, b = import_log(logs[0], cmap), import_log(logs[2], cmap)
     for what in ("heater", "fan"):  # the same events under either name: the same setting
