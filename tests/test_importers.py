@@ -56,6 +56,30 @@ def test_probe_fault_is_cut_with_a_note(real_data, tmp_path):
     assert any("probe fault" in n for n in b.notes)
 
 
+def test_probe_spikes_are_dropped_and_a_step_that_stays_is_cut(tmp_path):
+    """SYNTHETIC: a reading that leaps and comes back within seconds (a thermocouple's pick-up) is a
+    few samples dropped, not a fault that ends the roast at half time; a step that stays is cut."""
+    bt = [130.0 - 0.2 * i if i < 30 else 124.0 + 0.5 * (i - 30) for i in range(120)]
+    spiky = list(bt)
+    spiky[60] += 150.0  # one sample, 90 s into a 180 s log
+    spiky[80] -= 80.0
+    spiky[81] -= 80.0  # two samples
+    cmap = load_map(write_map(tmp_path, ROOM_AIR_MAP))
+    (tmp_path / "s.alog").write_text(fake_alog(bt=spiky))
+    (tmp_path / "c.alog").write_text(fake_alog(bt=bt))
+    b, clean = import_log(tmp_path / "s.alog", cmap), import_log(tmp_path / "c.alog", cmap)
+    assert b.n == clean.n - 3 and b.time_s[-1] == clean.time_s[-1]
+    kept = np.isin(clean.time_s, b.time_s)  # the clean log's samples at the spiky log's times
+    assert np.array_equal(b.Ta_C, clean.Ta_C[kept]) and np.diff(clean.time_s[~kept]).tolist() == [30.0, 1.5]
+    assert any("dropped 3 sample(s) of bean-probe spikes at t = " in n for n in b.notes), b.notes
+    stays = list(bt)
+    stays[90:] = [v - 45.0 for v in stays[90:]]  # 45 degC down for the rest of the roast: a fault
+    (tmp_path / "f.alog").write_text(fake_alog(bt=stays))
+    f = import_log(tmp_path / "f.alog", cmap)
+    assert any("probe fault" in n for n in f.notes) and f.n < clean.n - 15  # cut before the step
+    assert np.array_equal(f.Ta_C, clean.Ta_C[: f.n]) and f.time_s[-1] == clean.time_s[f.n - 1]
+
+
 def test_special_events_become_step_signals(real_data):
     log = read_alog(real_data / "roast_25-11-16_1235.alog")
     burner = log.channels["Burner"]

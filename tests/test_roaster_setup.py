@@ -1167,6 +1167,12 @@ def test_notes_said_alike_on_many_logs_are_one_line_with_the_range():
     assert lines[0] == "5 logs: dropped 1-6 incomplete sample(s) (missing values)"  # more than NAMED_UP_TO: counted
     assert "a.alog: ET reads 32 degC below BT (median from 60 s)" in lines  # said on two logs: each as said
     assert "c.alog: bean temperature jumps 176 -> 349 degC" in lines and len(lines) == 4
+    clock = {
+        f"{k}.alog": [f"no DROP marked: taken at {t} after CHARGE"] for k, t in enumerate(("10:01", "9:58", "11:48"))
+    }
+    assert roaster.grouped_notes(clock) == [
+        "3 logs (0.alog, 1.alog, 2.alog): no DROP marked: taken at 9:58-11:48 after CHARGE"
+    ]
     notes["f.alog"] = ["ET reads 40 degC below BT (median from 60 s)"]
     assert (
         "3 logs (a.alog, e.alog, f.alog): ET reads -3.5 to 40 degC below BT (median from 60 s)"

@@ -64,6 +64,7 @@ from ..io.importers.mapping import (
     is_log_by_content,
     names_of,
     probe_fault,
+    probe_spikes,
 )
 from ..io.importers.roastime import DRUM_AT_CHARGE, read_roastime
 from ..metrics.profile import (
@@ -401,8 +402,10 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
     names = list(log.channels)
     if "BT" not in log.channels or not np.isfinite(log.channels["BT"]).any():
         raise InputError("no bean temperature (BT) in this log: roastlab needs the bean probe", path)
-    bt = log.channels["BT"][np.isfinite(log.channels["BT"])]
-    bt = bt[: fault + 1] if (fault := probe_fault(bt)) is not None else bt  # the import cuts a probe fault so
+    read = np.isfinite(log.channels["BT"])
+    bt = log.channels["BT"][read]
+    bt = bt[~probe_spikes(log.time_s[read], bt)]  # the import drops spikes and cuts a probe fault so
+    bt = bt[: fault + 1] if (fault := probe_fault(bt)) is not None else bt
     if log.drop_index is not None and (why := hot_drop(float(bt[-1]))):
         raise InputError(why, path)  # the import refuses it too; say it before the files are written
     if not live_reading(bt):  # a probe that read nothing (0 degC throughout)
@@ -1201,7 +1204,19 @@ def init_roaster(paths, out_dir, *, batch_kg=None, capacity_kg=None, diameter_m=
     return {"survey": s, "plant": plant, "notes": notes}
 
 
-_NUMBER = re.compile(r"-?\d+(?:\.\d+)?")
+#: A number in a note, or a clock time (m:ss, h:mm:ss: one value, its seconds ordering it).
+_NUMBER = re.compile(r"-?\d+(?::\d\d)+|-?\d+(?:\.\d+)?")
+
+
+def _value(token: str) -> float:
+    """A :data:`_NUMBER` token's value, a clock time in seconds."""
+    sign = -1.0 if token.startswith("-") else 1.0
+    total = 0.0
+    for part in token.lstrip("-").split(":"):
+        total = 60.0 * total + float(part)
+    return sign * total
+
+
 #: A note said alike on this many logs or fewer names them; on more, it counts them.
 NAMED_UP_TO = 4
 
@@ -1222,7 +1237,7 @@ def grouped_notes(notes: dict[str, list[str]], at_least: int = 3) -> list[str]:
             continue
         spans = []
         for k in range(len(words) - 1):
-            by_value = sorted((float(r[2][k]), r[2][k]) for r in rows)
+            by_value = sorted((_value(r[2][k]), r[2][k]) for r in rows)
             lo, hi = by_value[0][1], by_value[-1][1]
             spans.append(
                 lo if by_value[0][0] == by_value[-1][0] else f"{lo} to {hi}" if lo.startswith("-") else f"{lo}-{hi}"

@@ -103,9 +103,30 @@ SECOND_BEAN_START_S = 10.0
 
 def probe_fault(bt_C: np.ndarray) -> int | None:
     """The last sample before the bean probe's first step larger than :data:`MAX_JUMP_C` between
-    two samples (a sensor fault), or None when it makes none."""
+    two samples (a sensor fault), or None when it makes none. Spikes (:func:`probe_spikes`) are
+    dropped first: this is a step that does not come back."""
     jumps = np.flatnonzero(np.abs(np.diff(bt_C)) > MAX_JUMP_C)
     return int(jumps[0]) if jumps.size else None
+
+
+def probe_spikes(time_s: np.ndarray, bt_C: np.ndarray) -> np.ndarray:
+    """Which samples are the bean probe's spikes: after a step larger than :data:`MAX_JUMP_C` between
+    two samples, the samples until the probe reads within half the step of the reading before it
+    again, where that happens within :data:`SPIKE_MAX_S` (a thermocouple's pick-up of a motor or a
+    loose contact; Artisan's own spike filter drops them as it records). A step that does not come
+    back so soon is a fault (:func:`probe_fault`), not a spike. A boolean mask over the samples."""
+    spikes = np.zeros(len(bt_C), dtype=bool)
+    start = 0
+    while (jumps := np.flatnonzero(np.abs(np.diff(bt_C[start:])) > MAX_JUMP_C)).size:
+        k = start + int(jumps[0])  # the last sample before the step
+        after = slice(k + 1, None)
+        step = abs(bt_C[k + 1] - bt_C[k])
+        back = np.flatnonzero((time_s[after] - time_s[k] <= SPIKE_MAX_S) & (np.abs(bt_C[after] - bt_C[k]) < 0.5 * step))
+        if not back.size:
+            break
+        start = k + 1 + int(back[0])
+        spikes[k + 1 : start] = True
+    return spikes
 
 
 def hot_drop(bt_at_drop_C: float) -> str | None:
@@ -121,6 +142,8 @@ MIN_RESAMPLE_S = 0.1
 MAX_SAMPLES = 1_000_000
 #: A bean probe cannot move this much between two samples: a larger step is a sensor fault.
 MAX_JUMP_C = 40.0
+#: A step of the bean probe undone within this long is a spike, dropped, not a fault that ends the log [s].
+SPIKE_MAX_S = 10.0
 
 
 @dataclass
@@ -853,6 +876,15 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
     notes = list(default_notes)
     if ok.sum() < ok.size:
         notes.append(f"dropped {ok.size - ok.sum()} incomplete sample(s) (missing values)")
+    if (spikes := probe_spikes(time_s, Ta)).any():
+        at = time_s[spikes]
+        notes.append(
+            f"dropped {spikes.sum()} sample(s) of bean-probe spikes at t = {at[0]:.0f}"
+            + (f"-{at[-1]:.0f}" if at[-1] > at[0] else "")
+            + f" s (a step over {MAX_JUMP_C:g} degC that came back within {SPIKE_MAX_S:g} s)"
+        )
+        time_s, Ta, Tgi, Gg = time_s[~spikes], Ta[~spikes], Tgi[~spikes], Gg[~spikes]
+        series = {k: v[~spikes] for k, v in series.items()}
     if (j := probe_fault(Ta)) is not None:
         # a probe fault: keep what came before it rather than fit a physically impossible step
         if j + 1 < max(2, 0.5 * len(Ta)):
