@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from conftest import REAL_DATA
 from roastlab.io.importers import gas_flow_pitot_kg_s, import_log, load_map
 from roastlab.io.importers.artisan import ET_BEFORE_CHARGE, events_internal_to_external, read_alog, read_artisan_csv
 
@@ -650,6 +651,52 @@ def test_a_roastime_log_without_a_map_is_read_as_a_bullet(tmp_path):
     assert b.fan is None and b.Tb2_C is None and "Tm0_C" not in b.initial and b.heater[-1] == 4
     (note,) = [n for n in b.notes if n.startswith("no map")]
     assert "the heater levels over room air" in note and "the IR" not in note and "drum at charge" not in note
+
+
+def as_roastworld(doc: dict) -> dict:
+    """A RoasTime log rewritten as RoastWorld's roast export lays it out (its public API's roast
+    detail: the IR curve as ``ibtsTemperature``, ``actions`` as ``[{type, second, setting}]``, no
+    ``sampleRate`` nor roast bounds, ``ambient`` 0 where no room was typed). Written here from the
+    export's field list, not taken from roastlab: the test checks the reader against it."""
+    rate, start = doc["sampleRate"], doc.get("roastStartIndex", 0)
+    end = doc.get("roastEndIndex") or len(doc["beanTemperature"])
+    out = {k: v for k, v in doc.items() if k not in ("sampleRate", "roastStartIndex", "roastEndIndex", "actions")}
+    for key in ("beanTemperature", "drumTemperature", "exitTemperature", "beanDerivative", "ibtsDerivative"):
+        if key in out:
+            out[key] = out[key][start:end]
+    out["ibtsTemperature"] = out.pop("drumTemperature")
+    out["totalRoastTime"] = (end - 1 - start) / rate
+    kinds = {0: "Power", 1: "Blower", 2: "Drum"}
+    out["actions"] = [
+        {"type": kinds[a["ctrlType"]], "second": max(a["index"] - start, 0) / rate, "setting": a["value"]}
+        for a in doc["actions"]["actionTimeList"]
+        if a["ctrlType"] in kinds
+    ]
+    for key in ("indexYellowingStart", "indexFirstCrackStart", "indexFirstCrackEnd"):
+        if out.get(key):
+            out[key] = out[key] - start
+    out["ambient"] = out.pop("ambientTemp", 0) or 0
+    return out
+
+
+@pytest.mark.skipif(not (REAL_DATA / "bullet").is_dir(), reason="needs ../shared/data/real/bullet")
+def test_roastworlds_export_of_a_roast_reads_as_roastimes_own_file(tmp_path):
+    """Every shared Bullet log rewritten in RoastWorld's export layout (:func:`as_roastworld`) imports
+    through the Bullet example's map to the same batch as RoasTime's own file: the same samples, the
+    same heater and fan steps, the same IR and drum at charge."""
+    cmap = load_map(Path(__file__).parents[1] / "examples" / "bullet" / "map.toml")
+    logs = sorted((REAL_DATA / "bullet").glob("bullet_*g.json"))
+    assert len(logs) >= 20
+    for log in logs:
+        doc = json.loads(log.read_text())
+        moved = tmp_path / log.name
+        moved.write_text(json.dumps(as_roastworld(doc)))
+        a, b = import_log(log, cmap), import_log(moved, cmap)
+        assert b.n == a.n and np.allclose(b.time_s, a.time_s), log.name
+        for key in ("Ta_C", "heater", "fan", "Tb2_C", "Tgi_C"):
+            assert np.allclose(getattr(a, key), getattr(b, key), equal_nan=True), (log.name, key)
+        assert a.initial == b.initial and a.Mb_kg == b.Mb_kg and a.unit == b.unit
+        assert any(n.startswith("no sampleRate: 2 samples/s from totalRoastTime") for n in b.notes)
 
 
 def test_an_unmarked_charge_and_drop_are_read_from_bt(tmp_path):

@@ -5,11 +5,14 @@ Fields used (see ``../shared/data/real/README.md`` for what each holds on a Bull
 * ``sampleRate`` [samples/s]; ``roastStartIndex`` / ``roastEndIndex`` bound the roast
   (charge to drop, end exclusive);
 * equal-length series ``beanTemperature`` (the lagging bean probe), ``drumTemperature``
-  (after charge an infrared bean-surface-like reading; before charge the drum), and
-  ``exitTemperature``, ``beanDerivative``, ``ibtsDerivative`` when present;
+  (after charge an infrared bean-surface-like reading; before charge the drum; RoastWorld's export
+  names it ``ibtsTemperature``, read under RoasTime's name), and ``exitTemperature``,
+  ``beanDerivative``, ``ibtsDerivative`` when present; ``sampleRate`` where RoastWorld's export
+  records none: from ``totalRoastTime`` over the samples;
 * ``actions.actionTimeList``: the operator's changes ``{ctrlType, index, value}``, ctrlType
   0 = heater power P (levels 1-9), 1 = fan F (0-12), 2 = drum speed D (0-9); each holds until
-  the next change of its type (before the first change: the first value);
+  the next change of its type (before the first change: the first value); RoastWorld's export
+  lists them as ``actions: [{type, second, setting}]``, type ``Power``, ``Blower``, ``Drum``;
 * ``weightGreen`` / ``weightRoasted`` [g] as strings or numbers ("0" = not weighed);
 * events ``indexYellowingStart``, ``indexFirstCrackStart``, ``indexFirstCrackEnd``,
   ``indexSecondCrackStart``, ``indexSecondCrackEnd`` (0 = not marked);
@@ -39,8 +42,14 @@ from .artisan import ArtisanLog, epoch_or_none, number_list, room_from_text
 
 #: RoasTime's control types in ``actions.actionTimeList`` and the channel each becomes.
 CONTROL_TYPES = {0: "heater", 1: "fan", 2: "drum"}
+#: The same controls by name, as RoastWorld's roast export lists its ``actions`` (``{type, second,
+#: setting}``: ``"Power"`` the heater's P, ``"Blower"`` the fan's F, ``"Drum"`` the drum's D).
+CONTROL_NAMES = {"power": "heater", "blower": "fan", "fan": "fan", "drum": "drum"}
 #: Temperature series read when present, under the file's own names.
 SERIES = ("beanTemperature", "drumTemperature", "exitTemperature")
+#: The infrared sensor's curve (IBTS) as RoastWorld's export names it; read as ``drumTemperature``,
+#: the name RoasTime's own files give the same curve, so one column map serves both.
+IR_SERIES = "ibtsTemperature"
 EVENTS = {
     "indexYellowingStart": "DRY",
     "indexFirstCrackStart": "FCs",
@@ -98,28 +107,34 @@ def _series(data: dict, key: str, path) -> np.ndarray | None:
     return number_list(data[key], path, key) if key in data else None
 
 
-def _actions(data: dict, n: int, path) -> dict[str, np.ndarray]:
-    """Step series of each control type over the n samples (held until the next change)."""
+def _actions(data: dict, n: int, rate: float, path) -> dict[str, np.ndarray]:
+    """Step series of each control type over the n samples (held until the next change): RoasTime's
+    ``actions.actionTimeList`` (``{ctrlType, index, value}``), or RoastWorld's ``actions`` list
+    (``{type, second, setting}``, a second at ``rate`` samples per second)."""
     actions = data.get("actions", {})
-    if not isinstance(actions, dict):
-        raise InputError("expected an object", path, "key actions")
-    items = actions.get("actionTimeList", [])
+    by_name = isinstance(actions, list)
+    if not isinstance(actions, dict) and not by_name:
+        raise InputError("expected an object or a list", path, "key actions")
+    items = actions if by_name else actions.get("actionTimeList", [])
     if not isinstance(items, list):
         raise InputError("expected a list", path, "key actions.actionTimeList")
+    keys = ("type", "second", "setting") if by_name else ("ctrlType", "index", "value")
     changes: dict[str, list[tuple[int, float]]] = {name: [] for name in CONTROL_TYPES.values()}
     for k, item in enumerate(items):
-        where = f"actions.actionTimeList[{k}]"
+        where = f"actions[{k}]" if by_name else f"actions.actionTimeList[{k}]"
         if not isinstance(item, dict):
             raise InputError("expected an object", path, where)
-        ctrl, index, value = item.get("ctrlType"), item.get("index"), item.get("value")
-        for label, v in (("ctrlType", ctrl), ("index", index), ("value", value)):
+        ctrl, index, value = (item.get(key) for key in keys)
+        for label, v in zip(keys[by_name:], (ctrl, index, value)[by_name:]):
             if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
                 raise InputError(f"{label} must be a finite number, got {str(v)[:20]!r}", path, where)
-        if ctrl not in CONTROL_TYPES:
+        control = CONTROL_NAMES.get(str(ctrl).strip().lower()) if by_name else CONTROL_TYPES.get(ctrl)
+        if control is None:
             continue  # a control this reader does not model
+        index = round(index * rate) if by_name else index
         if not 0 <= index < 10 * max(n, 1) or not -1e3 <= value <= 1e3:
-            raise InputError(f"index {index} or value {value} out of range", path, where)
-        changes[CONTROL_TYPES[int(ctrl)]].append((int(index), float(value)))
+            raise InputError(f"{keys[1]} {item.get(keys[1])} or {keys[2]} {value} out of range", path, where)
+        changes[control].append((int(index), float(value)))
     out = {}
     for name, steps in changes.items():
         if not steps:
@@ -130,6 +145,19 @@ def _actions(data: dict, n: int, path) -> dict[str, np.ndarray]:
             series[min(index, n) :] = value
         out[name] = series
     return out
+
+
+def _rate_from_length(data: dict, intervals: int, path) -> tuple[float, str]:
+    """The sample rate of a log that records none [1/s], from ``totalRoastTime`` [s] over the
+    roast's ``intervals`` between samples: a whole number of samples per second where the two agree
+    within 5 % (RoasTime records 2), else their ratio; with a note saying so."""
+    total = _number(data, "totalRoastTime", path, 1.0, 1e5, required=False)
+    if total is None:
+        raise InputError("missing key, and no totalRoastTime to tell the sample rate from", path, "key sampleRate")
+    ratio = intervals / total
+    whole = round(ratio)
+    rate = float(whole) if whole >= 1 and abs(ratio - whole) <= 0.05 * ratio else ratio
+    return rate, f"no sampleRate: {rate:g} samples/s from totalRoastTime ({total:g} s over {intervals + 1} samples)"
 
 
 def read_roastime(path: str | Path, keep_after_drop: bool = False) -> ArtisanLog:
@@ -144,22 +172,27 @@ def read_roastime(path: str | Path, keep_after_drop: bool = False) -> ArtisanLog
     n = len(bt)
     if n < 2:
         raise InputError(f"needs at least 2 samples, beanTemperature has {n}", path, "key beanTemperature")
-    rate = _number(data, "sampleRate", path, 1e-3, MAX_SAMPLE_RATE)
     start = int(_number(data, "roastStartIndex", path, 0, n - 1, required=False) or 0)
     end_raw = _number(data, "roastEndIndex", path, 0, 10 * n, required=False)
     end = n if not end_raw else int(min(end_raw, n))
     if end - start < 2:
         raise InputError(f"roastStartIndex {start} and roastEndIndex {end} leave fewer than 2 samples", path)
+    notes = []
+    rate = _number(data, "sampleRate", path, 1e-3, MAX_SAMPLE_RATE, required=False)
+    if rate is None:  # RoastWorld's export records none: the roast's length over its samples
+        rate, note = _rate_from_length(data, end - 1 - start, path)
+        notes.append(note)
     channels = {"beanTemperature": bt}
     for key in SERIES[1:]:
-        s = _series(data, key, path)
+        name = IR_SERIES if key == "drumTemperature" and key not in data and IR_SERIES in data else key
+        s = _series(data, name, path)
         if s is not None:
             if len(s) != n:
                 raise InputError(
-                    f"has {len(s)} values but beanTemperature has {n} (truncated file?)", path, f"key {key}"
+                    f"has {len(s)} values but beanTemperature has {n} (truncated file?)", path, f"key {name}"
                 )
             channels[key] = s
-    channels.update(_actions(data, n, path))
+    channels.update(_actions(data, n, rate, path))
     stop = n if keep_after_drop else end
     time_s = (np.arange(n, dtype=float) - start) / rate
     sl = slice(start, stop)
@@ -189,10 +222,12 @@ def read_roastime(path: str | Path, keep_after_drop: bool = False) -> ArtisanLog
             data.get("dateTime") / 1000.0 if isinstance(data.get("dateTime"), (int, float)) else None
         ),
     )
+    log.notes.extend(notes)
     # 0 is "not recorded" (no drum or bean is at 0 degC during a roast; Artisan writes 0 alike)
     log.fields = {k: v for k in FIELDS if (v := _number(data, k, path, -100, 1000, required=False)) not in (None, 0.0)}
-    # the room temperature the owner typed (older RoasTime: ambientTemp, later: ambient), as written
-    log.room = room_from_text(next((data[k] for k in ROOM_KEYS if data.get(k) not in (None, "")), None))
+    # the room temperature the owner typed (older RoasTime: ambientTemp, later: ambient), as written;
+    # a bare 0 is RoastWorld's "not typed", as for the fields above
+    log.room = room_from_text(next((data[k] for k in ROOM_KEYS if data.get(k) not in (None, "", 0)), None))
     serial = data.get("serialNumber")
     if isinstance(serial, (int, str)) and not isinstance(serial, bool) and str(serial).strip():
         log.unit = str(serial).strip()[:40]
