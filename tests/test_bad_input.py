@@ -503,6 +503,24 @@ ROASTIME = {
         "r.json",
         "key sampleRate",
     ),
+    "RoasTime with no sample rate nor roast length": (
+        lambda d: import_with(d, "r.json", RT.replace('"sampleRate": 2, ', ""), RT_MAP),
+        "r.json",
+        "no totalRoastTime to tell the sample rate from",
+    ),
+    "RoastWorld action of no number": (
+        lambda d: import_with(
+            d,
+            "r.json",
+            RT.replace('"sampleRate": 2', '"totalRoastTime": 1.5').replace(
+                '{"actionTimeList": [{"index": 0, "value": 6, "ctrlType": 0}]}',
+                '[{"type": "Power", "second": "six", "setting": 6}]',
+            ),
+            RT_MAP,
+        ),
+        "r.json",
+        "second must be a finite number",
+    ),
     "RoasTime truncated": (lambda d: import_with(d, "r.json", RT[:60], RT_MAP), "r.json", "r.json"),
     "RoasTime heater level of 600": (
         lambda d: import_with(d, "r.json", RT.replace('"value": 6', '"value": 600'), RT_MAP),

@@ -653,6 +653,33 @@ def test_a_roastime_log_without_a_map_is_read_as_a_bullet(tmp_path):
     assert "the heater levels over room air" in note and "the IR" not in note and "drum at charge" not in note
 
 
+def test_a_roastworld_export_steps_its_settings_at_their_seconds(tmp_path):
+    """SYNTHETIC roast in RoastWorld's export layout, 2 samples/s over 99.5 s (no sampleRate): Power 6
+    from the start and 4 from 50 s, Blower 2, the IR as ``ibtsTemperature``, ``ambient`` 0 (none
+    typed); a control it does not model (``Drum``) and one it does not know are passed over."""
+    n = 200
+    d = {
+        "weightGreen": 480,
+        "totalRoastTime": 99.5,
+        "preheatTemperature": 235,
+        "ambient": 0,
+        "beanTemperature": [150.0 - i if i < 60 else 30 + i for i in range(n)],
+        "ibtsTemperature": [235.0] + [25.0 + i for i in range(n - 1)],
+        "actions": [{"type": "Power", "second": 0, "setting": 6}, {"type": "Blower", "second": 0, "setting": 2},
+                    {"type": "Drum", "second": 0, "setting": 9}, {"type": "Power", "second": 50, "setting": 4},
+                    {"type": "Extra", "second": 10, "setting": 1}],
+    }  # fmt: skip
+    p = tmp_path / "rw.json"
+    p.write_text(json.dumps(d))
+    from roastlab.io.importers.roastime import read_roastime
+
+    b = import_log(p, None)
+    assert b.time_s[1] == 0.5 and b.n == n and read_roastime(p).room is None  # 0: no room typed
+    assert np.all(b.heater[b.time_s < 50] == 6) and np.all(b.heater[b.time_s >= 50] == 4) and np.all(b.fan == 2)
+    assert np.nanmax(b.Tb2_C) == 25.0 + n - 2 and b.initial["Tm0_C"] == 235.0
+    assert any("no sampleRate: 2 samples/s from totalRoastTime (99.5 s over 200 samples)" in n for n in b.notes)
+
+
 def as_roastworld(doc: dict) -> dict:
     """A RoasTime log rewritten as RoastWorld's roast export lays it out (its public API's roast
     detail: the IR curve as ``ibtsTemperature``, ``actions`` as ``[{type, second, setting}]``, no
