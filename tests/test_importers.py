@@ -401,7 +401,7 @@ def test_a_list_of_control_names_is_checked_and_serves_logs_not_csv(tmp_path):
     base = {"Ta": {"column": "BT"}, "Tgi": {"constant_C": 22.0}, "Gg": {"identify": True}}
     cmap = map_from_mapping({**base, "heater": {"column": ["Burner", "Power"]}}, "m.toml")
     assert cmap.heater["column"] == ["Burner", "Power"]
-    with pytest.raises(InputError, match="distinct names"):
+    with pytest.raises(InputError, match="list of names, each once"):
         map_from_mapping({**base, "heater": {"column": ["Burner", "Burner"]}}, "m.toml")
     csv = tmp_path / "r.csv"
     csv.write_text("time_s,BT,Burner\n0,20,50\n1,21,50\n")

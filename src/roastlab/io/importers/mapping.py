@@ -262,7 +262,7 @@ def _names(table: dict, key: str, src, where: str) -> str | list[str]:
     v = table.get(key)
     if isinstance(v, list):
         if not v or not all(isinstance(x, str) and x for x in v) or len(set(v)) < len(v):
-            raise InputError(f"must be a name or a list of distinct names, got {v!r}", src, f"{where}.{key}")
+            raise InputError(f"must be a name or a list of names, each once, got {v!r}", src, f"{where}.{key}")
         return list(v)
     return _check_str(table, key, src, where)
 
