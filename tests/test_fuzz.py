@@ -184,10 +184,24 @@ KEYS = {
         "beanTemperature": st.one_of(VALUES, NUMBER_LISTS),
         "drumTemperature": st.one_of(VALUES, NUMBER_LISTS),
         "weightGreen": st.one_of(VALUES, st.sampled_from(["0", "490", "-5", "1e999", ""])),
+        "ibtsTemperature": st.one_of(VALUES, NUMBER_LISTS),  # RoastWorld's export: the IR, no sampleRate
+        "totalRoastTime": st.one_of(VALUES, st.floats(-1, 1e6)),
+        "ambient": VALUES,
         "drumChargeTemperature": VALUES,
         "indexFirstCrackStart": VALUES,
         "actions": st.one_of(
             VALUES,
+            st.lists(  # RoastWorld's export: [{type, second, setting}]
+                st.fixed_dictionaries(
+                    {},
+                    optional={
+                        "type": st.one_of(VALUES, st.sampled_from(["Power", "Blower", "Drum", "fan", ""])),
+                        "second": st.one_of(VALUES, st.floats(-5, 1e5)),
+                        "setting": VALUES,
+                    },
+                ),
+                max_size=4,
+            ),
             st.fixed_dictionaries(
                 {
                     "actionTimeList": st.lists(
