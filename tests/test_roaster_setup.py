@@ -324,6 +324,10 @@ def test_init_reads_a_plain_csv_by_its_column_names(cli, tmp_path):
     assert b.initial["Tm0_C"] == pytest.approx((300.0 - 32) * 5 / 9) and b.Mb_kg == 0.25
     assert b.Ta_C[0] == pytest.approx((300.0 - 32) * 5 / 9) and b.heater[-1] == 70.0
     assert b.ET_C is not None and 0.9 < np.isfinite(b.ET_C).mean() < 1.0
+    # a CSV map names one column: a burner named otherwise in one log is refused in one line
+    logs[1].write_text(logs[1].read_text().replace("Burner %", "Power %", 1))
+    code, _, err = cli("init", *logs, "--out", tmp_path / "cfg2")
+    assert code == 2 and "the CSV logs name the heater column differently (Burner %, Power %)" in err, err
 
 
 def test_init_reads_a_plain_csv_whose_time_is_a_clock(cli, tmp_path):

@@ -593,8 +593,14 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
             for name in n
             if (v := [i.seen[what] for i in infos if getattr(i, what) == name and what in i.seen])
         }
+        one, odd = (next(i for i in infos if getattr(i, what) == name) for name in n[:2])
+        if first.columns is not None:  # a plain CSV's map names its one column
+            raise InputError(
+                f"the CSV logs name the {what} column differently ({', '.join(n)}): {one.path.name} vs "
+                f"{odd.path.name}. A CSV map names one column: give the column one name in every log",
+                odd.path,
+            )
         if len(set(by_name.values())) > 1:
-            one, odd = (next(i for i in infos if getattr(i, what) == name) for name in n[:2])
             raise InputError(
                 f"the logs disagree on {what} channels ({', '.join(f'{k} in {u}' for k, u in by_name.items())}): "
                 f"{one.path.name} vs {odd.path.name}. Set up one roaster (one layout) at a time",
