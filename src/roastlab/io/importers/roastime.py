@@ -125,7 +125,7 @@ def _actions(data: dict, n: int, rate: float, path) -> dict[str, np.ndarray]:
         if not isinstance(item, dict):
             raise InputError("expected an object", path, where)
         ctrl, index, value = (item.get(key) for key in keys)
-        for label, v in zip(keys[by_name:], (ctrl, index, value)[by_name:]):
+        for label, v in zip(keys[by_name:], (ctrl, index, value)[by_name:]):  # RoastWorld's type is a name
             if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
                 raise InputError(f"{label} must be a finite number, got {str(v)[:20]!r}", path, where)
         control = CONTROL_NAMES.get(str(ctrl).strip().lower()) if by_name else CONTROL_TYPES.get(ctrl)
