@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from conftest import REAL_DATA
+from roastlab.errors import InputError
 from roastlab.io.importers import gas_flow_pitot_kg_s, import_log, load_map
 from roastlab.io.importers.artisan import ET_BEFORE_CHARGE, events_internal_to_external, read_alog, read_artisan_csv
 
@@ -79,6 +80,41 @@ def test_probe_spikes_are_dropped_and_a_step_that_stays_is_cut(tmp_path):
     f = import_log(tmp_path / "f.alog", cmap)
     assert any("probe fault" in n for n in f.notes) and f.n < clean.n - 15  # cut before the step
     assert np.array_equal(f.Ta_C, clean.Ta_C[: f.n]) and f.time_s[-1] == clean.time_s[f.n - 1]
+
+
+def test_an_alog_whose_time_stumbles_keeps_its_samples_marks_and_events(tmp_path):
+    """SYNTHETIC Artisan log with a time stamp repeated at sample 40, one that goes back at sample 70
+    and a null BT reading at sample 90 (as a converter writes one not taken): those samples are
+    dropped, not the log (it was refused: "time not strictly increasing"); the marks and events that
+    index the samples keep their times."""
+    n = 120
+    extra = {"timeindex": [5, 0, 60, 0, 0, 0, 110, 0], **_burner_at(50, 8.0)}
+    clean = json.loads(fake_alog(n=n, extra=extra, as_json=True))
+    glitchy = json.loads(json.dumps(clean))
+    glitchy["timex"][40] = glitchy["timex"][39]
+    glitchy["timex"][70] = glitchy["timex"][69] - 0.5
+    glitchy["temp2"][90] = None
+    (tmp_path / "c.alog").write_text(json.dumps(clean))
+    (tmp_path / "g.alog").write_text(json.dumps(glitchy))
+    a, b = read_alog(tmp_path / "c.alog"), read_alog(tmp_path / "g.alog")
+    assert len(b.time_s) == len(a.time_s) - 2 and np.isnan(b.channels["BT"]).sum() == 1
+    assert (
+        b.events == a.events and b.notes[0] == "dropped 2 sample(s) whose time does not follow the one before (timex)"
+    )
+    kept = np.isin(a.time_s, b.time_s)
+    assert np.array_equal(b.channels["Burner"], a.channels["Burner"][kept], equal_nan=True)
+    cmap = load_map(write_map(tmp_path, ROOM_AIR_MAP))
+    assert import_log(tmp_path / "g.alog", cmap).n == import_log(tmp_path / "c.alog", cmap).n - 3
+    glitchy["timex"] = [0.0] * n
+    (tmp_path / "g.alog").write_text(json.dumps(glitchy))
+    with pytest.raises(InputError, match="fewer than 2 samples follow one another"):
+        read_alog(tmp_path / "g.alog")
+
+
+def _burner_at(sample: int, internal: float) -> dict:
+    """SYNTHETIC Burner events: 70 % from the start, ``internal`` (Artisan's encoding) from ``sample``."""
+    return {"specialevents": [0, sample], "specialeventstype": [3, 3], "specialeventsvalue": [8.0, internal],
+            "etypes": ["Air", "Drum", "Damper", "Burner", "--"]}  # fmt: skip
 
 
 def test_special_events_become_step_signals(real_data):

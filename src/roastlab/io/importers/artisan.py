@@ -371,12 +371,16 @@ def number_list(value, path: Path, key: str) -> np.ndarray:
     """A parsed list of numbers as a float array; else one InputError naming file and key.
 
     Shared by the log readers (Artisan, RoasTime): booleans and strings are refused, integers
-    beyond float range are "out of range", never an OverflowError.
+    beyond float range are "out of range", never an OverflowError. A null (JSON's ``null``, Python's
+    ``None``, as a converter writes a reading not taken) is NaN: a missing sample, as Artisan's -1.
     """
     if not isinstance(value, (list, tuple)):
         raise InputError(f"expected a list of numbers, got {type(value).__name__}", path, f"key {key}")
     out = np.empty(len(value))
     for i, v in enumerate(value):
+        if v is None:
+            out[i] = np.nan
+            continue
         if isinstance(v, bool) or not isinstance(v, (int, float)):
             raise InputError(f"expected numbers, found {type(v).__name__} at position {i}", path, f"key {key}")
         try:
@@ -451,6 +455,13 @@ def _special_events(data: dict, etypes: list, n: int, path) -> list[tuple[int, s
     return out
 
 
+def _time_follows(timex: np.ndarray) -> np.ndarray:
+    """Which samples' times are finite and later than every finite time before them (a boolean mask)."""
+    finite = np.isfinite(timex)
+    before = np.maximum.accumulate(np.where(finite, timex, -np.inf))
+    return finite & (timex > np.concatenate(([-np.inf], before[:-1])))
+
+
 def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: bool = True) -> ArtisanLog:
     """Parse an Artisan ``.alog`` file into an :class:`ArtisanLog` (see module docstring)."""
     path = Path(path)
@@ -467,9 +478,16 @@ def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: boo
     mode = data.get("mode", "C")
     if mode not in ("C", "F"):
         raise InputError(f"mode must be 'C' or 'F', got {mode!r}", path, "key mode")
-    if not np.all(np.isfinite(timex)) or np.any(np.diff(timex) <= 0):
-        bad = int(np.flatnonzero(~(np.diff(timex) > 0))[0]) + 1 if np.any(~(np.diff(timex) > 0)) else 0
-        raise InputError(f"time not strictly increasing at sample {bad}", path, "key timex")
+    # a sample whose time does not follow every one before it (a repeated or backward stamp, a
+    # missing one) is dropped, and the marks and events that index the samples are moved with them
+    kept = np.flatnonzero(_time_follows(timex))
+    if len(kept) < 2:
+        raise InputError("time not strictly increasing: fewer than 2 samples follow one another", path, "key timex")
+    dropped_times = n - len(kept)
+
+    def moved(k: int) -> int:
+        """Sample ``k`` of the file as a kept sample: itself, or the next kept one."""
+        return int(np.searchsorted(kept, k)) if 0 <= k < n else k
 
     channels = {"ET": et.copy(), "BT": bt.copy()}
     temps = {"ET", "BT"}
@@ -518,6 +536,10 @@ def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: boo
     if not isinstance(ti, list) or not all(isinstance(q, int) and not isinstance(q, bool) for q in ti):
         raise InputError("timeindex must be a list of integers", path, "key timeindex")
     ti = (ti + [0] * 8)[:8]
+    if dropped_times:
+        timex, n = timex[kept], len(kept)
+        channels = {name: arr[kept] for name, arr in channels.items()}
+        ti = [moved(k) if k > 0 or (k == 0 and i == 0) else k for i, k in enumerate(ti)]
     if 0 <= ti[0] < n and 0 < ti[6] < n and ti[6] <= ti[0]:
         raise InputError(
             f"DROP (sample {ti[6]}, {timex[ti[6]]:.0f} s) is marked at or before CHARGE (sample {ti[0]}, "
@@ -536,6 +558,8 @@ def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: boo
     beyond = [f"{name} (sample {k})" for name, k in zip(EVENT_NAMES, ti) if k >= n]
     if beyond:
         notes.insert(0, f"{', '.join(beyond)} marked past the log's last sample ({n - 1}): read as unmarked")
+    if dropped_times:
+        notes.insert(0, f"dropped {dropped_times} sample(s) whose time does not follow the one before (timex)")
     ti[0], ti[6] = charge, drop or 0
     events = {}
     for name, k in zip(EVENT_NAMES, ti):
