@@ -37,7 +37,10 @@ def cmd_init(args) -> int:
     )
     role = "offered in the map" if s.heater else "the model's input"
     inlet = f"; inlet air: {s.inlet} ({role})" if s.inlet else ""
-    print(f"  second bean reading: {s.second_bean or 'none'}; ET: {et}{inlet}")
+    from ..io.importers.roastime import IR_SERIES
+
+    ir = f" (the IR; {IR_SERIES} in RoastWorld's export)" if s.format == "roastime" and s.second_bean else ""
+    print(f"  second bean reading: {s.second_bean or 'none'}{ir}; ET: {et}{inlet}")
     masses = sorted({round(i.batch_kg * 1000) for i in s.logs})  # to the gram; a big drum's in kg
     print(f"  green batches: {', '.join(f'{g} g' if g < 1000 else f'{g / 1000:g} kg' for g in masses)}")
     for note in s.notes:
