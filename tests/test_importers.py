@@ -111,6 +111,20 @@ def test_an_alog_whose_time_stumbles_keeps_its_samples_marks_and_events(tmp_path
         read_alog(tmp_path / "g.alog")
 
 
+def test_a_csv_log_whose_time_stumbles_keeps_its_rows_in_order(tmp_path):
+    """SYNTHETIC plain CSV log with a row repeated and one stamped before the row above it: those rows
+    are dropped with a note, not the log (it was refused: "time not strictly increasing")."""
+    rows = ["time_s,BT,Burner"] + [f"{2.0 * i},{150.0 - i if i < 30 else 90.0 + i},60" for i in range(100)]
+    (tmp_path / "c.csv").write_text("\n".join(rows) + "\n")
+    rows.insert(41, rows[40])  # row 40 again
+    rows[71] = "55.0,150,60"  # before the row above it
+    (tmp_path / "g.csv").write_text("\n".join(rows) + "\n")
+    cmap = load_map(write_map(tmp_path, 'resample_s = 5.0\n[time]\ncolumn = "time_s"\n' + ROOM_AIR_MAP))
+    a, b = import_log(tmp_path / "c.csv", cmap), import_log(tmp_path / "g.csv", cmap)
+    assert np.array_equal(a.time_s, b.time_s) and np.array_equal(a.Ta_C, b.Ta_C)
+    assert "dropped 2 sample(s) whose time does not follow the one before" in b.notes
+
+
 def _burner_at(sample: int, internal: float) -> dict:
     """SYNTHETIC Burner events: 70 % from the start, ``internal`` (Artisan's encoding) from ``sample``."""
     return {"specialevents": [0, sample], "specialeventstype": [3, 3], "specialeventsvalue": [8.0, internal],

@@ -455,7 +455,7 @@ def _special_events(data: dict, etypes: list, n: int, path) -> list[tuple[int, s
     return out
 
 
-def _time_follows(timex: np.ndarray) -> np.ndarray:
+def time_follows(timex: np.ndarray) -> np.ndarray:
     """Which samples' times are finite and later than every finite time before them (a boolean mask)."""
     finite = np.isfinite(timex)
     before = np.maximum.accumulate(np.where(finite, timex, -np.inf))
@@ -480,7 +480,7 @@ def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: boo
         raise InputError(f"mode must be 'C' or 'F', got {mode!r}", path, "key mode")
     # a sample whose time does not follow every one before it (a repeated or backward stamp, a
     # missing one) is dropped, and the marks and events that index the samples are moved with them
-    kept = np.flatnonzero(_time_follows(timex))
+    kept = np.flatnonzero(time_follows(timex))
     if len(kept) < 2:
         raise InputError("time not strictly increasing: fewer than 2 samples follow one another", path, "key timex")
     dropped_times = n - len(kept)

@@ -82,7 +82,7 @@ from ...model.pitot import gas_flow_pitot_kg_s
 from ...model.quantities import default
 from ..batch import Batch, csv_log_text, read_table
 from ..files import as_path, finite_number, read_input_bytes, read_toml
-from .artisan import ArtisanLog, f_to_c, read_alog, read_artisan_csv
+from .artisan import ArtisanLog, f_to_c, read_alog, read_artisan_csv, time_follows
 from .roastime import DRUM_AT_CHARGE, read_roastime
 
 FORMATS = ("auto", "alog", "artisan-csv", "roastime", "csv", "parquet")
@@ -861,7 +861,10 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
 
     # missing samples (Artisan -1, empty cells) are dropped rather than invented; a missing
     # second bean reading (Tb2) only leaves a gap in that reading
-    ok = np.isfinite(time_s) & np.isfinite(Ta) & np.isfinite(Tgi) & np.isfinite(Gg)
+    # a row whose time does not follow every one before it (a repeated or backward stamp in a CSV
+    # log; an Artisan log's are dropped as it is read) is dropped too, not the log
+    ordered = time_follows(time_s)
+    ok = ordered & np.isfinite(Ta) & np.isfinite(Tgi) & np.isfinite(Gg)
     for k in ("heater", "fan"):
         if k in series:
             ok &= np.isfinite(series[k])
@@ -871,11 +874,14 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
         series["ET"] = np.where(series["ET"] > -1.0 + 1e-9, series["ET"], np.nan)
     if ok.sum() < 2:
         raise InputError("fewer than 2 complete samples after dropping missing values", path)
+    time_s_all = time_s
     time_s, Ta, Tgi, Gg = time_s[ok], Ta[ok], Tgi[ok], Gg[ok]
     series = {k: v[ok] for k, v in series.items()}
     notes = list(default_notes)
-    if ok.sum() < ok.size:
-        notes.append(f"dropped {ok.size - ok.sum()} incomplete sample(s) (missing values)")
+    if (stumbled := int((np.isfinite(time_s_all) & ~ordered).sum())) > 0:
+        notes.append(f"dropped {stumbled} sample(s) whose time does not follow the one before")
+    if (incomplete := int((ordered & ~ok).sum())) > 0:
+        notes.append(f"dropped {incomplete} incomplete sample(s) (missing values)")
     if (spikes := probe_spikes(time_s, Ta)).any():
         at = time_s[spikes]
         notes.append(
