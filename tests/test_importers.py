@@ -88,7 +88,7 @@ def test_an_alog_whose_time_stumbles_keeps_its_samples_marks_and_events(tmp_path
     dropped, not the log (it was refused: "time not strictly increasing"); the marks and events that
     index the samples keep their times."""
     n = 120
-    extra = {"timeindex": [5, 0, 60, 0, 0, 0, 110, 0], **_burner_at(50, 8.0)}
+    extra = {"timeindex": [5, 0, 60, 0, 0, 0, n - 1, 0], **_burner_at(50, 8.0)}  # DROP on the last sample
     clean = json.loads(fake_alog(n=n, extra=extra, as_json=True))
     glitchy = json.loads(json.dumps(clean))
     glitchy["timex"][40] = glitchy["timex"][39]

@@ -536,10 +536,10 @@ def read_alog(path: str | Path, keep_after_drop: bool = False, align_charge: boo
     if not isinstance(ti, list) or not all(isinstance(q, int) and not isinstance(q, bool) for q in ti):
         raise InputError("timeindex must be a list of integers", path, "key timeindex")
     ti = (ti + [0] * 8)[:8]
-    if dropped_times:
+    if dropped_times:  # the marks first, while n is still the file's count
+        ti = [moved(k) if k > 0 or (k == 0 and i == 0) else k for i, k in enumerate(ti)]
         timex, n = timex[kept], len(kept)
         channels = {name: arr[kept] for name, arr in channels.items()}
-        ti = [moved(k) if k > 0 or (k == 0 and i == 0) else k for i, k in enumerate(ti)]
     if 0 <= ti[0] < n and 0 < ti[6] < n and ti[6] <= ti[0]:
         raise InputError(
             f"DROP (sample {ti[6]}, {timex[ti[6]]:.0f} s) is marked at or before CHARGE (sample {ti[0]}, "
