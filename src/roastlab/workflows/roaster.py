@@ -557,7 +557,9 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
     # log is read by the first it has. A log without a control's events (the setting never moved while
     # Artisan recorded) does not say what the setting was: the map keeps the channel the other logs
     # name, fit-roaster leaves that log out (logs_without_controls)
-    control_names = {what: _control_names(infos, what) for what in ("heater", "fan")}
+    # the names the logs give each control, the most used first (a tie: the first log's first)
+    uses = {what: Counter(getattr(i, what) for i in infos if getattr(i, what)) for what in ("heater", "fan")}
+    control_names = {what: [name for name, _ in uses[what].most_common()] for what in uses}
     heater, fan = (control_names[what][0] if control_names[what] else None for what in ("heater", "fan"))
     layout = ("time", "time_unit", "BT", "temp_unit")  # ET may be unreadable on some logs (has_et says)
     if first.columns is not None and any(
@@ -615,9 +617,8 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
         )
     notes = [f"left out: {why}" for why in unreadable.values()]
     for what, n in renamed.items():
-        counts = Counter(getattr(i, what) for i in infos if getattr(i, what))
         notes.append(
-            f"the logs name the {what} differently ({', '.join(f'{k}: {counts[k]} log(s)' for k in n)}): read as "
+            f"the logs name the {what} differently ({', '.join(f'{k}: {uses[what][k]} log(s)' for k in n)}): read as "
             f"one {what}, each log by the name it has; if these are two roasters, set them up apart"
         )
     if unweighed:
@@ -755,13 +756,6 @@ def toml_string(text: str) -> str:
     """``text`` as a TOML basic string (JSON's escapes are TOML's): a channel name from a log may hold a
     quote or a backslash."""
     return json.dumps(text, ensure_ascii=False)
-
-
-def _control_names(infos, what: str) -> list[str]:
-    """The names the logs give the ``heater`` or the ``fan`` (:attr:`LogInfo.heater`), the most used
-    first (a tie: the first log's first); empty where no log records it."""
-    counts = Counter(getattr(i, what) for i in infos if getattr(i, what))
-    return sorted(counts, key=lambda name: -counts[name])
 
 
 def _one_setting(values) -> float | None:
