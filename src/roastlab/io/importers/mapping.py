@@ -880,7 +880,7 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
     notes = list(default_notes)
     if (stumbled := int((np.isfinite(time_s_all) & ~ordered).sum())) > 0:
         notes.append(f"dropped {stumbled} sample(s) whose time does not follow the one before")
-    if (incomplete := int((ordered & ~ok).sum())) > 0:
+    if (incomplete := int((~ok).sum()) - stumbled) > 0:  # a missing time is a missing value
         notes.append(f"dropped {incomplete} incomplete sample(s) (missing values)")
     if (spikes := probe_spikes(time_s, Ta)).any():
         at = time_s[spikes]
