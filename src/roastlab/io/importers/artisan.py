@@ -645,7 +645,8 @@ def _merge_repeated_times(time_s: np.ndarray, columns):
     """Rows that share a time stamp merged into one, each column the mean of its readings there
     (NaN where none): Artisan's CSV export writes whole seconds, so a log sampled faster than once a
     second, or with jitter, repeats times. Returns ``(times, columns, how many times repeat)``;
-    times that go backwards are left for the batch check to refuse."""
+    times that go backwards are left as they are, and the import drops the rows whose time does not
+    follow the ones before (:func:`time_follows`)."""
     if time_s.size < 2 or not np.any(np.diff(time_s) == 0) or np.any(np.diff(time_s) < 0):
         return time_s, columns, 0
     times, inverse, counts = np.unique(time_s, return_inverse=True, return_counts=True)
