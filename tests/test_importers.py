@@ -125,6 +125,19 @@ def test_a_csv_log_whose_time_stumbles_keeps_its_rows_in_order(tmp_path):
     assert "dropped 2 sample(s) whose time does not follow the one before" in b.notes
 
 
+def test_an_artisan_csv_export_with_a_row_stamped_back_drops_that_row(tmp_path):
+    """SYNTHETIC Artisan CSV export with one row stamped a minute back among the others: that row is
+    dropped with a note (the export was refused: time not strictly increasing)."""
+    rows = ["Date:01.01.2026\tUnit:C\tCHARGE:00:00\tDROP:03:00", "Time1\tTime2\tET\tBT\tEvent"]
+    rows += [f"{s // 60:02d}:{s % 60:02d}\t{s // 60:02d}:{s % 60:02d}\t{200 + s * 0.1:.1f}\t{120 + s * 0.3:.1f}\t"
+             for s in range(0, 182, 2)]  # fmt: skip
+    rows.insert(40, "00:14\t01:14\t207.4\t142.2\t")
+    (tmp_path / "e.csv").write_text("\n".join(rows) + "\n")
+    b = import_log(tmp_path / "e.csv", load_map(write_map(tmp_path, SKY_MAP)))
+    assert b.n == 91 and np.all(np.diff(b.time_s) > 0) and b.time_s[-1] == 180.0
+    assert "dropped 1 sample(s) whose time does not follow the one before" in b.notes
+
+
 def _burner_at(sample: int, internal: float) -> dict:
     """SYNTHETIC Burner events: 70 % from the start, ``internal`` (Artisan's encoding) from ``sample``."""
     return {"specialevents": [0, sample], "specialeventstype": [3, 3], "specialeventsvalue": [8.0, internal],
