@@ -588,6 +588,13 @@ def test_a_control_the_logs_name_differently_is_one_control_read_by_each_logs_na
     a, b = import_log(logs[0], cmap), import_log(logs[2], cmap)
     for what in ("heater", "fan"):  # the same events under either name: the same setting
         assert np.array_equal(getattr(a, what), getattr(b, what)) and np.nanmax(getattr(a, what)) > 0
+    # the only log of one name unweighed (left out): its name is still one of the heater's, no traceback
+    unweighed = tmp_path / "u.alog"
+    unweighed.write_text(
+        fake_alog(extra={**renamed, "etypes": ["Fan", "Drum", "Damper", "Heat", "--"], "weight": [0, 0, "g"]})
+    )
+    code, out, err = cli("init", *logs[:2], unweighed, "--out", tmp_path / "cfg3")
+    assert code == 0 and "Heat: 1 log(s)" in out and "1 log(s) record no green weight" in out, err
     watts = {"extratimex": [[1.5 * i for i in range(120)]], "extraname1": ["Power"], "extratemp1": [[900.0] * 120],
              "extraNoneTempHint1": [True]}  # fmt: skip
     logs[2].write_text(fake_alog(extra=watts))

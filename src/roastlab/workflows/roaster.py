@@ -561,6 +561,26 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
     uses = {what: Counter(getattr(i, what) for i in infos if getattr(i, what)) for what in ("heater", "fan")}
     control_names = {what: [name for name, _ in uses[what].most_common()] for what in uses}
     heater, fan = (control_names[what][0] if control_names[what] else None for what in ("heater", "fan"))
+    renamed = {what: n for what, n in control_names.items() if len(n) > 1}
+    for what, n in renamed.items():
+        by_name = {
+            name: _unit_of(np.concatenate(v))
+            for name in n
+            if (v := [i.seen[what] for i in infos if getattr(i, what) == name and what in i.seen])
+        }
+        one, odd = (next(i for i in infos if getattr(i, what) == name) for name in n[:2])
+        if first.columns is not None:  # a plain CSV's map names its one column
+            raise InputError(
+                f"the CSV logs name the {what} column differently ({', '.join(n)}): {one.path.name} vs "
+                f"{odd.path.name}. A CSV map names one column: give the column one name in every log",
+                odd.path,
+            )
+        if len(set(by_name.values())) > 1:
+            raise InputError(
+                f"the logs disagree on {what} channels ({', '.join(f'{k} in {u}' for k, u in by_name.items())}): "
+                f"{one.path.name} vs {odd.path.name}. Set up one roaster (one layout) at a time",
+                odd.path,
+            )
     layout = ("time", "time_unit", "BT", "temp_unit")  # ET may be unreadable on some logs (has_et says)
     if first.columns is not None and any(
         [i.columns[k] for k in layout] != [first.columns[k] for k in layout] for i in infos
@@ -588,26 +608,6 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
         if (seen := [i.seen[what] for i in infos if what in i.seen])
     }
     heater_unit, fan_unit = (_unit_of(pooled[what]) if what in pooled else None for what in ("heater", "fan"))
-    renamed = {what: n for what, n in control_names.items() if len(n) > 1}
-    for what, n in renamed.items():
-        by_name = {
-            name: _unit_of(np.concatenate(v))
-            for name in n
-            if (v := [i.seen[what] for i in infos if getattr(i, what) == name and what in i.seen])
-        }
-        one, odd = (next(i for i in infos if getattr(i, what) == name) for name in n[:2])
-        if first.columns is not None:  # a plain CSV's map names its one column
-            raise InputError(
-                f"the CSV logs name the {what} column differently ({', '.join(n)}): {one.path.name} vs "
-                f"{odd.path.name}. A CSV map names one column: give the column one name in every log",
-                odd.path,
-            )
-        if len(set(by_name.values())) > 1:
-            raise InputError(
-                f"the logs disagree on {what} channels ({', '.join(f'{k} in {u}' for k, u in by_name.items())}): "
-                f"{one.path.name} vs {odd.path.name}. Set up one roaster (one layout) at a time",
-                odd.path,
-            )
     in_tens = {what: _in_whole_tens(v) for what, v in pooled.items()}
     if first.format in ("alog", "artisan-csv") and len(machines) == 1 and artisan_shows_tens(next(iter(machines))):
         # Artisan's setup for this machine shows its levels in tens: a percent in whole tens is those levels
