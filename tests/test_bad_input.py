@@ -508,6 +508,19 @@ ROASTIME = {
         "r.json",
         "no totalRoastTime to tell the sample rate from",
     ),
+    "RoastWorld action at a second far past the roast": (
+        lambda d: import_with(
+            d,
+            "r.json",
+            RT.replace('"sampleRate": 2', '"totalRoastTime": 1.5').replace(
+                '{"actionTimeList": [{"index": 0, "value": 6, "ctrlType": 0}]}',
+                '[{"type": "Power", "second": 1e308, "setting": 6}]',
+            ),
+            RT_MAP,
+        ),
+        "r.json",
+        "second 1e+308 or setting 6 out of range",
+    ),
     "RoastWorld action of no number": (
         lambda d: import_with(
             d,

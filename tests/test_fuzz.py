@@ -196,7 +196,7 @@ KEYS = {
                     {},
                     optional={
                         "type": st.one_of(VALUES, st.sampled_from(["Power", "Blower", "Drum", "fan", ""])),
-                        "second": st.one_of(VALUES, st.floats(-5, 1e5)),
+                        "second": st.one_of(VALUES, st.floats(-5, 1e5), st.sampled_from([1e308, -1e308, 1e20])),
                         "setting": VALUES,
                     },
                 ),

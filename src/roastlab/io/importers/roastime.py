@@ -131,10 +131,10 @@ def _actions(data: dict, n: int, rate: float, path) -> dict[str, np.ndarray]:
         control = CONTROL_NAMES.get(str(ctrl).strip().lower()) if by_name else CONTROL_TYPES.get(ctrl)
         if control is None:
             continue  # a control this reader does not model
-        index = round(index * rate) if by_name else index
-        if not 0 <= index < 10 * max(n, 1) or not -1e3 <= value <= 1e3:
-            raise InputError(f"{keys[1]} {item.get(keys[1])} or {keys[2]} {value} out of range", path, where)
-        changes[control].append((int(index), float(value)))
+        at = index * rate if by_name else index  # the sample the change is at (a second's overflows to inf)
+        if not 0 <= at < 10 * max(n, 1) or not -1e3 <= value <= 1e3:
+            raise InputError(f"{keys[1]} {index} or {keys[2]} {value} out of range", path, where)
+        changes[control].append((round(at) if by_name else int(at), float(value)))
     out = {}
     for name, steps in changes.items():
         if not steps:
