@@ -63,8 +63,7 @@ from ..io.importers.mapping import (
     hot_drop,
     is_log_by_content,
     names_of,
-    probe_fault,
-    probe_spikes,
+    probe_faults,
 )
 from ..io.importers.roastime import DRUM_AT_CHARGE, read_roastime
 from ..metrics.profile import (
@@ -404,8 +403,9 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
         raise InputError("no bean temperature (BT) in this log: roastlab needs the bean probe", path)
     read = np.isfinite(log.channels["BT"])
     bt = log.channels["BT"][read]
-    bt = bt[~probe_spikes(log.time_s[read], bt)]  # the import drops spikes and cuts a probe fault so
-    bt = bt[: fault + 1] if (fault := probe_fault(bt)) is not None else bt
+    spikes, fault = probe_faults(log.time_s[read], bt)  # the import drops spikes and cuts a probe fault so
+    bt = bt[~spikes]
+    bt = bt[: fault + 1] if fault is not None else bt
     if log.drop_index is not None and (why := hot_drop(float(bt[-1]))):
         raise InputError(why, path)  # the import refuses it too; say it before the files are written
     if not live_reading(bt):  # a probe that read nothing (0 degC throughout)
@@ -556,8 +556,8 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
     # control if every name reads in one unit: the map lists its names, the most used first, and each
     # log is read by the first it has. A log without a control's events (the setting never moved while
     # Artisan recorded) does not say what the setting was: the map keeps the channel the other logs
-    # name, fit-roaster leaves that log out (logs_without_controls)
-    # the names the logs give each control, the most used first (a tie: the first log's first)
+    # name, fit-roaster leaves that log out (logs_without_controls). The names, the most used first
+    # (a tie: the first log's first), are those of every readable log, weighed or not
     uses = {what: Counter(getattr(i, what) for i in infos if getattr(i, what)) for what in ("heater", "fan")}
     control_names = {what: [name for name, _ in uses[what].most_common()] for what in uses}
     heater, fan = (control_names[what][0] if control_names[what] else None for what in ("heater", "fan"))

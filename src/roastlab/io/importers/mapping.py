@@ -129,6 +129,13 @@ def probe_spikes(time_s: np.ndarray, bt_C: np.ndarray) -> np.ndarray:
     return spikes
 
 
+def probe_faults(time_s: np.ndarray, bt_C: np.ndarray) -> tuple[np.ndarray, int | None]:
+    """The bean probe's spikes (:func:`probe_spikes`, a mask) and, in its readings without them, the
+    last sample before a fault (:func:`probe_fault`): the import and ``roastlab init`` read a probe so."""
+    spikes = probe_spikes(time_s, bt_C)
+    return spikes, probe_fault(bt_C[~spikes])
+
+
 def hot_drop(bt_at_drop_C: float) -> str | None:
     """Why a bean temperature at DROP above :data:`DROP_BT_LIMIT_C` is not a roast in degC (a log in
     degF declared as degC), else None."""
@@ -864,6 +871,7 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
     # a row whose time does not follow every one before it (a repeated or backward stamp in a CSV
     # log; an Artisan log's are dropped as it is read) is dropped too, not the log
     ordered = time_follows(time_s)
+    stumbled = int((np.isfinite(time_s) & ~ordered).sum())
     ok = ordered & np.isfinite(Ta) & np.isfinite(Tgi) & np.isfinite(Gg)
     for k in ("heater", "fan"):
         if k in series:
@@ -874,24 +882,27 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
         series["ET"] = np.where(series["ET"] > -1.0 + 1e-9, series["ET"], np.nan)
     if ok.sum() < 2:
         raise InputError("fewer than 2 complete samples after dropping missing values", path)
-    time_s_all = time_s
-    time_s, Ta, Tgi, Gg = time_s[ok], Ta[ok], Tgi[ok], Gg[ok]
-    series = {k: v[ok] for k, v in series.items()}
+
+    def select(which):
+        """The samples ``which`` (a mask or a slice) of every series."""
+        return time_s[which], Ta[which], Tgi[which], Gg[which], {k: v[which] for k, v in series.items()}
+
+    time_s, Ta, Tgi, Gg, series = select(ok)
     notes = list(default_notes)
-    if (stumbled := int((np.isfinite(time_s_all) & ~ordered).sum())) > 0:
+    if stumbled:
         notes.append(f"dropped {stumbled} sample(s) whose time does not follow the one before")
     if (incomplete := int((~ok).sum()) - stumbled) > 0:  # a missing time is a missing value
         notes.append(f"dropped {incomplete} incomplete sample(s) (missing values)")
-    if (spikes := probe_spikes(time_s, Ta)).any():
+    spikes, j = probe_faults(time_s, Ta)
+    if spikes.any():
         at = time_s[spikes]
         notes.append(
             f"dropped {spikes.sum()} sample(s) of bean-probe spikes at t = {at[0]:.0f}"
             + (f"-{at[-1]:.0f}" if at[-1] > at[0] else "")
             + f" s (a step over {MAX_JUMP_C:g} degC that came back within {SPIKE_MAX_S:g} s)"
         )
-        time_s, Ta, Tgi, Gg = time_s[~spikes], Ta[~spikes], Tgi[~spikes], Gg[~spikes]
-        series = {k: v[~spikes] for k, v in series.items()}
-    if (j := probe_fault(Ta)) is not None:
+        time_s, Ta, Tgi, Gg, series = select(~spikes)
+    if j is not None:
         # a probe fault: keep what came before it rather than fit a physically impossible step
         if j + 1 < max(2, 0.5 * len(Ta)):
             raise InputError(
@@ -901,8 +912,7 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
         notes.append(
             f"bean temperature jumps {Ta[j]:.0f} -> {Ta[j + 1]:.0f} degC at t = {time_s[j + 1]:.0f} s (probe fault): log cut there"
         )
-        time_s, Ta, Tgi, Gg = time_s[: j + 1], Ta[: j + 1], Tgi[: j + 1], Gg[: j + 1]
-        series = {k: v[: j + 1] for k, v in series.items()}
+        time_s, Ta, Tgi, Gg, series = select(slice(None, j + 1))
     if drop_known and (why := hot_drop(Ta[-1])):
         raise InputError(why, path)
     if cmap.resample_s > 0:
