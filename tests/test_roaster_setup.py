@@ -1386,3 +1386,43 @@ def test_a_fit_on_one_batch_size_holds_the_probe_depth_the_spec_frees():
     assert roaster.depth_held_on_one_size(spec, several) == (spec, None)
     no_depth = FitSpec([FreeParameter("hbm", 0.001, 1.0, 0.02)], {"h_probe_m": 0.155})
     assert roaster.depth_held_on_one_size(no_depth, one) == (no_depth, None)
+
+
+@pytest.mark.parametrize(
+    "name, unit",
+    [("Gas kPa", "kPa"), ("Gas (mbar)", "mbar"), ("Burner hPa", "hPa"), ('Gas "WC', "inWC"), ("Gas in. WC", "inWC"),
+     ("Gas inH2O", "inWC"), ("Gas mmH2O", "mmWC"), ("Gas psi", "psi"), ("Gas Pa", "Pa"), ("Gas", None),
+     ("Burner", None), ("Pan", None), ("Gas pressure", None), (None, None)],
+)  # fmt: skip
+def test_a_control_named_in_a_pressure_unit_is_that_pressure(name, unit):
+    assert roaster.pressure_unit(name) == unit
+
+
+def test_a_gas_burner_logged_as_its_pressure_in_kpa_is_read_in_kpa(cli, tmp_path):
+    """SYNTHETIC logs whose burner is an extra device "Gas kPa" reading 0.5-3.2 (a manometer's
+    reading, decimals): a gas pressure in kPa, as the name says, not a percent (which put its gain's
+    bound at 0.35 kW at the top setting and quantised programs to 0 or 5 kPa); the fit spec's gains are
+    per kPa over the logged range, programs continuous and labelled in kPa."""
+    from roastlab.io.importers.mapping import import_log, load_map
+
+    n = 120
+    gas = [0.55 if i < 30 else 3.2 if i < 80 else 1.85 for i in range(n)]  # kPa
+    extra = {"extratimex": [[1.5 * i for i in range(n)]], "extraname1": ["Gas kPa"], "extraname2": ["Fan"],
+             "extratemp1": [gas], "extratemp2": [[40.0] * n], "extraNoneTempHint1": [True],
+             "extraNoneTempHint2": [True]}  # fmt: skip
+    logs = [tmp_path / f"g{k}.alog" for k in range(2)]
+    for p in logs:
+        p.write_text(fake_alog(extra=extra))
+    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
+    assert code == 0 and "heater: Gas kPa (kPa)" in out, (out, err)
+    cmap = load_map(tmp_path / "cfg" / "map.toml")
+    heater = cmap.actuator("heater")
+    top = max(gas)
+    assert (heater.unit, heater.high, heater.step, heater.label(2.347)) == ("kPa", top, None, "2.35 kPa")
+    assert heater.describe() == f"heater 0 kPa-{top:g} kPa (continuous)"
+    fit = (tmp_path / "cfg" / "fit.toml").read_text()
+    qe_hi = float(fit.split("Qe_gain_kW = [")[1].split("]")[0].split(", ")[1])
+    capacity_kg = 2 * 0.2  # fake_alog's batch, the capacity twice the largest logged
+    assert "[kW per kPa]" in fit and qe_hi * top == pytest.approx(10.0 * capacity_kg, rel=1e-3)
+    batch = import_log(logs[0], cmap)
+    assert batch.heater is not None and np.nanmax(batch.heater) == top  # read as logged, in kPa

@@ -2,7 +2,8 @@
 
 A program a roaster can run is made of the settings the machine has: the Aillio Bullet's power
 P0-P9 and fan F0-F12 are whole steps, an Artisan slider is a percentage a roaster moves in
-5 % steps, a gas valve or an electric element may be continuous (kW). Transfer and MPC decide
+5 % steps, a gas valve or an electric element may be continuous (kW, or the gas pressure a
+burner's manometer reads, in kPa). Transfer and MPC decide
 programs on these levels, the Artisan background writes them as events, the what-if names the
 unit of a change. The column map declares a machine's controls (``[heater]`` / ``[fan]`` with
 ``unit`` and optionally ``min``, ``max``, ``step``, ``rate_per_min``); what it leaves out comes
@@ -13,6 +14,8 @@ from :data:`UNIT_DEFAULTS`, the one table of defaults per unit.
 ('P7', [7.0, 9.0, 0.0])
 >>> Actuator("fan", "percent", 0, 100, 5).label(35)
 '35 %'
+>>> Actuator("heater", "kPa", 0, 3.5).label(2.347)
+'2.35 kPa'
 """
 
 from __future__ import annotations
@@ -36,6 +39,11 @@ UNIT_DEFAULTS: dict[str, tuple[float, float, float | None, float]] = {
     "W": (0.0, 1e5, None, 1e5),  # a heater's power readout in watts (an Artisan extra device)
     "rpm": (0.0, 1e5, None, 1e5),  # a fan's speed readout (an Artisan extra device such as "Fan RPM")
 }
+#: A control logged as a gas pressure (a gas burner's pressure at its jet, read off a manometer or a
+#: pressure readout; kPa in most of the world, mbar/hPa in Europe, inches or mm of water column in
+#: North America and Asia): continuous, no limit on its rate, in the unit the channel names.
+PRESSURE_UNITS = ("kPa", "hPa", "mbar", "Pa", "psi", "inWC", "mmWC")
+UNIT_DEFAULTS.update({unit: (0.0, 1e5, None, 1e5) for unit in PRESSURE_UNITS})
 #: How a setting's value reads to a roaster, per control and unit ("P7", "F3", "35 %").
 _PREFIX = {("heater", "level"): "P", ("fan", "level"): "F", ("heater", "tens"): "P", ("fan", "tens"): "F"}
 #: What a logged value is worth in the machine's own steps, per unit (a level in tens: a tenth).
@@ -81,7 +89,7 @@ MIN_HOLD_S = 30.0
 @dataclass(frozen=True)
 class Actuator:
     """One control of a roaster: ``name`` ("heater" or "fan"), its ``unit`` ("percent",
-    "level", "tens", "kW", "W", "rpm"), the range ``low``..``high`` in that unit, the ``step`` between settings the
+    "level", "tens", "kW", "W", "rpm", or a gas pressure of :data:`PRESSURE_UNITS`), the range ``low``..``high`` in that unit, the ``step`` between settings the
     machine offers (None: continuous) and the fastest change ``rate_per_min`` [unit/min]."""
 
     name: str
@@ -122,6 +130,8 @@ class Actuator:
         prefix = _PREFIX.get((self.name, self.unit))
         if prefix:
             return f"{prefix}{value * _STEPS_PER_UNIT.get(self.unit, 1.0):g}"
+        if self.unit in PRESSURE_UNITS:  # read off a manometer: to its hundredths
+            return f"{round(float(value), 2):g} {self.unit}"
         return f"{value:g} %" if self.unit == "percent" else f"{value:g} {self.unit}"
 
     def artisan_slider(self, value: float) -> float:

@@ -75,7 +75,7 @@ from ..metrics.profile import (
     first_crack_s,
     mmss,
 )
-from ..model.actuators import UNIT_DEFAULTS
+from ..model.actuators import PRESSURE_UNITS, UNIT_DEFAULTS
 from ..model.bed import CROSS_VALIDATED, PROBE_DEPTH_OVER_DIAMETER
 from ..model.constants import FIRST_CRACK_BEAN_C, GREEN_BULK_DENSITY_KG_M3
 from ..model.parameters import FIRST_CRACK_WEIGHT, RESIDUAL_WEIGHT
@@ -84,6 +84,12 @@ from ..model.quantities import default, quantity
 #: Names of a heater/burner and a fan/air channel in Artisan's languages (lower case, substrings).
 HEATER_NAMES = ("burner", "heater", "power", "heat", "gas", "brûleur", "bruleur", "brenner", "quemador",
                 "queimador", "bruciatore", "potencia", "leistung", "puissance", "火力", "火")  # fmt: skip
+#: The words of a control's name that say it is logged as a gas pressure (lower case, whole words
+#: of the name: "Gas kPa", "Gas (mbar)", 'Gas "WC'), and the unit each names
+#: (:data:`roastlab.model.actuators.PRESSURE_UNITS`).
+PRESSURE_WORDS = {"kpa": "kPa", "hpa": "hPa", "mbar": "mbar", "pa": "Pa", "psi": "psi", "wc": "inWC",
+                  "inwc": "inWC", "inh2o": "inWC", "mmwc": "mmWC", "mmh2o": "mmWC", "mmaq": "mmWC"}  # fmt: skip
+assert set(PRESSURE_WORDS.values()) <= set(PRESSURE_UNITS)
 #: Logged controls the model does not use, named so the map can say so.
 OTHER_NAMES = {
     "damper": ("damper", "klappe", "registre", "valve"),
@@ -268,11 +274,24 @@ def _in_whole_tens(values: np.ndarray) -> bool:
     return bool(v.size) and bool(np.all(np.abs(v / 10.0 - np.round(v / 10.0)) < 1e-9))
 
 
-def _unit_of(values: np.ndarray) -> str:
-    """A logged setting's unit by its values (every log's, pooled: one unit for the channel): whole
+def pressure_unit(name: str | None) -> str | None:
+    """The gas-pressure unit a control's ``name`` says it is logged in ("Gas kPa" -> "kPa"), else None
+    (:data:`PRESSURE_WORDS`, whole words: "Gas (mbar)", 'Gas "WC', "Gas in. WC", "Gas mmH2O")."""
+    words = re.findall(r"[a-z0-9]+", (name or "").lower())
+    # "in. WC" / "in H2O": the inches of water column written apart
+    joined = [a + b for a, b in zip(words, words[1:]) if a in ("in", "mm") and b in ("wc", "h2o")]
+    return next((PRESSURE_WORDS[w] for w in joined + words if w in PRESSURE_WORDS), None)
+
+
+def _unit_of(values: np.ndarray, name: str | None = None) -> str:
+    """A logged setting's unit: a gas pressure where the channel's ``name`` names one
+    (:func:`pressure_unit`: a burner's manometer reads 0.5-3.5 kPa, which no value rule can tell
+    from a percent); else by its values (every log's, pooled: one unit for the channel): whole
     steps up to 20 a level; whole tens above 100 and up to :data:`TENS_MAX` levels shown in tens
     ("tens"); up to 100 a percent; above 100 otherwise a power in watts (a heater's power readout;
     a fan so logged is not used)."""
+    if unit := pressure_unit(name):
+        return unit
     v = values[np.isfinite(values)]
     whole = bool(v.size) and bool(np.all(np.abs(v - np.round(v)) < 1e-9))
     if whole and v.max() <= 20:
@@ -564,7 +583,7 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
     renamed = {what: n for what, n in control_names.items() if len(n) > 1}
     for what, n in renamed.items():
         by_name = {
-            name: _unit_of(np.concatenate(v))
+            name: _unit_of(np.concatenate(v), name)
             for name in n
             if (v := [i.seen[what] for i in infos if getattr(i, what) == name and what in i.seen])
         }
@@ -607,7 +626,9 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
         for what in ("heater", "fan")
         if (seen := [i.seen[what] for i in infos if what in i.seen])
     }
-    heater_unit, fan_unit = (_unit_of(pooled[what]) if what in pooled else None for what in ("heater", "fan"))
+    heater_unit, fan_unit = (
+        _unit_of(pooled[what], name) if what in pooled else None for what, name in (("heater", heater), ("fan", fan))
+    )
     in_tens = {what: _in_whole_tens(v) for what, v in pooled.items()}
     if first.format in ("alog", "artisan-csv") and len(machines) == 1 and artisan_shows_tens(next(iter(machines))):
         # Artisan's setup for this machine shows its levels in tens: a percent in whole tens is those levels
@@ -832,8 +853,11 @@ def estimate_plant(s: Survey, capacity_kg=None, diameter_m=None, length_m=None) 
 
 
 def _setting_span(unit: str, top: float) -> float:
-    """The range of a logged setting: 0..100 for percent, 0..the highest logged level."""
-    return 100.0 if unit == "percent" else max(top, 1.0)  # levels (also in tens), W and rpm: the highest logged
+    """The range of a logged setting: 0..100 for percent, 0..the highest logged value otherwise (a
+    level, also in tens, a power, a speed; a gas pressure, which may top out under 1 psi)."""
+    if unit == "percent":
+        return 100.0
+    return top if unit in PRESSURE_UNITS and top > 0 else max(top, 1.0)
 
 
 def map_text(s: Survey) -> str:
@@ -901,12 +925,12 @@ def map_text(s: Survey) -> str:
     ):
         if col:
             why = {
-                "level": "whole steps",
-                "tens": "whole tens: the machine's levels as Artisan's setup for it shows them, in tens",
-                "percent": "percent",
-                "W": "above 100: a power in watts",
-                "rpm": "above 100: the fan's speed",
-            }[unit]
+                "level": "by the logged values (whole steps)",
+                "tens": "by the logged values (whole tens: the machine's levels as Artisan's setup for it shows them, in tens)",
+                "percent": "by the logged values (percent)",
+                "W": "by the logged values (above 100: a power in watts)",
+                "rpm": "by the logged values (above 100: the fan's speed)",
+            }.get(unit, f"a gas pressure, as the name says ({unit})")
             column = (
                 f"column = [{', '.join(map(toml_string, s.renamed[name]))}]      # detected by name; the logs name it "
                 "differently: each log is read by the first name it has"
@@ -916,9 +940,9 @@ def map_text(s: Survey) -> str:
             lines += [
                 f"[{name}]",
                 column,
-                f'unit = "{unit}"       # by the logged values ({why})',
+                f'unit = "{unit}"       # {why}',
             ]
-            if unit in ("level", "tens", "W", "rpm"):
+            if unit in ("level", "tens", "W", "rpm", *PRESSURE_UNITS):
                 lines += ["min = 0", f"max = {top:g}                # the highest setting the logs use"]
             if unit in ("level", "tens"):
                 lines.append(f"step = {UNIT_DEFAULTS[unit][2]:g}")
@@ -1095,12 +1119,12 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
             "air flow per fan step [kg/s]" if step == 1 else f"air flow per logged fan unit [kg/s] (a step is {step:g})"
         )
         rows.append(line("Gg_fan_kg_s", 0.0, 0.01 / step, 0.001 / step, why))
-    elif s.fan and s.fan_unit in ("percent", "rpm"):
+    elif s.fan and s.fan_unit in ("percent", "rpm", *PRESSURE_UNITS):
         # the flow rises with the fan (or damper) the roaster moves through the roast: at full setting it
         # adds at most the largest base flow, a tenth of that to start (rhs.gas_inputs, Gg + Gg_fan fan);
         # a speed in rpm: in proportion to it (the fan laws: volume flow ~ speed), the highest logged as full
         span = _setting_span(s.fan_unit, s.fan_max)
-        per = "%" if s.fan_unit == "percent" else "rpm"
+        per = "%" if s.fan_unit == "percent" else s.fan_unit
         hi, start = (float(f"{x:.3g}") for x in (gg_hi / span, gg_hi / span / 10))
         rows.append(line("Gg_fan_kg_s", 0.0, hi, start, f"air flow per {per} of the fan [kg/s]"))
     rows += ["", "[initial]", f"Tb0_C = {default('T_room_C'):.1f}                          # green beans at room temperature",
