@@ -1426,3 +1426,29 @@ def test_a_gas_burner_logged_as_its_pressure_in_kpa_is_read_in_kpa(cli, tmp_path
     assert "[kW per kPa]" in fit and qe_hi * top == pytest.approx(10.0 * capacity_kg, rel=1e-3)
     batch = import_log(logs[0], cmap)
     assert batch.heater is not None and np.nanmax(batch.heater) == top  # read as logged, in kPa
+
+
+def test_a_readouts_offset_about_its_zero_is_off_and_a_step_below_zero_a_wrong_unit(cli, tmp_path):
+    """SYNTHETIC logs whose "Gas kPa" readout reads -0.02 kPa with the burner off (a gauge's offset
+    about its zero): read as 0 with a note, where it refused the log (outside 0..); -0.8 kPa (a quarter of
+    the top) is not an offset and stays refused in one line, as does a percent below 0."""
+    from roastlab.io.importers.mapping import import_log, load_map, readout_zero_offset
+
+    n = 120
+    extra = {"extratimex": [[1.5 * i for i in range(n)]], "extraname1": ["Gas kPa"], "extraname2": ["Fan"],
+             "extratemp2": [[40.0] * n], "extraNoneTempHint1": [True], "extraNoneTempHint2": [True]}  # fmt: skip
+    logs = [tmp_path / f"g{k}.alog" for k in range(2)]
+    for p in logs:
+        p.write_text(fake_alog(extra=extra | {"extratemp1": [[3.0 if 10 < i < 60 else -0.02 for i in range(n)]]}))
+    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
+    assert code == 0, (out, err)
+    cmap = load_map(tmp_path / "cfg" / "map.toml")
+    batch = import_log(logs[0], cmap)
+    assert np.nanmin(batch.heater) == 0.0 and any("a sensor's offset about its zero" in n for n in batch.notes)
+    logs[1].write_text(fake_alog(extra=extra | {"extratemp1": [[3.0 if 10 < i < 60 else -0.8 for i in range(n)]]}))
+    with pytest.raises(InputError, match="outside 0"):
+        import_log(logs[1], cmap)
+    assert not readout_zero_offset("percent", np.array([-0.02, 50.0]))  # a stepped setting: a wrong unit
+    assert readout_zero_offset("W", np.array([-20.0, 900.0])) and not readout_zero_offset(
+        "W", np.array([-100.0, 900.0])
+    )

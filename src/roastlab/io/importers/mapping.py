@@ -617,6 +617,22 @@ def _drop_et_not_drum_air(time_s, Ta, drop_s, settings: dict, series: dict, note
     return {spec["column"]}
 
 
+#: How far below zero a control's readout may read, as a share of its highest reading, and still be
+#: a sensor's offset about its zero rather than a wrong unit (:func:`readout_zero_offset`).
+ZERO_OFFSET_SHARE = 0.05
+
+
+def readout_zero_offset(unit: str, values: np.ndarray) -> bool:
+    """True where a control logged by a readout in a continuous unit (W, rpm, a gas pressure: no step
+    in :data:`roastlab.model.actuators.UNIT_DEFAULTS`) dips below 0 by no more than
+    :data:`ZERO_OFFSET_SHARE` of its highest reading: a pressure gauge or a power meter at rest reads
+    a little either side of its zero (-0.02 kPa with the burner off), which is off, not a wrong unit.
+    A stepped setting (percent, level) below 0 stays a wrong unit."""
+    if UNIT_DEFAULTS[unit][2] is not None or not values.size or values.min() >= 0.0:
+        return False
+    return bool(values.max() > 0.0 and -values.min() <= ZERO_OFFSET_SHARE * values.max())
+
+
 def roastime_default_map(log: ArtisanLog) -> ColumnMap:
     """The map the parsed RoasTime ``log`` is read with when none is given: the channels a Bullet logs.
 
@@ -845,6 +861,13 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
         if k in ("heater", "fan"):
             lo, hi = SETTING_UNITS[spec["unit"]]
             v = series[k][np.isfinite(series[k])]
+            if v.size and readout_zero_offset(spec["unit"], v):
+                default_notes.append(
+                    f"{k}: the {spec['column']} readout reads down to {v.min():g} {spec['unit']}, a sensor's offset "
+                    "about its zero: read as 0 there"
+                )
+                series[k] = np.where(series[k] < 0.0, 0.0, series[k])
+                v = np.maximum(v, 0.0)
             if v.size and (v.min() < lo or v.max() > hi):
                 raise InputError(
                     f"{k} setting {v.min():g}..{v.max():g} outside {lo:g}..{hi:g} for unit {spec['unit']!r} "
