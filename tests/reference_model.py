@@ -47,7 +47,7 @@ def bed_segment(Mb, Dch, Lch, rho=680.0):
 
 def make_rhs(plant: str, theta, X0: float, moisture: str = "schwartzberg", act=None, bed=None, process=None):
     """The slow reference right-hand side. ``act`` holds the actuator extension's values
-    (Qe_gain, Qe_offset, Tgi_gain, tau, Gg_fan, U_shell, T_room); None = the paper's model.
+    (Qe_gain, Qe_offset, Tgi_gain, tau, Gg_fan, U_shell, T_room, heater_exp); None = the paper's model.
     ``bed`` the bed laws and the probe's depth: {"contact": "paper"|"wall", "probe": "rest"|"tumbling",
     "probe_gas": "outlet"|"mean", "h_probe": m, "eps_rad": the wall's radiation to the bed's free
     surface, 0-1, "k_flight": the gas-bean area over that surface, 0 = the contact law's}; None =
@@ -92,8 +92,12 @@ def make_rhs(plant: str, theta, X0: float, moisture: str = "schwartzberg", act=N
         Tb, Tm, X, He, Ta, H = x
         # actuator extension: fan -> flow, lagged heater -> inlet gas rise and heat into the metal
         Gg = max(Gg + a.get("Gg_fan", 0.0) * fan, 1e-6)
-        Tgi = Tgi + a.get("Tgi_gain", 0.0) * H
-        Qe = max(a.get("Qe_offset", 0.0) + a.get("Qe_gain", 0.0) * H, 0.0)
+        # the heat the lagged setting releases: H^e (a gas burner's pressure: e = 0.5, the orifice law),
+        # a millionth of a unit added under the power so that its slope is finite at 0
+        e = a.get("heater_exp", 1.0)
+        D = H if e == 1.0 else H * (max(H, 0.0) + 1e-6) ** (e - 1.0)
+        Tgi = Tgi + a.get("Tgi_gain", 0.0) * D
+        Qe = max(a.get("Qe_offset", 0.0) + a.get("Qe_gain", 0.0) * D, 0.0)
         dH = (heater - H) / a.get("tau", 1.0)
         cg = sum(a * (Tgi + 273.15) ** i for i, a in enumerate(ALPHA)) / 1000
         he = 0.49 - 0.443 * math.exp(-0.206 * X)

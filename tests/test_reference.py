@@ -84,6 +84,37 @@ def test_actuator_extension_matches_reference(seed, hold):
     assert np.ptp(fast.states[:, 5]) > 1.0  # the heater really moved
 
 
+def test_a_gas_burners_square_root_law_matches_reference():
+    """The heater's drive as the square root of its lagged setting (heater_exp 0.5: a gas burner
+    logged as its pressure, the orifice law), through the lag into Qe and Tgi, the burner off (0) at
+    times: compiled vs reference; and it is not the linear law's run."""
+    t, Gg, Tgi, x0 = random_case(21, "120kg")
+    n = len(t)
+    heater = np.array([0.0, 0.5, 1.2, 3.5, 2.0, 0.0, 2.8])[(np.arange(n) // 4) % 7]  # kPa, held for 4 samples
+    act = {"Qe_gain": 20.0, "Tgi_gain": 30.0, "tau": 20.0, "heater_exp": 0.5}
+    values = {"Qe_gain_kW": 20.0, "Tgi_gain_C": 30.0, "tau_heater_s": 20.0, "heater_exp": 0.5}
+    theta = (0.03, 0.04, 0.6)
+    fast = simulate("120kg", t, Gg, Tgi - 150.0, theta=theta, initial=x0, hold="zoh", heater=heater, values=values)
+    ref, ref_tgo = reference_simulate(
+        "120kg", theta, t, Gg, Tgi - 150.0, x0.vector(), hold="zoh", heater=heater, act=act
+    )
+    for j in (0, 1, 4):
+        assert np.max(np.abs(fast.states[:, j] - ref[:, j])) < TOL_C
+    assert np.max(np.abs(fast.Tgo_C - ref_tgo)) < TOL_C
+    linear = simulate(
+        "120kg",
+        t,
+        Gg,
+        Tgi - 150.0,
+        theta=theta,
+        initial=x0,
+        hold="zoh",
+        heater=heater,
+        values=values | {"heater_exp": 1.0},
+    )
+    assert np.max(np.abs(linear.Tb_C - fast.Tb_C)) > 1.0  # the law matters at these pressures
+
+
 def test_printed_moisture_law_matches_reference():
     t, Gg, Tgi, x0 = random_case(7, "120kg")
     theta = (0.02, 0.05, 0.6)

@@ -37,6 +37,8 @@ def _params(codes: dict, rng) -> np.ndarray:
     p[P["eps_rad"]] = rng.uniform(0.3, 0.9)  # the wall's radiation to the bed
     # the gas at the bed's surface in half the combinations (the contact laws' own Agb in the rest)
     p[P["k_flight"]] = rng.uniform(2.0, 20.0) if codes.get("probe_gas_law") == 1.0 else 0.0
+    # the heater's drive as a power of its setting (a gas burner's pressure) in half the combinations
+    p[P["heater_exp"]] = rng.uniform(0.4, 0.9) if codes.get("probe_law") == 1.0 else 1.0
     for name, value in codes.items():
         p[P[name]] = value
     return p
@@ -114,6 +116,20 @@ def test_generated_jacobian_matches_casadi(codes):
         Jx_ca, Ju_ca = (np.array(a) for a in jac(x, u))
         np.testing.assert_allclose(Jx, Jx_ca, rtol=1e-10, atol=1e-14)
         np.testing.assert_allclose(Ju, Ju_ca, rtol=1e-10, atol=1e-14)
+
+
+def test_a_burner_off_has_a_finite_jacobian_under_the_square_root_law():
+    """heater_exp 0.5 (a gas burner logged as its pressure) with the lagged setting at 0, the burner
+    off: the square root's slope is infinite there, the drive's (linear below a floor) is not, so
+    every Jacobian entry is finite and the program optimiser's gradient is a number."""
+    rng = np.random.default_rng(5)
+    p = _params(COMBOS[0], rng)
+    p[P["heater_exp"]] = 0.5
+    x, u = _point(rng)
+    x[-1], u[2] = 0.0, 0.0
+    f, Jx, Ju, Jp = _generated(x, u, p)
+    assert np.all(np.isfinite(f)) and np.all(np.isfinite(Jx)) and np.all(np.isfinite(Ju)) and np.all(np.isfinite(Jp))
+    assert Jx[1, -1] > 0.0  # more lagged gas heats the drum
 
 
 def test_generated_source_is_the_cached_one():

@@ -44,6 +44,10 @@ UNIT_DEFAULTS: dict[str, tuple[float, float, float | None, float]] = {
 #: North America and Asia): continuous, no limit on its rate, in the unit the channel names.
 PRESSURE_UNITS = ("kPa", "hPa", "mbar", "Pa", "psi", "inWC", "mmWC")
 UNIT_DEFAULTS.update({unit: (0.0, 1e5, None, 1e5) for unit in PRESSURE_UNITS})
+#: The power of a gas burner's pressure in the heat it releases (``heater_exp``,
+#: :func:`roastlab.model.rhs.heater_drive`): the burner's heat follows its gas flow, and the flow
+#: through its jet, an orifice, goes as the square root of the pressure across it.
+PRESSURE_HEATER_EXP = 0.5
 #: How a setting's value reads to a roaster, per control and unit ("P7", "F3", "35 %").
 _PREFIX = {("heater", "level"): "P", ("fan", "level"): "F", ("heater", "tens"): "P", ("fan", "tens"): "F"}
 #: What a logged value is worth in the machine's own steps, per unit (a level in tens: a tenth).

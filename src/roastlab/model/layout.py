@@ -84,6 +84,8 @@ PARAM_NAMES = (
     "k_flight",  # gas-bean area over the bed's free surface [-] (>= 1: the beans in flight add to it)
     # the drum at CHARGE from a reading that shows a share of its rise over the room (extension; 1 = the drum's own)
     "Tm0_share",  # read once per batch at CHARGE (roastlab.model.rhs.drum_at_charge_C), never by the right-hand side
+    # the heater's setting in the heat it releases (extension; 1 = in proportion, the linear law)
+    "heater_exp",  # exponent of the lagged setting: 0.5 for a gas burner logged as its pressure (orifice law)
 )
 P = {name: i for i, name in enumerate(PARAM_NAMES)}
 N_PARAMS = len(PARAM_NAMES)
@@ -96,3 +98,4 @@ I_USH, I_ASH, I_TROOM = (P[k] for k in ("U_shell", "Ashell", "T_room"))
 I_HBED, I_HPROBE = P["h_bed"], P["h_probe"]
 I_AWALL, I_CONTACT, I_PROBELAW, I_PROBEGAS = (P[k] for k in ("A_wall", "contact_law", "probe_law", "probe_gas_law"))
 I_EPSRAD, I_ASURF, I_KFLIGHT = P["eps_rad"], P["A_surf"], P["k_flight"]
+I_HEXP = P["heater_exp"]

@@ -171,6 +171,10 @@ _TABLE: tuple[Quantity, ...] = (
              "share of the drum's rise over the room at CHARGE that the map's drum-start reading shows "
              "(1: the reading is the drum's; a probe soaked in the empty drum reads less)",
              (0.3, 1.0), False, "Tm0_share"),
+    Quantity("heater_exp", "-", "extension", 1.0, (0.1, 2.0),
+             "exponent of the heater's lagged setting in the heat it releases (1: in proportion; 0.5: a gas "
+             "burner logged as its pressure, whose gas flow through the jet goes as the pressure's square root)",
+             (0.3, 1.5), False, "heater_exp"),
     # --- closed-loop scenarios (roastlab.io.scenario) --------------------------------------------
     Quantity("mass_factor", "-", "scenario", 1.0, (0.1, 5.0), "batch mass over the reference's"),
     Quantity("Gg_factor", "-", "scenario", 1.0, (0.1, 5.0), "gas flow the plant gets over the flow set"),

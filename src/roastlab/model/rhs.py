@@ -61,6 +61,7 @@ from .layout import (  # noqa: E402, F401
     I_HBED,
     I_HBM,
     I_HET,
+    I_HEXP,
     I_HGM,
     I_HPROBE,
     I_K1,
@@ -190,22 +191,48 @@ def dry_mass_kg(Mb_kg, X0):
     return Mb_kg / (1.0 + X0)
 
 
+#: The lagged setting [its unit] added under the power in the heater's drive :func:`heater_drive`, so
+#: that its slope stays finite at 0 (the square root's is not): 1e-6 kPa, a millionth of a burner's
+#: pressure, changes the heat by less than a millionth wherever the burner is lit.
+HEATER_DRIVE_FLOOR = 1e-6
+
+
+@register_jitable
+def heater_drive(H, p):
+    """The heater's lagged setting ``H`` as the heat it releases, D = H^e [setting unit^e] (extension).
+
+    e = ``heater_exp``. 1 (the default) is the heat in proportion to the setting (a percentage of
+    an element's power, a level), D = H exactly. A gas burner logged as its pressure releases heat
+    in proportion to its gas flow, and the flow through the burner's jet (an orifice) goes as the
+    square root of the pressure across it, m = Cd A sqrt(2 rho dp) (Bernoulli for an orifice): e =
+    0.5. Computed as D = H (H + h0)^(e - 1), h0 = :data:`HEATER_DRIVE_FLOOR`: H^e wherever H >> h0,
+    0 at H = 0 with a finite slope h0^(e - 1) there (the Jacobian, :mod:`roastlab.sim.jacobian`),
+    where the square root's is infinite.
+    """
+    e = p[I_HEXP]
+    if e == 1.0:
+        return H
+    return H * power(fmax(H, 0.0) + HEATER_DRIVE_FLOOR, e - 1.0)
+
+
 @register_jitable
 def gas_inputs(Gg, Tgi, H, fan, p):
     """The gas flow [kg/s] and inlet temperature [degC] the chamber sees (actuator extension).
 
     Gg_eff = Gg Gg_scale + Gg_fan fan (at least :data:`GG_MIN_KG_S`): the logged or placeholder
-    flow, scaled, plus the fan map; Tgi_eff = Tgi + Tgi_gain H: the logged or ambient inlet
-    temperature plus the lagged heater's rise. Both reduce to (Gg, Tgi) in the paper's model.
+    flow, scaled, plus the fan map; Tgi_eff = Tgi + Tgi_gain D: the logged or ambient inlet
+    temperature plus the lagged heater's rise (D = :func:`heater_drive`). Both reduce to (Gg, Tgi)
+    in the paper's model.
     """
     g = Gg * p[I_GGS] + p[I_GGF] * fan
-    return fmax(g, GG_MIN_KG_S), Tgi + p[I_TGIG] * H
+    return fmax(g, GG_MIN_KG_S), Tgi + p[I_TGIG] * heater_drive(H, p)
 
 
 @register_jitable
 def heater_power_kW(H, p):
-    """Heat into the drum metal Qe = Qe_offset + Qe_gain H [kW], never negative (eq. 12's Qe)."""
-    return fmax(p[I_QEO] + p[I_QEG] * H, 0.0)
+    """Heat into the drum metal Qe = Qe_offset + Qe_gain D [kW], never negative (eq. 12's Qe; D the
+    heater's drive :func:`heater_drive`, the lagged setting H itself unless ``heater_exp`` says)."""
+    return fmax(p[I_QEO] + p[I_QEG] * heater_drive(H, p), 0.0)
 
 
 @register_jitable

@@ -75,7 +75,7 @@ from ..metrics.profile import (
     first_crack_s,
     mmss,
 )
-from ..model.actuators import PRESSURE_UNITS, UNIT_DEFAULTS
+from ..model.actuators import PRESSURE_HEATER_EXP, PRESSURE_UNITS, UNIT_DEFAULTS
 from ..model.bed import CROSS_VALIDATED, PROBE_DEPTH_OVER_DIAMETER
 from ..model.constants import FIRST_CRACK_BEAN_C, GREEN_BULK_DENSITY_KG_M3
 from ..model.parameters import FIRST_CRACK_WEIGHT, RESIDUAL_WEIGHT
@@ -1053,9 +1053,19 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
     path = entry[1] if entry else ("both" if s.has_et else "drum")
     if s.heater and path == "drum" and not entry:
         rows.append("# no ET logged to tell the heater's paths apart: the heater heats the drum metal alone")
+    fixed = []  # the [fixed] table's lines
     if s.heater:
-        span = _setting_span(s.heater_unit, s.heater_max)
+        # the heat the setting releases goes as its power heater_exp (rhs.heater_drive): a gas pressure's
+        # square root (the orifice law), any other setting in proportion
+        exp = PRESSURE_HEATER_EXP if s.heater_unit in PRESSURE_UNITS else 1.0
+        span = _setting_span(s.heater_unit, s.heater_max) ** exp
         per = "logged unit, a level is 10" if s.heater_unit == "tens" else s.heater_unit
+        if exp != 1.0:
+            per = f"{per}^{exp:g}"
+            fixed.append(
+                f"heater_exp = {exp:g}".ljust(38) + "# a gas burner's heat goes as the square root of its pressure "
+                "(its gas flow through the jet, an orifice)"
+            )
         qe_hi = round(10.0 * capacity_kg / span, 4)  # ~10 kW per kg of capacity at full setting, generous
         if s.heater_unit == "W":  # a power readout: the drum gets at most all of it
             qe_hi = KW_PER_W
@@ -1137,12 +1147,12 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
         *(f'{k} = "{v}"' for k, v in CROSS_VALIDATED.as_dict().items()),
     ]
     if not fit_depth:
-        rows += [
-            "",
-            "[fixed]",
+        fixed.append(
             f"h_probe_m = {depth_m}".ljust(38)
             + "# bed depth that covers the probe [m]: the drum's diameter; only other batch sizes determine it",
-        ]
+        )
+    if fixed:
+        rows += ["", "[fixed]", *fixed]
     if spans_sizes and not fit_depth:
         lo, hi = quantity("h_probe_m").bounds
         rows += [
