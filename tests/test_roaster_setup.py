@@ -1401,8 +1401,9 @@ def test_a_control_named_in_a_pressure_unit_is_that_pressure(name, unit):
 def test_a_gas_burner_logged_as_its_pressure_in_kpa_is_read_in_kpa(cli, tmp_path):
     """SYNTHETIC logs whose burner is an extra device "Gas kPa" reading 0.5-3.2 (a manometer's
     reading, decimals): a gas pressure in kPa, as the name says, not a percent (which put its gain's
-    bound at 0.35 kW at the top setting and quantised programs to 0 or 5 kPa); the fit spec's gains are
-    per kPa over the logged range, programs continuous and labelled in kPa."""
+    bound at 0.35 kW at the top setting and quantised programs to 0 or 5 kPa); the fit spec fixes the
+    square-root law and its gains are per kPa^0.5 over the logged range, programs continuous and
+    labelled in kPa."""
     from roastlab.io.importers.mapping import import_log, load_map
 
     n = 120
@@ -1423,7 +1424,10 @@ def test_a_gas_burner_logged_as_its_pressure_in_kpa_is_read_in_kpa(cli, tmp_path
     fit = (tmp_path / "cfg" / "fit.toml").read_text()
     qe_hi = float(fit.split("Qe_gain_kW = [")[1].split("]")[0].split(", ")[1])
     capacity_kg = 2 * 0.2  # fake_alog's batch, the capacity twice the largest logged
-    assert "[kW per kPa]" in fit and qe_hi * top == pytest.approx(10.0 * capacity_kg, rel=1e-3)
+    # its heat goes as the pressure's square root (the orifice law): the gains per kPa^0.5, ~10 kW per
+    # kg of capacity at the top logged pressure
+    assert "[kW per kPa^0.5]" in fit and "\nheater_exp = 0.5 " in fit.split("[fixed]")[1]
+    assert qe_hi * top**0.5 == pytest.approx(10.0 * capacity_kg, rel=1e-3)
     batch = import_log(logs[0], cmap)
     assert batch.heater is not None and np.nanmax(batch.heater) == top  # read as logged, in kPa
 
