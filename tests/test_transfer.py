@@ -316,3 +316,21 @@ def test_a_target_from_another_roast_is_followed_from_the_references_inputs(cli,
     code, _, err = cli("transfer", "--model", tmp_path / "model.json", "--reference", tmp_path / "ref.csv",
                        "--target", tmp_path / "none.csv", "--out", tmp_path / "q.csv")  # fmt: skip
     assert code == 2 and "none.csv" in err and err.count("\n") == 1
+
+
+def test_a_logged_readouts_noise_is_no_event_and_its_moves_are():
+    """A heater logged by a readout (a gas pressure in kPa, continuous) replayed as events (whatif's
+    background and alarms): its noise (0.01 kPa) is no event, a roaster's move (2.4 -> 1.8 kPa) is one,
+    labelled in its unit; a stepped setting keeps every change it has."""
+    from roastlab.io.background import setting_events
+    from roastlab.model.actuators import Actuator
+
+    t = np.arange(0.0, 300.0, 5.0)
+    rng = np.random.default_rng(3)
+    gas = np.where(t < 150.0, 2.4, 1.8) + np.round(rng.normal(0.0, 0.01, t.size), 2)
+    events = setting_events(t, [("heater", gas, Actuator("heater", "kPa", 0.0, 3.0), False)])
+    assert len(events) == 2 and events[1][0] == int(np.argmax(t >= 150.0))
+    assert events[1][3] == f"Burner {round(gas[events[1][0]], 2):g} kPa"
+    steps = np.where(t < 150.0, 60.0, 55.0)
+    stepped = setting_events(t, [("heater", steps, Actuator("heater", "percent", 0.0, 100.0, 5.0), False)])
+    assert [e[2] for e in stepped] == [60.0, 55.0] and stepped[1][3] == "Burner 55"

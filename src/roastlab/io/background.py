@@ -21,6 +21,10 @@ from .importers.artisan import DEFAULT_ETYPES, EVENT_NAMES, events_external_to_i
 
 #: The event type each setting is written as.
 SETTING_ETYPES = {"heater": "Burner", "fan": "Air"}
+#: A change of a continuous control (a readout: a gas pressure, W, rpm) smaller than this share of its
+#: range is the readout's noise, not a roaster's move (:func:`setting_events`): 2 %, 0.06 kPa on a
+#: burner logged to 3 kPa, 20 W on a 1 kW element.
+READOUT_DEADBAND_SHARE = 0.02
 
 #: Artisan's alarm table (Config > Alarms; an ``.alrm`` file is its export): "From" CHARGE is alarm time 0;
 #: an empty "Source" (no temperature condition) is source -3; the action "Slider <event type k>" is 3 + k
@@ -41,19 +45,25 @@ def setting_events(time_s, series) -> list[tuple[int, str, float, str]]:
     change. ``series``: ``(setting, values, actuator, thin)`` with ``setting`` "heater" or "fan" and
     the values in the actuator's units; ``thin``: the values are an optimiser's, quantised to the
     actuator's steps and held at least :data:`~roastlab.model.actuators.MIN_HOLD_S` (a logged
-    setting keeps its own changes). The label is the machine's (``P7``, ``F3``) for levels, else
-    the type and the value."""
+    setting keeps its own changes; a logged continuous one, a readout, those beyond its noise,
+    :data:`READOUT_DEADBAND_SHARE` of its range). The label is the machine's (``P7``, ``F3``) for
+    levels, else the type and the value (in its unit where it is continuous: ``Burner 2.45 kPa``)."""
     t = np.asarray(time_s, dtype=float)
     out = []
     for setting, values, act, thin in series:
         etype = SETTING_ETYPES[setting]
+        noise = 0.0 if act.stepped or thin else READOUT_DEADBAND_SHARE * (act.high - act.low)  # a logged readout
         last_v, last_t = None, -np.inf
         for i, v in enumerate(np.asarray(values, dtype=float)):
             if thin:
                 v = float(act.quantise(v))
-            if last_v is not None and (v == last_v or (thin and t[i] - last_t < MIN_HOLD_S)):
+            if last_v is not None and (abs(v - last_v) <= noise or (thin and t[i] - last_t < MIN_HOLD_S)):
                 continue
-            out.append((i, etype, float(v), act.label(v) if act.unit in ("level", "tens") else f"{etype} {v:g}"))
+            if act.unit in ("level", "tens"):
+                label = act.label(v)
+            else:
+                label = f"{etype} {v:g}" if act.stepped else f"{etype} {act.label(v)}"
+            out.append((i, etype, float(v), label))
             last_v, last_t = v, t[i]
     return sorted(out, key=lambda e: e[0])
 
