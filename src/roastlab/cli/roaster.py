@@ -111,7 +111,8 @@ def add_parsers(sub) -> None:
         help="read a roaster's logs and write its column map, plant, fit spec and fleet spec",
         description="Inspect LOG... (Artisan .alog/.csv, RoasTime .json (RoasTime's own or RoastWorld's export), or "
         "plain CSV with a header naming time, BT and ET, its first row the charge, of one roaster) and write DIR/map.toml "
-        "(which channel is BT, the heater, the fan, a second bean reading, ET, the inlet air), DIR/plant.toml (the drum, from its "
+        "(which channel is BT, the heater (a gas burner's pressure in the unit its name says, 'Gas kPa'), the fan, a second "
+        "bean reading, ET, the inlet air), DIR/plant.toml (the drum, from its "
         "dimensions, a catalogue entry or the batch capacity, each estimate stated), DIR/fit.toml (what these "
         "logs can determine) and DIR/fleet.toml (what a fleet fit frees per batch under the fitted model), each "
         "commented with what was detected and what was guessed. A LOG that is a folder "
