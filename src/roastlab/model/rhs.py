@@ -216,23 +216,23 @@ def heater_drive(H, p):
 
 
 @register_jitable
-def gas_inputs(Gg, Tgi, H, fan, p):
+def gas_inputs(Gg, Tgi, D, fan, p):
     """The gas flow [kg/s] and inlet temperature [degC] the chamber sees (actuator extension).
 
     Gg_eff = Gg Gg_scale + Gg_fan fan (at least :data:`GG_MIN_KG_S`): the logged or placeholder
     flow, scaled, plus the fan map; Tgi_eff = Tgi + Tgi_gain D: the logged or ambient inlet
-    temperature plus the lagged heater's rise (D = :func:`heater_drive`). Both reduce to (Gg, Tgi)
-    in the paper's model.
+    temperature plus the lagged heater's rise, D its drive (:func:`heater_drive` of the lagged
+    setting H; H itself unless ``heater_exp`` says). Both reduce to (Gg, Tgi) in the paper's model.
     """
     g = Gg * p[I_GGS] + p[I_GGF] * fan
-    return fmax(g, GG_MIN_KG_S), Tgi + p[I_TGIG] * heater_drive(H, p)
+    return fmax(g, GG_MIN_KG_S), Tgi + p[I_TGIG] * D
 
 
 @register_jitable
-def heater_power_kW(H, p):
+def heater_power_kW(D, p):
     """Heat into the drum metal Qe = Qe_offset + Qe_gain D [kW], never negative (eq. 12's Qe; D the
-    heater's drive :func:`heater_drive`, the lagged setting H itself unless ``heater_exp`` says)."""
-    return fmax(p[I_QEO] + p[I_QEG] * heater_drive(H, p), 0.0)
+    heater's drive, :func:`heater_drive` of the lagged setting H, H itself unless ``heater_exp`` says)."""
+    return fmax(p[I_QEO] + p[I_QEG] * D, 0.0)
 
 
 @register_jitable
@@ -408,10 +408,11 @@ def derivatives(Tb, Tm, X, He, Ta, H, Gg, Tgi, heater, fan, p):
     """Time derivatives of the six states (eqs. 15a-15d, 17, actuator lag) as a tuple.
 
     ``Gg`` [kg/s], ``Tgi`` [degC] are the logged (or placeholder) gas inputs, ``heater`` and
-    ``fan`` the logged settings (0 when not used); :func:`gas_inputs` and
+    ``fan`` the logged settings (0 when not used); :func:`heater_drive`, :func:`gas_inputs` and
     :func:`heater_power_kW` turn them into what the chamber sees.
     """
-    g, T = gas_inputs(Gg, Tgi, H, fan, p)
+    D = heater_drive(H, p)  # the heat the lagged setting releases, once per evaluation
+    g, T = gas_inputs(Gg, Tgi, D, fan, p)
     path = exchanger(Tb, Tm, X, g, T, p)  # eq. 15e's gas path, once per evaluation
     Tgo, Qgb, Qgm, Qbm = gas_heat_flows(Tb, Tm, g, T, path, p)
     dX = moisture_rate_1_s(Tb, X, p)  # eq. 15c
@@ -421,7 +422,7 @@ def derivatives(Tb, Tm, X, He, Ta, H, Gg, Tgi, heater, fan, p):
     Qrad = wall_radiation_kW(Tb, Tm, p)  # the wall's radiation to the bed (extension; 0 in the paper)
     dTb = (Qgb - Qgm + Qbm + Qrad + Mbd * (Qr + p[I_LAM] * dX)) / (Mbd * (cs + p[I_CW] * X))  # eq. 15a
     # eq. 15b, eq. 12's Qe; 1/(Mm cm) and 1/tau depend on the parameters alone (once per run compiled)
-    dTm = (Qgm - Qbm - Qrad + heater_power_kW(H, p) - shell_loss_kW(Tm, p)) * (1.0 / (p[I_MM] * p[I_CM]))
+    dTm = (Qgm - Qbm - Qrad + heater_power_kW(D, p) - shell_loss_kW(Tm, p)) * (1.0 / (p[I_MM] * p[I_CM]))
     dTa = probe_rate_C_s(Tb, Ta, probe_gas_C(T, Tgo, path[0], path[1], p), p)  # eq. 17 (probe immersion: extension)
     dH = (heater - H) * (1.0 / p[I_TAUH])  # actuator lag (extension)
     return dTb, dTm, dX, Qr, dTa, dH
@@ -430,7 +431,7 @@ def derivatives(Tb, Tm, X, He, Ta, H, Gg, Tgi, heater, fan, p):
 @register_jitable
 def outlet_gas_C(x, Gg, Tgi, fan, p):
     """Outlet gas temperature Tgo [degC] at state ``x`` (eq. 15e, effective gas inputs)."""
-    g, T = gas_inputs(Gg, Tgi, x[S_H], fan, p)
+    g, T = gas_inputs(Gg, Tgi, heater_drive(x[S_H], p), fan, p)
     return heat_flows(x[S_TB], x[S_TM], x[S_X], g, T, p)[0]
 
 

@@ -21,6 +21,7 @@ from ..model.rhs import (
     P,
     gas_inputs,
     heat_flows,
+    heater_drive,
     heater_power_kW,
     pack_params,
     reaction_heat_rate_kW_kg,
@@ -115,7 +116,7 @@ class SimulationResult(Result):
         """Gas flow [kg/s] and inlet temperature [degC] the chamber saw (after the actuator maps)."""
         _, f = self._settings()
         pairs = [
-            gas_inputs(g, T, H, fi, self.params)
+            gas_inputs(g, T, heater_drive(H, self.params), fi, self.params)
             for g, T, H, fi in zip(self.Gg_kg_s, self.Tgi_C, self.states[:, S_H], f)
         ]
         a = np.array(pairs, dtype=float).reshape(-1, 2)
@@ -152,7 +153,14 @@ class SimulationResult(Result):
             Tb, Tm, X, He, _, H = self.states[i]
             _, Qgb, Qgm, Qbm = heat_flows(Tb, Tm, X, g[i], T[i], self.params)
             Qr = Mbd * reaction_heat_rate_kW_kg(Tb, He, self.params)
-            q[i] = (Qgb, Qgm, Qbm, Qr, heater_power_kW(H, self.params), shell_loss_kW(Tm, self.params))
+            q[i] = (
+                Qgb,
+                Qgm,
+                Qbm,
+                Qr,
+                heater_power_kW(heater_drive(H, self.params), self.params),
+                shell_loss_kW(Tm, self.params),
+            )
         out = {"Qgb_kW": q[:, 0], "Qgm_kW": q[:, 1], "Qbm_kW": q[:, 2], "Qr_kW": q[:, 3]}
         if self.uses_actuators:
             out["Qe_kW"] = q[:, 4]
