@@ -166,15 +166,19 @@ def test_lanes_stop_where_the_scalar_integrator_stops():
 
 def test_law_key_names_one_set_of_laws_or_none():
     _, _, _, PP = _runs(1, 4)
-    assert lanes.law_key(PP) == 2 * 4**3  # the paper's laws, Schwartzberg's exponent 2
+    linear = 4**4  # the heater's drive in proportion to its setting (heater_exp 1)
+    assert lanes.law_key(PP) == 2 * 4**3 + linear  # the paper's laws, Schwartzberg's exponent 2
     _, _, _, PB = _runs(1, 4, BULLET_LAWS)
-    assert lanes.law_key(PB) == 1 + 4 + 16 + 128
+    assert lanes.law_key(PB) == 1 + 4 + 16 + 128 + linear
     assert lanes.law_key(np.vstack([PP, PB])) is None  # mixed laws: the scalar integrator
     odd = PP.copy()
     odd[:, P["x_exp"]] = 1.5  # an exponent the key cannot hold as a whole number
     assert lanes.law_key(odd) is None
+    gas = PP.copy()
+    gas[:, P["heater_exp"]] = 0.5  # a gas burner's square root: the scalar integrator
+    assert lanes.law_key(gas) is None
     assert lanes.usable(PP) is None  # too few runs to fill the lanes
-    assert lanes.usable(np.repeat(PP, lanes.MIN_RUNS, axis=0)) == 128
+    assert lanes.usable(np.repeat(PP, lanes.MIN_RUNS, axis=0)) == 128 + linear
 
 
 def test_population_takes_the_lanes_for_many_runs(monkeypatch):

@@ -210,7 +210,7 @@ def heater_drive(H, p):
     where the square root's is infinite.
     """
     e = p[I_HEXP]
-    if e == 1.0:
+    if e == 1.0:  # the lanes compile this slot in as a constant (roastlab.sim.lanes.LAW_SLOTS)
         return H
     return H * power(fmax(H, 0.0) + HEATER_DRIVE_FLOOR, e - 1.0)
 
