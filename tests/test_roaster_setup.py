@@ -208,6 +208,21 @@ def test_init_leaves_the_drum_start_as_read_where_et_drives_the_model(cli, tmp_p
     assert "Tm0_share" not in (tmp_path / "cfg" / "fit.toml").read_text()
 
 
+def _heater_readout_logs(tmp_path, name: str, readings: list, stem: str, k: int = 2) -> list:
+    """SYNTHETIC: ``k`` fake Artisan logs whose heater is an extra device ``name`` reading ``readings``
+    (one per sample, or one list per log) beside a Fan device at 40."""
+    n = len(readings[0]) if isinstance(readings[0], list) else len(readings)
+    logs = []
+    for i in range(k):
+        values = readings[i] if isinstance(readings[0], list) else readings
+        extra = {"extratimex": [[1.5 * j for j in range(n)]], "extraname1": [name], "extraname2": ["Fan"],
+                 "extratemp1": [values], "extratemp2": [[40.0] * n], "extraNoneTempHint1": [True],
+                 "extraNoneTempHint2": [True]}  # fmt: skip
+        logs.append(tmp_path / f"{stem}{i}.alog")
+        logs[-1].write_text(fake_alog(n=n, extra=extra))
+    return logs
+
+
 def test_a_heater_logged_in_watts_is_read_as_a_power(cli, tmp_path):
     """SYNTHETIC logs whose heater is an extra device reading 450-900 (a power readout, not a
     percent): the map says W with the logs' top, the fit spec bounds the drum's share of it at all of
@@ -215,14 +230,7 @@ def test_a_heater_logged_in_watts_is_read_as_a_power(cli, tmp_path):
     from roastlab.io.importers.mapping import load_map
     from roastlab.workflows.roaster import KW_PER_W
 
-    n = 120
-    power = [450.0 if i < 60 else 900.0 for i in range(n)]
-    extra = {"extratimex": [[1.5 * i for i in range(n)]], "extraname1": ["Heater W"], "extraname2": ["Fan"],
-             "extratemp1": [power], "extratemp2": [[40.0] * n], "extraNoneTempHint1": [True],
-             "extraNoneTempHint2": [True]}  # fmt: skip
-    logs = [tmp_path / f"w{k}.alog" for k in range(2)]
-    for p in logs:
-        p.write_text(fake_alog(extra=extra))
+    logs = _heater_readout_logs(tmp_path, "Heater W", [450.0 if i < 60 else 900.0 for i in range(120)], "w")
     code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
     assert code == 0 and "heater: Heater W (W)" in out, err
     heater = load_map(tmp_path / "cfg" / "map.toml").actuator("heater")
@@ -1406,14 +1414,8 @@ def test_a_gas_burner_logged_as_its_pressure_in_kpa_is_read_in_kpa(cli, tmp_path
     labelled in kPa."""
     from roastlab.io.importers.mapping import import_log, load_map
 
-    n = 120
-    gas = [0.55 if i < 30 else 3.2 if i < 80 else 1.85 for i in range(n)]  # kPa
-    extra = {"extratimex": [[1.5 * i for i in range(n)]], "extraname1": ["Gas kPa"], "extraname2": ["Fan"],
-             "extratemp1": [gas], "extratemp2": [[40.0] * n], "extraNoneTempHint1": [True],
-             "extraNoneTempHint2": [True]}  # fmt: skip
-    logs = [tmp_path / f"g{k}.alog" for k in range(2)]
-    for p in logs:
-        p.write_text(fake_alog(extra=extra))
+    gas = [0.55 if i < 30 else 3.2 if i < 80 else 1.85 for i in range(120)]  # kPa
+    logs = _heater_readout_logs(tmp_path, "Gas kPa", gas, "g")
     code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
     assert code == 0 and "heater: Gas kPa (kPa)" in out, (out, err)
     cmap = load_map(tmp_path / "cfg" / "map.toml")
@@ -1438,20 +1440,15 @@ def test_a_readouts_offset_about_its_zero_is_off_and_a_step_below_zero_a_wrong_u
     the top) is not an offset and stays refused in one line, as does a percent below 0."""
     from roastlab.io.importers.mapping import import_log, load_map, readout_zero_offset
 
-    n = 120
-    extra = {"extratimex": [[1.5 * i for i in range(n)]], "extraname1": ["Gas kPa"], "extraname2": ["Fan"],
-             "extratemp2": [[40.0] * n], "extraNoneTempHint1": [True], "extraNoneTempHint2": [True]}  # fmt: skip
-    logs = [tmp_path / f"g{k}.alog" for k in range(2)]
-    for p in logs:
-        p.write_text(fake_alog(extra=extra | {"extratemp1": [[3.0 if 10 < i < 60 else -0.02 for i in range(n)]]}))
+    logs = _heater_readout_logs(tmp_path, "Gas kPa", [3.0 if 10 < i < 60 else -0.02 for i in range(120)], "g")
     code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
     assert code == 0, (out, err)
     cmap = load_map(tmp_path / "cfg" / "map.toml")
     batch = import_log(logs[0], cmap)
     assert np.nanmin(batch.heater) == 0.0 and any("a sensor's offset about its zero" in n for n in batch.notes)
-    logs[1].write_text(fake_alog(extra=extra | {"extratemp1": [[3.0 if 10 < i < 60 else -0.8 for i in range(n)]]}))
+    (far,) = _heater_readout_logs(tmp_path, "Gas kPa", [3.0 if 10 < i < 60 else -0.8 for i in range(120)], "far", 1)
     with pytest.raises(InputError, match="outside 0"):
-        import_log(logs[1], cmap)
+        import_log(far, cmap)
     assert not readout_zero_offset("percent", np.array([-0.02, 50.0]))  # a stepped setting: a wrong unit
     assert readout_zero_offset("W", np.array([-20.0, 900.0])) and not readout_zero_offset(
         "W", np.array([-100.0, 900.0])
