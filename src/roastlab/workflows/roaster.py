@@ -854,10 +854,9 @@ def estimate_plant(s: Survey, capacity_kg=None, diameter_m=None, length_m=None) 
 
 def _setting_span(unit: str, top: float) -> float:
     """The range of a logged setting: 0..100 for percent, 0..the highest logged value otherwise (a
-    level, also in tens, a power, a speed; a gas pressure, which may top out under 1 psi)."""
-    if unit == "percent":
-        return 100.0
-    return top if unit in PRESSURE_UNITS and top > 0 else max(top, 1.0)
+    level, also in tens, a power, a speed, a gas pressure, which may top out under 1 psi; 1 where
+    nothing above 0 was logged)."""
+    return 100.0 if unit == "percent" else (top if top > 0 else 1.0)
 
 
 def map_text(s: Survey) -> str:
