@@ -1434,6 +1434,39 @@ def test_a_gas_burner_logged_as_its_pressure_in_kpa_is_read_in_kpa(cli, tmp_path
     assert batch.heater is not None and np.nanmax(batch.heater) == top  # read as logged, in kPa
 
 
+def test_a_decimal_readout_whose_name_gives_no_unit_is_read_over_its_range_and_a_unit_can_be_given(cli, tmp_path):
+    """SYNTHETIC logs whose burner is an extra device "Gas" reading 0.55-3.2 (decimals; the name gives
+    no unit): no percent a roaster roasts with, so a "reading" over its logged range (as a percent its
+    gains' bounds gave the burner a thirtieth of its heat and programs stepped it 0 or 5), linear, with
+    a note naming init --heater-unit; given as kPa, it is the gas pressure the name would have said."""
+    from roastlab.io.importers.mapping import load_map
+    from roastlab.workflows.roaster import PERCENT_TOP_ABOVE
+
+    gas = [0.55 if i < 30 else 3.2 if i < 80 else 1.85 for i in range(120)]
+    top = max(gas)
+    assert top <= PERCENT_TOP_ABOVE
+    logs = _heater_readout_logs(tmp_path, "Gas", gas, "g")
+    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
+    assert code == 0 and "heater: Gas (reading)" in out and "init --heater-unit UNIT" in out, (out, err)
+    heater = load_map(tmp_path / "cfg" / "map.toml").actuator("heater")
+    assert (heater.unit, heater.high, heater.step, heater.label(2.347)) == ("reading", top, None, "2.35")
+    fit = (tmp_path / "cfg" / "fit.toml").read_text()
+    qe_hi = float(fit.split("Qe_gain_kW = [")[1].split("]")[0].split(", ")[1])
+    assert qe_hi * top == pytest.approx(10.0 * 2 * 0.2, rel=1e-3)  # ~10 kW per kg of capacity at the top reading
+    assert "[kW per logged unit]" in fit and "heater_exp" not in fit
+    code, out, err = cli("init", *logs, "--out", tmp_path / "kpa", "--heater-unit", "kPa")
+    assert code == 0 and "heater: Gas (kPa)" in out and "read in kPa, as given" in out, (out, err)
+    assert load_map(tmp_path / "kpa" / "map.toml").actuator("heater").label(2.347) == "2.35 kPa"
+    assert "\nheater_exp = 0.5 " in (tmp_path / "kpa" / "fit.toml").read_text()
+    # a percent stays a percent: the same readout in 0-100 % with decimals
+    pct = _heater_readout_logs(tmp_path, "Gas", [v * 25.0 + 0.3 for v in gas], "p")
+    code, out, err = cli("init", *pct, "--out", tmp_path / "pct")
+    assert code == 0 and "heater: Gas (percent)" in out, (out, err)
+    # a unit roastlab does not know is refused in one line
+    code, out, err = cli("init", *logs, "--out", tmp_path / "x", "--heater-unit", "furlong")
+    assert code == 2 and "invalid choice" in err
+
+
 def test_a_readouts_offset_about_its_zero_is_off_and_a_step_below_zero_a_wrong_unit(cli, tmp_path):
     """SYNTHETIC logs whose "Gas kPa" readout reads -0.02 kPa with the burner off (a gauge's offset
     about its zero): read as 0 with a note, where it refused the log (outside 0..); -0.8 kPa (a quarter of

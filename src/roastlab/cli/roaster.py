@@ -18,6 +18,7 @@ def cmd_init(args) -> int:
         capacity_kg=args.batch_capacity_kg,
         diameter_m=args.drum_diameter_m,
         length_m=args.drum_length_m,
+        units={"heater": args.heater_unit, "fan": args.fan_unit},
     )
     s = r["survey"]
     aside = f" (and {len(s.unweighed)} without a green weight, below)" if s.unweighed else ""
@@ -137,6 +138,16 @@ def add_parsers(sub) -> None:
     p.add_argument("--batch-capacity-kg", type=float_arg("--batch-capacity-kg"), help="the roaster's rated batch [kg]")
     p.add_argument("--drum-diameter-m", type=float_arg("--drum-diameter-m"), help="inner drum diameter [m]")
     p.add_argument("--drum-length-m", type=float_arg("--drum-length-m"), help="inner drum length [m]")
+    from ..model.actuators import CONTROL_UNITS
+
+    for what, example in (("heater", "a 'Gas' readout in kPa gets the burner's square-root law"), ("fan", "")):
+        p.add_argument(
+            f"--{what}-unit",
+            choices=CONTROL_UNITS[what],
+            metavar="UNIT",
+            help=f"the unit the {what} is logged in, where its name does not say it (default: by its name, else its "
+            f"values); one of {', '.join(CONTROL_UNITS[what])}" + (f" ({example})" if example else ""),
+        )
     p.set_defaults(func=cmd_init)
 
     p = sub.add_parser(

@@ -558,9 +558,12 @@ def limit_spans(t, u, limits: ProgramLimits) -> list[dict]:
     tol = 1e-4 * (limits.high - limits.low)
     name, unit = limits.decide, limits.unit
     high, low, rate = f"{limits.high:g} {unit}", f"{limits.low:g} {unit}", f"{limits.rate_per_min:g} {unit}/min"
-    if unit == "tens":  # levels shown in tens (the actuator's unit): said as the machine's levels
+    if limits.actuator is not None:  # a setting as the roaster reads it: "P9", "100 %", "3.2" (a reading)
         high, low = limits.actuator.label(limits.high), limits.actuator.label(limits.low)
+    if unit == "tens":  # levels shown in tens (the actuator's unit): said as the machine's levels
         rate = f"{limits.rate_per_min / 10.0:g} levels/min"
+    elif unit == "reading":  # no unit to name
+        rate = f"{limits.rate_per_min:g}/min"
     flags = {
         f"{name} at its {high} ceiling": u >= limits.high - tol,
         f"{name} at its {low} floor": u <= limits.low + tol,

@@ -16,6 +16,8 @@ from :data:`UNIT_DEFAULTS`, the one table of defaults per unit.
 '35 %'
 >>> Actuator("heater", "kPa", 0, 3.5).label(2.347)
 '2.35 kPa'
+>>> Actuator("heater", "reading", 0, 3.5).label(2.347)
+'2.35'
 """
 
 from __future__ import annotations
@@ -44,6 +46,12 @@ UNIT_DEFAULTS: dict[str, tuple[float, float, float | None, float]] = {
 #: North America and Asia): continuous, no limit on its rate, in the unit the channel names.
 PRESSURE_UNITS = ("kPa", "hPa", "mbar", "Pa", "psi", "inWC", "mmWC")
 UNIT_DEFAULTS.update({unit: (0.0, 1e5, None, 1e5) for unit in PRESSURE_UNITS})
+#: A continuous readout in a unit its name does not give (a burner's "Gas" reading 0.5-3.5, a pressure
+#: or a power whose unit nobody wrote down): read as it is, its range the logged one.
+UNIT_DEFAULTS["reading"] = (0.0, 1e5, None, 1e5)
+#: The units ``roastlab init --heater-unit``/``--fan-unit`` may say a control is logged in: every unit
+#: for the heater; not a power for the fan (a fan's power is not its air flow).
+CONTROL_UNITS = {"heater": tuple(UNIT_DEFAULTS), "fan": tuple(u for u in UNIT_DEFAULTS if u not in ("kW", "W"))}
 #: The power of a gas burner's pressure in the heat it releases (``heater_exp``,
 #: :func:`roastlab.model.rhs.heater_drive`): the burner's heat follows its gas flow, and the flow
 #: through its jet, an orifice, goes as the square root of the pressure across it.
@@ -93,7 +101,8 @@ MIN_HOLD_S = 30.0
 @dataclass(frozen=True)
 class Actuator:
     """One control of a roaster: ``name`` ("heater" or "fan"), its ``unit`` ("percent",
-    "level", "tens", "kW", "W", "rpm", or a gas pressure of :data:`PRESSURE_UNITS`), the range ``low``..``high`` in that unit, the ``step`` between settings the
+    "level", "tens", "kW", "W", "rpm", a gas pressure of :data:`PRESSURE_UNITS`, or "reading": a
+    readout in a unit nobody named), the range ``low``..``high`` in that unit, the ``step`` between settings the
     machine offers (None: continuous) and the fastest change ``rate_per_min`` [unit/min]."""
 
     name: str
@@ -136,6 +145,8 @@ class Actuator:
             return f"{prefix}{value * _STEPS_PER_UNIT.get(self.unit, 1.0):g}"
         if self.unit in PRESSURE_UNITS:  # read off a manometer: to its hundredths
             return f"{round(float(value), 2):g} {self.unit}"
+        if self.unit == "reading":  # no unit to name: the number, to its hundredths
+            return f"{round(float(value), 2):g}"
         return f"{value:g} %" if self.unit == "percent" else f"{value:g} {self.unit}"
 
     def artisan_slider(self, value: float) -> float:

@@ -418,7 +418,8 @@ def plot_transfer(r, path=None, outputs=None):
     else:
         ax2.plot(t_min, u, color="tab:blue", lw=1.6, label="optimised program")
     ax2.set_ylim(lim.low - 0.08 * span, lim.high + 0.08 * span)
-    ax2.set_ylabel("Tgi [°C]" if lim.decide == "Tgi" else f"heater [{lim.unit}]")
+    heater = "heater (as logged)" if lim.unit == "reading" else f"heater [{lim.unit}]"  # "reading": no unit to name
+    ax2.set_ylabel("Tgi [°C]" if lim.decide == "Tgi" else heater)
     ax2.legend(loc="lower left", fontsize=7, ncol=2, framealpha=0.9)
     ax2.grid(alpha=0.3)
 

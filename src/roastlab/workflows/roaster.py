@@ -75,7 +75,7 @@ from ..metrics.profile import (
     first_crack_s,
     mmss,
 )
-from ..model.actuators import PRESSURE_HEATER_EXP, PRESSURE_UNITS, UNIT_DEFAULTS
+from ..model.actuators import CONTROL_UNITS, PRESSURE_HEATER_EXP, PRESSURE_UNITS, UNIT_DEFAULTS
 from ..model.bed import CROSS_VALIDATED, PROBE_DEPTH_OVER_DIAMETER
 from ..model.constants import FIRST_CRACK_BEAN_C, GREEN_BULK_DENSITY_KG_M3
 from ..model.parameters import FIRST_CRACK_WEIGHT, RESIDUAL_WEIGHT
@@ -249,6 +249,8 @@ class Survey:
     # the mark as the beans' temperature ([Tb2] first_crack, roastlab.model.constants.FIRST_CRACK_BEAN_C)
     renamed: dict = field(default_factory=dict)  # {"heater": [names, the most used first]} where the logs
     # name a control differently; the heater or fan field above is the first of them
+    # {"heater": "kPa"}: a control's unit as the roaster gave it (init --heater-unit), not as detected
+    given: dict = field(default_factory=dict)
 
     @property
     def drum_start_from_probe(self) -> bool:
@@ -283,19 +285,28 @@ def pressure_unit(name: str | None) -> str | None:
     return next((PRESSURE_WORDS[w] for w in joined + words if w in PRESSURE_WORDS), None)
 
 
+#: A setting read as a percent reaches above this somewhere in the logs: a roaster who never sets the
+#: burner or the fan above 10 % of its range does not roast coffee with it, so a readout with decimals
+#: that stays below is a reading in a unit its name does not give ("reading": a "Gas" manometer at
+#: 0.5-3.5 kPa), read over its logged range rather than as a sliver of 0-100 %.
+PERCENT_TOP_ABOVE = 10.0
+
+
 def _unit_of(values: np.ndarray, name: str | None = None) -> str:
     """A logged setting's unit: a gas pressure where the channel's ``name`` names one
-    (:func:`pressure_unit`: a burner's manometer reads 0.5-3.5 kPa, which no value rule can tell
-    from a percent); else by its values (every log's, pooled: one unit for the channel): whole
-    steps up to 20 a level; whole tens above 100 and up to :data:`TENS_MAX` levels shown in tens
-    ("tens"); up to 100 a percent; above 100 otherwise a power in watts (a heater's power readout;
-    a fan so logged is not used)."""
+    (:func:`pressure_unit`); else by its values (every log's, pooled: one unit for the channel):
+    whole steps up to 20 a level; decimals never above :data:`PERCENT_TOP_ABOVE` a "reading" in a
+    unit nobody named (a burner's manometer at 0.5-3.5 kPa under the name "Gas"); whole tens above
+    100 and up to :data:`TENS_MAX` levels shown in tens ("tens"); up to 100 a percent; above 100
+    otherwise a power in watts (a heater's power readout; a fan so logged is not used)."""
     if unit := pressure_unit(name):
         return unit
     v = values[np.isfinite(values)]
     whole = bool(v.size) and bool(np.all(np.abs(v - np.round(v)) < 1e-9))
     if whole and v.max() <= 20:
         return "level"
+    if v.size and 0.0 < v.max() <= PERCENT_TOP_ABOVE:
+        return "reading"
     if v.size and 100.0 < v.max() <= TENS_MAX and _in_whole_tens(v):
         return "tens"
     return "W" if v.size and v.max() > 100.0 else "percent"
@@ -554,10 +565,11 @@ def readable_logs(paths, batch_kg: float | None = None) -> tuple[list[LogInfo], 
     return infos, {**unreadable, **copies}
 
 
-def survey(paths, batch_kg: float | None = None) -> Survey:
+def survey(paths, batch_kg: float | None = None, units: dict | None = None) -> Survey:
     """Inspect every log; refuse logs that disagree (formats, channels, machines) or have no
     batch mass, each with one message saying what to pass. A log that cannot be read as a roast
-    is left out and named (:func:`readable_logs`)."""
+    is left out and named (:func:`readable_logs`). ``units`` (``{"heater": "kPa"}``, the roaster's
+    word, :data:`CONTROL_UNITS`) sets a control's unit in place of what its name and values say."""
     paths = log_paths(paths)
     if not paths:
         raise InputError("give the roast logs of one roaster", "init")
@@ -637,6 +649,26 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
             for unit, what in ((heater_unit, "heater"), (fan_unit, "fan"))
         )
     notes = [f"left out: {why}" for why in unreadable.values()]
+    given = {what: u for what, u in (units or {}).items() if u is not None}
+    unit_of, name_of = {"heater": heater_unit, "fan": fan_unit}, {"heater": heater, "fan": fan}
+    for what, unit in given.items():
+        if unit not in CONTROL_UNITS[what]:
+            raise InputError(f"--{what}-unit {unit}: one of {', '.join(CONTROL_UNITS[what])}", "init")
+        if what not in pooled:
+            raise InputError(f"--{what}-unit {unit}: the logs have no {what} setting to read in it", "init")
+        if unit != unit_of[what]:
+            notes.append(
+                f"the {what} ({name_of[what]}) read in {unit}, as given (its name and values read as {unit_of[what]})"
+            )
+        unit_of[what] = unit
+    for what, unit in unit_of.items():
+        if unit == "reading" and what not in given:
+            notes.append(
+                f"the {what} ({name_of[what]}) logs decimals never above {pooled[what].max():g}: no percent a "
+                f"roaster roasts with, so it is read as it is, over its logged range; if you know its unit, "
+                f"init --{what}-unit UNIT says it (a gas pressure: kPa, mbar, inWC ...)"
+            )
+    heater_unit, fan_unit = unit_of["heater"], unit_of["fan"]
     for what, n in renamed.items():
         notes.append(
             f"the logs name the {what} differently ({', '.join(f'{k}: {uses[what][k]} log(s)' for k in n)}): read as "
@@ -770,6 +802,7 @@ def survey(paths, batch_kg: float | None = None) -> Survey:
         fan_at=fan_at,
         first_crack=first_crack,
         renamed=renamed,
+        given=given,
     )
 
 
@@ -929,7 +962,16 @@ def map_text(s: Survey) -> str:
                 "percent": "by the logged values (percent)",
                 "W": "by the logged values (above 100: a power in watts)",
                 "rpm": "by the logged values (above 100: the fan's speed)",
+                "reading": f"by the logged values (decimals, never above {top:g}: no percent a roaster "
+                "roasts with; a reading in a unit the name does not give"
+                + (
+                    ". A gas pressure? init --heater-unit kPa (or its unit) fits the burner's square-root law)"
+                    if name == "heater"
+                    else ")"
+                ),
             }.get(unit, f"a gas pressure, as the name says ({unit})")
+            if name in s.given:
+                why = f"as given (init --{name}-unit {unit})"
             column = (
                 f"column = [{', '.join(map(toml_string, s.renamed[name]))}]      # detected by name; the logs name it "
                 "differently: each log is read by the first name it has"
@@ -941,7 +983,7 @@ def map_text(s: Survey) -> str:
                 column,
                 f'unit = "{unit}"       # {why}',
             ]
-            if unit in ("level", "tens", "W", "rpm", *PRESSURE_UNITS):
+            if unit != "percent":
                 lines += ["min = 0", f"max = {top:g}                # the highest setting the logs use"]
             if unit in ("level", "tens"):
                 lines.append(f"step = {UNIT_DEFAULTS[unit][2]:g}")
@@ -1058,7 +1100,7 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
         # square root (the orifice law), any other setting in proportion
         exp = PRESSURE_HEATER_EXP if s.heater_unit in PRESSURE_UNITS else 1.0
         span = _setting_span(s.heater_unit, s.heater_max) ** exp
-        per = "logged unit, a level is 10" if s.heater_unit == "tens" else s.heater_unit
+        per = {"tens": "logged unit, a level is 10", "reading": "logged unit"}.get(s.heater_unit, s.heater_unit)
         if exp != 1.0:
             per = f"{per}^{exp:g}"
             fixed.append(
@@ -1128,12 +1170,12 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
             "air flow per fan step [kg/s]" if step == 1 else f"air flow per logged fan unit [kg/s] (a step is {step:g})"
         )
         rows.append(line("Gg_fan_kg_s", 0.0, 0.01 / step, 0.001 / step, why))
-    elif s.fan and s.fan_unit in ("percent", "rpm", *PRESSURE_UNITS):
+    elif s.fan and s.fan_unit in ("percent", "rpm", "reading", *PRESSURE_UNITS):
         # the flow rises with the fan (or damper) the roaster moves through the roast: at full setting it
         # adds at most the largest base flow, a tenth of that to start (rhs.gas_inputs, Gg + Gg_fan fan);
         # a speed in rpm: in proportion to it (the fan laws: volume flow ~ speed), the highest logged as full
         span = _setting_span(s.fan_unit, s.fan_max)
-        per = "%" if s.fan_unit == "percent" else s.fan_unit
+        per = {"percent": "%", "reading": "logged unit"}.get(s.fan_unit, s.fan_unit)
         hi, start = (float(f"{x:.3g}") for x in (gg_hi / span, gg_hi / span / 10))
         rows.append(line("Gg_fan_kg_s", 0.0, hi, start, f"air flow per {per} of the fan [kg/s]"))
     rows += ["", "[initial]", f"Tb0_C = {default('T_room_C'):.1f}                          # green beans at room temperature",
@@ -1218,12 +1260,15 @@ def plant_text(plant: dict, notes: list[str]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def init_roaster(paths, out_dir, *, batch_kg=None, capacity_kg=None, diameter_m=None, length_m=None) -> dict:
-    """Survey the logs and write ``out_dir``/map.toml, plant.toml, fit.toml and fleet.toml; returns a summary."""
+def init_roaster(
+    paths, out_dir, *, batch_kg=None, capacity_kg=None, diameter_m=None, length_m=None, units=None
+) -> dict:
+    """Survey the logs and write ``out_dir``/map.toml, plant.toml, fit.toml and fleet.toml; returns a summary.
+    ``units``: a control's unit as the roaster gives it (:func:`survey`)."""
     from ..io.files import Outputs
 
     paths = log_paths(paths)
-    s = survey(paths, batch_kg)
+    s = survey(paths, batch_kg, units)
     plant, notes = estimate_plant(s, capacity_kg, diameter_m, length_m)
     cap, _ = batch_capacity(s, capacity_kg)
     out = Path(out_dir)

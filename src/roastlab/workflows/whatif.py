@@ -81,12 +81,12 @@ class SettingChange:
 
     def __str__(self) -> str:
         steps = " step" if abs(self.value) == 1 else " steps"
-        unit = {"percent": " %", "level": steps, "tens": "", "": ""}.get(self.unit, f" {self.unit}")
+        unit = {"percent": " %", "level": steps, "tens": "", "reading": "", "": ""}.get(self.unit, f" {self.unit}")
         when = f" from {mmss(self.from_s)}" if self.from_s > 0 else ""
         if np.isfinite(self.until_s):
             when = f" from {mmss(self.from_s)} to {mmss(self.until_s)}"
         if self.how == "set":
-            unit = {"percent": " %", "level": "", "tens": ""}.get(self.unit, unit)
+            unit = {"percent": " %", "level": "", "tens": "", "reading": ""}.get(self.unit, unit)
             return f"{self.setting} = {self.value:g}{unit}{when or ' from CHARGE'}"
         if self.how == "scale":
             return f"{self.setting} x{self.value:g}{when}"

@@ -38,7 +38,8 @@ A map is a TOML file::
     [heater]                   # a logged heater/burner setting, held between changes
     column = "Burner"          # Artisan event type, RoasTime "heater" (P1-P9), or a CSV column;
                                # ["Burner", "Power"]: logs that name it differently, the first a log has
-    unit = "percent"           # percent | level | tens (levels shown x10) | kW | W
+    unit = "percent"           # percent | level | tens (levels shown x10) | kW | W | rpm | a gas
+                               # pressure (kPa, hPa, mbar, Pa, psi, inWC, mmWC) | reading (no unit named)
     [fan]                      # a logged fan/air setting
     column = "Air"             # Artisan event type, RoasTime "fan" (F0-F12), or a CSV column
     unit = "percent"
