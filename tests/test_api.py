@@ -358,6 +358,7 @@ def test_whatif_figure_shows_the_first_crack_mark_and_no_mark_past_the_curves(sk
     well past the curves (COOL, minutes after DROP) gets no label outside the axes."""
     from matplotlib.text import Annotation
 
+    from roastlab.model.actuators import Actuator
     from roastlab.model.constants import FIRST_CRACK_BEAN_C
     from roastlab.report.figures import plot_whatif
     from roastlab.workflows.whatif import parse_setting_change, whatif
@@ -374,6 +375,13 @@ def test_whatif_figure_shows_the_first_crack_mark_and_no_mark_past_the_curves(sk
     labels = [c.get_text() for c in ax.get_children() if isinstance(c, Annotation)]
     assert any(s.startswith("FCs ") for s in labels) and any(s.startswith("DRY ") for s in labels)
     assert not any(s.startswith("COOL ") for s in labels)
+    # the settings in one unit share an axis in it; in two units (a heater in kPa, the fan in %) each
+    # its own scale, the fan on the right (a kPa under 100 % sat flat along the floor)
+    assert len(fig.axes) == 3 and fig.axes[2].get_ylabel() == "setting [%]"
+    w = whatif(model, batch, [parse_setting_change("heater", "+5@3:00")])
+    w.actuators["heater"] = Actuator("heater", "kPa", 0.0, 3.5)
+    fig = plot_whatif(w)
+    assert [a.get_ylabel() for a in fig.axes[2:]] == ["heater [kPa]", "fan [%]"]
 
 
 def _whatif_written(cli, sky_model, heater: str, option: str, path):

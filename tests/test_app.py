@@ -303,6 +303,19 @@ def test_the_page_draws_a_real_log_and_follows_a_what_if(page, data_dir, tmp_pat
     assert page.inner_text("#figures").startswith("model bullet-model.json as run against this log")
     page.screenshot(path=str(tmp_path / "whatif.png"), full_page=True)
     assert (tmp_path / "whatif.png").stat().st_size > 20_000
+    # heater and fan in one unit share the settings' scale; in two (a burner in kPa, the fan in steps)
+    # each its own, the fan's on the right
+    layout = "document.getElementById('plot')._fullLayout"
+    assert page.evaluate(f"{layout}.yaxis4 === undefined")
+    model = json.loads((data_dir / "bullet-model.json").read_text())
+    model["map"]["heater"]["unit"] = "kPa"
+    (data_dir / "bullet-kpa-model.json").write_text(json.dumps(model))
+    page.reload()
+    _open(page, "logs/bullet-500g.json", "bullet-kpa-model.json")
+    assert page.evaluate(f"[{layout}.yaxis3.title.text, {layout}.yaxis4.title.text]") == [
+        "heater [kPa] (drag a step)",
+        "fan [steps]",
+    ]
 
 
 @pytest.mark.slow

@@ -66,10 +66,17 @@ function stepsOf(t, values) {
 }
 
 const STEP_COLORS = { heater: "#d62728", fan: "#2ca02c" };
+// Heater and fan in different units (a burner in kPa, the fan in %) each get their own scale: the fan's
+// on the right of the settings panel (yaxis4), where on one scale a kPa lay flat along 0-100 %.
+function twoScales() {
+  const a = (state.open && state.open.actuators) || {};
+  return Boolean(a.heater && a.fan && a.heater.unit !== a.fan.unit);
+}
+const settingAxis = (name) => (name === "fan" && twoScales() ? "y4" : "y3");
 function programShapes() {
   const shapes = [];
   for (const [name, steps] of Object.entries(state.program)) {
-    steps.forEach((st, k) => shapes.push({ type: "line", xref: "x", yref: "y3", x0: st.from_s / 60, x1: st.until_s / 60,
+    steps.forEach((st, k) => shapes.push({ type: "line", xref: "x", yref: settingAxis(name), x0: st.from_s / 60, x1: st.until_s / 60,
       y0: st.value, y1: st.value, editable: true, name: `${name}:${k}`,
       line: { color: STEP_COLORS[name], width: st.value !== st.logged ? 7 : 5 }, opacity: st.value !== st.logged ? 0.9 : 0.45 }));
   }
@@ -160,7 +167,7 @@ function draw() {
   if (c.RoR_measured) traces.push({ x, y: c.RoR_measured.map(dtemp), name: "RoR measured", yaxis: "y2", line: { color: "#555", width: 1 } });
   traces.push({ x, y: ch.RoR_model.map(dtemp), name: "RoR model, changed", yaxis: "y2", line: { color: "#ff7f0e", width: 1 } });
   if (ch.heater) traces.push({ x, y: ch.heater, name: `heater [${unitName("heater")}]`, yaxis: "y3", line: { shape: "hv", color: "#d62728" } });
-  if (ch.fan) traces.push({ x, y: ch.fan, name: `fan [${unitName("fan")}]`, yaxis: "y3", line: { shape: "hv", color: "#2ca02c" } });
+  if (ch.fan) traces.push({ x, y: ch.fan, name: `fan [${unitName("fan")}]`, yaxis: settingAxis("fan"), line: { shape: "hv", color: "#2ca02c" } });
   const ev = eventShapes(o.events), ph = phaseShapes(o.phases);
   const rorAfter = (ch.RoR_model || []).filter((v, i) => v !== null && c.time_s[i] > 90).map(dtemp);
   const rorTop = rorAfter.length ? Math.max(...rorAfter) * 1.2 + 2 : 30;
@@ -171,7 +178,10 @@ function draw() {
     yaxis: { title: { text: `temperature [${unit()}]` }, domain: [0.42, 1] },
     yaxis2: { title: { text: `RoR [${unit()}/min]` }, overlaying: "y", side: "right", range: [dtemp(-2), rorTop], showgrid: false,
               tickmode: "auto", nticks: 6, tickformat: ".0f" },
-    yaxis3: { title: { text: "setting (drag a step)" }, domain: [0, 0.32] },
+    yaxis3: { title: { text: twoScales() ? `heater [${unitName("heater")}] (drag a step)` : "setting (drag a step)" },
+              domain: [0, 0.32] },
+    ...(twoScales() ? { yaxis4: { title: { text: `fan [${unitName("fan")}]`, font: { color: STEP_COLORS.fan } },
+                                  overlaying: "y3", side: "right", showgrid: false, tickmode: "auto", nticks: 5 } } : {}),
     shapes: [...ph.shapes, ...ev.shapes, ...programShapes()], annotations: [...ph.notes, ...ev.notes], uirevision: "keep",
   }, { displaylogo: false }).then(() => {
     if (!state.hooked) { $("plot").on("plotly_relayout", onRelayout); state.hooked = true; }
@@ -184,7 +194,7 @@ function draw() {
 }
 
 // A setting's unit as the page shows it (a level shown in tens, as Artisan's Aillio setup logs it: "steps ×10").
-const shownUnit = (u) => ({ level: "steps", tens: "steps ×10", percent: "%" }[u] || u);
+const shownUnit = (u) => ({ level: "steps", tens: "steps ×10", percent: "%", reading: "as logged" }[u] || u);
 function unitName(name) {
   const a = (state.open && state.open.actuators || {})[name];
   return a ? shownUnit(a.unit) : "as logged";

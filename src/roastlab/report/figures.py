@@ -294,6 +294,14 @@ def plot_fig3(ident, valid, path, note="synthetic data", outputs=None):
     return finish_figure(fig, path, None, outputs)
 
 
+def setting_axis_label(name: str, unit: str) -> str:
+    """A setting's axis label in the unit it is logged in: "heater [%]", "fan [kPa]", "heater [level]"
+    (also a level shown in tens), "heater (as logged)" for a reading whose unit nobody named."""
+    if unit == "reading":
+        return f"{name} (as logged)"
+    return f"{name} [{ {'percent': '%', 'tens': 'level x10'}.get(unit, unit) }]"
+
+
 def plot_whatif(w, path=None, outputs=None):
     """Artisan-style: measured BT, the model's probe BT and bean temperature as run and with the
     changes, the log's event marks; below, BT's rate of rise (clipped to the roast after the
@@ -341,21 +349,29 @@ def plot_whatif(w, path=None, outputs=None):
     ax_r.set_ylabel(f"RoR [°C/min]\n({ROR_SPAN_S:g} s)")
     ax_r.legend(loc="upper right", fontsize=7, ncol=3)
     ax_r.grid(alpha=0.3)
-    shown = False
-    for name, color in (("heater", "tab:red"), ("fan", "tab:green")):
-        before = getattr(b, name)
-        after = getattr(w.changed, name)
-        if before is not None:
-            ax2.step(t_min, before, where="post", color=color, lw=1.2, label=f"{name} as run")
-            if after is not None and not np.array_equal(after, before):
-                ax2.step(t_min, after, where="post", color=color, lw=1.2, ls="--", label=f"{name} changed")
-            shown = True
-    if not shown:
-        ax2.plot(t_min, w.as_run.Tgi_C, color="tab:red", label="inlet gas Tgi as run")
-        ax2.plot(t_min, w.changed.Tgi_C, color="tab:red", ls="--", label="inlet gas Tgi changed")
-    ax2.set_ylabel("setting" if shown else "Tgi [°C]")
+    logged = [(n, c) for n, c in (("heater", "tab:red"), ("fan", "tab:green")) if getattr(b, n) is not None]
+    units = {n: w.actuators[n].unit if n in w.actuators else "percent" for n, _ in logged}
+    # settings in different units (a heater in kPa, a fan in %) each on its own scale: the fan on the right
+    axes = {n: ax2 for n, _ in logged}
+    if len(set(units.values())) > 1:
+        axes["fan"] = ax2.twinx()
+    handles = []
+    for name, color in logged:
+        before, after, on = getattr(b, name), getattr(w.changed, name), axes[name]
+        handles += on.step(t_min, before, where="post", color=color, lw=1.2, label=f"{name} as run")
+        if after is not None and not np.array_equal(after, before):
+            handles += on.step(t_min, after, where="post", color=color, lw=1.2, ls="--", label=f"{name} changed")
+    if len(set(axes.values())) > 1:
+        ax2.set_ylabel(setting_axis_label("heater", units["heater"]), color="tab:red")
+        axes["fan"].set_ylabel(setting_axis_label("fan", units["fan"]), color="tab:green")
+    elif logged:
+        ax2.set_ylabel(setting_axis_label("setting", next(iter(units.values()))))
+    if not logged:
+        handles += ax2.plot(t_min, w.as_run.Tgi_C, color="tab:red", label="inlet gas Tgi as run")
+        handles += ax2.plot(t_min, w.changed.Tgi_C, color="tab:red", ls="--", label="inlet gas Tgi changed")
+        ax2.set_ylabel("Tgi [°C]")
     time_axis(ax2)
-    ax2.legend(loc="upper right", fontsize=7, ncol=2)
+    ax2.legend(handles=handles, loc="upper right", fontsize=7, ncol=2, framealpha=0.9)
     ax2.grid(alpha=0.3)
     return finish_figure(fig, path, f"what if: {b.name}", outputs)
 
@@ -418,8 +434,7 @@ def plot_transfer(r, path=None, outputs=None):
     else:
         ax2.plot(t_min, u, color="tab:blue", lw=1.6, label="optimised program")
     ax2.set_ylim(lim.low - 0.08 * span, lim.high + 0.08 * span)
-    heater = "heater (as logged)" if lim.unit == "reading" else f"heater [{lim.unit}]"  # "reading": no unit to name
-    ax2.set_ylabel("Tgi [°C]" if lim.decide == "Tgi" else heater)
+    ax2.set_ylabel("Tgi [°C]" if lim.decide == "Tgi" else setting_axis_label("heater", lim.unit))
     ax2.legend(loc="lower left", fontsize=7, ncol=2, framealpha=0.9)
     ax2.grid(alpha=0.3)
 
