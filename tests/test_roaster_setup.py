@@ -268,6 +268,30 @@ def test_a_fan_logged_only_as_its_speed_in_rpm_sets_the_flow(cli, tmp_path):
     assert "\nGg_fan_kg_s" not in (tmp_path / "cfg2" / "fit.toml").read_text()
 
 
+def test_a_fan_named_in_hz_is_its_drives_frequency(cli, tmp_path):
+    """SYNTHETIC logs whose fan is an extra device "Fan Hz" reading 32.5-48.3 (a variable-frequency
+    drive's readout, decimals): read in Hz as its name says, not as a percent by its values; the flow in
+    proportion to it (the fan laws), the map's top the logs' highest, a program labels it in Hz."""
+    from roastlab.io.importers.mapping import load_map
+
+    n = 120
+    logs = [tmp_path / f"hz{k}.alog" for k in range(2)]
+    for k, p in enumerate(logs):
+        hz = [32.5 if i < 60 else 40.0 + 8.3 * k for i in range(n)]
+        extra = {"extratimex": [[1.5 * i for i in range(n)]], "extraname1": ["Fan Hz"], "extraname2": ["Voltage"],
+                 "extratemp1": [hz], "extratemp2": [[230.0] * n], "extraNoneTempHint1": [True],
+                 "extraNoneTempHint2": [True], "specialevents": [10, 40], "specialeventstype": [3, 3],
+                 "specialeventsvalue": [8.0, 6.0], "etypes": ["Air", "Drum", "Damper", "Burner", "--"]}  # fmt: skip
+        p.write_text(fake_alog(extra=extra))
+    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
+    assert code == 0 and "fan: Fan Hz (Hz)" in out, (out, err)
+    fan = load_map(tmp_path / "cfg" / "map.toml").actuator("fan")
+    assert (fan.unit, fan.high, fan.step, fan.label(45)) == ("Hz", 48.3, None, "45 Hz")
+    fit = (tmp_path / "cfg" / "fit.toml").read_text()
+    gg_hi = float(fit.split("Gg_kg_s = [")[1].split("]")[0].split(", ")[1])
+    assert f"Gg_fan_kg_s = [0, {float(f'{gg_hi / 48.3:.3g}'):g}," in fit and "per Hz of the fan" in fit
+
+
 def test_a_fan_logged_in_tens_above_100_is_the_machines_levels(cli, tmp_path):
     """SYNTHETIC logs whose Fan events run 10-120 in tens, as Artisan's Aillio setup shows the
     Bullet's F1-F12 (a log that never passes F2 beside one that reaches F12): one unit for the
@@ -1400,10 +1424,11 @@ def test_a_fit_on_one_batch_size_holds_the_probe_depth_the_spec_frees():
     "name, unit",
     [("Gas kPa", "kPa"), ("Gas (mbar)", "mbar"), ("Burner hPa", "hPa"), ('Gas "WC', "inWC"), ("Gas in. WC", "inWC"),
      ("Gas inH2O", "inWC"), ("Gas mmH2O", "mmWC"), ("Gas psi", "psi"), ("Gas Pa", "Pa"), ("Gas", None),
-     ("Burner", None), ("Pan", None), ("Gas pressure", None), (None, None)],
+     ("Burner", None), ("Pan", None), ("Gas pressure", None), (None, None), ("Fan Hz", "Hz"),
+     ("Exhaust (Hz)", "Hz"), ("Fan", None), ("Fan Hzx", None)],
 )  # fmt: skip
-def test_a_control_named_in_a_pressure_unit_is_that_pressure(name, unit):
-    assert roaster.pressure_unit(name) == unit
+def test_a_control_named_in_a_unit_is_read_in_it(name, unit):
+    assert roaster.named_unit(name) == unit
 
 
 def test_a_gas_burner_logged_as_its_pressure_in_kpa_is_read_in_kpa(cli, tmp_path):

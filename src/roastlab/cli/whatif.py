@@ -71,7 +71,7 @@ def add_parsers(sub) -> None:
         "where it has one), the probe BT below: a batch-size change also changes how deep the probe sits in the "
         "bed. DRY END and first crack are when a curve reaches the temperature the log marks them at. A note "
         "says where a change is within the model's own error. Settings (heater, fan) exist when the model's map "
-        "reads them, in the map's units (percent, level; W, rpm; a gas pressure such as kPa); a model that does "
+        "reads them, in the map's units (percent, level; W, rpm, Hz; a gas pressure such as kPa; a reading as logged); a model that does "
         "not respond to a changed setting says so; --tgi works on any model.",
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog="examples:\n"
@@ -92,7 +92,7 @@ def add_parsers(sub) -> None:
         help="shift (+1, -2) or scale (x1.1) the logged heater setting, from CHARGE or from time T (m:ss or s), "
         "in the map's unit (percent, level, W or a gas pressure such as kPa)",
     )
-    p.add_argument("--fan", metavar="+D[@T]|xF[@T]", help="as --heater, for the fan setting (percent, level or rpm)")
+    p.add_argument("--fan", metavar="+D[@T]|xF[@T]", help="as --heater, for the fan setting (percent, level, rpm or Hz)")
     p.add_argument(
         "--set",
         action="append",

@@ -40,6 +40,9 @@ UNIT_DEFAULTS: dict[str, tuple[float, float, float | None, float]] = {
     "kW": (0.0, 1e4, None, 1e4),
     "W": (0.0, 1e5, None, 1e5),  # a heater's power readout in watts (an Artisan extra device)
     "rpm": (0.0, 1e5, None, 1e5),  # a fan's speed readout (an Artisan extra device such as "Fan RPM")
+    # a fan's speed as its drive's frequency (a variable-frequency drive's readout, "Fan Hz"): the air
+    # flow in proportion to it, as to the speed (the fan laws)
+    "Hz": (0.0, 1e3, None, 1e3),
 }
 #: A control logged as a gas pressure (a gas burner's pressure at its jet, read off a manometer or a
 #: pressure readout; kPa in most of the world, mbar/hPa in Europe, inches or mm of water column in
@@ -101,7 +104,7 @@ MIN_HOLD_S = 30.0
 @dataclass(frozen=True)
 class Actuator:
     """One control of a roaster: ``name`` ("heater" or "fan"), its ``unit`` ("percent",
-    "level", "tens", "kW", "W", "rpm", a gas pressure of :data:`PRESSURE_UNITS`, or "reading": a
+    "level", "tens", "kW", "W", "rpm", "Hz", a gas pressure of :data:`PRESSURE_UNITS`, or "reading": a
     readout in a unit nobody named), the range ``low``..``high`` in that unit, the ``step`` between settings the
     machine offers (None: continuous) and the fastest change ``rate_per_min`` [unit/min]."""
 

@@ -90,6 +90,11 @@ HEATER_NAMES = ("burner", "heater", "power", "heat", "gas", "brûleur", "bruleur
 PRESSURE_WORDS = {"kpa": "kPa", "hpa": "hPa", "mbar": "mbar", "pa": "Pa", "psi": "psi", "wc": "inWC",
                   "inwc": "inWC", "inh2o": "inWC", "mmwc": "mmWC", "mmh2o": "mmWC", "mmaq": "mmWC"}  # fmt: skip
 assert set(PRESSURE_WORDS.values()) <= set(PRESSURE_UNITS)
+#: Every word of a control's name that names its unit: the gas pressures, and a fan's drive
+#: frequency ("Fan Hz", "Exhaust (Hz)": a variable-frequency drive's readout, 30-60 Hz, which the
+#: values alone would read as a percent).
+UNIT_WORDS = {**PRESSURE_WORDS, "hz": "Hz"}
+assert set(UNIT_WORDS.values()) <= set(UNIT_DEFAULTS)
 #: Logged controls the model does not use, named so the map can say so.
 OTHER_NAMES = {
     "damper": ("damper", "klappe", "registre", "valve"),
@@ -276,13 +281,13 @@ def _in_whole_tens(values: np.ndarray) -> bool:
     return bool(v.size) and bool(np.all(np.abs(v / 10.0 - np.round(v / 10.0)) < 1e-9))
 
 
-def pressure_unit(name: str | None) -> str | None:
-    """The gas-pressure unit a control's ``name`` says it is logged in ("Gas kPa" -> "kPa"), else None
-    (:data:`PRESSURE_WORDS`, whole words: "Gas (mbar)", 'Gas "WC', "Gas in. WC", "Gas mmH2O")."""
+def named_unit(name: str | None) -> str | None:
+    """The unit a control's ``name`` says it is logged in ("Gas kPa" -> "kPa", "Fan Hz" -> "Hz"), else
+    None (:data:`UNIT_WORDS`, whole words: "Gas (mbar)", 'Gas "WC', "Gas in. WC", "Gas mmH2O")."""
     words = re.findall(r"[a-z0-9]+", (name or "").lower())
     # "in. WC" / "in H2O": the inches of water column written apart
     joined = [a + b for a, b in zip(words, words[1:]) if a in ("in", "mm") and b in ("wc", "h2o")]
-    return next((PRESSURE_WORDS[w] for w in joined + words if w in PRESSURE_WORDS), None)
+    return next((UNIT_WORDS[w] for w in joined + words if w in UNIT_WORDS), None)
 
 
 #: A setting read as a percent reaches above this somewhere in the logs: a roaster who never sets the
@@ -293,13 +298,13 @@ PERCENT_TOP_ABOVE = 10.0
 
 
 def _unit_of(values: np.ndarray, name: str | None = None) -> str:
-    """A logged setting's unit: a gas pressure where the channel's ``name`` names one
-    (:func:`pressure_unit`); else by its values (every log's, pooled: one unit for the channel):
+    """A logged setting's unit: the one the channel's ``name`` names (:func:`named_unit`: a gas
+    pressure, a drive's frequency); else by its values (every log's, pooled: one unit for the channel):
     whole steps up to 20 a level; decimals never above :data:`PERCENT_TOP_ABOVE` a "reading" in a
     unit nobody named (a burner's manometer at 0.5-3.5 kPa under the name "Gas"); whole tens above
     100 and up to :data:`TENS_MAX` levels shown in tens ("tens"); up to 100 a percent; above 100
     otherwise a power in watts (a heater's power readout; a fan so logged is not used)."""
-    if unit := pressure_unit(name):
+    if unit := named_unit(name):
         return unit
     v = values[np.isfinite(values)]
     whole = bool(v.size) and bool(np.all(np.abs(v - np.round(v)) < 1e-9))
@@ -969,7 +974,10 @@ def map_text(s: Survey) -> str:
                     if name == "heater"
                     else ")"
                 ),
-            }.get(unit, f"a gas pressure, as the name says ({unit})")
+            }.get(
+                unit,
+                f"as the name says ({unit}: {'a gas pressure' if unit in PRESSURE_UNITS else 'a drive frequency'})",
+            )
             if name in s.given:
                 why = f"as given (init --{name}-unit {unit})"
             column = (
@@ -1170,7 +1178,7 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
             "air flow per fan step [kg/s]" if step == 1 else f"air flow per logged fan unit [kg/s] (a step is {step:g})"
         )
         rows.append(line("Gg_fan_kg_s", 0.0, 0.01 / step, 0.001 / step, why))
-    elif s.fan and s.fan_unit in ("percent", "rpm", "reading", *PRESSURE_UNITS):
+    elif s.fan and s.fan_unit in ("percent", "rpm", "Hz", "reading", *PRESSURE_UNITS):
         # the flow rises with the fan (or damper) the roaster moves through the roast: at full setting it
         # adds at most the largest base flow, a tenth of that to start (rhs.gas_inputs, Gg + Gg_fan fan);
         # a speed in rpm: in proportion to it (the fan laws: volume flow ~ speed), the highest logged as full
