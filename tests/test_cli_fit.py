@@ -122,3 +122,29 @@ def test_a_weight_from_the_residuals_is_read_from_the_command_line():
     from roastlab.cli.common import weights_arg
 
     assert weights_arg(["ET=residual", "Tb2=0.5"]) == {"ET": "residual", "Tb2": 0.5}
+
+
+def test_a_stage_of_unknown_length_shows_its_elapsed_time_and_clears_its_line(monkeypatch):
+    """``progress(desc)``'s callback with total 0 opens a stage ("fitting 8 logs") whose clock keeps
+    ticking on a terminal while the work reports nothing (a first run's compile); the next call closes
+    it and clears its line. Off a terminal it draws nothing."""
+    import io
+    import sys
+    import time
+
+    from roastlab.cli import common
+
+    class Terminal(io.StringIO):
+        def isatty(self):
+            return True
+
+    for stream, shown in ((Terminal(), True), (io.StringIO(), False)):
+        monkeypatch.setattr(sys, "stderr", stream)
+        monkeypatch.setattr(common, "PROGRESS_DELAY_S", 0.5)
+        update = common.progress("fit-roaster")
+        update(0, 0, "fitting 8 logs")
+        time.sleep(2.2)  # the clock redrawn at 1 and 2 s
+        update(1, 1, "done")
+        drawn = stream.getvalue()
+        assert ("fit-roaster: fitting 8 logs [00:01]" in drawn and "[00:02]" in drawn) == shown, drawn
+        assert drawn.endswith("\r") if shown else drawn == ""

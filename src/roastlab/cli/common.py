@@ -88,22 +88,60 @@ def count_arg(name: str, lo: int, hi: int):
     return parse
 
 
+#: Work shorter than this shows no progress [s].
+PROGRESS_DELAY_S = 2.0
+
+
 def progress(desc: str):
-    """A progress callback drawing a tqdm bar on a terminal, shown only for work over ~2 s."""
+    """A progress callback ``update(done, total, text)`` drawing a tqdm bar on a terminal, shown only
+    for work over :data:`PROGRESS_DELAY_S`. ``total`` 0 opens a stage of unknown length (``text`` says
+    what it is: "fitting 8 logs"), its elapsed time kept ticking until the next call, so that work
+    which reports nothing for a while (a first run's compile) is seen to be alive."""
+    import threading
+    import time
+
     from tqdm import tqdm
 
     state: dict = {}
 
+    def close() -> None:
+        if (ticker := state.pop("ticker", None)) is not None:
+            ticker.set()
+        if (bar := state.pop("bar", None)) is not None:
+            bar.close()
+
+    def tick(bar, stop: threading.Event) -> None:  # redraw the open stage's clock once a second
+        while not stop.wait(1.0):
+            if time.monotonic() - state["since"] >= PROGRESS_DELAY_S:
+                bar.refresh()
+                bar.last_print_t = bar._time()  # drawn: its close clears the line (tqdm keys that on this)
+
     def update(done: int, total: int, text: str = "") -> None:
         bar = state.get("bar")
+        if total == 0:  # a stage of unknown length
+            close()
+            bar = state["bar"] = tqdm(
+                desc=f"{desc}: {text}",
+                file=sys.stderr,
+                delay=PROGRESS_DELAY_S,
+                disable=None,
+                leave=False,
+                bar_format="{desc} [{elapsed}]",
+            )
+            if not bar.disable:
+                state["since"], stop = time.monotonic(), threading.Event()
+                state["ticker"] = stop
+                threading.Thread(target=tick, args=(bar, stop), daemon=True).start()
+            return
         if bar is None or bar.total != total or done < bar.n:  # the first call, or the next stage of the work
-            if bar is not None:
-                bar.close()
-            bar = state["bar"] = tqdm(total=total, desc=desc, file=sys.stderr, delay=2.0, disable=None, leave=False)
+            close()
+            bar = state["bar"] = tqdm(
+                total=total, desc=desc, file=sys.stderr, delay=PROGRESS_DELAY_S, disable=None, leave=False
+            )
         bar.set_postfix_str(text[:60], refresh=False)
         bar.update(done - bar.n)
         if done >= total:
-            bar.close()
+            close()
 
     return update
 

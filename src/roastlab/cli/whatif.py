@@ -92,7 +92,9 @@ def add_parsers(sub) -> None:
         help="shift (+1, -2) or scale (x1.1) the logged heater setting, from CHARGE or from time T (m:ss or s), "
         "in the map's unit (percent, level, W or a gas pressure such as kPa)",
     )
-    p.add_argument("--fan", metavar="+D[@T]|xF[@T]", help="as --heater, for the fan setting (percent, level, rpm or Hz)")
+    p.add_argument(
+        "--fan", metavar="+D[@T]|xF[@T]", help="as --heater, for the fan setting (percent, level, rpm or Hz)"
+    )
     p.add_argument(
         "--set",
         action="append",

@@ -55,6 +55,13 @@ def cache_dir() -> Path | None:
     return path if os.access(path, os.W_OK) else None
 
 
+def cold() -> bool:
+    """No kernel compiled into this source's cache folder yet (or no folder to cache in): the next run
+    compiles them first, a minute or more on a small machine, and later runs load them."""
+    folder = cache_dir()
+    return folder is None or not any(folder.rglob("*.nbi"))
+
+
 @contextlib.contextmanager
 def _cache_dir_set(path: Path):
     before = config.CACHE_DIR

@@ -1546,8 +1546,14 @@ def fit_roaster(
     sizes = size_split(batches, fit_size_kg) if (by_size or fit_size_kg is not None) else None
     fit_b, val_b = batches[0::2], batches[1::2]
     spec, depth_held = depth_held_on_one_size(load_fit_spec(d / "fit.toml"), fit_b)
+    stage = progress or (lambda done, total, text="": None)  # a stage of unknown length: total 0
+    from ..sim.cache import cold
+
+    first = "; first run: compiling, 1-2 min once" if cold() else ""  # the kernels, then cached
+    stage(0, 0, f"fitting {len(fit_b)} logs{first}")
     result, spec, refit = fit_checked(fit_b, d, spec, cmap, seed, progress)
     model = result.model
+    stage(0, 0, "validating, the baseline and the band")
     v_fit, v_val = model.validate(fit_b), model.validate(val_b)
     base = fit_first_order(fit_b)
     _, b_fit = validate_first_order(fit_b, base)
@@ -1633,6 +1639,8 @@ def fit_roaster(
             + " |"
             for g in by_unit
         ]
+    if every_log:
+        stage(0, 0, f"each log held out once: {len(batches)} fits")
     every = held_out_one_by_one(batches, d, cmap, seed, progress, spec) if every_log else None
     if every is not None:
         lines += every_log_lines(every, len(batches))
@@ -1640,6 +1648,7 @@ def fit_roaster(
     if sizes is not None:
         size_b = [batches[k] for k in sizes.fit]
         size_spec, size_depth = depth_held_on_one_size(spec, size_b)
+        stage(0, 0, f"fitting {sizes.fit_size} alone ({len(size_b)} logs) for the other sizes")
         size_fit, _, size_refit = fit_checked(size_b, d, size_spec, cmap, seed, progress)
         across = across_sizes(size_fit.model, batches, sizes)
         across["failed"], across["refit"] = size_fit.failed, size_refit
@@ -1653,6 +1662,7 @@ def fit_roaster(
     from ..report.figures import figure_bytes
     from ..report.markdown import html_document
 
+    stage(0, 0, "writing the report and its figures")
     figures = {d / HELD_OUT_FIGURE: v_val.plot()}
     if across is not None:
         figures[d / SIZES_FIGURE] = across_sizes_figure(across)
@@ -1666,6 +1676,7 @@ def fit_roaster(
         out.write_text(d / "report.html", html_document(title, report, {p.name: b for p, b in pngs.items()}))
         for path, png in pngs.items():
             out.write_bytes(path, png)
+    stage(1, 1, "done")  # closes the open stage
     return {
         "fit": {"FIT": v_fit.average["FIT"], "MAE": v_fit.average["MAE"]},
         "held_out": {"FIT": v_val.average["FIT"], "MAE": v_val.average["MAE"]},
