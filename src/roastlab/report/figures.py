@@ -352,16 +352,15 @@ def plot_whatif(w, path=None, outputs=None):
     logged = [(n, c) for n, c in (("heater", "tab:red"), ("fan", "tab:green")) if getattr(b, n) is not None]
     units = {n: w.actuators[n].unit if n in w.actuators else "percent" for n, _ in logged}
     # settings in different units (a heater in kPa, a fan in %) each on its own scale: the fan on the right
-    axes = {n: ax2 for n, _ in logged}
-    if len(set(units.values())) > 1:
-        axes["fan"] = ax2.twinx()
+    two = len(set(units.values())) > 1
+    axes = {n: ax2 for n, _ in logged} | ({"fan": ax2.twinx()} if two else {})
     handles = []
     for name, color in logged:
         before, after, on = getattr(b, name), getattr(w.changed, name), axes[name]
         handles += on.step(t_min, before, where="post", color=color, lw=1.2, label=f"{name} as run")
         if after is not None and not np.array_equal(after, before):
             handles += on.step(t_min, after, where="post", color=color, lw=1.2, ls="--", label=f"{name} changed")
-    if len(set(axes.values())) > 1:
+    if two:
         ax2.set_ylabel(setting_axis_label("heater", units["heater"]), color="tab:red")
         axes["fan"].set_ylabel(setting_axis_label("fan", units["fan"]), color="tab:green")
     elif logged:
