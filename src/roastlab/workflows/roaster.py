@@ -671,7 +671,12 @@ def survey(paths, batch_kg: float | None = None, units: dict | None = None) -> S
             notes.append(
                 f"the {what} ({name_of[what]}) logs decimals never above {pooled[what].max():g}: no percent a "
                 f"roaster roasts with, so it is read as it is, over its logged range; if you know its unit, "
-                f"init --{what}-unit UNIT says it (a gas pressure: kPa, mbar, inWC ...)"
+                f"init --{what}-unit UNIT says it ("
+                + (
+                    "a gas pressure: kPa, mbar, inWC ...)"
+                    if what == "heater"
+                    else "a drive frequency: Hz; a draft: Pa ...)"
+                )
             )
     heater_unit, fan_unit = unit_of["heater"], unit_of["fan"]
     for what, n in renamed.items():
