@@ -1425,7 +1425,7 @@ def test_a_fit_on_one_batch_size_holds_the_probe_depth_the_spec_frees():
     [("Gas kPa", "kPa"), ("Gas (mbar)", "mbar"), ("Burner hPa", "hPa"), ('Gas "WC', "inWC"), ("Gas in. WC", "inWC"),
      ("Gas inH2O", "inWC"), ("Gas mmH2O", "mmWC"), ("Gas psi", "psi"), ("Gas Pa", "Pa"), ("Gas", None),
      ("Burner", None), ("Pan", None), ("Gas pressure", None), (None, None), ("Fan Hz", "Hz"),
-     ("Exhaust (Hz)", "Hz"), ("Fan", None), ("Fan Hzx", None)],
+     ("Exhaust (Hz)", "Hz"), ("Fan", None), ("Fan Hzx", None), ("Gas %", "percent"), ("Fan (pct)", "percent")],
 )  # fmt: skip
 def test_a_control_named_in_a_unit_is_read_in_it(name, unit):
     assert roaster.named_unit(name) == unit

@@ -93,7 +93,7 @@ assert set(PRESSURE_WORDS.values()) <= set(PRESSURE_UNITS)
 #: Every word of a control's name that names its unit: the gas pressures, and a fan's drive
 #: frequency ("Fan Hz", "Exhaust (Hz)": a variable-frequency drive's readout, 30-60 Hz, which the
 #: values alone would read as a percent).
-UNIT_WORDS = {**PRESSURE_WORDS, "hz": "Hz"}
+UNIT_WORDS = {**PRESSURE_WORDS, "hz": "Hz", "percent": "percent", "pct": "percent"}
 assert set(UNIT_WORDS.values()) <= set(UNIT_DEFAULTS)
 #: Logged controls the model does not use, named so the map can say so.
 OTHER_NAMES = {
@@ -282,8 +282,10 @@ def _in_whole_tens(values: np.ndarray) -> bool:
 
 
 def named_unit(name: str | None) -> str | None:
-    """The unit a control's ``name`` says it is logged in ("Gas kPa" -> "kPa", "Fan Hz" -> "Hz"), else
-    None (:data:`UNIT_WORDS`, whole words: "Gas (mbar)", 'Gas "WC', "Gas in. WC", "Gas mmH2O")."""
+    """The unit a control's ``name`` says it is logged in ("Gas kPa" -> "kPa", "Fan Hz" -> "Hz",
+    "Gas %" -> "percent"), else None (:data:`UNIT_WORDS`, whole words: "Gas (mbar)", 'Gas "WC', "Gas in. WC", "Gas mmH2O")."""
+    if "%" in (name or ""):  # "Gas %", "Fan (%)": a percent, whatever its values
+        return "percent"
     words = re.findall(r"[a-z0-9]+", (name or "").lower())
     # "in. WC" / "in H2O": the inches of water column written apart
     joined = [a + b for a, b in zip(words, words[1:]) if a in ("in", "mm") and b in ("wc", "h2o")]
