@@ -45,6 +45,8 @@ VALUES = {
     "--batch-capacity-kg",
     "--drum-diameter-m",
     "--drum-length-m",
+    "--heater-unit",
+    "--fan-unit",
     "--host",
     "--port",
     "--no-browser",
