@@ -47,7 +47,8 @@ def bed_segment(Mb, Dch, Lch, rho=680.0):
 
 def make_rhs(plant: str, theta, X0: float, moisture: str = "schwartzberg", act=None, bed=None, process=None):
     """The slow reference right-hand side. ``act`` holds the actuator extension's values
-    (Qe_gain, Qe_offset, Tgi_gain, tau, Gg_fan, U_shell, T_room, heater_exp); None = the paper's model.
+    (Qe_gain, Qe_offset, Tgi_gain, tau, Gg_fan, U_shell, T_room, heater_exp, fan_exp); None = the paper's
+    model.
     ``bed`` the bed laws and the probe's depth: {"contact": "paper"|"wall", "probe": "rest"|"tumbling",
     "probe_gas": "outlet"|"mean", "h_probe": m, "eps_rad": the wall's radiation to the bed's free
     surface, 0-1, "k_flight": the gas-bean area over that surface, 0 = the contact law's}; None =
@@ -91,7 +92,10 @@ def make_rhs(plant: str, theta, X0: float, moisture: str = "schwartzberg", act=N
     def f(x, Gg, Tgi, heater=0.0, fan=0.0):
         Tb, Tm, X, He, Ta, H = x
         # actuator extension: fan -> flow, lagged heater -> inlet gas rise and heat into the metal
-        Gg = max(Gg + a.get("Gg_fan", 0.0) * fan, 1e-6)
+        # the fan's drive: fan^e (a fan logged as the pressure it makes across the drum: e = 0.5, the flow
+        # through a fixed resistance), with the heater's millionth under the power
+        ef = a.get("fan_exp", 1.0)
+        Gg = max(Gg + a.get("Gg_fan", 0.0) * (fan if ef == 1.0 else fan * (max(fan, 0.0) + 1e-6) ** (ef - 1.0)), 1e-6)
         # the heat the lagged setting releases: H^e (a gas burner's pressure: e = 0.5, the orifice law),
         # a millionth of a unit added under the power so that its slope is finite at 0
         e = a.get("heater_exp", 1.0)

@@ -166,7 +166,7 @@ def test_lanes_stop_where_the_scalar_integrator_stops():
 
 def test_law_key_names_one_set_of_laws_or_none():
     _, _, _, PP = _runs(1, 4)
-    linear = 4**4  # the heater's drive in proportion to its setting (heater_exp 1)
+    linear = 4**4 + 4**5  # the heater's and the fan's drives in proportion to their settings (exponents 1)
     assert lanes.law_key(PP) == 2 * 4**3 + linear  # the paper's laws, Schwartzberg's exponent 2
     _, _, _, PB = _runs(1, 4, BULLET_LAWS)
     assert lanes.law_key(PB) == 1 + 4 + 16 + 128 + linear
@@ -177,6 +177,9 @@ def test_law_key_names_one_set_of_laws_or_none():
     gas = PP.copy()
     gas[:, P["heater_exp"]] = 0.5  # a gas burner's square root: the scalar integrator
     assert lanes.law_key(gas) is None
+    draft = PP.copy()
+    draft[:, P["fan_exp"]] = 0.5  # a fan logged as its draft: the square root, the scalar integrator
+    assert lanes.law_key(draft) is None
     assert lanes.usable(PP) is None  # too few runs to fill the lanes
     assert lanes.usable(np.repeat(PP, lanes.MIN_RUNS, axis=0)) == 128 + linear
 

@@ -115,6 +115,44 @@ def test_a_gas_burners_square_root_law_matches_reference():
     assert np.max(np.abs(linear.Tb_C - fast.Tb_C)) > 1.0  # the law matters at these pressures
 
 
+def test_a_draft_fans_square_root_law_matches_reference():
+    """The fan's drive as the square root of its setting (fan_exp 0.5: a fan logged as the draft it makes
+    across the drum, in Pa, the flow through a fixed resistance), off (0) at times, held and
+    interpolated: compiled vs reference; and it is not the linear law's run."""
+    t, Gg, Tgi, x0 = random_case(23, "120kg")
+    n = len(t)
+    fan = np.array([0.0, 20.0, 80.0, 45.0, 0.0, 60.0])[(np.arange(n) // 4) % 6]  # Pa, held for 4 samples
+    theta = (0.03, 0.04, 0.6)
+    from roastlab.sim import kernels
+
+    # held linearly, the draft ramps up from 0 over 9-39 s between these samples, and its square root rises
+    # as the root of the time there, which the integrator's error control resolves to 0.015 degC at its
+    # default largest step (kernels.H_MAX_S, 30 s): at 5 s, within the tolerance (0.0008 degC at 1 s)
+    for hold, h_max_s in (("zoh", kernels.H_MAX_S), ("linear", 5.0)):
+        fast = simulate(
+            "120kg",
+            t,
+            Gg,
+            Tgi,
+            theta=theta,
+            initial=x0,
+            hold=hold,
+            fan=fan,
+            values={"Gg_fan_kg_s": 0.15, "fan_exp": 0.5},
+            h_max_s=h_max_s,
+        )
+        ref, ref_tgo = reference_simulate(
+            "120kg", theta, t, Gg, Tgi, x0.vector(), hold=hold, fan=fan, act={"Gg_fan": 0.15, "fan_exp": 0.5}
+        )
+        for j in (0, 1, 4):
+            assert np.max(np.abs(fast.states[:, j] - ref[:, j])) < TOL_C
+        assert np.max(np.abs(fast.Tgo_C - ref_tgo)) < TOL_C
+    linear = simulate(
+        "120kg", t, Gg, Tgi, theta=theta, initial=x0, hold="linear", fan=fan, values={"Gg_fan_kg_s": 0.15}
+    )
+    assert np.max(np.abs(linear.Tb_C - fast.Tb_C)) > 1.0  # the law matters at these drafts
+
+
 def test_printed_moisture_law_matches_reference():
     t, Gg, Tgi, x0 = random_case(7, "120kg")
     theta = (0.02, 0.05, 0.6)

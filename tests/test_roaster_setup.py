@@ -268,28 +268,44 @@ def test_a_fan_logged_only_as_its_speed_in_rpm_sets_the_flow(cli, tmp_path):
     assert "\nGg_fan_kg_s" not in (tmp_path / "cfg2" / "fit.toml").read_text()
 
 
-def test_a_fan_named_in_hz_is_its_drives_frequency(cli, tmp_path):
-    """SYNTHETIC logs whose fan is an extra device "Fan Hz" reading 32.5-48.3 (a variable-frequency
-    drive's readout, decimals): read in Hz as its name says, not as a percent by its values; the flow in
-    proportion to it (the fan laws), the map's top the logs' highest, a program labels it in Hz."""
-    from roastlab.io.importers.mapping import load_map
-
+def _fan_readout_logs(tmp_path, name: str, low: float, high: float) -> list:
+    """SYNTHETIC: two fake Artisan logs whose fan is an extra device ``name`` reading ``low``, then
+    ``high`` in the second (decimals), beside Burner events."""
     n = 120
-    logs = [tmp_path / f"hz{k}.alog" for k in range(2)]
+    logs = [tmp_path / f"fan{k}.alog" for k in range(2)]
     for k, p in enumerate(logs):
-        hz = [32.5 if i < 60 else 40.0 + 8.3 * k for i in range(n)]
-        extra = {"extratimex": [[1.5 * i for i in range(n)]], "extraname1": ["Fan Hz"], "extraname2": ["Voltage"],
-                 "extratemp1": [hz], "extratemp2": [[230.0] * n], "extraNoneTempHint1": [True],
+        values = [low if i < 60 else low + (high - low) * (0.5 + 0.5 * k) for i in range(n)]
+        extra = {"extratimex": [[1.5 * i for i in range(n)]], "extraname1": [name], "extraname2": ["Voltage"],
+                 "extratemp1": [values], "extratemp2": [[230.0] * n], "extraNoneTempHint1": [True],
                  "extraNoneTempHint2": [True], "specialevents": [10, 40], "specialeventstype": [3, 3],
                  "specialeventsvalue": [8.0, 6.0], "etypes": ["Air", "Drum", "Damper", "Burner", "--"]}  # fmt: skip
         p.write_text(fake_alog(extra=extra))
-    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
-    assert code == 0 and "fan: Fan Hz (Hz)" in out, (out, err)
+    return logs
+
+
+@pytest.mark.parametrize(
+    "name, unit, exp", [("Fan Hz", "Hz", 1.0), ("Draft Pa", "Pa", 0.5), ("Air (mmH2O)", "mmWC", 0.5)]
+)
+def test_a_fan_named_in_a_unit_is_read_in_it_with_its_flow_law(cli, tmp_path, name, unit, exp):
+    """SYNTHETIC logs whose fan is an extra device reading 32.5-48.3 with decimals: "Fan Hz" (a
+    variable-frequency drive's readout) is read in Hz, not as a percent by its values, the flow in
+    proportion to it (the fan laws); "Draft Pa" (the pressure the fan makes across the drum) in Pa, the
+    flow as its square root (the flow through a fixed resistance: fan_exp 0.5 fixed, the gain per
+    Pa^0.5). The map's top is the logs' highest and a program labels the setting in its unit."""
+    from roastlab.io.importers.mapping import load_map
+
+    code, out, err = cli("init", *_fan_readout_logs(tmp_path, name, 32.5, 48.3), "--out", tmp_path / "cfg")
+    assert code == 0 and f"fan: {name} ({unit})" in out, (out, err)
     fan = load_map(tmp_path / "cfg" / "map.toml").actuator("fan")
-    assert (fan.unit, fan.high, fan.step, fan.label(45)) == ("Hz", 48.3, None, "45 Hz")
+    assert (fan.unit, fan.high, fan.step) == (unit, 48.3, None) and fan.label(45).endswith(f"45 {unit}")
     fit = (tmp_path / "cfg" / "fit.toml").read_text()
     gg_hi = float(fit.split("Gg_kg_s = [")[1].split("]")[0].split(", ")[1])
-    assert f"Gg_fan_kg_s = [0, {float(f'{gg_hi / 48.3:.3g}'):g}," in fit and "per Hz of the fan" in fit
+    per = unit if exp == 1.0 else f"{unit}^{exp:g}"
+    assert f"Gg_fan_kg_s = [0, {float(f'{gg_hi / 48.3**exp:.3g}'):g}," in fit and f"per {per} of the fan" in fit
+    assert ("\nfan_exp = 0.5 " in fit) == (exp == 0.5)
+    from roastlab.io.fitspec import load_fit_spec
+
+    assert load_fit_spec(tmp_path / "cfg" / "fit.toml").fixed.get("fan_exp", 1.0) == exp
 
 
 def test_a_fan_logged_in_tens_above_100_is_the_machines_levels(cli, tmp_path):

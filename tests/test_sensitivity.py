@@ -39,6 +39,8 @@ def _params(codes: dict, rng) -> np.ndarray:
     p[P["k_flight"]] = rng.uniform(2.0, 20.0) if codes.get("probe_gas_law") == 1.0 else 0.0
     # the heater's drive as a power of its setting (a gas burner's pressure) in half the combinations
     p[P["heater_exp"]] = rng.uniform(0.4, 0.9) if codes.get("probe_law") == 1.0 else 1.0
+    # the fan's drive as a power of its setting (a draft in Pa) in the other half
+    p[P["fan_exp"]] = rng.uniform(0.4, 0.9) if codes.get("probe_law") != 1.0 else 1.0
     for name, value in codes.items():
         p[P[name]] = value
     return p
@@ -120,13 +122,14 @@ def test_generated_jacobian_matches_casadi(codes):
 
 def test_a_burner_off_has_a_finite_jacobian_under_the_square_root_law():
     """heater_exp 0.5 (a gas burner logged as its pressure) with the lagged setting at 0, the burner
-    off: the square root's slope is infinite there, the drive's (linear below a floor) is not, so
-    every Jacobian entry is finite and the program optimiser's gradient is a number."""
+    off, and fan_exp 0.5 with a draft of 0: the square root's slope is infinite there, the drive's
+    (linear below a floor) is not, so every Jacobian entry is finite and the program optimiser's
+    gradient is a number."""
     rng = np.random.default_rng(5)
     p = _params(COMBOS[0], rng)
-    p[P["heater_exp"]] = 0.5
+    p[P["heater_exp"]] = p[P["fan_exp"]] = 0.5  # and a fan logged as its draft, off
     x, u = _point(rng)
-    x[-1], u[2] = 0.0, 0.0
+    x[-1], u[2], u[3] = 0.0, 0.0, 0.0
     f, Jx, Ju, Jp = _generated(x, u, p)
     assert np.all(np.isfinite(f)) and np.all(np.isfinite(Jx)) and np.all(np.isfinite(Ju)) and np.all(np.isfinite(Jp))
     assert Jx[1, -1] > 0.0  # more lagged gas heats the drum

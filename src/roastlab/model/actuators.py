@@ -59,6 +59,10 @@ CONTROL_UNITS = {"heater": tuple(UNIT_DEFAULTS), "fan": tuple(u for u in UNIT_DE
 #: :func:`roastlab.model.rhs.heater_drive`): the burner's heat follows its gas flow, and the flow
 #: through its jet, an orifice, goes as the square root of the pressure across it.
 PRESSURE_HEATER_EXP = 0.5
+#: The power of a fan's pressure in the air flow it moves (``fan_exp``, :func:`roastlab.model.rhs.fan_drive`):
+#: a fan logged as the pressure it makes across the drum (a draft in Pa) drives the air through a fixed
+#: resistance, the drum and its beans, where the flow goes as the square root of the pressure drop.
+PRESSURE_FAN_EXP = 0.5
 #: How a setting's value reads to a roaster, per control and unit ("P7", "F3", "35 %").
 _PREFIX = {("heater", "level"): "P", ("fan", "level"): "F", ("heater", "tens"): "P", ("fan", "tens"): "F"}
 #: What a logged value is worth in the machine's own steps, per unit (a level in tens: a tenth).

@@ -86,6 +86,8 @@ PARAM_NAMES = (
     "Tm0_share",  # read once per batch at CHARGE (roastlab.model.rhs.drum_at_charge_C), never by the right-hand side
     # the heater's setting in the heat it releases (extension; 1 = in proportion, the linear law)
     "heater_exp",  # exponent of the lagged setting: 0.5 for a gas burner logged as its pressure (orifice law)
+    # the fan's setting in the air flow it moves (extension; 1 = in proportion, the linear law)
+    "fan_exp",  # exponent of the fan setting: 0.5 for a fan logged as the pressure it makes (orifice law)
 )
 P = {name: i for i, name in enumerate(PARAM_NAMES)}
 N_PARAMS = len(PARAM_NAMES)
@@ -98,4 +100,4 @@ I_USH, I_ASH, I_TROOM = (P[k] for k in ("U_shell", "Ashell", "T_room"))
 I_HBED, I_HPROBE = P["h_bed"], P["h_probe"]
 I_AWALL, I_CONTACT, I_PROBELAW, I_PROBEGAS = (P[k] for k in ("A_wall", "contact_law", "probe_law", "probe_gas_law"))
 I_EPSRAD, I_ASURF, I_KFLIGHT = P["eps_rad"], P["A_surf"], P["k_flight"]
-I_HEXP = P["heater_exp"]
+I_HEXP, I_FEXP = P["heater_exp"], P["fan_exp"]

@@ -175,6 +175,10 @@ _TABLE: tuple[Quantity, ...] = (
              "exponent of the heater's lagged setting in the heat it releases (1: in proportion; 0.5: a gas "
              "burner logged as its pressure, whose gas flow through the jet goes as the pressure's square root)",
              (0.3, 1.5), False, "heater_exp"),
+    Quantity("fan_exp", "-", "extension", 1.0, (0.1, 2.0),
+             "exponent of the fan setting in the air flow it moves (1: in proportion; 0.5: a fan logged as "
+             "the pressure it makes across the drum, whose flow goes as the pressure's square root)",
+             (0.3, 1.5), False, "fan_exp"),
     # --- closed-loop scenarios (roastlab.io.scenario) --------------------------------------------
     Quantity("mass_factor", "-", "scenario", 1.0, (0.1, 5.0), "batch mass over the reference's"),
     Quantity("Gg_factor", "-", "scenario", 1.0, (0.1, 5.0), "gas flow the plant gets over the flow set"),

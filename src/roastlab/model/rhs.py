@@ -55,6 +55,7 @@ from .layout import (  # noqa: E402, F401
     I_CW,
     I_DB,
     I_EPSRAD,
+    I_FEXP,
     I_GGF,
     I_GGS,
     I_HAR,
@@ -191,10 +192,21 @@ def dry_mass_kg(Mb_kg, X0):
     return Mb_kg / (1.0 + X0)
 
 
-#: The lagged setting [its unit] added under the power in the heater's drive :func:`heater_drive`, so
-#: that its slope stays finite at 0 (the square root's is not): 1e-6 kPa, a millionth of a burner's
+#: The setting [its unit] added under the power in a setting's drive (:func:`setting_power`), so that
+#: its slope stays finite at 0 (the square root's is not): 1e-6 kPa, a millionth of a burner's
 #: pressure, changes the heat by less than a millionth wherever the burner is lit.
 HEATER_DRIVE_FLOOR = 1e-6
+
+
+@register_jitable
+def setting_power(u, e):
+    """A setting ``u`` to the power ``e`` [unit^e] (extension): u itself at e = 1, else computed as
+    u (u + h0)^(e - 1), h0 = :data:`HEATER_DRIVE_FLOOR`: u^e wherever u >> h0, 0 at u = 0 with a
+    finite slope h0^(e - 1) there (the Jacobian, :mod:`roastlab.sim.jacobian`), where the square
+    root's is infinite."""
+    if e == 1.0:  # the lanes compile the exponents in as constants (roastlab.sim.lanes.LAW_SLOTS)
+        return u
+    return u * power(fmax(u, 0.0) + HEATER_DRIVE_FLOOR, e - 1.0)
 
 
 @register_jitable
@@ -205,26 +217,35 @@ def heater_drive(H, p):
     an element's power, a level), D = H exactly. A gas burner logged as its pressure releases heat
     in proportion to its gas flow, and the flow through the burner's jet (an orifice) goes as the
     square root of the pressure across it, m = Cd A sqrt(2 rho dp) (Bernoulli for an orifice): e =
-    0.5. Computed as D = H (H + h0)^(e - 1), h0 = :data:`HEATER_DRIVE_FLOOR`: H^e wherever H >> h0,
-    0 at H = 0 with a finite slope h0^(e - 1) there (the Jacobian, :mod:`roastlab.sim.jacobian`),
-    where the square root's is infinite.
+    0.5 (:func:`setting_power`).
     """
-    e = p[I_HEXP]
-    if e == 1.0:  # the lanes compile this slot in as a constant (roastlab.sim.lanes.LAW_SLOTS)
-        return H
-    return H * power(fmax(H, 0.0) + HEATER_DRIVE_FLOOR, e - 1.0)
+    return setting_power(H, p[I_HEXP])
+
+
+@register_jitable
+def fan_drive(fan, p):
+    """The fan setting ``fan`` as the air flow it moves, in proportion to fan^e [setting unit^e] (extension).
+
+    e = ``fan_exp``. 1 (the default): the flow in proportion to the setting (a percentage, a speed in
+    rpm or Hz: the fan laws, volume flow ~ speed). A fan logged as the pressure it makes across the
+    drum (a draft in Pa) drives the air through a fixed resistance, the drum and its beans, where the
+    flow goes as the square root of the pressure drop (Bernoulli, as for an orifice): e = 0.5
+    (:func:`setting_power`).
+    """
+    return setting_power(fan, p[I_FEXP])
 
 
 @register_jitable
 def gas_inputs(Gg, Tgi, D, fan, p):
     """The gas flow [kg/s] and inlet temperature [degC] the chamber sees (actuator extension).
 
-    Gg_eff = Gg Gg_scale + Gg_fan fan (at least :data:`GG_MIN_KG_S`): the logged or placeholder
-    flow, scaled, plus the fan map; Tgi_eff = Tgi + Tgi_gain D: the logged or ambient inlet
+    Gg_eff = Gg Gg_scale + Gg_fan F (at least :data:`GG_MIN_KG_S`): the logged or placeholder
+    flow, scaled, plus the fan map, F the fan's drive (:func:`fan_drive`: the setting itself unless
+    ``fan_exp`` says); Tgi_eff = Tgi + Tgi_gain D: the logged or ambient inlet
     temperature plus the lagged heater's rise, D its drive (:func:`heater_drive` of the lagged
     setting H; H itself unless ``heater_exp`` says). Both reduce to (Gg, Tgi) in the paper's model.
     """
-    g = Gg * p[I_GGS] + p[I_GGF] * fan
+    g = Gg * p[I_GGS] + p[I_GGF] * fan_drive(fan, p)
     return fmax(g, GG_MIN_KG_S), Tgi + p[I_TGIG] * D
 
 

@@ -26,7 +26,7 @@ from numba.core import cgutils, types
 from numba.core.errors import NumbaIRAssumptionWarning
 from numba.extending import intrinsic, register_jitable
 
-from ..model.layout import I_CONTACT, I_HEXP, I_PROBEGAS, I_PROBELAW, I_XEXP, N_PARAMS
+from ..model.layout import I_CONTACT, I_FEXP, I_HEXP, I_PROBEGAS, I_PROBELAW, I_XEXP, N_PARAMS
 from ..model.rhs import outlet_gas_C, rebind
 from . import vecmath
 from .cache import compiled
@@ -117,11 +117,11 @@ def _k(stage, i):
     return _K1 + (stage - 1) * NS + i
 
 
-#: The parameter slots that choose a law (bed laws, the moisture exponent, the heater drive's
-#: exponent): one value for every run of a lanes call, compiled in as constants (see :func:`law_key`;
-#: a heater exponent other than 1, a gas burner's square root, runs the scalar integrator, as its
-#: power in every lane would cost more than the lanes gain).
-LAW_SLOTS = (I_CONTACT, I_PROBELAW, I_PROBEGAS, I_XEXP, I_HEXP)
+#: The parameter slots that choose a law (bed laws, the moisture exponent, the heater's and the fan's
+#: drive exponents): one value for every run of a lanes call, compiled in as constants (see
+#: :func:`law_key`; an exponent other than 1, a gas burner's or a draft's square root, runs the scalar
+#: integrator, as its power in every lane would cost more than the lanes gain).
+LAW_SLOTS = (I_CONTACT, I_PROBELAW, I_PROBEGAS, I_XEXP, I_HEXP, I_FEXP)
 _LAW_BASE = 4  # each law slot's value is a whole number below this
 
 
@@ -133,7 +133,7 @@ def law_key(PP: np.ndarray) -> int | None:
     The lanes integrator is compiled once per key with these values as constants, so the laws'
     branches are decided when compiling instead of evaluated, both sides, in every lane
     (a vector instruction computes both sides of a branch). Paper's laws: contact, probe and probe
-    gas 0, moisture exponent 2, heater exponent 1: key 128 + 256 = 384.
+    gas 0, moisture exponent 2, heater and fan exponents 1: key 128 + 256 + 1024 = 1408.
     """
     if PP.shape[0] == 0:
         return None

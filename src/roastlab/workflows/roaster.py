@@ -75,7 +75,7 @@ from ..metrics.profile import (
     first_crack_s,
     mmss,
 )
-from ..model.actuators import CONTROL_UNITS, PRESSURE_HEATER_EXP, PRESSURE_UNITS, UNIT_DEFAULTS
+from ..model.actuators import CONTROL_UNITS, PRESSURE_FAN_EXP, PRESSURE_HEATER_EXP, PRESSURE_UNITS, UNIT_DEFAULTS
 from ..model.bed import CROSS_VALIDATED, PROBE_DEPTH_OVER_DIAMETER
 from ..model.constants import FIRST_CRACK_BEAN_C, GREEN_BULK_DENSITY_KG_M3
 from ..model.parameters import FIRST_CRACK_WEIGHT, RESIDUAL_WEIGHT
@@ -100,7 +100,21 @@ OTHER_NAMES = {
     "damper": ("damper", "klappe", "registre", "valve"),
     "drum speed": ("drum", "trommel", "tambour", "tambor"),
 }
-FAN_NAMES = ("air", "fan", "airflow", "ventilateur", "lüfter", "luefter", "luft", "ventilador", "aria", "風", "风")
+FAN_NAMES = (
+    "air",
+    "fan",
+    "airflow",
+    "draft",
+    "draught",
+    "ventilateur",
+    "lüfter",
+    "luefter",
+    "luft",
+    "ventilador",
+    "aria",
+    "風",
+    "风",
+)
 #: Names of a temperature channel that logs the air entering the drum, the paper's inlet gas Tgi
 #: (lower case, substrings): an extra device many shop roasters log beside BT and ET.
 INLET_NAMES = ("inlet", "intake", "zuluft", "eintritt", "entrée", "entree", "entrada", "ingresso")
@@ -1189,8 +1203,17 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
         # the flow rises with the fan (or damper) the roaster moves through the roast: at full setting it
         # adds at most the largest base flow, a tenth of that to start (rhs.gas_inputs, Gg + Gg_fan fan);
         # a speed in rpm: in proportion to it (the fan laws: volume flow ~ speed), the highest logged as full
-        span = _setting_span(s.fan_unit, s.fan_max)
+        # a fan logged as the pressure it makes across the drum: the flow through a fixed resistance goes
+        # as its square root (rhs.fan_drive), the gain per unit^0.5
+        exp = PRESSURE_FAN_EXP if s.fan_unit in PRESSURE_UNITS else 1.0
+        span = _setting_span(s.fan_unit, s.fan_max) ** exp
         per = {"percent": "%", "reading": "logged unit"}.get(s.fan_unit, s.fan_unit)
+        if exp != 1.0:
+            per = f"{per}^{exp:g}"
+            fixed.append(
+                f"fan_exp = {exp:g}".ljust(38)
+                + "# the air flow a draft drives through the drum goes as its square root"
+            )
         hi, start = (float(f"{x:.3g}") for x in (gg_hi / span, gg_hi / span / 10))
         rows.append(line("Gg_fan_kg_s", 0.0, hi, start, f"air flow per {per} of the fan [kg/s]"))
     rows += ["", "[initial]", f"Tb0_C = {default('T_room_C'):.1f}                          # green beans at room temperature",
