@@ -918,6 +918,25 @@ def _setting_span(unit: str, top: float) -> float:
     return 100.0 if unit == "percent" else (top if top > 0 else 1.0)
 
 
+#: A setting's drive as a power of it where the setting is a pressure (rhs.heater_drive, rhs.fan_drive):
+#: the exponent and why, per control.
+PRESSURE_DRIVES = {
+    "heater": (PRESSURE_HEATER_EXP, "a gas burner's heat goes as the square root of its pressure (its gas flow through the jet, an orifice)"),
+    "fan": (PRESSURE_FAN_EXP, "the air flow a draft drives through the drum goes as its square root"),
+}  # fmt: skip
+
+
+def _drive_law(what: str, unit: str, top: float, per: str, fixed: list) -> tuple[float, str]:
+    """The span over which a setting's gain is bounded and the unit its gain is per: a setting logged
+    as a pressure drives as its power (``heater_exp``/``fan_exp`` of :data:`PRESSURE_DRIVES`, the line
+    appended to the fit spec's ``fixed`` table), its gain per unit^exp; any other in proportion."""
+    exp, why = PRESSURE_DRIVES[what] if unit in PRESSURE_UNITS else (1.0, "")
+    if exp != 1.0:
+        fixed.append(f"{what}_exp = {exp:g}".ljust(38) + f"# {why}")
+        per = f"{per}^{exp:g}"
+    return _setting_span(unit, top) ** exp, per
+
+
 def map_text(s: Survey) -> str:
     """The column map, commented with what was detected."""
     lines = [
@@ -1125,17 +1144,8 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
         rows.append("# no ET logged to tell the heater's paths apart: the heater heats the drum metal alone")
     fixed = []  # the [fixed] table's lines
     if s.heater:
-        # the heat the setting releases goes as its power heater_exp (rhs.heater_drive): a gas pressure's
-        # square root (the orifice law), any other setting in proportion
-        exp = PRESSURE_HEATER_EXP if s.heater_unit in PRESSURE_UNITS else 1.0
-        span = _setting_span(s.heater_unit, s.heater_max) ** exp
         per = {"tens": "logged unit, a level is 10", "reading": "logged unit"}.get(s.heater_unit, s.heater_unit)
-        if exp != 1.0:
-            per = f"{per}^{exp:g}"
-            fixed.append(
-                f"heater_exp = {exp:g}".ljust(38) + "# a gas burner's heat goes as the square root of its pressure "
-                "(its gas flow through the jet, an orifice)"
-            )
+        span, per = _drive_law("heater", s.heater_unit, s.heater_max, per, fixed)
         qe_hi = round(10.0 * capacity_kg / span, 4)  # ~10 kW per kg of capacity at full setting, generous
         if s.heater_unit == "W":  # a power readout: the drum gets at most all of it
             qe_hi = KW_PER_W
@@ -1203,17 +1213,8 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
         # the flow rises with the fan (or damper) the roaster moves through the roast: at full setting it
         # adds at most the largest base flow, a tenth of that to start (rhs.gas_inputs, Gg + Gg_fan fan);
         # a speed in rpm: in proportion to it (the fan laws: volume flow ~ speed), the highest logged as full
-        # a fan logged as the pressure it makes across the drum: the flow through a fixed resistance goes
-        # as its square root (rhs.fan_drive), the gain per unit^0.5
-        exp = PRESSURE_FAN_EXP if s.fan_unit in PRESSURE_UNITS else 1.0
-        span = _setting_span(s.fan_unit, s.fan_max) ** exp
         per = {"percent": "%", "reading": "logged unit"}.get(s.fan_unit, s.fan_unit)
-        if exp != 1.0:
-            per = f"{per}^{exp:g}"
-            fixed.append(
-                f"fan_exp = {exp:g}".ljust(38)
-                + "# the air flow a draft drives through the drum goes as its square root"
-            )
+        span, per = _drive_law("fan", s.fan_unit, s.fan_max, per, fixed)
         hi, start = (float(f"{x:.3g}") for x in (gg_hi / span, gg_hi / span / 10))
         rows.append(line("Gg_fan_kg_s", 0.0, hi, start, f"air flow per {per} of the fan [kg/s]"))
     rows += ["", "[initial]", f"Tb0_C = {default('T_room_C'):.1f}                          # green beans at room temperature",
