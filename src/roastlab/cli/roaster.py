@@ -125,7 +125,8 @@ def add_parsers(sub) -> None:
         "fit --spec R=DIR/fleet.toml --model R=DIR/model.json' fits each batch of a fleet store under it.",
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog="examples:\n  roastlab init roasts/*.alog --out myroaster\n  roastlab fit-roaster myroaster roasts/*.alog\n"
-        "  roastlab init roasts --out myroaster        the logs in the folder roasts",
+        "  roastlab init roasts --out myroaster        the logs in the folder roasts\n"
+        "  roastlab init roasts --out mygas --heater-unit kPa   a burner logged as 'Gas' in kPa",
     )
     p.add_argument("logs", nargs="+", metavar="LOG", help="roast logs of one roaster, or a folder of them")
     p.add_argument("--out", required=True, metavar="DIR", help="folder for map.toml, plant.toml, fit.toml, fleet.toml")
@@ -140,7 +141,10 @@ def add_parsers(sub) -> None:
     p.add_argument("--drum-length-m", type=float_arg("--drum-length-m"), help="inner drum length [m]")
     from ..model.actuators import CONTROL_UNITS
 
-    for what, example in (("heater", "a 'Gas' readout in kPa gets the burner's square-root law"), ("fan", "")):
+    for what, example in (
+        ("heater", "a 'Gas' readout in kPa gets the burner's square-root law"),
+        ("fan", "a draft in Pa gets the square-root law of the flow it drives"),
+    ):
         p.add_argument(
             f"--{what}-unit",
             choices=CONTROL_UNITS[what],
