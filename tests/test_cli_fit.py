@@ -148,3 +148,24 @@ def test_a_stage_of_unknown_length_shows_its_elapsed_time_and_clears_its_line(mo
         drawn = stream.getvalue()
         assert ("fit-roaster: fitting 8 logs [00:01]" in drawn and "[00:02]" in drawn) == shown, drawn
         assert drawn.endswith("\r") if shown else drawn == ""
+
+
+def test_a_first_run_says_it_compiles_on_a_terminal(monkeypatch):
+    """A command that compiles the kernels, on a machine whose cache holds none yet, says so on a
+    terminal before the minute or two it takes; not off a terminal, not once the cache holds kernels,
+    not for a command that compiles nothing (init), nor fit-roaster, whose progress says it."""
+    import io
+
+    from roastlab.cli.main import first_run_note
+    from roastlab.sim import cache
+
+    class Terminal(io.StringIO):
+        def isatty(self):
+            return True
+
+    monkeypatch.setattr(cache, "cold", lambda: True)
+    assert "first run compiles" in first_run_note("validate", Terminal())
+    assert first_run_note("validate", io.StringIO()) is None
+    assert first_run_note("init", Terminal()) is None and first_run_note("fit-roaster", Terminal()) is None
+    monkeypatch.setattr(cache, "cold", lambda: False)
+    assert first_run_note("validate", Terminal()) is None

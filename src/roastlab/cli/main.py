@@ -62,12 +62,32 @@ def _on_sigterm(signum, frame):
     raise Terminated()
 
 
+#: Commands that run no compiled code (and fit-roaster, whose own progress says a first run's compile).
+NOT_COMPILING = ("plant", "init", "import", "fit-roaster")
+
+
+def first_run_note(command: str, stream=None) -> str | None:
+    """The line a terminal gets before a command that compiles the model's kernels on a machine that has
+    none in its cache yet (:func:`roastlab.sim.cache.cold`), a minute or two of nothing on screen
+    otherwise; None off a terminal, for a command that compiles nothing, or once the cache holds kernels."""
+    stream = sys.stderr if stream is None else stream
+    if command in NOT_COMPILING or not (hasattr(stream, "isatty") and stream.isatty()):
+        return None
+    from ..sim.cache import cold
+
+    if not cold():
+        return None
+    return "roastlab: a first run compiles the model's kernels first (1-2 minutes on a small machine, once; later runs load them)"
+
+
 def main(argv: list[str] | None = None) -> int:
     from ..io.files import begin_run
 
     parser = build_parser()
     args = parser.parse_args(argv)
     begin_run()
+    if note := first_run_note(args.command):
+        print(note, file=sys.stderr)
     previous = None
     if threading.current_thread() is threading.main_thread():
         previous = signal.signal(signal.SIGTERM, _on_sigterm)
