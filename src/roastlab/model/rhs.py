@@ -195,18 +195,18 @@ def dry_mass_kg(Mb_kg, X0):
 #: The setting [its unit] added under the power in a setting's drive (:func:`setting_power`), so that
 #: its slope stays finite at 0 (the square root's is not): 1e-6 kPa, a millionth of a burner's
 #: pressure, changes the heat by less than a millionth wherever the burner is lit.
-HEATER_DRIVE_FLOOR = 1e-6
+SETTING_POWER_FLOOR = 1e-6
 
 
 @register_jitable
 def setting_power(u, e):
     """A setting ``u`` to the power ``e`` [unit^e] (extension): u itself at e = 1, else computed as
-    u (u + h0)^(e - 1), h0 = :data:`HEATER_DRIVE_FLOOR`: u^e wherever u >> h0, 0 at u = 0 with a
+    u (u + h0)^(e - 1), h0 = :data:`SETTING_POWER_FLOOR`: u^e wherever u >> h0, 0 at u = 0 with a
     finite slope h0^(e - 1) there (the Jacobian, :mod:`roastlab.sim.jacobian`), where the square
     root's is infinite."""
     if e == 1.0:  # the lanes compile the exponents in as constants (roastlab.sim.lanes.LAW_SLOTS)
         return u
-    return u * power(fmax(u, 0.0) + HEATER_DRIVE_FLOOR, e - 1.0)
+    return u * power(fmax(u, 0.0) + SETTING_POWER_FLOOR, e - 1.0)
 
 
 @register_jitable

@@ -1209,7 +1209,7 @@ def fit_spec_text(s: Survey, capacity_kg: float, diameter_m: float) -> str:
             "air flow per fan step [kg/s]" if step == 1 else f"air flow per logged fan unit [kg/s] (a step is {step:g})"
         )
         rows.append(line("Gg_fan_kg_s", 0.0, 0.01 / step, 0.001 / step, why))
-    elif s.fan and s.fan_unit in ("percent", "rpm", "Hz", "reading", *PRESSURE_UNITS):
+    elif s.fan:  # every other unit (init reads a fan in W as its speed in rpm, and never in kW)
         # the flow rises with the fan (or damper) the roaster moves through the roast: at full setting it
         # adds at most the largest base flow, a tenth of that to start (rhs.gas_inputs, Gg + Gg_fan fan);
         # a speed in rpm: in proportion to it (the fan laws: volume flow ~ speed), the highest logged as full
