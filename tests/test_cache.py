@@ -52,6 +52,13 @@ def test_an_edit_to_the_right_hand_side_reaches_the_cached_kernels(tmp_path):
     again = _run(copy, home)  # unchanged: the same value, from the same cache folder
     assert again == before
     assert len(list((home / "roastlab" / "numba").iterdir())) == 1
+    # the same sources at another path (a fresh clone, the installed wheel) load those kernels:
+    # numba rewrites a kernel's index when it compiles it, so no file of the cache changes
+    files = {p: p.stat().st_mtime_ns for p in (home / "roastlab").rglob("*") if p.is_file()}
+    elsewhere = tmp_path / "elsewhere"
+    shutil.copytree(copy, elsewhere)
+    assert _run(elsewhere, home) == before
+    assert {p: p.stat().st_mtime_ns for p in (home / "roastlab").rglob("*") if p.is_file()} == files
     # nothing in numba's per-file cache beside the sources: it would outlive an edit to the layout
     assert not [p.name for p in copy.rglob("*.nb[ic]")]
     rhs = copy / "roastlab" / "model" / "rhs.py"

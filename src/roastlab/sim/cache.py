@@ -10,18 +10,22 @@ unchanged checkout reuses its cache.
 The folder is ``$XDG_CACHE_HOME/roastlab/numba/<hash>`` (``~/.cache`` when unset);
 ``NUMBA_CACHE_DIR``, when the user sets it, is honoured as the parent instead. Only roastlab's
 kernels use it: other numba code in the same process keeps numba's own cache settings.
+
+Inside it a kernel is filed by its module's place in the package (``sim/``, ``fit/``), not by the
+absolute path of its file, which numba's own locators hash into the folder's name: the same sources
+installed elsewhere (a fresh clone, the wheel, a second virtual environment) load what another
+copy compiled instead of compiling for minutes again (:class:`SourceLocator`).
 """
 
 from __future__ import annotations
 
-import contextlib
 import functools
 import hashlib
 import os
 from pathlib import Path
 
 import numba
-from numba.core import config
+from numba.core import caching
 
 #: Subpackages whose files the compiled code is built from: the kernels (sim, fit) and the
 #: right-hand side and layout they compile in (model). tests/test_cache.py checks every module
@@ -62,14 +66,51 @@ def cold() -> bool:
     return folder is None or not any(folder.rglob("*.nbi"))
 
 
-@contextlib.contextmanager
-def _cache_dir_set(path: Path):
-    before = config.CACHE_DIR
-    config.CACHE_DIR = str(path)
-    try:
-        yield
-    finally:
-        config.CACHE_DIR = before
+class SourceLocator(caching._CacheLocator):
+    """numba's cache locator for roastlab's kernels: the folder :func:`cache_dir` plus the module's
+    folder inside the package, and the module file's bytes as its stamp.
+
+    numba's own locators file a kernel under a hash of its file's absolute path, so the same sources at
+    another path compiled afresh; :func:`cache_dir`'s name already keys on every compiled source, so the
+    path adds nothing. The stamp is the file's SHA-256 (numba since 0.60 does the same; older releases
+    stamped the file's modification time, which differs in every clone)."""
+
+    def __init__(self, py_func, py_file: str, folder: Path):
+        self._py_file = py_file
+        self._lineno = py_func.__code__.co_firstlineno
+        self._cache_path = str(folder / Path(py_file).resolve().parent.relative_to(_ROOT))
+
+    def get_cache_path(self) -> str:
+        return self._cache_path
+
+    def get_source_stamp(self) -> str:
+        return hashlib.sha256(Path(self._py_file).read_bytes()).hexdigest()
+
+    def get_disambiguator(self) -> str:
+        return str(self._lineno)
+
+    @classmethod
+    def from_function(cls, py_func, py_file):
+        """This locator for a function defined in roastlab's compiled sources, None for any other
+        (numba's own locators take those)."""
+        folder = cache_dir()
+        try:
+            inside = Path(py_file).resolve().relative_to(_ROOT).parts[0] in COMPILED_SOURCES
+        except (OSError, ValueError):
+            inside = False
+        if folder is None or not inside:
+            return None
+        self = cls(py_func, py_file, folder)
+        try:
+            self.ensure_cache_path()
+        except OSError:
+            return None
+        return self
+
+
+_IMPL = getattr(caching, "CacheImpl", None) or caching._CacheImpl  # older numba names it _CacheImpl
+if SourceLocator not in _IMPL._locator_classes:
+    _IMPL._locator_classes.insert(0, SourceLocator)
 
 
 def compiled(*args, **options):
@@ -77,11 +118,7 @@ def compiled(*args, **options):
     rather than a stale one, when that folder cannot be written)."""
 
     def decorate(function):
-        path = cache_dir()
-        if path is None:
-            return numba.njit(cache=False, **options)(function)
-        with _cache_dir_set(path):  # numba picks the cache folder when the function is decorated
-            return numba.njit(cache=True, **options)(function)
+        return numba.njit(cache=cache_dir() is not None, **options)(function)
 
     if args and callable(args[0]):
         return decorate(args[0])
