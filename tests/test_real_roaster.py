@@ -526,19 +526,21 @@ def test_bullet_logs_recorded_through_artisan_fit_as_the_roastime_logs_do(cli, b
     """The shared Bullet logs rewritten as Artisan's Aillio Bullet R1 IBTS device records them
     (:func:`bullet_as_artisan`): init reads the ET that falls to the green beans at CHARGE as the
     second bean reading and the drum at charge from ET before it, and fit-roaster predicts the
-    held-out logs as it does from the RoasTime files (81.2 % and 5.34 °C both ways since init fits the
-    exotherm where a second bean reading pins it, 79.3 % and 5.89 °C before; 78.8 %
-    with that ET weighed as the drum's air and the drum at BT's charge reading)."""
-    logs = [bullet_as_artisan(p, tmp_path / f"{p.stem}.alog") for p in sorted(bullet_data.glob("*.json"))]
+    held-out logs as it does from the RoasTime files. On all 28 logs: 81.2 % and 5.34 °C both ways since
+    init fits the exotherm where a second bean reading pins it, 79.3 % and 5.89 °C before; 78.8 % with that
+    ET weighed as the drum's air and the drum at BT's charge reading. Since 2026-11-28 eight 490 g logs
+    (85.2 % both ways), a quarter of the time: the comparison is of the two paths, not of the sizes."""
+    given = sorted(bullet_data.glob("*_49[0]g.json"))[:8]  # one size, one drum: what is compared is the path
+    logs = [bullet_as_artisan(p, tmp_path / f"{p.stem}.alog") for p in given]
     code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
     assert code == 0 and "ET: a bean reading, not the drum's air" in out and "fan: Fan (tens)" in out, err
     assert 'Tm0_C = ["ET before CHARGE", "BT"]' in (tmp_path / "cfg" / "map.toml").read_text()
     code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
     assert code == 0, err
     held = printed_percent(out, "held out: FIT ")
-    code, out, err = cli("init", *sorted(bullet_data.glob("*.json")), "--out", tmp_path / "rt")
+    code, out, err = cli("init", *given, "--out", tmp_path / "rt")
     assert code == 0, err
-    code, out, err = cli("fit-roaster", tmp_path / "rt", *sorted(bullet_data.glob("*.json")))
+    code, out, err = cli("fit-roaster", tmp_path / "rt", *given)
     assert code == 0, err
     assert abs(held - printed_percent(out, "held out: FIT ")) < 1.5, (held, out)
 
