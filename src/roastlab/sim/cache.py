@@ -19,13 +19,14 @@ copy compiled instead of compiling for minutes again (:class:`SourceLocator`).
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import hashlib
 import os
 from pathlib import Path
 
 import numba
-from numba.core import caching
+from numba.core import caching, config
 
 #: Subpackages whose files the compiled code is built from: the kernels (sim, fit) and the
 #: right-hand side and layout they compile in (model). tests/test_cache.py checks every module
@@ -113,12 +114,28 @@ if SourceLocator not in _IMPL._locator_classes:
     _IMPL._locator_classes.insert(0, SourceLocator)
 
 
+@contextlib.contextmanager
+def _cache_dir_set(path: Path):
+    before = config.CACHE_DIR
+    config.CACHE_DIR = str(path)
+    try:
+        yield
+    finally:
+        config.CACHE_DIR = before
+
+
 def compiled(*args, **options):
     """``numba.njit(cache=True, **options)`` with the cache in :func:`cache_dir` (no disk cache,
-    rather than a stale one, when that folder cannot be written)."""
+    rather than a stale one, when that folder cannot be written). numba's own folder setting points
+    there too while a kernel is decorated, so that where ``NUMBA_CACHE_LOCATOR_CLASSES`` replaces
+    :class:`SourceLocator` with numba's user-provided locator, the kernels still key on the sources."""
 
     def decorate(function):
-        return numba.njit(cache=cache_dir() is not None, **options)(function)
+        path = cache_dir()
+        if path is None:
+            return numba.njit(cache=False, **options)(function)
+        with _cache_dir_set(path):  # numba picks the locator when the function is decorated
+            return numba.njit(cache=True, **options)(function)
 
     if args and callable(args[0]):
         return decorate(args[0])
