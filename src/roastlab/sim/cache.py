@@ -73,8 +73,8 @@ class SourceLocator(caching._CacheLocator):
 
     numba's own locators file a kernel under a hash of its file's absolute path, so the same sources at
     another path compiled afresh; :func:`cache_dir`'s name already keys on every compiled source, so the
-    path adds nothing. The stamp is the file's SHA-256 (numba since 0.60 does the same; older releases
-    stamped the file's modification time, which differs in every clone)."""
+    path adds nothing. The stamp is the file's SHA-256, as numba 0.68's own (older releases stamped the
+    file's modification time and size, and the time differs in every clone)."""
 
     def __init__(self, py_func, py_file: str, folder: Path):
         self._py_file = py_file
