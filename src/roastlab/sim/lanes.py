@@ -104,14 +104,16 @@ _PT = _U + 13  # the parameter vector (N_PARAMS rows)
 _ROWS = _PT + N_PARAMS
 
 
-@register_jitable(inline="always")
+@register_jitable
 def _at(row, lane):
     """Z's index of ``row`` for lane ``lane`` (unsigned: no negative-index wraparound for the compiler
-    to reason about)."""
+    to reason about). A small function the compiler inlines itself: inlined in numba's IR as well, at
+    each of the thousands of places the lanes code indexes Z, it took half of a set of laws' compile
+    (83 s against 43 s on 2026-11-28, 2 cores) and ran no faster (lanes over scalar 0.75 either way)."""
     return np.uint64(row * LANES + lane)
 
 
-@register_jitable(inline="always")
+@register_jitable
 def _k(stage, i):
     """Z's row of state i's derivative at Dormand-Prince stage ``stage`` (1-7)."""
     return _K1 + (stage - 1) * NS + i
