@@ -77,7 +77,7 @@ def first_run_note(command: str, stream=None) -> str | None:
 
     if not cold():
         return None
-    return "roastlab: a first run compiles the model's kernels first (1-2 minutes on a small machine, once; later runs load them)"
+    return "roastlab: a first run compiles the model's kernels first (1-3 minutes on a small machine, once; later runs load them)"
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -1580,7 +1580,7 @@ def fit_roaster(
     stage = progress or (lambda done, total, text="": None)  # a stage of unknown length: total 0
     from ..sim.cache import cold
 
-    first = "; first run: compiling, 1-2 min once" if cold() else ""  # the kernels, then cached
+    first = "; first run: compiling, 2-3 min once" if cold() else ""  # the kernels, then cached
     stage(0, 0, f"fitting {len(fit_b)} logs{first}")
     result, spec, refit = fit_checked(fit_b, d, spec, cmap, seed, progress)
     model = result.model
