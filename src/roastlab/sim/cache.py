@@ -76,10 +76,10 @@ class SourceLocator(caching._CacheLocator):
     path adds nothing. The stamp is the file's SHA-256, as numba 0.68's own (older releases stamped the
     file's modification time and size, and the time differs in every clone)."""
 
-    def __init__(self, py_func, py_file: str, folder: Path):
+    def __init__(self, py_func, py_file: str, cache_path: Path):
         self._py_file = py_file
         self._lineno = py_func.__code__.co_firstlineno
-        self._cache_path = str(folder / Path(py_file).resolve().parent.relative_to(_ROOT))
+        self._cache_path = str(cache_path)
 
     def get_cache_path(self) -> str:
         return self._cache_path
@@ -96,12 +96,12 @@ class SourceLocator(caching._CacheLocator):
         (numba's own locators take those)."""
         folder = cache_dir()
         try:
-            inside = Path(py_file).resolve().relative_to(_ROOT).parts[0] in COMPILED_SOURCES
+            module_dir = Path(py_file).resolve().parent.relative_to(_ROOT)  # e.g. sim
         except (OSError, ValueError):
-            inside = False
-        if folder is None or not inside:
             return None
-        self = cls(py_func, py_file, folder)
+        if folder is None or not module_dir.parts or module_dir.parts[0] not in COMPILED_SOURCES:
+            return None
+        self = cls(py_func, py_file, folder / module_dir)
         try:
             self.ensure_cache_path()
         except OSError:
