@@ -19,8 +19,13 @@ $(STAMP): pyproject.toml
 # in one process. Each worker runs numba's parallel loops on its share of the cores (tests/conftest.py):
 # with a thread per core in each of 2 workers the suite took 703 s in a warm clone on 2026-11-28, with one
 # thread per worker 569 s, back to back.
+# Each kernel is compiled first, once, in a pool of processes (roastlab compile): started together, the
+# workers compiled the same kernels at the same time (128 s of a clean clone's 445 s of compiling,
+# 2026-11-29); with a warm cache the step takes a few seconds. The lanes for the paper's laws and the
+# Bullet example's, which most tests call; the lanes tests' own laws still compile in the suite.
 TEST_WORKERS ?= auto
 test: $(STAMP)
+	$(VENV)/bin/roastlab compile examples/bullet/fit.toml
 	$(PY) -m pytest -n $(TEST_WORKERS)
 
 # The inner loop: every test but those marked slow (make test, which CI runs, has them all).

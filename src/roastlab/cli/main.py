@@ -18,7 +18,7 @@ import sys
 import threading
 
 from ..errors import RoastlabError
-from . import app, bench, control, data, fit, fleet, roaster, simulate, transfer, whatif
+from . import app, bench, control, data, fit, fleet, precompile, roaster, simulate, transfer, whatif
 from .common import Parser
 
 
@@ -48,7 +48,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
     sub.required = True
 
-    for module in (simulate, fit, roaster, data, whatif, transfer, control, fleet, bench, app):
+    for module in (simulate, fit, roaster, data, whatif, transfer, control, fleet, bench, app, precompile):
         module.add_parsers(sub)
     return parser
 
@@ -62,8 +62,8 @@ def _on_sigterm(signum, frame):
     raise Terminated()
 
 
-#: Commands that run no compiled code (and fit-roaster, whose own progress says a first run's compile).
-NOT_COMPILING = ("plant", "init", "import", "fit-roaster")
+#: Commands that run no compiled code (and fit-roaster and compile, whose own progress says a first run's compile).
+NOT_COMPILING = ("plant", "init", "import", "fit-roaster", "compile")
 
 
 def first_run_note(command: str, stream=None) -> str | None:
@@ -77,7 +77,10 @@ def first_run_note(command: str, stream=None) -> str | None:
 
     if not cold():
         return None
-    return "roastlab: a first run compiles the model's kernels first (1-3 minutes on a small machine, once; later runs load them)"
+    return (
+        "roastlab: a first run compiles the model's kernels first (1-3 minutes on a small machine, once; later runs "
+        "load them; 'roastlab compile' does it ahead on every core)"
+    )
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -1,0 +1,184 @@
+"""Compile the kernels ahead, on every core: ``roastlab compile``.
+
+The compiled kernels (:mod:`roastlab.sim`) are built on their first call and kept in the disk cache
+(:func:`roastlab.sim.cache.cache_dir`); a first fit takes minutes of that. Each kernel compiles on one
+core, and processes started together each compile what they need, the same kernel in each: under
+``pytest -n 2`` both workers compiled the lanes, the sensitivities, the probe's population kernel and
+the per-batch fitter at the same time, 128 s of the 445 s of compiling a clean clone's suite did
+(measured 2026-11-29 with numba's compile events). Here each kernel is compiled once, in one of a pool
+of processes, by a small run through the same public call as a fit makes (so the signatures are the
+ones a fit asks for), the longest first; later processes load them from the cache.
+
+A *job* is one group of kernels that share compiled callees (compiled in one process, so a callee is
+not compiled twice): the lanes integrator once per set of laws (:func:`roastlab.sim.lanes.law_key`),
+the scalar population kernels with the per-batch fitter, the exact sensitivities with the program's,
+and the single-run stepper. With a warm cache every job only loads, in about a second.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..model.bed import BedLaws
+
+
+@dataclass(frozen=True)
+class LawSet:
+    """The laws a set of runs shares, which the lanes integrator compiles in (one kernel per set)."""
+
+    bed: BedLaws = BedLaws()
+    moisture: str = "schwartzberg"
+
+    @property
+    def name(self) -> str:
+        return f"{self.bed.name}, {self.moisture} moisture"
+
+
+def law_set_of(path) -> LawSet:
+    """The laws of a fit spec (``.toml``: its ``[bed]``, the default moisture law) or a model file
+    (``.json``: its bed and moisture law)."""
+    from pathlib import Path
+
+    path = Path(path)
+    if path.suffix.lower() == ".json":
+        from .model import load_model
+
+        model = load_model(path)
+        return LawSet(model.bed or BedLaws(), model.moisture)
+    from ..io.fitspec import load_fit_spec
+
+    return LawSet(load_fit_spec(path).bed)
+
+
+def _batch():
+    """One short SYNTHETIC batch on the 120 kg plant: inputs only, to call the kernels with."""
+    from ..io.batch import Batch
+
+    t = np.arange(0.0, 121.0, 30.0)
+    b = Batch("compile", t, np.full_like(t, 0.4), np.full_like(t, 450.0), Ta_C=np.full_like(t, 25.0))
+    b.heater = np.full_like(t, 50.0)
+    b.fan = np.full_like(t, 50.0)
+    return b
+
+
+def _packed(laws: LawSet = LawSet(), n: int = 1):
+    from ..model.parameters import THETA_PAPER
+    from ..sim.population import pack_batches
+
+    return pack_batches([_batch()] * n, "120kg", THETA_PAPER, moisture=laws.moisture, bed=laws.bed)
+
+
+def job_lanes(bed: str, moisture: str) -> str:
+    """The lanes integrator for one set of laws (:func:`roastlab.sim.population.predict_outputs`)."""
+    from ..sim import lanes
+    from ..sim.population import predict_outputs
+
+    packed = _packed(LawSet(BedLaws.parse(bed), moisture))
+    values = np.full((lanes.MIN_RUNS, 1, 1), 0.0254)
+    predict_outputs(packed, ["hbm"], values, with_tgo=True, use_lanes=True)
+    return f"lanes ({bed}, {moisture} moisture)"
+
+
+def job_population() -> str:
+    """The scalar population kernels (probe and all states) and the per-batch fitter, which share the
+    integrator (:func:`roastlab.sim.kernels.integrate_into`)."""
+    from ..fit.batchfit import identify_each
+    from ..sim.population import predict_outputs, simulate_population
+
+    packed = _packed()
+    predict_outputs(packed, ["hbm"], np.full((1, 1, 1), 0.0254), with_tgo=True, use_lanes=False)
+    simulate_population(packed, use_lanes=False)
+    identify_each(packed, n_trial=2, max_iter=1)
+    return "population kernels and the per-batch fitter"
+
+
+def job_sensitivities() -> str:
+    """The exact sensitivities of a fit (every output, the outlet gas's too) and of a program."""
+    from ..sim.population import output_sensitivities
+    from ..sim.sensitivity import program_sensitivity
+
+    packed = _packed()
+    output_sensitivities(packed, ["hbm"], np.full((1, 1), 0.0254), [(0, -1)], with_tgo=True)
+    b = _batch()
+    n = b.n
+    x0 = packed.x0[0].copy()
+    p = packed.PB[0].copy()
+    program_sensitivity(b.time_s, b.Gg_kg_s, b.Tgi_C, np.zeros(n), np.zeros(n), x0, p, False, 0)
+    return "sensitivities"
+
+
+def job_stepper() -> str:
+    """The one stepper (:func:`roastlab.sim.simulate.advance`) and the single-run simulator."""
+    from ..sim.simulate import advance, simulate
+
+    packed = _packed()
+    u = np.array([0.4, 450.0, 0.0, 0.0])
+    advance(packed.x0[0].copy(), u, u, 1.0, packed.PB[0].copy())
+    b = _batch()
+    simulate("120kg", b.time_s, b.Gg_kg_s, b.Tgi_C)
+    return "stepper and single run"
+
+
+def jobs(law_sets=(LawSet(),)) -> list[tuple]:
+    """The jobs for ``law_sets`` (the paper's laws by default), longest first: (function, args)."""
+    seen: list[LawSet] = []
+    for laws in law_sets:
+        if laws not in seen:
+            seen.append(laws)
+    return [
+        *((job_lanes, (laws.bed.name, laws.moisture)) for laws in seen),
+        (job_population, ()),
+        (job_sensitivities, ()),
+        (job_stepper, ()),
+    ]
+
+
+def _run(job, args):
+    import numba
+
+    numba.set_num_threads(1)  # compiling is one core's work; the runs are tiny
+    t0 = time.perf_counter()
+    text = job(*args)
+    return text, time.perf_counter() - t0
+
+
+def process_count(n_jobs: int, processes: int | None = None) -> int:
+    """The processes :func:`compile_kernels` uses for ``n_jobs``: ``processes``, or one per core, never
+    more than the jobs."""
+    return max(1, min(processes or os.cpu_count() or 1, n_jobs))
+
+
+def compile_kernels(law_sets=(LawSet(),), processes: int | None = None, progress=None) -> list[tuple[str, float]]:
+    """Compile (or load from the cache) every kernel a fit, a prediction and the page use, for the
+    lanes' ``law_sets``, in ``processes`` processes (:func:`process_count`).
+
+    ``progress(done, total, text)`` is called as each job finishes, ``text`` naming it and its seconds.
+    Returns (job, seconds) in the order they finished.
+    """
+    todo = jobs(law_sets)
+    n = process_count(len(todo), processes)
+    done: list[tuple[str, float]] = []
+
+    def finished(item):
+        done.append(item)
+        if progress:
+            progress(len(done), len(todo), f"{item[0]}: {item[1]:.1f} s")
+
+    if n == 1:
+        for job, args in todo:
+            finished(_run(job, args))
+        return done
+    # spawn: a fresh interpreter per process (numba's threads and a forked parent do not mix)
+    with ProcessPoolExecutor(n, mp_context=multiprocessing.get_context("spawn")) as pool:
+        for future in as_completed([pool.submit(_run, job, args) for job, args in todo]):
+            finished(future.result())
+    return done
+
+
+__all__ = ["LawSet", "law_set_of", "compile_kernels", "jobs", "process_count"]

@@ -1,0 +1,79 @@
+"""``roastlab compile``: the kernels compiled ahead are the ones the commands then call."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from roastlab.cli.main import main
+from roastlab.model.bed import BedLaws
+from roastlab.workflows import precompile
+
+REPO = Path(__file__).resolve().parents[1]
+
+#: In a fresh interpreter: run every job in-process, note each kernel's compiled signatures, then fit,
+#: validate and simulate a population as the commands do, and print the signatures any kernel gained.
+AFTER_THE_JOBS = """
+import json, importlib, pkgutil
+import numpy as np
+from numba.core.registry import CPUDispatcher
+import roastlab
+from roastlab.sim.population import pack_batches, simulate_population
+from roastlab.workflows import precompile
+
+def dispatchers():
+    found = {}
+    for pkg in ("roastlab.sim", "roastlab.fit"):
+        for info in pkgutil.iter_modules(importlib.import_module(pkg).__path__):
+            m = importlib.import_module(f"{pkg}.{info.name}")
+            for name, obj in vars(m).items():
+                if isinstance(obj, CPUDispatcher) and obj.py_func.__module__ == m.__name__:
+                    found[f"{m.__name__}.{name}"] = obj
+    return found
+
+for job, args in precompile.jobs():
+    job(*args)
+before = {k: set(d.overloads) for k, d in dispatchers().items()}
+batches = roastlab.read_dataset(roastlab.default_dataset_root() / "dataset-I").batches[:1]
+res = roastlab.fit(batches, "120kg", starts=1)
+res.model.validate(batches)
+simulate_population(pack_batches(batches, "120kg", roastlab.THETA_PAPER), ["hbm"], np.full((16, 1, 1), 0.03))
+roastlab.simulate("120kg", batches[0].time_s, batches[0].Gg_kg_s, batches[0].Tgi_C)
+gained = {k: [str(s) for s in set(d.overloads) - before.get(k, set())] for k, d in dispatchers().items()}
+print(json.dumps({k: v for k, v in gained.items() if v}))
+"""
+
+
+def test_lanes_once_per_set_of_laws_and_first():
+    """The lanes (the longest jobs) come first, once per distinct set of laws, the paper's by default;
+    a fit spec's laws are its [bed] section's."""
+    bullet = precompile.law_set_of(REPO / "examples" / "bullet" / "fit.toml")
+    assert bullet.bed == BedLaws(probe="tumbling", probe_gas="mean")
+    todo = precompile.jobs([precompile.LawSet(), bullet, precompile.LawSet(), bullet])
+    names = [job.__name__ for job, _ in todo]
+    assert names == ["job_lanes", "job_lanes", "job_population", "job_sensitivities", "job_stepper"]
+    assert [args for _, args in todo[:2]] == [
+        ("paper", "schwartzberg"),
+        ("probe=tumbling,probe_gas=mean", "schwartzberg"),
+    ]
+    assert [job.__name__ for job, _ in precompile.jobs()][0] == "job_lanes"
+    assert precompile.process_count(5, None) >= 1
+    assert precompile.process_count(5, 64) == 5 and precompile.process_count(5, 2) == 2
+
+
+def test_compile_names_a_missing_file(tmp_path, capsys):
+    assert main(["compile", str(tmp_path / "nosuch.toml")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "nosuch.toml" in err[0], err
+
+
+@pytest.mark.slow
+def test_a_fit_after_compile_calls_nothing_compile_left_out():
+    """After the jobs, a fit, a validation, a population of lanes and a single run add no compiled
+    signature to any kernel: the jobs built exactly what the commands call (a job left out, the
+    sensitivities say, shows here as the fit's sensitivity kernel gaining its signature)."""
+    proc = subprocess.run([sys.executable, "-c", AFTER_THE_JOBS], capture_output=True, text=True, timeout=900, cwd=REPO)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert json.loads(proc.stdout.strip().splitlines()[-1]) == {}
