@@ -47,8 +47,8 @@ def bed_segment(Mb, Dch, Lch, rho=680.0):
 
 def make_rhs(plant: str, theta, X0: float, moisture: str = "schwartzberg", act=None, bed=None, process=None):
     """The slow reference right-hand side. ``act`` holds the actuator extension's values
-    (Qe_gain, Qe_offset, Tgi_gain, tau, Gg_fan, U_shell, T_room, heater_exp, fan_exp); None = the paper's
-    model.
+    (Qe_gain, Qe_offset, Tgi_gain, tau, Gg_fan, U_shell, T_room, heater_exp, fan_exp, heater_lag_exp,
+    heater_full); None = the paper's model.
     ``bed`` the bed laws and the probe's depth: {"contact": "paper"|"wall", "probe": "rest"|"tumbling",
     "probe_gas": "outlet"|"mean", "h_probe": m, "eps_rad": the wall's radiation to the bed's free
     surface, 0-1, "k_flight": the gas-bean area over that surface, 0 = the contact law's}; None =
@@ -102,7 +102,10 @@ def make_rhs(plant: str, theta, X0: float, moisture: str = "schwartzberg", act=N
         D = H if e == 1.0 else H * (max(H, 0.0) + 1e-6) ** (e - 1.0)
         Tgi = Tgi + a.get("Tgi_gain", 0.0) * D
         Qe = max(a.get("Qe_offset", 0.0) + a.get("Qe_gain", 0.0) * D, 0.0)
-        dH = (heater - H) / a.get("tau", 1.0)
+        # the lag: tau at full power, (full / H)^e at setting H (a radiant element: e = 3/4), H at least
+        # a twentieth of full power there
+        full, elag = a.get("heater_full", 100.0), a.get("heater_lag_exp", 0.0)
+        dH = (heater - H) / (a.get("tau", 1.0) * (full / max(H, 0.05 * full)) ** elag)
         cg = sum(a * (Tgi + 273.15) ** i for i, a in enumerate(ALPHA)) / 1000
         he = 0.49 - 0.443 * math.exp(-0.206 * X)
         F = hgm * Agm / (he * Agb)

@@ -115,6 +115,34 @@ def test_a_gas_burners_square_root_law_matches_reference():
     assert np.max(np.abs(linear.Tb_C - fast.Tb_C)) > 1.0  # the law matters at these pressures
 
 
+def test_a_radiant_heaters_lag_matches_reference():
+    """The heater's lag growing as its setting falls (heater_lag_exp 3/4: a radiant element, its lag
+    tau_heater (full / H)^(3/4)), the setting a percentage stepped up and down and once to 0 (below the
+    floor of a twentieth of full power): compiled vs reference; and a step down settles more slowly than
+    the first-order law's, as the element keeps glowing."""
+    t, Gg, Tgi, x0 = random_case(29, "120kg")
+    n = len(t)
+    heater = np.array([80.0, 40.0, 100.0, 0.0, 30.0, 65.0])[(np.arange(n) // 5) % 6]  # %, held for 5 samples
+    act = {"Qe_gain": 0.3, "Tgi_gain": 1.5, "tau": 25.0, "heater_lag_exp": 0.75, "heater_full": 100.0}
+    values = {"Qe_gain_kW": 0.3, "Tgi_gain_C": 1.5, "tau_heater_s": 25.0, "heater_lag_exp": 0.75}
+    theta = (0.03, 0.04, 0.6)
+    fast = simulate("120kg", t, Gg, Tgi - 150.0, theta=theta, initial=x0, hold="zoh", heater=heater, values=values)
+    ref, ref_tgo = reference_simulate(
+        "120kg", theta, t, Gg, Tgi - 150.0, x0.vector(), hold="zoh", heater=heater, act=act
+    )
+    for j in (0, 1, 4):
+        assert np.max(np.abs(fast.states[:, j] - ref[:, j])) < TOL_C
+    assert np.max(np.abs(fast.states[:, 5] - ref[:, 5])) < 1e-3  # the lagged setting, in percent
+    assert np.max(np.abs(fast.Tgo_C - ref_tgo)) < TOL_C
+    first_order = simulate(
+        "120kg", t, Gg, Tgi - 150.0, theta=theta, initial=x0, hold="zoh", heater=heater,
+        values=values | {"heater_lag_exp": 0.0},
+    )  # fmt: skip
+    # 80 % -> 40 % (samples 5-9): there the radiant heater's lagged setting lies above the first-order one's
+    assert n >= 10
+    assert np.all(fast.states[6:10, 5] > first_order.states[6:10, 5] + 1.0)
+
+
 def test_a_draft_fans_square_root_law_matches_reference():
     """The fan's drive as the square root of its setting (fan_exp 0.5: a fan logged as the draft it makes
     across the drum, in Pa, the flow through a fixed resistance), off (0) at times, held and

@@ -41,6 +41,10 @@ def _params(codes: dict, rng) -> np.ndarray:
     p[P["heater_exp"]] = rng.uniform(0.4, 0.9) if codes.get("probe_law") == 1.0 else 1.0
     # the fan's drive as a power of its setting (a draft in Pa) in the other half
     p[P["fan_exp"]] = rng.uniform(0.4, 0.9) if codes.get("probe_law") != 1.0 else 1.0
+    # the heater's lag growing as its setting falls (a radiant element) in half the combinations, full
+    # power above the settings of _point (1-9) so that the lag's power law, not its floor, is exercised
+    p[P["heater_lag_exp"]] = rng.uniform(0.5, 1.0) if codes.get("contact_law") == 1.0 else 0.0
+    p[P["heater_full"]] = rng.uniform(9.0, 12.0)
     for name, value in codes.items():
         p[P[name]] = value
     return p

@@ -9,13 +9,13 @@ from .common import count_arg
 
 
 def cmd_compile(args) -> int:
+    t0 = time.perf_counter()  # a new version of the sources also generates its Jacobian here (SymPy, once)
     from ..sim.cache import cache_dir
     from ..workflows.precompile import LawSet, compile_kernels, jobs, law_set_of, process_count
 
     law_sets = [LawSet(), *(law_set_of(path) for path in args.laws)]
     total = len(jobs(law_sets))
     n = process_count(total, args.processes)
-    t0 = time.perf_counter()
     print(
         f"roastlab compile: {total} jobs in {n} process{'es' if n > 1 else ''} (from an empty cache a few "
         "minutes, from a warm one seconds)",

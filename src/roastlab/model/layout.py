@@ -88,6 +88,9 @@ PARAM_NAMES = (
     "heater_exp",  # exponent of the lagged setting: 0.5 for a gas burner logged as its pressure (orifice law)
     # the fan's setting in the air flow it moves (extension; 1 = in proportion, the linear law)
     "fan_exp",  # exponent of the fan setting: 0.5 for a fan logged as the pressure it makes (orifice law)
+    # the heater's lag with its setting (extension; 0 = one lag at every setting, the first-order law)
+    "heater_lag_exp",  # 3/4 for a radiant element: its lag goes as (full / H)^(3/4) (roastlab.model.rhs.heater_lag_factor)
+    "heater_full",  # the heater setting at full power [setting unit] (100 for a percentage)
 )
 P = {name: i for i, name in enumerate(PARAM_NAMES)}
 N_PARAMS = len(PARAM_NAMES)
@@ -101,3 +104,4 @@ I_HBED, I_HPROBE = P["h_bed"], P["h_probe"]
 I_AWALL, I_CONTACT, I_PROBELAW, I_PROBEGAS = (P[k] for k in ("A_wall", "contact_law", "probe_law", "probe_gas_law"))
 I_EPSRAD, I_ASURF, I_KFLIGHT = P["eps_rad"], P["A_surf"], P["k_flight"]
 I_HEXP, I_FEXP = P["heater_exp"], P["fan_exp"]
+I_HLEXP, I_HFULL = P["heater_lag_exp"], P["heater_full"]

@@ -179,6 +179,13 @@ _TABLE: tuple[Quantity, ...] = (
              "exponent of the fan setting in the air flow it moves (1: in proportion; 0.5: a fan logged as "
              "the pressure it makes across the drum, whose flow goes as the pressure's square root)",
              (0.3, 1.5), False, "fan_exp"),
+    Quantity("heater_lag_exp", "-", "extension", 0.0, (0.0, 1.0),
+             "exponent of the heater's lag in full power over its lagged setting, tau_heater (full / H)^e (0: one "
+             "lag at every setting; 0.75: a radiant element, whose output goes as its temperature to the fourth)",
+             (0.0, 1.0), False, "heater_lag_exp"),
+    Quantity("heater_full", "unit", "extension", 100.0, (1e-6, 1e6),
+             "the heater setting at full power, at which the lag is tau_heater_s (100 for a percentage)",
+             None, False, "heater_full"),
     # --- closed-loop scenarios (roastlab.io.scenario) --------------------------------------------
     Quantity("mass_factor", "-", "scenario", 1.0, (0.1, 5.0), "batch mass over the reference's"),
     Quantity("Gg_factor", "-", "scenario", 1.0, (0.1, 5.0), "gas flow the plant gets over the flow set"),
