@@ -24,6 +24,7 @@ from test_bad_input import GOOD_ALOG, GOOD_ROWS, HEADER, PLANT
 OUTPUTS = {"--out", "--json", "--plot", "--predictions", "--save", "--alog", "--alarms", "--db"}
 #: Options that name a file or folder the command reads.
 INPUTS = {"--model", "--theta", "--plant", "--inputs", "--map", "--spec", "--data", "batches", "log", "plant"}
+INPUTS |= {"laws"}  # compile: fit specs or model files whose laws to compile
 INPUTS |= {
     "--from",
     "--to",
@@ -38,6 +39,7 @@ INPUTS |= {
 }
 #: Options that take no path: numbers, names, choices and flags.
 VALUES = {
+    "--processes",
     "--every-log",
     "--by-size",
     "--fit-size-kg",
@@ -238,6 +240,8 @@ RUNS = {
     ("init",): ("init {d}/log.alog --out {d}/cfg --batch-kg 0.2", ["log.alog"]),
     # writes into the folder init made (no output option): tested in test_roaster_setup.py
     ("fit-roaster",): ("fit-roaster {d}/cfg {d}/log.alog", []),
+    # writes only the compile cache (no output option): tested in test_precompile.py
+    ("compile",): ("compile --processes 1", []),
 }
 
 PARSER = build_parser()

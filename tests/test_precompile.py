@@ -63,6 +63,20 @@ def test_lanes_once_per_set_of_laws_and_first():
     assert precompile.process_count(5, 64) == 5 and precompile.process_count(5, 2) == 2
 
 
+def test_each_family_of_jobs_keeps_its_processes():
+    """Every job runs once whatever the processes; on 2 the lanes of both sets of laws run in one process
+    and the scalar kernels in the other, so neither compiles the other family's shared callees."""
+    todo = precompile.jobs([precompile.LawSet(), precompile.LawSet(BedLaws(probe="tumbling"))])
+    for n in range(1, 9):
+        groups = precompile.chains(todo, n)
+        assert 1 <= len(groups) <= n
+        assert sorted(map(repr, sum(groups, []))) == sorted(map(repr, todo))
+    lanes, rest = precompile.chains(todo, 2)
+    assert [job.__name__ for job, _ in lanes] == ["job_lanes", "job_lanes"]
+    assert [job.__name__ for job, _ in rest] == ["job_population", "job_sensitivities", "job_stepper"]
+    assert precompile.chains(todo, 1) == [todo]
+
+
 def test_compile_names_a_missing_file(tmp_path, capsys):
     assert main(["compile", str(tmp_path / "nosuch.toml")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
