@@ -440,9 +440,10 @@ def create_app(data_dir: str | Path):
     def transfer_(session: Session, body: dict) -> dict:
         from ..evaluate.bands import BAND_LEVEL, why_no_band
         from ..io.importers import import_log
+        from ..model.actuators import TM0_FREE_RANGE_C
         from ..model.limits import check_value
         from ..model.plant import preset_names
-        from ..workflows.transfer import TM0_FREE_RANGE_C, aim_at, transfer
+        from ..workflows.transfer import aim_at, transfer
 
         need(session)
         kg = body.get("batch_kg")

@@ -98,9 +98,9 @@ def cmd_transfer(args) -> int:
 
 def add_parsers(sub) -> None:
     """Register this module's command(s) on the ``roastlab`` subparsers ``sub``."""
-    from ..model.actuators import MIN_HOLD_S, TGI_LIMITS
+    # the model's tables only: the transfer itself (its exact sensitivities) is imported when it runs
+    from ..model.actuators import MIN_HOLD_S, TGI_LIMITS, TM0_FREE_RANGE_C
     from ..model.quantities import default
-    from ..workflows.transfer import TM0_FREE_RANGE_C
 
     p = sub.add_parser(
         "transfer",

@@ -168,3 +168,8 @@ class Actuator:
             step = self.step * _STEPS_PER_UNIT.get(self.unit, 1.0)  # a level shown in tens steps by 1 level
             return f"{self.name} {self.label(self.low)}-{self.label(self.high)} in steps of {step:g}"
         return f"{self.name} {self.label(self.low)}-{self.label(self.high)} (continuous)"
+
+
+#: Range of the drum temperature at CHARGE when a transfer chooses it (``--tm0 free``) [degC]:
+#: from a barely warm drum to the top of the range an identification may give ``Tm0_C``.
+TM0_FREE_RANGE_C = (60.0, quantity("Tm0_C").bounds[1])

@@ -40,7 +40,6 @@ from ..model.actuators import MIN_HOLD_S, SETTING_GAINS, inert_settings
 from ..model.layout import S_TB, S_TM, STATE0
 from ..model.limits import check_value
 from ..model.plant import Plant
-from ..model.quantities import QUANTITIES
 from ..model.rhs import P, drum_start_reading_C
 from ..report.result import Result, draw_curves
 from ..sim.population import PARAM_SLOTS
@@ -288,11 +287,6 @@ class TransferResult(Result):
     def _draw(self, ax) -> None:
         t = self.time_s
         draw_curves(ax, {"reference BT": (t, self.target_C), "predicted BT": (t, self.program.Ta_pred_C)}, "BT [°C]")
-
-
-#: Range of the drum temperature at CHARGE when a transfer chooses it (``--tm0 free``) [degC]:
-#: from a barely warm drum to the top of the range an identification may give ``Tm0_C``.
-TM0_FREE_RANGE_C = (60.0, QUANTITIES["Tm0_C"].bounds[1])
 
 
 def default_limits(model, plant_from=None, plant_to=None) -> ProgramLimits:
