@@ -58,6 +58,21 @@ def test_compiled_matches_reference(seed, plant, hold, hgm, hbm, Pbm):
     assert np.max(np.abs(fast.He_kJ_kg - ref[:, 3])) < 0.01
 
 
+def _matches_reference(t, Gg, Tgi, x0, hold, act, values, heater=None, fan=None, theta=(0.03, 0.04, 0.6)):
+    """The compiled run with the extension's ``values`` against the reference with the same ``act``:
+    Tb, Tm, Ta and Tgo within :data:`TOL_C`, the lagged heater within 1e-3 of its unit. Returns the
+    compiled run."""
+    fast = simulate("120kg", t, Gg, Tgi, theta=theta, initial=x0, hold=hold, heater=heater, fan=fan, values=values)
+    ref, ref_tgo = reference_simulate(
+        "120kg", theta, t, Gg, Tgi, x0.vector(), hold=hold, heater=heater, fan=fan, act=act
+    )
+    for j in (0, 1, 4):
+        assert np.max(np.abs(fast.states[:, j] - ref[:, j])) < TOL_C
+    assert np.max(np.abs(fast.states[:, 5] - ref[:, 5])) < 1e-3  # the lagged heater, in its unit
+    assert np.max(np.abs(fast.Tgo_C - ref_tgo)) < TOL_C
+    return fast
+
+
 @pytest.mark.parametrize("seed, hold", [(11, "zoh"), (12, "linear"), (13, "zoh")])
 def test_actuator_extension_matches_reference(seed, hold):
     """Heater steps through the lag into Qe and Tgi, fan steps into Gg, the shell loses heat to
@@ -70,17 +85,7 @@ def test_actuator_extension_matches_reference(seed, hold):
     act = {"Qe_gain": 4.0, "Qe_offset": 2.0, "Tgi_gain": 6.0, "tau": 25.0, "Gg_fan": 0.01, "U_shell": 0.02}
     values = {"Qe_gain_kW": 4.0, "Qe_offset_kW": 2.0, "Tgi_gain_C": 6.0, "tau_heater_s": 25.0, "Gg_fan_kg_s": 0.01}
     values["U_shell_kW_m2K"] = 0.02  # shell loss to a 22 degC room
-    theta = (0.03, 0.04, 0.6)
-    fast = simulate(
-        "120kg", t, Gg, Tgi - 150.0, theta=theta, initial=x0, hold=hold, heater=heater, fan=fan, values=values
-    )
-    ref, ref_tgo = reference_simulate(
-        "120kg", theta, t, Gg, Tgi - 150.0, x0.vector(), hold=hold, heater=heater, fan=fan, act=act
-    )
-    for j in (0, 1, 4):
-        assert np.max(np.abs(fast.states[:, j] - ref[:, j])) < TOL_C
-    assert np.max(np.abs(fast.states[:, 5] - ref[:, 5])) < 1e-3  # the lagged heater, in levels
-    assert np.max(np.abs(fast.Tgo_C - ref_tgo)) < TOL_C
+    fast = _matches_reference(t, Gg, Tgi - 150.0, x0, hold, act, values, heater=heater, fan=fan)
     assert np.ptp(fast.states[:, 5]) > 1.0  # the heater really moved
 
 
@@ -93,25 +98,11 @@ def test_a_gas_burners_square_root_law_matches_reference():
     heater = np.array([0.0, 0.5, 1.2, 3.5, 2.0, 0.0, 2.8])[(np.arange(n) // 4) % 7]  # kPa, held for 4 samples
     act = {"Qe_gain": 20.0, "Tgi_gain": 30.0, "tau": 20.0, "heater_exp": 0.5}
     values = {"Qe_gain_kW": 20.0, "Tgi_gain_C": 30.0, "tau_heater_s": 20.0, "heater_exp": 0.5}
-    theta = (0.03, 0.04, 0.6)
-    fast = simulate("120kg", t, Gg, Tgi - 150.0, theta=theta, initial=x0, hold="zoh", heater=heater, values=values)
-    ref, ref_tgo = reference_simulate(
-        "120kg", theta, t, Gg, Tgi - 150.0, x0.vector(), hold="zoh", heater=heater, act=act
-    )
-    for j in (0, 1, 4):
-        assert np.max(np.abs(fast.states[:, j] - ref[:, j])) < TOL_C
-    assert np.max(np.abs(fast.Tgo_C - ref_tgo)) < TOL_C
+    fast = _matches_reference(t, Gg, Tgi - 150.0, x0, "zoh", act, values, heater=heater)
     linear = simulate(
-        "120kg",
-        t,
-        Gg,
-        Tgi - 150.0,
-        theta=theta,
-        initial=x0,
-        hold="zoh",
-        heater=heater,
+        "120kg", t, Gg, Tgi - 150.0, theta=(0.03, 0.04, 0.6), initial=x0, hold="zoh", heater=heater,
         values=values | {"heater_exp": 1.0},
-    )
+    )  # fmt: skip
     assert np.max(np.abs(linear.Tb_C - fast.Tb_C)) > 1.0  # the law matters at these pressures
 
 
@@ -125,17 +116,9 @@ def test_a_radiant_heaters_lag_matches_reference():
     heater = np.array([80.0, 40.0, 100.0, 0.0, 30.0, 65.0])[(np.arange(n) // 5) % 6]  # %, held for 5 samples
     act = {"Qe_gain": 0.3, "Tgi_gain": 1.5, "tau": 25.0, "heater_lag_exp": 0.75, "heater_full": 100.0}
     values = {"Qe_gain_kW": 0.3, "Tgi_gain_C": 1.5, "tau_heater_s": 25.0, "heater_lag_exp": 0.75}
-    theta = (0.03, 0.04, 0.6)
-    fast = simulate("120kg", t, Gg, Tgi - 150.0, theta=theta, initial=x0, hold="zoh", heater=heater, values=values)
-    ref, ref_tgo = reference_simulate(
-        "120kg", theta, t, Gg, Tgi - 150.0, x0.vector(), hold="zoh", heater=heater, act=act
-    )
-    for j in (0, 1, 4):
-        assert np.max(np.abs(fast.states[:, j] - ref[:, j])) < TOL_C
-    assert np.max(np.abs(fast.states[:, 5] - ref[:, 5])) < 1e-3  # the lagged setting, in percent
-    assert np.max(np.abs(fast.Tgo_C - ref_tgo)) < TOL_C
+    fast = _matches_reference(t, Gg, Tgi - 150.0, x0, "zoh", act, values, heater=heater)
     first_order = simulate(
-        "120kg", t, Gg, Tgi - 150.0, theta=theta, initial=x0, hold="zoh", heater=heater,
+        "120kg", t, Gg, Tgi - 150.0, theta=(0.03, 0.04, 0.6), initial=x0, hold="zoh", heater=heater,
         values=values | {"heater_lag_exp": 0.0},
     )  # fmt: skip
     # 80 % -> 40 % (samples 5-9): there the radiant heater's lagged setting lies above the first-order one's
