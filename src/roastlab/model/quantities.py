@@ -184,8 +184,9 @@ _TABLE: tuple[Quantity, ...] = (
              "lag at every setting; 0.75: a radiant element, whose output goes as its temperature to the fourth)",
              (0.0, 1.0), False, "heater_lag_exp"),
     Quantity("heater_full", "unit", "extension", 100.0, (1e-6, 1e6),
-             "the heater setting at full power, at which the lag is tau_heater_s (100 for a percentage)",
-             None, False, "heater_full"),
+             "the heater setting at full power, at which the lag is tau_heater_s (100 for a percentage; a "
+             "fit spec fixes it for another scale, 9 for levels P1-P9)",
+             (1e-3, 1e4), False, "heater_full"),
     # --- closed-loop scenarios (roastlab.io.scenario) --------------------------------------------
     Quantity("mass_factor", "-", "scenario", 1.0, (0.1, 5.0), "batch mass over the reference's"),
     Quantity("Gg_factor", "-", "scenario", 1.0, (0.1, 5.0), "gas flow the plant gets over the flow set"),
