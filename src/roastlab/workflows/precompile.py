@@ -7,7 +7,8 @@ core, and processes started together each compile what they need, the same kerne
 the per-batch fitter at the same time, 128 s of the 445 s of compiling a clean clone's suite did
 (measured 2026-11-29 with numba's compile events). Here each kernel is compiled once, in one of a pool
 of processes, by a small run through the same public call as a fit makes (so the signatures are the
-ones a fit asks for), the longest first; later processes load them from the cache.
+ones a fit asks for), each family of jobs in processes of its own (:func:`chains`); later processes
+load them from the cache.
 
 A *job* is one group of kernels that share compiled callees (compiled in one process, so a callee is
 not compiled twice): the lanes integrator once per set of laws (:func:`roastlab.sim.lanes.law_key`),
