@@ -35,7 +35,8 @@ def add_parsers(sub) -> None:
         "compile",
         help="compile the model's kernels ahead, on every core (a first fit then starts at once)",
         description="Compile every kernel a fit, a prediction, a what-if and the page call (or load them from "
-        "the cache), each once, in a pool of processes, the longest first. A first run of any command otherwise "
+        "the cache), each once, in a pool of processes, the lanes and the other kernels each in processes of their own. "
+        "A first run of any command otherwise "
         "compiles what it needs on one core (2-3 minutes on a small machine). The lanes integrator, which "
         "simulates many runs at once, is compiled once per set of bed and moisture laws: the paper's always, "
         "and those of each fit spec or model file given. With a warm cache it takes seconds.",
