@@ -63,6 +63,19 @@ def test_lanes_once_per_set_of_laws_and_first():
     assert precompile.process_count(5, 64) == 5 and precompile.process_count(5, 2) == 2
 
 
+def test_a_model_files_laws_are_its_bed_and_moisture_law(tmp_path):
+    """A model file fitted with the tumbling probe (laws whose lanes ``make test`` compiles first): its
+    lanes job is for those laws, after the paper's."""
+    import roastlab
+
+    batches = roastlab.read_dataset(roastlab.default_dataset_root() / "dataset-I").batches[:1]
+    model = roastlab.fit(batches, "120kg", starts=1, bed="probe=tumbling,probe_gas=mean").model
+    laws = precompile.law_set_of(model.save(tmp_path / "model.json"))
+    assert laws == precompile.LawSet(BedLaws(probe="tumbling", probe_gas="mean"), "schwartzberg")
+    todo = precompile.jobs([precompile.LawSet(), laws])
+    assert todo[1] == (precompile.job_lanes, ("probe=tumbling,probe_gas=mean", "schwartzberg"))
+
+
 def test_each_family_of_jobs_keeps_its_processes():
     """Every job runs once whatever the processes; on 2 the lanes of both sets of laws run in one process
     and the scalar kernels in the other, so neither compiles the other family's shared callees."""
