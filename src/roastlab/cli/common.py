@@ -88,6 +88,10 @@ def count_arg(name: str, lo: int, hi: int):
     return parse
 
 
+#: How long a first run's compile takes, as the first-run note and ``compile --help`` say it (measured:
+#: 150-163 s for a first fit-roaster on 2 cores, 2026-11-28/29; docs/your-roaster.md).
+FIRST_COMPILE = "1-3 minutes on a small machine"
+
 #: Work shorter than this shows no progress [s].
 PROGRESS_DELAY_S = 2.0
 

@@ -19,7 +19,7 @@ import threading
 
 from ..errors import RoastlabError
 from . import app, bench, control, data, fit, fleet, precompile, roaster, simulate, transfer, whatif
-from .common import Parser
+from .common import FIRST_COMPILE, Parser
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -78,7 +78,7 @@ def first_run_note(command: str, stream=None) -> str | None:
     if not cold():
         return None
     return (
-        "roastlab: a first run compiles the model's kernels first (1-3 minutes on a small machine, once; later runs "
+        f"roastlab: a first run compiles the model's kernels first ({FIRST_COMPILE}, once; later runs "
         "load them; 'roastlab compile' does it ahead on every core)"
     )
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import sys
 import time
 
-from .common import count_arg
+from .common import FIRST_COMPILE, count_arg
 
 
 def cmd_compile(args) -> int:
@@ -37,7 +37,7 @@ def add_parsers(sub) -> None:
         description="Compile every kernel a fit, a prediction, a what-if and the page call (or load them from "
         "the cache), each once, in a pool of processes, the lanes and the other kernels each in processes of their own. "
         "A first run of any command otherwise "
-        "compiles what it needs on one core (2-3 minutes on a small machine). The lanes integrator, which "
+        f"compiles what it needs on one core ({FIRST_COMPILE}). The lanes integrator, which "
         "simulates many runs at once, is compiled once per set of bed and moisture laws: the paper's always, "
         "and those of each fit spec or model file given. With a warm cache it takes seconds.",
     )
