@@ -51,8 +51,8 @@ def make_rhs(plant: str, theta, X0: float, moisture: str = "schwartzberg", act=N
     heater_full); None = the paper's model.
     ``bed`` the bed laws and the probe's depth: {"contact": "paper"|"wall", "probe": "rest"|"tumbling",
     "probe_gas": "outlet"|"mean", "h_probe": m, "eps_rad": the wall's radiation to the bed's free
-    surface, 0-1, "k_flight": the gas-bean area over that surface, 0 = the contact law's}; None =
-    the paper's. ``process`` overrides values of PROCESS (and the plant's metal mass Mm)."""
+    surface, 0-1, "k_flight": the gas-bean area over that surface, 0 = the contact law's, "swell": the
+    beans' volume gain when the roast reactions are complete, V/V0 - 1}; None = the paper's. ``process`` overrides values of PROCESS (and the plant's metal mass Mm)."""
     process = dict(process or {})
     g = {**PLANTS[plant], **({"Mm": process.pop("Mm")} if "Mm" in process else {})}
     c = {**PROCESS, **process}
@@ -66,24 +66,34 @@ def make_rhs(plant: str, theta, X0: float, moisture: str = "schwartzberg", act=N
         "h_probe": 0.0,
         "eps_rad": 0.0,
         "k_flight": 0.0,
+        "swell": 0.0,
         **(bed or {}),
     }
-    angle, h_bed, A_wall = bed_segment(g["Mb"], g["Dch"], g["Lch"])
-    A_surf = 2 * (g["Dch"] / 2) * math.sin(angle / 2) * g["Lch"]  # the segment's chord along the drum
-    if bed["contact"] == "wall":  # beans touch the wetted wall; the rest of their surface meets the gas
-        Abm = Pbm * A_wall
-        Agb = Ab - Abm
-    else:
-        Agb, Abm = Ab * (1 - Pbm), Ab * Pbm
-    if bed["k_flight"] > 0:  # the gas meets the beans at the bed's surface (and the beans in flight)
-        Agb = bed["k_flight"] * A_surf
-    hp = bed["h_probe"]
-    if hp == 0:
-        cover = 1.0
-    elif bed["probe"] == "tumbling":
-        cover = 1 - math.exp(-h_bed / hp)
-    else:
-        cover = min(1.0, h_bed / hp)
+    angle, h_bed0, A_wall0 = bed_segment(g["Mb"], g["Dch"], g["Lch"])
+    A_surf0 = 2 * (g["Dch"] / 2) * math.sin(angle / 2) * g["Lch"]  # the segment's chord along the drum
+
+    def geometry(He):
+        """The bed's areas, the probe's cover and the free surface for beans swollen by the reactions'
+        extent He / Het: volume 1 + swell He/Het times the green, so lengths z = its cube root, each
+        bean's area z^2, a shallow bed's depth z^2 (segment area ~ h^1.5), its arc and chord z (~ h^0.5)."""
+        z = (1 + bed["swell"] * max(He, 0.0) / c["Het"]) ** (1 / 3)
+        ab, h_bed, A_surf = Ab * z * z, h_bed0 * z * z, A_surf0 * z
+        if bed["contact"] == "wall":  # beans touch the wetted wall; the rest of their surface meets the gas
+            Abm = Pbm * A_wall0 * z
+            Agb = ab - Abm
+        else:
+            Agb, Abm = ab * (1 - Pbm), ab * Pbm
+        if bed["k_flight"] > 0:  # the gas meets the beans at the bed's surface (and the beans in flight)
+            Agb = bed["k_flight"] * A_surf
+        hp = bed["h_probe"]
+        if hp == 0:
+            cover = 1.0
+        elif bed["probe"] == "tumbling":
+            cover = 1 - math.exp(-h_bed / hp)
+        else:
+            cover = min(1.0, h_bed / hp)
+        return Agb, Abm, cover, A_surf
+
     Mbd = g["Mb"] / (1 + X0)
     k1, xexp = (c["k1"], 2) if moisture == "schwartzberg" else (4.32e-9, 0)
 
@@ -106,6 +116,7 @@ def make_rhs(plant: str, theta, X0: float, moisture: str = "schwartzberg", act=N
         # a twentieth of full power there
         full, elag = a.get("heater_full", 100.0), a.get("heater_lag_exp", 0.0)
         dH = (heater - H) / (a.get("tau", 1.0) * (full / max(H, 0.05 * full)) ** elag)
+        Agb, Abm, cover, A_surf = geometry(He)
         cg = sum(a * (Tgi + 273.15) ** i for i, a in enumerate(ALPHA)) / 1000
         he = 0.49 - 0.443 * math.exp(-0.206 * X)
         F = hgm * Agm / (he * Agb)

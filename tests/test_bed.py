@@ -49,10 +49,10 @@ def test_paper_bed_packs_the_paper_and_codes_each_law():
     both = rhs.pack_params(plant, theta, bed="contact=wall,probe=tumbling,probe_gas=mean")
     assert [both[P[k]] for k in ("contact_law", "probe_law", "probe_gas_law")] == [1.0, 1.0, 1.0]
     assert both[P["A_wall"]] == pytest.approx(plant.wall_contact_area_m2)
-    Agb, Abm = rhs.bed_areas_m2(both)
+    Agb, Abm = rhs.bed_areas_m2(both, 1.0)
     assert Abm == pytest.approx(0.5793 * plant.wall_contact_area_m2)
     assert Agb == pytest.approx(plant.Ab_m2 - Abm)
-    assert rhs.bed_areas_m2(paper) == rhs.bean_areas_m2(plant.Ab_m2, 0.5793)
+    assert rhs.bed_areas_m2(paper, 1.0) == rhs.bean_areas_m2(plant.Ab_m2, 0.5793)
 
 
 def test_tumbling_probe_reads_its_covered_mix_and_is_eq17_without_a_depth():
@@ -75,8 +75,8 @@ def test_mean_gas_is_the_mean_of_the_exchanger_profile():
     plant = as_plant("120kg")
     p = rhs.pack_params(plant, (0.02, 0.05, 0.6), bed="probe_gas=mean")
     Tb, Tm, X, Gg, Tgi = 150.0, 220.0, 0.05, 30.0, 400.0
-    Tgo = rhs.heat_flows(Tb, Tm, X, Gg, Tgi, p)[0]
-    T_star, NTU = rhs.exchanger(Tb, Tm, X, Gg, Tgi, p)[:2]
+    Tgo = rhs.heat_flows(Tb, Tm, X, 0.0, Gg, Tgi, p)[0]
+    T_star, NTU = rhs.exchanger(Tb, Tm, X, 1.0, Gg, Tgi, p)[:2]
     by_quad = quad(lambda s: T_star + (Tgi - T_star) * math.exp(-NTU * s), 0.0, 1.0)[0]
     mean = rhs.probe_gas_C(Tgi, Tgo, T_star, NTU, p)
     assert mean == pytest.approx(by_quad, rel=1e-12)
@@ -92,7 +92,7 @@ def test_wall_contact_makes_the_batch_response_flatter():
     small, large = dataclasses.replace(plant, Mb_kg=40.0), dataclasses.replace(plant, Mb_kg=160.0)
 
     def abm_per_kg(pl, bed):
-        return rhs.bed_areas_m2(rhs.pack_params(pl, (0.01, 0.03, 0.5), bed=bed))[1] / pl.Mb_kg
+        return rhs.bed_areas_m2(rhs.pack_params(pl, (0.01, 0.03, 0.5), bed=bed), 1.0)[1] / pl.Mb_kg
 
     assert abm_per_kg(small, None) == pytest.approx(abm_per_kg(large, None))
     assert abm_per_kg(small, "contact=wall") / abm_per_kg(large, "contact=wall") > 1.5
@@ -180,10 +180,10 @@ def test_bed_surface_and_wall_radiation_by_hand():
     t, _, _ = bed_segment(small.Mb_kg, small.Dch_m, small.Lch_m)
     assert small.bed_surface_area_m2 == pytest.approx(2 * R * math.sin(t / 2) * L, rel=1e-9)
     p = rhs.pack_params(small, (0.01, 0.03, 0.5))
-    assert rhs.wall_radiation_kW(200.0, 300.0, p) == 0.0  # eps_rad 0: the paper
+    assert rhs.wall_radiation_kW(200.0, 300.0, 1.0, p) == 0.0  # eps_rad 0: the paper
     p[P["eps_rad"]] = 0.8
     watts = 0.8 * 5.670374419e-8 * small.bed_surface_area_m2 * (573.15**4 - 473.15**4)
-    assert rhs.wall_radiation_kW(200.0, 300.0, p) == pytest.approx(watts / 1000.0, rel=1e-12)
+    assert rhs.wall_radiation_kW(200.0, 300.0, 1.0, p) == pytest.approx(watts / 1000.0, rel=1e-12)
     large = dataclasses.replace(plant, Mb_kg=0.3 * full)
     assert small.bed_surface_area_m2 / small.Mb_kg > 2.5 * large.bed_surface_area_m2 / large.Mb_kg
 
@@ -194,19 +194,49 @@ def test_gas_area_at_the_bed_surface_by_hand():
     plant = as_plant("120kg")
     for bed in ("paper", "contact=wall"):
         p = rhs.pack_params(plant, (0.01, 0.03, 0.5), bed=bed)
-        Agb0, Abm0 = rhs.bed_areas_m2(p)
+        Agb0, Abm0 = rhs.bed_areas_m2(p, 1.0)
         p[P["k_flight"]] = 4.0
-        Agb, Abm = rhs.bed_areas_m2(p)
+        Agb, Abm = rhs.bed_areas_m2(p, 1.0)
         assert Agb == pytest.approx(4.0 * plant.bed_surface_area_m2, rel=1e-12) and Abm == Abm0
         p[P["Pbm"]] = 0.7
-        assert rhs.bed_areas_m2(p)[0] == Agb  # the gas's area no longer depends on Pbm
+        assert rhs.bed_areas_m2(p, 1.0)[0] == Agb  # the gas's area no longer depends on Pbm
         assert Agb0 != Agb
     small, large = (dataclasses.replace(plant, Mb_kg=m) for m in (40.0, 200.0))
-    per_kg = [rhs.bed_areas_m2(rhs.pack_params(q, (0.01, 0.03, 0.5)))[0] / q.Mb_kg for q in (small, large)]
+    per_kg = [rhs.bed_areas_m2(rhs.pack_params(q, (0.01, 0.03, 0.5)), 1.0)[0] / q.Mb_kg for q in (small, large)]
     assert per_kg[0] == pytest.approx(per_kg[1])  # the paper: the same gas area per kilogram
     with_surface = []
     for q in (small, large):
         p = rhs.pack_params(q, (0.01, 0.03, 0.5))
         p[P["k_flight"]] = 4.0
-        with_surface.append(rhs.bed_areas_m2(p)[0] / q.Mb_kg)
+        with_surface.append(rhs.bed_areas_m2(p, 1.0)[0] / q.Mb_kg)
     assert with_surface[0] > 2.0 * with_surface[1]
+
+
+def test_swollen_beans_scale_the_bed_as_their_size():
+    """bean_swell (roastlab.model.rhs.swell_factor): 0 is the paper's beans exactly; with the reactions
+    complete (He = Het) a volume gain of 1 doubles each bean's volume, so its size is 2^(1/3) and the
+    beans' area, the probe's bed depth, the wetted arc and the free surface scale as s^2, s^2, s and s.
+    The shallow bed's depth law against the exact segment: doubling the bed's volume (twice the batch
+    at rest, computed by the plant's own segment geometry) deepens it by 2^(2/3) within 4 %."""
+    plant = as_plant("120kg")
+    p = rhs.pack_params(plant, (0.02, 0.05, 0.6), bed="probe=tumbling")
+    p[P["h_probe"]] = plant.bed_depth_m
+    Het = p[P["Het"]]
+    assert rhs.swell_factor(Het, p) == 1.0  # bean_swell 0: the paper
+    p[P["bean_swell"]] = 1.0
+    assert rhs.swell_factor(0.0, p) == 1.0  # green beans
+    s = rhs.swell_factor(Het, p)
+    assert s == pytest.approx(2.0 ** (1.0 / 3.0), rel=1e-14)
+    assert rhs.swell_factor(Het / 2.0, p) == pytest.approx(1.5 ** (1.0 / 3.0), rel=1e-14)
+    assert rhs.bed_areas_m2(p, s) == pytest.approx(rhs.bean_areas_m2(plant.Ab_m2 * s * s, 0.6), rel=1e-14)
+    assert rhs.probe_coverage(p, s) == pytest.approx(1.0 - math.exp(-(s * s)), rel=1e-14)  # h_bed s^2 over h_bed
+    wall = rhs.pack_params(plant, (0.02, 0.05, 0.6), bed="contact=wall")
+    assert rhs.bed_areas_m2(wall, s)[1] == pytest.approx(0.6 * plant.wall_contact_area_m2 * s, rel=1e-14)
+    wall[P["eps_rad"]] = 0.8
+    assert rhs.wall_radiation_kW(150.0, 250.0, s, wall) == pytest.approx(
+        s * rhs.wall_radiation_kW(150.0, 250.0, 1.0, wall), rel=1e-14
+    )
+    for Mb in (0.2 * plant.Mb_kg, plant.Mb_kg, 1.5 * plant.Mb_kg):  # fills of 3-18 %
+        green = dataclasses.replace(plant, Mb_kg=Mb)
+        doubled = dataclasses.replace(plant, Mb_kg=2.0 * Mb)
+        assert doubled.bed_depth_m / green.bed_depth_m == pytest.approx(2.0 ** (2.0 / 3.0), rel=0.04)

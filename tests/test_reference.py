@@ -361,3 +361,39 @@ def test_gas_at_the_bed_surface_matches_reference(contact):
         assert np.max(np.abs(runs[k].Tgo_C - ref_tgo)) < TOL_C
     # 3 times the surface is far less than the beans' own area at 120 kg: the gas leaves hotter
     assert np.max(runs[3.0].Tgo_C - runs[0.0].Tgo_C) > 5.0
+
+
+@pytest.mark.parametrize(
+    "laws, extra",
+    [
+        ({"probe": "tumbling", "probe_gas": "mean"}, {}),
+        ({"contact": "wall", "probe": "rest"}, {"eps_rad": 0.6}),
+        ({"contact": "wall"}, {"k_flight": 3.0}),
+    ],
+)
+def test_swelling_beans_match_reference(laws, extra):
+    """Beans swelling with the roast reactions' extent (bean_swell, roastlab.model.rhs.swell_factor):
+    their area, the bed's depth under the probe, its wetted arc and its free surface, over the bed laws:
+    compiled vs reference, which computes its own geometry; and the swelling acts."""
+    from roastlab.model.plant import as_plant
+
+    t, Gg, Tgi, x0 = random_case(21, "120kg")
+    Gg = 8.0 * Gg  # much air, so the probe's gas and the beans' area matter
+    h_probe = 1.5 * as_plant("120kg").bed_depth_m
+    theta = (0.03, 0.3, 0.4)
+    heater = np.full(len(t), 300.0)
+    runs = {}
+    for swell in (0.0, 1.0):
+        values = {"h_probe_m": h_probe, "Qe_gain_kW": 0.5, "bean_swell": swell, **extra}
+        runs[swell] = simulate(
+            "120kg", t, Gg, Tgi - 200.0, theta=theta, initial=x0, heater=heater, values=values, bed=laws
+        )
+        ref, ref_tgo = reference_simulate(
+            "120kg", theta, t, Gg, Tgi - 200.0, x0.vector(), heater=heater,
+            act={"Qe_gain": 0.5}, bed={**laws, **extra, "h_probe": h_probe, "swell": swell},
+        )  # fmt: skip
+        for j in (0, 1, 4):
+            assert np.max(np.abs(runs[swell].states[:, j] - ref[:, j])) < TOL_C
+        assert np.max(np.abs(runs[swell].Tgo_C - ref_tgo)) < TOL_C
+    assert runs[1.0].He_kJ_kg[-1] > 20.0  # the reactions ran, so the beans swelled
+    assert np.max(np.abs(runs[1.0].states - runs[0.0].states)) > 0.5  # and it acts

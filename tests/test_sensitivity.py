@@ -18,8 +18,10 @@ from roastlab.sim.kernels import H_MAX_S, N_OUT, integrate_into
 from roastlab.sim.sensitivity import integrate_sens_into, program_sensitivity
 
 NS = N_STATES
-#: Continuous entries whose value 0 switches their extension off (a kink at 0, where(k > 0, ...)).
-SWITCHES = ("k_flight",)
+#: Continuous entries whose value 0 switches their extension off (a kink at 0, where(k > 0, ...), or a
+#: branch there whose difference quotient would take a step of 1e-11: the swelling's derivative at 0 is
+#: checked where another combination switches it on).
+SWITCHES = ("k_flight", "bean_swell")
 RHS_JACOBIAN = load()
 
 
@@ -45,6 +47,8 @@ def _params(codes: dict, rng) -> np.ndarray:
     # power above the settings of _point (1-9) so that the lag's power law, not its floor, is exercised
     p[P["heater_lag_exp"]] = rng.uniform(0.5, 1.0) if codes.get("contact_law") == 1.0 else 0.0
     p[P["heater_full"]] = rng.uniform(9.0, 12.0)
+    # the beans swelling with the reactions' extent (bed areas, depth and surface) in the half without k_flight
+    p[P["bean_swell"]] = rng.uniform(0.3, 1.0) if codes.get("probe_gas_law") != 1.0 else 0.0
     for name, value in codes.items():
         p[P[name]] = value
     return p

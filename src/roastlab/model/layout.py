@@ -91,6 +91,8 @@ PARAM_NAMES = (
     # the heater's lag with its setting (extension; 0 = one lag at every setting, the first-order law)
     "heater_lag_exp",  # 3/4 for a radiant element: its lag goes as (full / H)^(3/4) (roastlab.model.rhs.heater_lag_factor)
     "heater_full",  # the heater setting at full power [setting unit] (100 for a percentage)
+    # the beans swell as they roast (extension; 0 = the paper's beans, whose size never changes)
+    "bean_swell",  # the beans' volume gain at the roast reactions' end, V/V0 - 1 [-] (roastlab.model.rhs.swell_factor)
 )
 P = {name: i for i, name in enumerate(PARAM_NAMES)}
 N_PARAMS = len(PARAM_NAMES)
@@ -105,3 +107,4 @@ I_AWALL, I_CONTACT, I_PROBELAW, I_PROBEGAS = (P[k] for k in ("A_wall", "contact_
 I_EPSRAD, I_ASURF, I_KFLIGHT = P["eps_rad"], P["A_surf"], P["k_flight"]
 I_HEXP, I_FEXP = P["heater_exp"], P["fan_exp"]
 I_HLEXP, I_HFULL = P["heater_lag_exp"], P["heater_full"]
+I_SWELL = P["bean_swell"]

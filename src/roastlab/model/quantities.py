@@ -187,6 +187,10 @@ _TABLE: tuple[Quantity, ...] = (
              "the heater setting at full power, at which the lag is tau_heater_s (100 for a percentage; a "
              "fit spec fixes it for another scale, 9 for levels P1-P9)",
              (1e-3, 1e4), False, "heater_full"),
+    Quantity("bean_swell", "-", "extension", 0.0, (0.0, 3.0),
+             "the beans' volume gain when the roast reactions are complete, V/V0 - 1, growing with their extent "
+             "He/Het (0: beans of a fixed size; roasted coffee has gained 50-100 % of its green volume)",
+             (0.0, 1.0), True, "bean_swell"),
     # --- closed-loop scenarios (roastlab.io.scenario) --------------------------------------------
     Quantity("mass_factor", "-", "scenario", 1.0, (0.1, 5.0), "batch mass over the reference's"),
     Quantity("Gg_factor", "-", "scenario", 1.0, (0.1, 5.0), "gas flow the plant gets over the flow set"),

@@ -79,6 +79,7 @@ from .layout import (  # noqa: E402, F401
     I_PROBELAW,
     I_QEG,
     I_QEO,
+    I_SWELL,
     I_TAUH,
     I_TGIG,
     I_TROOM,
@@ -157,8 +158,30 @@ def bean_areas_m2(Ab_m2, Pbm):
 
 
 @register_jitable
-def bed_areas_m2(p):
-    """(Agb, Abm) [m^2] under the model's contact law (:mod:`roastlab.model.bed`) and gas area.
+def swell_factor(He, p):
+    """The beans' size over their green size, s = (V / V0)^(1/3) [-] (extension; 1 in the paper).
+
+    Roasting swells coffee beans: the water vapour and the carbon dioxide the roast reactions release
+    press on cell walls that the heat has made rubbery, and a roasted bean has gained 50-100 % of its
+    green volume while losing 12-20 % of its mass (Schenker, "Investigations on the hot air roasting of
+    coffee beans", ETH Zurich diss. 13620, 2000; Perren, Geiger, Schenker and Escher, ASIC 2004). The
+    volume gain is taken in proportion to the reactions' extent He/Het (eq. 14's exothermic heat over
+    its total): V / V0 = 1 + bean_swell He / Het. With the number of beans fixed, each bean's surface
+    goes as s^2, and so does the beans' area Ab (section 3.1; :func:`bed_areas_m2`); the bed's volume
+    goes as s^3 at a fixed porosity, so a shallow bed's depth goes as s^2 (a circular segment of depth
+    h << D holds an area (4/3) sqrt(D) h^(3/2) per unit length) and its wetted arc and free surface as s
+    (their widths go as sqrt(h)): :func:`probe_coverage`, :func:`bed_areas_m2`, :func:`wall_radiation_kW`.
+    ``bean_swell`` 0 (the default): s = 1 exactly, the paper's beans.
+    """
+    if p[I_SWELL] == 0.0:  # the lanes compile it in as a constant (roastlab.sim.lanes.LAW_SLOTS)
+        return 1.0
+    return power(1.0 + p[I_SWELL] * fmax(He, 0.0) * (1.0 / p[I_HET]), 1.0 / 3.0)
+
+
+@register_jitable
+def bed_areas_m2(p, s):
+    """(Agb, Abm) [m^2] under the model's contact law (:mod:`roastlab.model.bed`) and gas area, for
+    beans of ``s`` times their green size (:func:`swell_factor`; 1 in the paper).
 
     ``contact_law`` 0 (the paper, section 3.1): :func:`bean_areas_m2`, both shares of Ab.
     1 (``"wall"``): Abm = Pbm A_wall, the share Pbm of the drum wall the bed wets
@@ -174,12 +197,13 @@ def bed_areas_m2(p):
     batch loses less heat to cool air per kilogram than the paper's Agb gives. Agb then no longer
     depends on Pbm, so hbm and Pbm act only as their product (hold Pbm when fitting).
     """
+    Ab = p[I_AB] * (s * s)  # each bean's surface as its size squared
     if p[I_CONTACT] == 0.0:
-        Agb, Abm = bean_areas_m2(p[I_AB], p[I_PBM])
+        Agb, Abm = bean_areas_m2(Ab, p[I_PBM])
     else:
-        Abm = p[I_PBM] * p[I_AWALL]
-        Agb = fmax(p[I_AB] - Abm, 0.01 * p[I_AB])
-    return where(p[I_KFLIGHT] > 0.0, p[I_KFLIGHT] * p[I_ASURF], Agb), Abm
+        Abm = p[I_PBM] * p[I_AWALL] * s  # the wetted arc widens as the bed deepens
+        Agb = fmax(Ab - Abm, 0.01 * Ab)
+    return where(p[I_KFLIGHT] > 0.0, p[I_KFLIGHT] * p[I_ASURF] * s, Agb), Abm
 
 
 @register_jitable
@@ -325,7 +349,7 @@ def drum_start_reading_C(drum_C, share, room_C):
 
 
 @register_jitable
-def wall_radiation_kW(Tb, Tm, p):
+def wall_radiation_kW(Tb, Tm, s, p):
     """Heat the drum wall radiates to the bean bed, Qrad = eps sigma A_surf (Tm^4 - Tb^4) [kW]
     (temperatures in kelvin; ``Tb``, ``Tm`` [degC]).
 
@@ -337,17 +361,17 @@ def wall_radiation_kW(Tb, Tm, p):
     ``eps_rad`` [-] (about 0.8 for beans at 0.9 in a steel drum at 0.6 whose wall is six times
     the surface, the Bullet at 500 g). The surface grows more slowly than the batch (the chord of
     the bed's segment), so a small batch takes more of this heat per kilogram than a large one;
-    eps_rad 0 (the default) is the paper's model.
+    swollen beans (``s``, :func:`swell_factor`) widen it as s. eps_rad 0 (the default) is the paper's model.
     """
     a = Tm + KELVIN
     b = Tb + KELVIN
     a2 = a * a
     b2 = b * b
-    return p[I_EPSRAD] * STEFAN_BOLTZMANN_KW_M2K4 * p[I_ASURF] * (a2 * a2 - b2 * b2)
+    return p[I_EPSRAD] * STEFAN_BOLTZMANN_KW_M2K4 * p[I_ASURF] * s * (a2 * a2 - b2 * b2)
 
 
 @register_jitable
-def probe_coverage(p):
+def probe_coverage(p, s):
     """Share c of the bean probe the bean bed covers [-] (eq. 17 extended; :mod:`roastlab.model.bed`).
 
     The paper's probe is always immersed: c = 1, also whenever h_probe is 0 (the default).
@@ -356,31 +380,34 @@ def probe_coverage(p):
     where the probe sits, is identified from the logs. ``probe_law`` 0 (a bed at rest):
     c = min(1, h_bed / h_probe), coverage linear in the depth up to the covering depth h_probe;
     1 (a tumbling bed): c = 1 - exp(-h_bed / h_probe), the Boolean-coverage law of beans laid
-    over the probe at random, h_probe the e-folding depth.
+    over the probe at random, h_probe the e-folding depth. Beans ``s`` times their green size
+    (:func:`swell_factor`) deepen the bed to h_bed s^2.
     """
     h_probe = p[I_HPROBE]
+    h_bed = p[I_HBED] * (s * s)  # swollen beans deepen the bed (:func:`swell_factor`)
     if p[I_PROBELAW] == 0.0:
-        return where(h_probe > p[I_HBED], p[I_HBED] / fmax(h_probe, 1e-12), 1.0)
-    return where(h_probe > 0.0, 1.0 - exp(-p[I_HBED] / fmax(h_probe, 1e-12)), 1.0)
+        return where(h_probe > h_bed, h_bed / fmax(h_probe, 1e-12), 1.0)
+    return where(h_probe > 0.0, 1.0 - exp(-h_bed / fmax(h_probe, 1e-12)), 1.0)
 
 
 @register_jitable
-def probe_rate_C_s(Tb, Ta, Tg, p):
+def probe_rate_C_s(Tb, Ta, Tg, s, p):
     """dTa/dt [degC/s]: eq. 17, Kt (Tb - Ta), with the probe-immersion extension
     Kt [c (Tb - Ta) + (1 - c) (Tg - Ta)]: the covered share c of the probe (:func:`probe_coverage`)
-    follows the beans, the rest the gas in the drum at ``Tg`` (:func:`probe_gas_C`). With c = 1
-    it is eq. 17 exactly.
+    follows the beans, the rest the gas in the drum at ``Tg`` (:func:`probe_gas_C`), ``s`` the
+    beans' size (:func:`swell_factor`). With c = 1 it is eq. 17 exactly.
     """
-    c = probe_coverage(p)
+    c = probe_coverage(p, s)
     return p[I_KT] * (c * (Tb - Ta) + (1.0 - c) * (Tg - Ta))
 
 
 @register_jitable
-def exchanger(Tb, Tm, X, Gg, Tgi, p):
+def exchanger(Tb, Tm, X, s, Gg, Tgi, p):
     """The gas path of eq. 15e: ``(T_star [degC], NTU [-], w [-], Agb, Abm [m^2], he [kW/(m^2 K)], cg [kJ/(kg K)])``.
 
     T* = (Tb + F Tm)/(1 + F) is the mean sink temperature (eq. 5/15e), NTU = he Agb (1 + F)/(Gg cg)
-    (eq. 15e), F = hgm Agm/(he Agb) eq. 6, the areas from :func:`bed_areas_m2`, he eq. 3, cg eq. 2;
+    (eq. 15e), F = hgm Agm/(he Agb) eq. 6, the areas from :func:`bed_areas_m2` for beans of size ``s``
+    (:func:`swell_factor`), he eq. 3, cg eq. 2;
     w = F/(1 + F) is the metal's share of the sink conductance, the factor of eq. 10.
 
     Evaluated through the conductances G = he Agb (gas-bean) and C = hgm Agm (gas-metal), F = C/G:
@@ -388,7 +415,7 @@ def exchanger(Tb, Tm, X, Gg, Tgi, p):
     w = C/(G + C) and NTU = (G + C)/(Gg cg), one reciprocal for all three where F's own quotient
     and the three divisions by (1 + F) took four (the integrator's inner loop; same values to rounding).
     """
-    Agb, Abm = bed_areas_m2(p)  # section 3.1 (or the bed's contact law)
+    Agb, Abm = bed_areas_m2(p, s)  # section 3.1 (or the bed's contact law), beans of size s
     he = bean_heat_transfer_coefficient_kW_m2K(X)  # eq. 3
     cg = gas_heat_capacity_kJ_kgK(Tgi)  # eq. 2
     G = he * Agb  # gas-bean conductance [kW/K]
@@ -427,13 +454,14 @@ def gas_heat_flows(Tb, Tm, Gg, Tgi, path, p):
 
 
 @register_jitable
-def heat_flows(Tb, Tm, X, Gg, Tgi, p):
+def heat_flows(Tb, Tm, X, He, Gg, Tgi, p):
     """Outlet gas temperature and heat flows at one instant, for the gas the chamber sees.
 
-    ``Gg`` [kg/s] and ``Tgi`` [degC] are the effective gas inputs (:func:`gas_inputs`).
+    ``Gg`` [kg/s] and ``Tgi`` [degC] are the effective gas inputs (:func:`gas_inputs`); ``He``
+    [kJ/kg dry] sets the beans' size (:func:`swell_factor`).
     Returns ``(Tgo [degC], Qgb, Qgm, Qbm [kW])`` (:func:`gas_heat_flows` of :func:`exchanger`).
     """
-    return gas_heat_flows(Tb, Tm, Gg, Tgi, exchanger(Tb, Tm, X, Gg, Tgi, p), p)
+    return gas_heat_flows(Tb, Tm, Gg, Tgi, exchanger(Tb, Tm, X, swell_factor(He, p), Gg, Tgi, p), p)
 
 
 @register_jitable
@@ -466,17 +494,18 @@ def derivatives(Tb, Tm, X, He, Ta, H, Gg, Tgi, heater, fan, p):
     """
     D = heater_drive(H, p)  # the heat the lagged setting releases, once per evaluation
     g, T = gas_inputs(Gg, Tgi, D, fan, p)
-    path = exchanger(Tb, Tm, X, g, T, p)  # eq. 15e's gas path, once per evaluation
+    s = swell_factor(He, p)  # the beans' size (extension; 1 in the paper)
+    path = exchanger(Tb, Tm, X, s, g, T, p)  # eq. 15e's gas path, once per evaluation
     Tgo, Qgb, Qgm, Qbm = gas_heat_flows(Tb, Tm, g, T, path, p)
     dX = moisture_rate_1_s(Tb, X, p)  # eq. 15c
     Qr = reaction_heat_rate_kW_kg(Tb, He, p)  # eq. 15d
     Mbd = p[I_MBD]
     cs = 1.099 + 0.007 * Tb  # partial heat capacity of bean solids, section 3.2
-    Qrad = wall_radiation_kW(Tb, Tm, p)  # the wall's radiation to the bed (extension; 0 in the paper)
+    Qrad = wall_radiation_kW(Tb, Tm, s, p)  # the wall's radiation to the bed (extension; 0 in the paper)
     dTb = (Qgb - Qgm + Qbm + Qrad + Mbd * (Qr + p[I_LAM] * dX)) / (Mbd * (cs + p[I_CW] * X))  # eq. 15a
     # eq. 15b, eq. 12's Qe; 1/(Mm cm) and 1/tau depend on the parameters alone (once per run compiled)
     dTm = (Qgm - Qbm - Qrad + heater_power_kW(D, p) - shell_loss_kW(Tm, p)) * (1.0 / (p[I_MM] * p[I_CM]))
-    dTa = probe_rate_C_s(Tb, Ta, probe_gas_C(T, Tgo, path[0], path[1], p), p)  # eq. 17 (probe immersion: extension)
+    dTa = probe_rate_C_s(Tb, Ta, probe_gas_C(T, Tgo, path[0], path[1], p), s, p)  # eq. 17 (probe immersion: extension)
     dH = (heater - H) * (1.0 / p[I_TAUH]) * heater_lag_factor(H, p)  # actuator lag (extension)
     return dTb, dTm, dX, Qr, dTa, dH
 
@@ -485,7 +514,7 @@ def derivatives(Tb, Tm, X, He, Ta, H, Gg, Tgi, heater, fan, p):
 def outlet_gas_C(x, Gg, Tgi, fan, p):
     """Outlet gas temperature Tgo [degC] at state ``x`` (eq. 15e, effective gas inputs)."""
     g, T = gas_inputs(Gg, Tgi, heater_drive(x[S_H], p), fan, p)
-    return heat_flows(x[S_TB], x[S_TM], x[S_X], g, T, p)[0]
+    return heat_flows(x[S_TB], x[S_TM], x[S_X], x[S_HE], g, T, p)[0]
 
 
 @register_jitable

@@ -26,7 +26,7 @@ from numba.core import cgutils, types
 from numba.core.errors import NumbaIRAssumptionWarning
 from numba.extending import intrinsic, register_jitable
 
-from ..model.layout import I_CONTACT, I_FEXP, I_HEXP, I_HLEXP, I_PROBEGAS, I_PROBELAW, I_XEXP, N_PARAMS
+from ..model.layout import I_CONTACT, I_FEXP, I_HEXP, I_HLEXP, I_PROBEGAS, I_PROBELAW, I_SWELL, I_XEXP, N_PARAMS
 from ..model.rhs import outlet_gas_C, rebind
 from . import vecmath
 from .cache import compiled
@@ -120,11 +120,11 @@ def _k(stage, i):
 
 
 #: The parameter slots that choose a law (bed laws, the moisture exponent, the heater's and the fan's
-#: drive exponents, the heater's lag exponent): one value for every run of a lanes call, compiled in as
-#: constants (see :func:`law_key`; an exponent that is not a whole number, a gas burner's or a draft's
-#: square root, a radiant heater's 3/4, runs the scalar integrator, as its power in every lane would
-#: cost more than the lanes gain).
-LAW_SLOTS = (I_CONTACT, I_PROBELAW, I_PROBEGAS, I_XEXP, I_HEXP, I_FEXP, I_HLEXP)
+#: drive exponents, the heater's lag exponent, the beans' swelling): one value for every run of a lanes
+#: call, compiled in as constants (see :func:`law_key`; an exponent or a swelling that is not a whole
+#: number, a gas burner's or a draft's square root, a radiant heater's 3/4, runs the scalar integrator,
+#: as its power in every lane would cost more than the lanes gain).
+LAW_SLOTS = (I_CONTACT, I_PROBELAW, I_PROBEGAS, I_XEXP, I_HEXP, I_FEXP, I_HLEXP, I_SWELL)
 _LAW_BASE = 4  # each law slot's value is a whole number below this
 
 

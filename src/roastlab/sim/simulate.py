@@ -151,7 +151,7 @@ class SimulationResult(Result):
         g, T = self.gas_seen()
         for i in range(n):
             Tb, Tm, X, He, _, H = self.states[i]
-            _, Qgb, Qgm, Qbm = heat_flows(Tb, Tm, X, g[i], T[i], self.params)
+            _, Qgb, Qgm, Qbm = heat_flows(Tb, Tm, X, He, g[i], T[i], self.params)
             Qr = Mbd * reaction_heat_rate_kW_kg(Tb, He, self.params)
             q[i] = (
                 Qgb,
