@@ -118,10 +118,11 @@ def test_skywalker_fit_on_bt_alone_fails_on_its_states(cli, real_data, tmp_path)
     common = ["--plant", EXAMPLE / "plant.toml", "--map", EXAMPLE / "map.toml"]
     # the example's spec, the fan's share of the flow left out (held at 0) and the drum at CHARGE BT
     # itself (Tm0_share held at 1, the example until 2026-11-27; freed, the drum starts hotter and
-    # these two logs find a physical optimum on BT alone)
+    # these two logs find a physical optimum on BT alone), the beans of a fixed size (the example until
+    # session 35; with them swelling, this fit fails first on the beans' temperature at first crack)
     spec = tmp_path / "fit.toml"
     lines = (EXAMPLE / "fit.toml").read_text().splitlines(keepends=True)
-    spec.write_text("".join(ln for ln in lines if not ln.startswith(("Gg_fan_kg_s", "Tm0_share"))))
+    spec.write_text("".join(ln for ln in lines if not ln.startswith(("Gg_fan_kg_s", "Tm0_share", "bean_swell"))))
     args = ("identify", *common, "--spec", spec, *fit_logs, "--out", theta, "--starts", "2")
     code, out, err = cli(*args, "--weight", "ET=0", "--weight", "Tb2=0")  # the probe alone
     errors = [line for line in err.splitlines() if line.startswith("error:")]
@@ -740,7 +741,10 @@ def test_skywalker_whatif_set_and_tm0(cli, real_data, tmp_path):
     logs = sorted(real_data.glob("*.alog"))[3:6]  # ET read as the drum's air on these (the map)
     model = tmp_path / "sky.json"
     common = ["--plant", EXAMPLE / "plant.toml", "--map", EXAMPLE / "map.toml"]
-    assert cli("identify", *common, "--spec", EXAMPLE / "fit.toml", *logs[:2], "--out", model, "--starts", "2")[0] == 0
+    # fitted on all three: the first two, one afternoon's, leave the example's 12 parameters an optimum with
+    # the drum under the beans since the beans swell (session 35), a fit that fails as it should
+    code, _, err = cli("identify", *common, "--spec", EXAMPLE / "fit.toml", *logs, "--out", model, "--starts", "2")
+    assert code == 0, err
     code, out, err = cli(
         "whatif", logs[2], "--model", model, "--set", "heater=0@60", "--tm0", "150", "--json", tmp_path / "w.json"
     )
