@@ -183,7 +183,8 @@ def bed_areas_m2(p, s):
     """(Agb, Abm) [m^2] under the model's contact law (:mod:`roastlab.model.bed`) and gas area, for
     beans of ``s`` times their green size (:func:`swell_factor`; 1 in the paper).
 
-    ``contact_law`` 0 (the paper, section 3.1): :func:`bean_areas_m2`, both shares of Ab.
+    ``contact_law`` 0 (the paper, section 3.1): :func:`bean_areas_m2`, both shares of Ab. Swollen beans
+    (s > 1) scale Ab by s^2 and A_wall and A_surf below by s (:func:`swell_factor`).
     1 (``"wall"``): Abm = Pbm A_wall, the share Pbm of the drum wall the bed wets
     (:attr:`roastlab.model.plant.Plant.wall_contact_area_m2`), and Agb = Ab - Abm, every other
     bean surface (never below 1 % of Ab).
