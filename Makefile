@@ -21,11 +21,12 @@ $(STAMP): pyproject.toml
 # thread per worker 569 s, back to back.
 # Each kernel is compiled first, once, in a pool of processes (roastlab compile): started together, the
 # workers compiled the same kernels at the same time (128 s of a clean clone's 445 s of compiling,
-# 2026-11-29); with a warm cache the step takes a few seconds. The lanes for the paper's laws and the
-# Bullet example's, which most tests call; the lanes tests' own laws still compile in the suite.
+# 2026-11-29); with a warm cache the step takes a few seconds. The lanes for the paper's laws and both
+# examples' (the Skywalker's with its held swelling), which most tests call; the lanes tests' and the
+# synthetic comparisons' own laws still compile in the suite.
 TEST_WORKERS ?= auto
 test: $(STAMP)
-	$(VENV)/bin/roastlab compile examples/bullet/fit.toml
+	$(VENV)/bin/roastlab compile examples/bullet/fit.toml examples/skywalker/fit.toml
 	$(PY) -m pytest -n $(TEST_WORKERS)
 
 # The inner loop: every test but those marked slow (make test, which CI runs, has them all).

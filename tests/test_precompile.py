@@ -33,12 +33,15 @@ def dispatchers():
                     found[f"{m.__name__}.{name}"] = obj
     return found
 
-for job, args in precompile.jobs():
+# the paper's laws, and the Skywalker example's (its bed laws and its held swelling, a lanes constant)
+held = precompile.law_set_of("examples/skywalker/fit.toml")
+for job, args in precompile.jobs([precompile.LawSet(), held]):
     job(*args)
 before = {k: set(d.overloads) for k, d in dispatchers().items()}
 batches = roastlab.read_dataset(roastlab.default_dataset_root() / "dataset-I").batches[:1]
 res = roastlab.fit(batches, "120kg", starts=1)
 res.model.validate(batches)
+roastlab.fit(batches, "120kg", starts=1, bed=held.bed, fix=dict(held.held))
 simulate_population(pack_batches(batches, "120kg", roastlab.THETA_PAPER), ["hbm"], np.full((16, 1, 1), 0.03))
 roastlab.simulate("120kg", batches[0].time_s, batches[0].Gg_kg_s, batches[0].Tgi_C)
 gained = {k: [str(s) for s in set(d.overloads) - before.get(k, set())] for k, d in dispatchers().items()}
@@ -74,6 +77,30 @@ def test_a_model_files_laws_are_its_bed_and_moisture_law(tmp_path):
     assert laws == precompile.LawSet(BedLaws(probe="tumbling", probe_gas="mean"), "schwartzberg")
     todo = precompile.jobs([precompile.LawSet(), laws])
     assert todo[1] == (precompile.job_lanes, ("probe=tumbling,probe_gas=mean", "schwartzberg"))
+
+
+def test_a_held_value_the_lanes_compile_in_is_part_of_the_set_of_laws(tmp_path):
+    """A spec's or a model file's held value of a lanes constant (the beans' swelling) that differs from
+    the quantity table's default is part of its set of laws, so ``compile`` builds the lanes a fit with
+    it calls; a held value equal to the default, or of a parameter the lanes do not compile in, is not."""
+    from roastlab.workflows.model import FittedModel
+
+    spec = tmp_path / "fit.toml"
+    spec.write_text(
+        "[free]\nhbm = [0.001, 0.1, 0.02]\n[fixed]\nbean_swell = 1.0\nheater_exp = 1.0\nhgm = 0.02\n"
+        '[bed]\nprobe = "tumbling"\n'
+    )
+    laws = precompile.law_set_of(spec)
+    assert laws == precompile.LawSet(BedLaws(probe="tumbling"), "schwartzberg", (("bean_swell", 1.0),))
+    assert laws.name.endswith("bean_swell 1")
+    todo = precompile.jobs([precompile.LawSet(), laws, precompile.LawSet(BedLaws(probe="tumbling"))])
+    assert [args for _, args in todo[:3]] == [
+        ("paper", "schwartzberg"),
+        ("probe=tumbling", "schwartzberg", (("bean_swell", 1.0),)),
+        ("probe=tumbling", "schwartzberg"),
+    ]
+    model = FittedModel.paper().with_values(bean_swell=1.0, heater_exp=1.0)
+    assert precompile.law_set_of(model.save(tmp_path / "model.json")).held == (("bean_swell", 1.0),)
 
 
 def test_each_family_of_jobs_keeps_its_processes():

@@ -38,15 +38,16 @@ def add_parsers(sub) -> None:
         "the cache), each once, in a pool of processes, the lanes and the other kernels each in processes of their own. "
         "A first run of any command otherwise "
         f"compiles what it needs on one core ({FIRST_COMPILE}). The lanes integrator, which "
-        "simulates many runs at once, is compiled once per set of bed and moisture laws: the paper's always, "
-        "and those of each fit spec or model file given. With a warm cache it takes seconds.",
+        "simulates many runs at once, is compiled once per set of laws (the bed and moisture laws, and the held "
+        "values it compiles in: the drive exponents, the beans' swelling): the paper's always, and those of each "
+        "fit spec or model file given. With a warm cache it takes seconds.",
     )
     p.add_argument(
         "laws",
         nargs="*",
         metavar="SPEC_OR_MODEL",
-        help="fit specs (fit.toml) or model files (MODEL.json) whose bed and moisture laws to compile the "
-        "lanes for, besides the paper's",
+        help="fit specs (fit.toml) or model files (MODEL.json) whose laws (bed, moisture, held exponents and "
+        "swelling) to compile the lanes for, besides the paper's",
     )
     p.add_argument(
         "--processes",

@@ -31,19 +31,42 @@ from ..model.bed import BedLaws
 
 @dataclass(frozen=True)
 class LawSet:
-    """The laws a set of runs shares, which the lanes integrator compiles in (one kernel per set)."""
+    """The laws a set of runs shares, which the lanes integrator compiles in (one kernel per set):
+    the bed laws, the moisture law, and ``held``, the held values of the other parameters the lanes
+    compile in as constants (:data:`roastlab.sim.lanes.LAW_SLOTS`: the drive exponents, the beans'
+    swelling) where they differ from the quantity table's defaults, as sorted (name, value) pairs."""
 
     bed: BedLaws = BedLaws()
     moisture: str = "schwartzberg"
+    held: tuple[tuple[str, float], ...] = ()
 
     @property
     def name(self) -> str:
-        return f"{self.bed.name}, {self.moisture} moisture"
+        held = "".join(f", {k} {v:g}" for k, v in self.held)
+        return f"{self.bed.name}, {self.moisture} moisture{held}"
+
+
+def held_law_values(values: dict[str, float]) -> tuple[tuple[str, float], ...]:
+    """The entries of ``values`` (registry names) that the lanes compile in as constants and that differ
+    from the quantity table's defaults, sorted by name: :attr:`LawSet.held`. The bed laws' and the
+    moisture law's slots are set by those laws, not here."""
+    from ..model.parameters import REGISTRY
+    from ..sim.lanes import LAW_SLOTS
+    from ..sim.population import PARAM_SLOTS
+
+    return tuple(
+        sorted(
+            (name, float(v))
+            for name, v in values.items()
+            if PARAM_SLOTS.get(name) in LAW_SLOTS and float(v) != REGISTRY[name].default
+        )
+    )
 
 
 def law_set_of(path) -> LawSet:
-    """The laws of a fit spec (``.toml``: its ``[bed]``, the default moisture law) or a model file
-    (``.json``: its bed and moisture law)."""
+    """The laws of a fit spec (``.toml``: its ``[bed]``, the default moisture law, its ``[fixed]``
+    values the lanes compile in) or a model file (``.json``: its bed and moisture law, its values the
+    lanes compile in)."""
     from pathlib import Path
 
     path = Path(path)
@@ -51,10 +74,11 @@ def law_set_of(path) -> LawSet:
         from .model import load_model
 
         model = load_model(path)
-        return LawSet(model.bed or BedLaws(), model.moisture)
+        return LawSet(model.bed or BedLaws(), model.moisture, held_law_values(model.values))
     from ..io.fitspec import load_fit_spec
 
-    return LawSet(load_fit_spec(path).bed)
+    spec = load_fit_spec(path)
+    return LawSet(spec.bed, held=held_law_values(spec.fixed))
 
 
 def _batch():
@@ -75,15 +99,18 @@ def _packed(laws: LawSet = LawSet(), n: int = 1):
     return pack_batches([_batch()] * n, "120kg", THETA_PAPER, moisture=laws.moisture, bed=laws.bed)
 
 
-def job_lanes(bed: str, moisture: str) -> str:
+def job_lanes(bed: str, moisture: str, held: tuple[tuple[str, float], ...] = ()) -> str:
     """The lanes integrator for one set of laws (:func:`roastlab.sim.population.predict_outputs`)."""
     from ..sim import lanes
     from ..sim.population import predict_outputs
 
-    packed = _packed(LawSet(BedLaws.parse(bed), moisture))
-    values = np.full((lanes.MIN_RUNS, 1, 1), 0.0254)
-    predict_outputs(packed, ["hbm"], values, with_tgo=True, use_lanes=True)
-    return f"lanes ({bed}, {moisture} moisture)"
+    laws = LawSet(BedLaws.parse(bed), moisture, tuple(held))
+    packed = _packed(laws)
+    names = ["hbm", *(k for k, _ in laws.held)]
+    values = np.empty((lanes.MIN_RUNS, 1, len(names)))
+    values[:] = [0.0254, *(v for _, v in laws.held)]
+    predict_outputs(packed, names, values, with_tgo=True, use_lanes=True)
+    return f"lanes ({laws.name})"
 
 
 def job_population() -> str:
@@ -133,7 +160,7 @@ def jobs(law_sets=(LawSet(),)) -> list[tuple]:
         if laws not in seen:
             seen.append(laws)
     return [
-        *((job_lanes, (laws.bed.name, laws.moisture)) for laws in seen),
+        *((job_lanes, (laws.bed.name, laws.moisture, *((laws.held,) if laws.held else ()))) for laws in seen),
         (job_population, ()),
         (job_sensitivities, ()),
         (job_stepper, ()),
