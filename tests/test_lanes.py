@@ -33,6 +33,8 @@ def _apply(name, x, a=0.0):
     for i in range(x.size):
         if name == "exp":
             out[i] = vecmath.exp(x[i])
+        elif name == "cube_root":
+            out[i] = vecmath.cube_root(x[i])
         elif name == "log":
             out[i] = vecmath.log(x[i])
         else:
@@ -61,6 +63,10 @@ def test_vectorisable_exp_log_power_match_numpy():
     assert np.max(np.abs(_apply("power", base, -0.2) / base**-0.2 - 1.0)) < 1e-14
     assert _apply("power", np.array([0.0]), -0.2)[0] == np.inf and _apply("power", np.array([0.0]), 2.0)[0] == 0.0
     assert _apply("power", np.array([0.3]), 0.0)[0] == 1.0
+    v = np.concatenate([np.linspace(0.2, 16.0, 400_001), [1.0, 4.0, 8.0]])  # the range its docstring states
+    cube = _apply("cube_root", v)
+    assert np.max(np.abs(cube - np.cbrt(v)) / np.spacing(np.cbrt(v))) <= 1.0
+    assert cube[-3] == 1.0 and cube[-1] == 2.0
 
 
 def _runs(seed: int, n_runs: int, bed=None, moisture="schwartzberg", actuators=False, held=()):

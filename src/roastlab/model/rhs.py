@@ -126,6 +126,14 @@ def power(x, a):
 
 
 @register_jitable
+def cube_root(v):
+    """``v ** (1/3)``: the beans' size (:func:`swell_factor`), an operation of its own so that
+    :func:`rebind` can replace it (the vectorised integrator's plain-arithmetic root,
+    :func:`roastlab.sim.vecmath.cube_root`)."""
+    return v ** (1.0 / 3.0)
+
+
+@register_jitable
 def where(condition, a, b):
     """``a`` where ``condition`` holds, else ``b`` (a branch that symbolic types can also take)."""
     return a if condition else b
@@ -175,7 +183,7 @@ def swell_factor(He, p):
     """
     if p[I_SWELL] == 0.0:  # the lanes compile it in as a constant (roastlab.sim.lanes.LAW_SLOTS)
         return 1.0
-    return power(1.0 + p[I_SWELL] * fmax(He, 0.0) * (1.0 / p[I_HET]), 1.0 / 3.0)
+    return cube_root(1.0 + p[I_SWELL] * fmax(He, 0.0) * (1.0 / p[I_HET]))
 
 
 @register_jitable
@@ -589,14 +597,14 @@ def checked_rhs(t, x, u, p) -> np.ndarray:
 
 
 #: The elementary operations :func:`rebind` may replace.
-OPERATIONS = ("exp", "fmax", "where", "power")
+OPERATIONS = ("exp", "fmax", "where", "power", "cube_root")
 
 
 def rebind(**operations) -> types.SimpleNamespace:
     """This module's equations evaluated with other elementary operations: the one right-hand side
     for other number types, never a copy of it.
 
-    ``operations`` replace ``exp``, ``fmax``, ``where`` and ``power`` (e.g. ``casadi.exp``,
+    ``operations`` replace ``exp``, ``fmax``, ``where``, ``power`` and ``cube_root`` (e.g. ``casadi.exp``,
     ``casadi.fmax``, ``casadi.if_else``; branch-free arithmetic versions for
     :mod:`roastlab.sim.lanes`). Returns a namespace of every function of this module rebuilt over those
     operations (``derivatives``, ``heat_flows`` ...); the parameter vector stays numeric.

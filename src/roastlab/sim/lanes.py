@@ -4,7 +4,7 @@
 right-hand side is ~35 ns of scalar work, a third of it four calls of the C library's ``exp``.
 Here :data:`LANES` runs share the same instructions: every stage evaluates the one right-hand
 side (:func:`roastlab.model.rhs.derivatives`, rebuilt by :func:`roastlab.model.rhs.rebind` with
-``exp`` and ``power`` of :mod:`roastlab.sim.vecmath`, plain arithmetic the compiler turns into
+``exp``, ``power`` and ``cube_root`` of :mod:`roastlab.sim.vecmath`, plain arithmetic the compiler turns into
 vector instructions) for every lane in one loop, so a vector register carries several runs.
 
 Each lane keeps its own step size, sample interval and error control, exactly the rules of
@@ -82,7 +82,7 @@ LANES = 32
 GROUPS_PER_THREAD = 4
 
 # the one right-hand side over vectorisable elementary operations, compiled inline into the lanes
-_vector_model = rebind(exp=vecmath.exp, power=vecmath.power)
+_vector_model = rebind(exp=vecmath.exp, power=vecmath.power, cube_root=vecmath.cube_root)
 for _name, _function in vars(_vector_model).items():
     # derivatives inline in numba's IR, as in the scalar integrator (the compiler would not inline a
     # function that large, and a call stops the loop's vectorisation); the compiler inlines the small
