@@ -99,6 +99,8 @@ def test_a_held_value_the_lanes_compile_in_is_part_of_the_set_of_laws(tmp_path):
         ("probe=tumbling", "schwartzberg", (("bean_swell", 1.0),)),
         ("probe=tumbling", "schwartzberg"),
     ]
+    gas = precompile.LawSet(held=(("heater_exp", 0.5),))  # a gas burner's square root: the scalar integrator
+    assert [job.__name__ for job, _ in precompile.jobs([gas])] == ["job_population", "job_sensitivities", "job_stepper"]
     model = FittedModel.paper().with_values(bean_swell=1.0, heater_exp=1.0)
     assert precompile.law_set_of(model.save(tmp_path / "model.json")).held == (("bean_swell", 1.0),)
 

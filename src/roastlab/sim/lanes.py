@@ -143,9 +143,16 @@ def law_key(PP: np.ndarray) -> int | None:
     first = PP[0, list(LAW_SLOTS)]
     if not np.all(PP[:, list(LAW_SLOTS)] == first[None, :]):
         return None
-    if not np.all((first == np.round(first)) & (first >= 0) & (first < _LAW_BASE)):
+    if not compiles_in(first):
         return None
     return int(sum(int(v) * _LAW_BASE**j for j, v in enumerate(first)))
+
+
+def compiles_in(values) -> bool:
+    """Whether law-slot ``values`` can be compiled in as constants (:func:`law_key`): whole numbers
+    from 0 to 3. Others (a gas burner's square root, a swelling of 0.5) run the scalar integrator."""
+    v = np.asarray(values, dtype=float)
+    return bool(np.all((v == np.round(v)) & (v >= 0) & (v < _LAW_BASE)))
 
 
 @intrinsic

@@ -154,10 +154,14 @@ def job_stepper() -> str:
 
 
 def jobs(law_sets=(LawSet(),)) -> list[tuple]:
-    """The jobs for ``law_sets`` (the paper's laws by default), the lanes first: (function, args)."""
+    """The jobs for ``law_sets`` (the paper's laws by default), the lanes first: (function, args). A set
+    whose held values the lanes cannot compile in (a gas burner's square root, a swelling of 0.5) has
+    no lanes job: its runs take the scalar integrator (:func:`roastlab.sim.lanes.compiles_in`)."""
+    from ..sim.lanes import compiles_in
+
     seen: list[LawSet] = []
     for laws in law_sets:
-        if laws not in seen:
+        if laws not in seen and compiles_in([v for _, v in laws.held]):
             seen.append(laws)
     return [
         *((job_lanes, (laws.bed.name, laws.moisture, *((laws.held,) if laws.held else ()))) for laws in seen),
