@@ -275,4 +275,4 @@ def compile_kernels(law_sets=(LawSet(),), processes: int | None = None, progress
     return done
 
 
-__all__ = ["LawSet", "law_set_of", "compile_kernels", "chains", "jobs", "process_count"]
+__all__ = ["LawSet", "law_set_of", "held_law_values", "compile_kernels", "chains", "jobs", "process_count"]
