@@ -60,7 +60,7 @@ wheel-check:
 
 # The measured figures of docs/real-roaster.md, from the real logs in ../shared/data/real.
 # Then every bed-law variant, the probe depth scale's profile and the two surface-scaled heat paths
-# cross-validated by batch size on the Bullet (14 variants x 9 fits), then by roaster (3 variants x 6
+# cross-validated by batch size on the Bullet (15 variants x 9 fits; the swelling beans since session 36), then by roaster (3 variants x 6
 # fits). Then the band's calibration: the example leave-one-log-out on the 17 nominal logs (18 fits)
 # and on 16 splits of them into 9 fit and 8 held out, and the Skywalker's held-out FIT on 16 halves of
 # its logs, with and without the fan (docs/band_splits.py, 4 + 4 min). Last, the Skywalker's 16
@@ -77,6 +77,7 @@ real-roaster: $(STAMP)
 	  $(foreach h,$(H_PROBE_PROFILE_M),--variant $(BED_EXAMPLE),h_probe_m=$(h),$(PAPER_EXOTHERM)) \
 	  --variant $(BED_BEFORE),h_probe_m=0.2,$(PAPER_EXOTHERM) \
 	  $(foreach x,$(SURFACE_HEAT),--variant $(BED_EXAMPLE),$(x)) \
+	  --variant $(BED_EXAMPLE),bean_swell=$(SKYWALKER_SWELL) \
 	  --json docs/real-roaster-compare.json --plot docs/real-roaster-compare.png
 	$(VENV)/bin/roastlab compare-models --plant examples/bullet/plant.toml --map examples/bullet/map.toml \
 	  --spec examples/bullet/fit.toml $(BULLET_WEIGHED) --group-by unit \
@@ -90,6 +91,8 @@ real-roaster: $(STAMP)
 	  --spec examples/skywalker/fit.toml $(SKYWALKER)/*.alog --group-by log \
 	  --variant $(BED_EXAMPLE) --variant $(BED_EXAMPLE),h_probe_m=$(SKYWALKER_DEPTH_M) --variant paper,h_probe_m=0 \
 	  --json docs/real-roaster-skywalker.json --plot docs/real-roaster-skywalker.png
+# the beans' swelling the Skywalker example holds, tried on the Bullet's sizes (docs/real-roaster.md, "Skywalker: the beans swell")
+SKYWALKER_SWELL = $(shell $(PY) -c "from roastlab.workflows.precompile import law_set_of as f; print(dict(f('examples/skywalker/fit.toml').held)['bean_swell'])")
 # the two heat paths that grow with the bed's surface, as the code holds them (roastlab.model.bed.SURFACE_HEAT)
 SURFACE_HEAT = $(shell $(PY) -c "from roastlab.model.bed import SURFACE_HEAT as s; print(' '.join(s))")
 # each bed law with the probe's depth scale fitted, then that scale's profile under the example's laws
