@@ -92,7 +92,7 @@ real-roaster: $(STAMP)
 	  --variant $(BED_EXAMPLE) --variant $(BED_EXAMPLE),h_probe_m=$(SKYWALKER_DEPTH_M) --variant paper,h_probe_m=0 \
 	  --json docs/real-roaster-skywalker.json --plot docs/real-roaster-skywalker.png
 # the beans' swelling the Skywalker example holds, tried on the Bullet's sizes (docs/real-roaster.md, "Skywalker: the beans swell")
-SKYWALKER_SWELL = $(shell $(PY) -c "from roastlab.workflows.precompile import law_set_of as f; print(dict(f('examples/skywalker/fit.toml').held)['bean_swell'])")
+SKYWALKER_SWELL = $(shell $(PY) -c "from roastlab.io.fitspec import load_fit_spec as f; print(f('examples/skywalker/fit.toml').fixed['bean_swell'])")
 # the two heat paths that grow with the bed's surface, as the code holds them (roastlab.model.bed.SURFACE_HEAT)
 SURFACE_HEAT = $(shell $(PY) -c "from roastlab.model.bed import SURFACE_HEAT as s; print(' '.join(s))")
 # each bed law with the probe's depth scale fitted, then that scale's profile under the example's laws

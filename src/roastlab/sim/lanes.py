@@ -121,9 +121,12 @@ def _k(stage, i):
 
 #: The parameter slots that choose a law (bed laws, the moisture exponent, the heater's and the fan's
 #: drive exponents, the heater's lag exponent, the beans' swelling): one value for every run of a lanes
-#: call, compiled in as constants (see :func:`law_key`; an exponent or a swelling that is not a whole
-#: number, a gas burner's or a draft's square root, a radiant heater's 3/4, runs the scalar integrator,
-#: as its power in every lane would cost more than the lanes gain).
+#: call, compiled in as constants (see :func:`law_key`). An exponent that is not a whole number, a gas
+#: burner's or a draft's square root, a radiant heater's 3/4, runs the scalar integrator, as its power in
+#: every lane would cost more than the lanes gain; so does a swelling that is not a whole number, as the
+#: key holds whole numbers only (its cube root is cheap, :func:`roastlab.sim.vecmath.cube_root`, but as
+#: a per-lane value the paper's beans would pay for it too: a vector instruction computes both sides of
+#: ``swell_factor``'s branch).
 LAW_SLOTS = (I_CONTACT, I_PROBELAW, I_PROBEGAS, I_XEXP, I_HEXP, I_FEXP, I_HLEXP, I_SWELL)
 _LAW_BASE = 4  # each law slot's value is a whole number below this
 
