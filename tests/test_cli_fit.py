@@ -150,6 +150,30 @@ def test_a_stage_of_unknown_length_shows_its_elapsed_time_and_clears_its_line(mo
         assert drawn.endswith("\r") if shown else drawn == ""
 
 
+def test_long_work_off_a_terminal_writes_a_plain_line_now_and_then(monkeypatch):
+    """Off a terminal (stderr a log file) no bar is drawn, but work longer than ``PROGRESS_LINE_S`` writes
+    one plain line with its count and elapsed time at most that often; short work writes nothing."""
+    import io
+    import sys
+    import time
+
+    from roastlab.cli import common
+
+    stream = io.StringIO()
+    monkeypatch.setattr(sys, "stderr", stream)
+    monkeypatch.setattr(common, "PROGRESS_LINE_S", 1.0)
+    update = common.progress("compare-models")
+    update(1, 4, "paper: all logs")  # at once: nothing
+    time.sleep(1.1)
+    update(2, 4, "paper: without 0.2 kg")
+    update(3, 4, "paper: without 0.35 kg")  # within a second of the last line: nothing
+    lines = stream.getvalue().splitlines()
+    assert lines == ["compare-models: 2/4 paper: without 0.2 kg [00:01]"], lines
+    time.sleep(1.1)
+    update(0, 0, "fitting 8 logs")  # a stage of unknown length: no count
+    assert stream.getvalue().splitlines()[1:] == ["compare-models: fitting 8 logs [00:02]"]
+
+
 def test_a_first_run_says_it_compiles_on_a_terminal(monkeypatch):
     """A command that compiles the kernels, on a machine whose cache holds none yet, says so on a
     terminal before the minute or two it takes; not off a terminal, not once the cache holds kernels,

@@ -94,18 +94,24 @@ FIRST_COMPILE = "1-3 minutes on a small machine"
 
 #: Work shorter than this shows no progress [s].
 PROGRESS_DELAY_S = 2.0
+#: Off a terminal (a log file, CI) long work writes one plain progress line at most this often [s].
+PROGRESS_LINE_S = 60.0
 
 
 def progress(desc: str):
     """A progress callback ``update(done, total, text)`` drawing a tqdm bar on a terminal, shown only
     for work over :data:`PROGRESS_DELAY_S`. ``total`` 0 opens a stage of unknown length (``text`` says
     what it is: "fitting 8 logs"), its elapsed time kept ticking until the next call, so that work
-    which reports nothing for a while (a first run's compile) is seen to be alive."""
+    which reports nothing for a while (a first run's compile) is seen to be alive. Off a terminal
+    (stderr redirected to a file) there is no bar to redraw: :func:`progress_lines` writes a plain line
+    instead, at most every :data:`PROGRESS_LINE_S`."""
     import threading
     import time
 
     from tqdm import tqdm
 
+    if not (hasattr(sys.stderr, "isatty") and sys.stderr.isatty()):
+        return progress_lines(desc)
     state: dict = {}
 
     def close() -> None:
@@ -146,6 +152,30 @@ def progress(desc: str):
         bar.update(done - bar.n)
         if done >= total:
             close()
+
+    return update
+
+
+def progress_lines(desc: str):
+    """:func:`progress` off a terminal: a plain line ``desc: done/total text [elapsed]`` on stderr at a call
+    :data:`PROGRESS_LINE_S` or more after the start and after the last line, so that a run of many minutes
+    redirected to a log (``make real-roaster``'s comparisons, an hour of fits) says that it is alive and how
+    far it has got, and a short one writes nothing."""
+    import time
+
+    from tqdm import tqdm
+
+    start = last = time.monotonic()
+
+    def update(done: int, total: int, text: str = "") -> None:
+        nonlocal last
+        now = time.monotonic()
+        if now - last < PROGRESS_LINE_S:
+            return
+        last = now
+        count = f" {done}/{total}" if total else ""
+        note = f" {text[:60]}" if text else ""
+        print(f"{desc}:{count}{note} [{tqdm.format_interval(now - start)}]", file=sys.stderr, flush=True)
 
     return update
 
