@@ -174,7 +174,7 @@ def progress_lines(desc: str):
             return
         last = now
         count = f" {done}/{total}" if total else ""
-        note = f" {text[:60]}" if text else ""
+        note = f" {text}" if text else ""  # a line, not a bar's postfix: said whole
         print(f"{desc}:{count}{note} [{tqdm.format_interval(now - start)}]", file=sys.stderr, flush=True)
 
     return update
