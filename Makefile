@@ -60,8 +60,8 @@ wheel-check:
 
 # The measured figures of docs/real-roaster.md, from the real logs in ../shared/data/real.
 # Then every bed-law variant, the probe depth scale's profile and the two surface-scaled heat paths
-# cross-validated by batch size on the Bullet (15 variants x 9 fits; the swelling beans since session 36), then by roaster (3 variants x 6
-# fits). Then the band's calibration: the example leave-one-log-out on the 17 nominal logs (18 fits)
+# cross-validated by batch size on the Bullet (15 variants x 9 fits; the swelling beans since session
+# 36), then by roaster (3 variants x 6 fits). Then the band's calibration: the example leave-one-log-out on the 17 nominal logs (18 fits)
 # and on 16 splits of them into 9 fit and 8 held out, and the Skywalker's held-out FIT on 16 halves of
 # its logs, with and without the fan (docs/band_splits.py, 4 + 4 min). Last, the Skywalker's 16
 # logs one by one: the example's bed laws, the same with the probe's depth at the Skywalker's, the paper's

@@ -105,13 +105,13 @@ def progress(desc: str):
     which reports nothing for a while (a first run's compile) is seen to be alive. Off a terminal
     (stderr redirected to a file) there is no bar to redraw: :func:`progress_lines` writes a plain line
     instead, at most every :data:`PROGRESS_LINE_S`."""
+    if not (hasattr(sys.stderr, "isatty") and sys.stderr.isatty()):
+        return progress_lines(desc)
     import threading
     import time
 
     from tqdm import tqdm
 
-    if not (hasattr(sys.stderr, "isatty") and sys.stderr.isatty()):
-        return progress_lines(desc)
     state: dict = {}
 
     def close() -> None:
@@ -134,20 +134,16 @@ def progress(desc: str):
                 desc=f"{desc}: {text}",
                 file=sys.stderr,
                 delay=PROGRESS_DELAY_S,
-                disable=None,
                 leave=False,
                 bar_format="{desc} [{elapsed}]",
             )
-            if not bar.disable:
-                state["since"], stop = time.monotonic(), threading.Event()
-                state["ticker"] = stop
-                threading.Thread(target=tick, args=(bar, stop), daemon=True).start()
+            state["since"], stop = time.monotonic(), threading.Event()
+            state["ticker"] = stop
+            threading.Thread(target=tick, args=(bar, stop), daemon=True).start()
             return
         if bar is None or bar.total != total or done < bar.n:  # the first call, or the next stage of the work
             close()
-            bar = state["bar"] = tqdm(
-                total=total, desc=desc, file=sys.stderr, delay=PROGRESS_DELAY_S, disable=None, leave=False
-            )
+            bar = state["bar"] = tqdm(total=total, desc=desc, file=sys.stderr, delay=PROGRESS_DELAY_S, leave=False)
         bar.set_postfix_str(text[:60], refresh=False)
         bar.update(done - bar.n)
         if done >= total:
