@@ -45,7 +45,7 @@ def add_parsers(sub) -> None:
         epilog="example:\n  roastlab app --data-dir roasts/          (put logs and model files in roasts/)",
     )
     p.add_argument("--data-dir", default=".", metavar="DIR", help="the folder of logs and models (default: here)")
-    p.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1, this machine only)")
-    p.add_argument("--port", type=int, default=8765, help="port (default 8765)")
+    p.add_argument("--host", default="127.0.0.1", help="address to bind (default %(default)s, this machine only)")
+    p.add_argument("--port", type=int, default=8765, help="port (default %(default)s)")
     p.add_argument("--no-browser", action="store_true", help="print the URL, do not open a browser")
     p.set_defaults(func=cmd_app)

@@ -203,6 +203,16 @@ def write_json_and_plot(out, args, doc, figure) -> None:
         figure.plot(args.plot, outputs=out)
 
 
+def write_artisan_files(out, args, result) -> None:
+    """Write ``--alog`` (``result.alog_text()``, an Artisan background) and ``--alarms``
+    (``result.alarms_text()``, an Artisan alarm set) through ``out`` when asked for: what ``whatif``
+    and ``transfer`` hand a roaster to roast against."""
+    if args.alog:
+        out.write_text(args.alog, result.alog_text())
+    if args.alarms:
+        out.write_text(args.alarms, result.alarms_text())
+
+
 def say(notes) -> None:
     for note in notes:
         print(f"note: {note}", file=sys.stderr)

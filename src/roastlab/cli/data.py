@@ -61,7 +61,7 @@ def add_parsers(sub) -> None:
     p.add_argument(
         "--data", metavar="DIR", help="folder holding dataset-I and dataset-V (default: the shipped synthetic data)"
     )
-    p.add_argument("--seed", type=seed_arg, default=0, help="seed of the identification (default 0)")
+    p.add_argument("--seed", type=seed_arg, default=0, help="seed of the identification (default %(default)s)")
     p.set_defaults(func=cmd_reproduce)
 
     p = sub.add_parser(

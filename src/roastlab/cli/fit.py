@@ -277,7 +277,7 @@ def add_parsers(sub) -> None:
     p.add_argument(
         "--method", choices=("global", "de"), default="global", help="global search (default) or differential evolution"
     )
-    p.add_argument("--seed", type=seed_arg, default=0, help="random seed of the search (default 0)")
+    p.add_argument("--seed", type=seed_arg, default=0, help="random seed of the search (default %(default)s)")
     add_starts_option(p)
     p.add_argument(
         "--fix", action="append", metavar="NAME=V", help="hold a parameter fixed, e.g. --fix hgm=0.01 (repeatable)"
@@ -364,7 +364,7 @@ def add_parsers(sub) -> None:
         type=float_arg("--group-step-kg"),
         help=f"green weights are grouped by rounding to this step [kg] (default {GROUP_STEP_SHARE:g} x the median)",
     )
-    p.add_argument("--seed", type=seed_arg, default=0, help="random seed of every fit (default 0)")
+    p.add_argument("--seed", type=seed_arg, default=0, help="random seed of every fit (default %(default)s)")
     add_starts_option(p, " per fit")
     p.add_argument("--json", metavar="COMPARE.json", help="write every variant's figures as JSON")
     p.add_argument(

@@ -136,6 +136,8 @@ def _add_wait(q) -> None:
 
 def add_parsers(sub) -> None:
     """Register ``roastlab fleet`` and its subcommands on the subparsers ``sub``."""
+    from ..fleet.drift import CUSUM_H, CUSUM_K
+
     parser_class = Parser
 
     p = sub.add_parser(
@@ -202,7 +204,7 @@ def add_parsers(sub) -> None:
         "--chunk",
         type=count_arg("--chunk", 1, 1_000_000),
         default=500,
-        help="batches per task and commit (default 500)",
+        help="batches per task and commit (default %(default)s)",
     )
     _add_wait(q)
     q.set_defaults(func=cmd_fleet_fit)
@@ -211,7 +213,7 @@ def add_parsers(sub) -> None:
         "report",
         help="each machine's coefficient history, drift alarms and outlier batches",
         description="Print each machine's coefficients (median and batch-to-batch spread), its drift alarms "
-        "(self-starting CUSUM, k = 0.5, h = 12) and outlier batches. --json writes the report (per machine: "
+        f"(self-starting CUSUM, k = {CUSUM_K:g}, h = {CUSUM_H:g}) and outlier batches. --json writes the report (per machine: "
         "alarms [{parameter, batch_index, started_at, direction, ...}], outliers, periods); --plot writes one "
         "figure per machine.",
     )
@@ -228,7 +230,7 @@ def add_parsers(sub) -> None:
     )
     q.add_argument("--out", required=True, metavar="DIR", help="folder to write into")
     q.add_argument(
-        "--batches", type=count_arg("--batches", 1, 10_000_000), default=1000, help="batches in all (default 1000)"
+        "--batches", type=count_arg("--batches", 1, 10_000_000), default=1000, help="batches in all (default %(default)s)"
     )
-    q.add_argument("--seed", type=int, default=14, help="random seed (default 14)")
+    q.add_argument("--seed", type=int, default=14, help="random seed (default %(default)s)")
     q.set_defaults(func=cmd_fleet_synthetic)

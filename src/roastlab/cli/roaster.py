@@ -174,7 +174,7 @@ def add_parsers(sub) -> None:
     )
     p.add_argument("dir", metavar="DIR", help="the folder 'roastlab init' wrote")
     p.add_argument("logs", nargs="+", metavar="LOG", help="the roaster's logs, or a folder of them")
-    p.add_argument("--seed", type=int, default=0, help="seed of the global search (default 0)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the global search (default %(default)s)")
     p.add_argument(
         "--every-log",
         action="store_true",

@@ -14,6 +14,7 @@ from .common import (
     read_inputs,
     say,
     warn_if_failed,
+    write_artisan_files,
     write_json_and_plot,
 )
 
@@ -89,10 +90,7 @@ def cmd_transfer(args) -> int:
     with outputs as out:
         out.write_text(args.out, result.program_csv_text())
         write_json_and_plot(out, args, result.to_json_dict(), result)
-        if args.alog:
-            out.write_text(args.alog, result.alog_text())
-        if args.alarms:
-            out.write_text(args.alarms, result.alarms_text())
+        write_artisan_files(out, args, result)
     return 0
 
 
@@ -230,13 +228,13 @@ def add_parsers(sub) -> None:
         "--interval-s",
         type=float_arg("--interval-s"),
         default=5.0,
-        help="spacing of the program's knots [s] (default 5)",
+        help="spacing of the program's knots [s] (default %(default)g)",
     )
     p.add_argument(
         "--tolerance",
         type=float_arg("--tolerance"),
         default=2.0,
-        help="feasible when max |predicted - target| <= this [degC] (default 2)",
+        help="feasible when max |predicted - target| <= this [degC] (default %(default)g)",
     )
     add_band_option(p, "the predicted BT's prediction band", "its median width and BT at DROP in the output, "
                     "shaded in --plot, in --json: where a roast run with the program is expected")  # fmt: skip

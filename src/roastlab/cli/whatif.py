@@ -14,6 +14,7 @@ from .common import (
     read_inputs,
     say,
     warn_if_failed,
+    write_artisan_files,
     write_json_and_plot,
 )
 
@@ -52,10 +53,7 @@ def cmd_whatif(args) -> int:
     print(result.table(units=args.units))
     with outputs as out:
         write_json_and_plot(out, args, result.to_json_dict(), result)
-        if args.alog:
-            out.write_text(args.alog, result.alog_text())
-        if args.alarms:
-            out.write_text(args.alarms, result.alarms_text())
+        write_artisan_files(out, args, result)
     return 0
 
 
