@@ -69,7 +69,8 @@ wheel-check:
 # docs/real_roaster.py 5 min, the variants 13, the roasters 3, the bands 5, the Skywalker 2). On
 # 2026-11-29 the machine ran the same code about three times slower (the Bullet example's fit 23-25 s
 # with the code of 2026-11-27 and with this one, against 7.9 s then): 69 min for the variants, 98 min
-# to the last step, whose 51 fits at about 22 s each were stopped.
+# to the last step, whose 51 fits at about 22 s each were stopped; run alone later that day (session 38)
+# the last step took 11 min and wrote its JSON and figure byte for byte as before.
 SKYWALKER = ../shared/data/real/skywalker
 real-roaster: $(STAMP)
 	$(PY) docs/real_roaster.py
