@@ -483,9 +483,14 @@ def test_a_folder_of_logs_is_read_and_a_recording_that_is_no_roast_is_named_and_
         "(1:00): an aborted recording, or CHARGE marked where the beans did not go in?)" in out
     )
     assert "LICENSE" not in out and ".r9" not in out and "r0.csv" not in out
+    # the files of another format are not read, and counted: here an export, in another folder another
+    # roaster's logs, which a roaster would otherwise not know were passed over
+    csv_passed_over = f"left out: 1 .csv file(s) in {folder}, not read: a folder stands for its logs of one format"
+    assert csv_passed_over in out and out.count("left out: ") == 5, out
     code, out, err = cli("fit-roaster", tmp_path / "cfg", folder)
     assert code == 0, err
-    assert out.count("left out: ") == 4 and "left out: empty.alog cannot be read as a roast" in out
+    assert out.count("left out: ") == 5 and "left out: empty.alog cannot be read as a roast" in out
+    assert csv_passed_over in out
     assert "held out: FIT" in out
     # the logs named one by one read the same; a folder with no log, or only recordings that are no
     # roast, is one line naming it (the latter: the first log's own problem)

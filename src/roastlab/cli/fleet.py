@@ -230,7 +230,10 @@ def add_parsers(sub) -> None:
     )
     q.add_argument("--out", required=True, metavar="DIR", help="folder to write into")
     q.add_argument(
-        "--batches", type=count_arg("--batches", 1, 10_000_000), default=1000, help="batches in all (default %(default)s)"
+        "--batches",
+        type=count_arg("--batches", 1, 10_000_000),
+        default=1000,
+        help="batches in all (default %(default)s)",
     )
     q.add_argument("--seed", type=int, default=14, help="random seed (default %(default)s)")
     q.set_defaults(func=cmd_fleet_synthetic)

@@ -543,10 +543,13 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
 FOLDER_LOG_SUFFIXES = (".alog", ".json", "", ".csv")
 
 
-def log_paths(paths) -> list[Path]:
+def log_paths(paths, passed_over: dict[str, str] | None = None) -> list[Path]:
     """The LOG arguments as files. A folder stands for the logs directly inside it, by name, of one
     format: the first of :data:`FOLDER_LOG_SUFFIXES` it holds (its hidden files, subfolders and
-    files of other suffixes are not logs). A folder with no log in it is refused, naming it."""
+    files of other suffixes are not logs). A folder with no log in it is refused, naming it.
+    ``passed_over``, where given, gets ``{folder: why}`` for each folder that also holds logs of a
+    later suffix, which are not read (the CSV exports beside Artisan's logs, or another roaster's
+    logs in the same folder): counted, so a roaster can name them to read them instead."""
     out: list[Path] = []
     for arg in map(Path, paths):
         if not arg.is_dir():
@@ -561,7 +564,14 @@ def log_paths(paths) -> list[Path]:
                 found.setdefault(suffix, []).append(p)
         if not found:
             raise InputError("no roast logs in this folder (Artisan .alog/.csv, RoasTime .json, CSV)", arg)
-        out += found[next(s for s in FOLDER_LOG_SUFFIXES if s in found)]
+        chosen = next(s for s in FOLDER_LOG_SUFFIXES if s in found)
+        out += found[chosen]
+        others = [f"{len(v)} {k or 'suffix-less'} file(s)" for k, v in found.items() if k != chosen]
+        if others and passed_over is not None:
+            passed_over[str(arg)] = (
+                f"{' and '.join(others)} in {arg}, not read: a folder stands for its logs of one format (its "
+                f"{chosen or 'suffix-less'} files); name the others to read them instead"
+            )
     return out
 
 
@@ -591,10 +601,12 @@ def survey(paths, batch_kg: float | None = None, units: dict | None = None) -> S
     batch mass, each with one message saying what to pass. A log that cannot be read as a roast
     is left out and named (:func:`readable_logs`). ``units`` (``{"heater": "kPa"}``, the roaster's
     word, :data:`CONTROL_UNITS`) sets a control's unit in place of what its name and values say."""
-    paths = log_paths(paths)
+    passed_over: dict[str, str] = {}
+    paths = log_paths(paths, passed_over)
     if not paths:
         raise InputError("give the roast logs of one roaster", "init")
     infos, unreadable = readable_logs(paths, batch_kg)
+    unreadable = {**passed_over, **unreadable}
     first = infos[0]
     kinds = {i.format for i in infos}
     if len(kinds) > 1:
@@ -1306,8 +1318,8 @@ def init_roaster(
     ``units``: a control's unit as the roaster gives it (:func:`survey`)."""
     from ..io.files import Outputs
 
-    paths = log_paths(paths)
     s = survey(paths, batch_kg, units)
+    paths = log_paths(paths)
     plant, notes = estimate_plant(s, capacity_kg, diameter_m, length_m)
     cap, _ = batch_capacity(s, capacity_kg)
     out = Path(out_dir)
@@ -1543,7 +1555,8 @@ def fit_roaster(
     for name in ("map.toml", "plant.toml", "fit.toml"):
         if not (d / name).is_file():
             raise InputError(f"no {name} here: run 'roastlab init LOG... --out {d}' first", d)
-    paths = log_paths(paths)
+    passed_over: dict[str, str] = {}
+    paths = log_paths(paths, passed_over)
     if len(paths) < 2:
         raise InputError(
             "give at least two logs: one to fit, one to hold out; one log alone is fitted, unchecked, by "
@@ -1558,7 +1571,7 @@ def fit_roaster(
         **logs_without_weight(infos),
         **logs_without_controls(infos, {k: (getattr(cmap, k) or {}).get("column") for k in ("heater", "fan")}),
     }
-    left_out = {**unreadable, **other_units, **unusable}
+    left_out = {**passed_over, **unreadable, **other_units, **unusable}
     if left_out:
         keep = [k for k, i in enumerate(infos) if i.path.name not in unusable]
         paths, infos = [paths[k] for k in keep], [infos[k] for k in keep]
