@@ -606,7 +606,6 @@ def survey(paths, batch_kg: float | None = None, units: dict | None = None) -> S
     if not paths:
         raise InputError("give the roast logs of one roaster", "init")
     infos, unreadable = readable_logs(paths, batch_kg)
-    unreadable = {**passed_over, **unreadable}
     first = infos[0]
     kinds = {i.format for i in infos}
     if len(kinds) > 1:
@@ -681,7 +680,7 @@ def survey(paths, batch_kg: float | None = None, units: dict | None = None) -> S
             "tens" if unit == "percent" and in_tens.get(what) else unit
             for unit, what in ((heater_unit, "heater"), (fan_unit, "fan"))
         )
-    notes = [f"left out: {why}" for why in unreadable.values()]
+    notes = [f"left out: {why}" for why in (*passed_over.values(), *unreadable.values())]
     given = {what: u for what, u in (units or {}).items() if u is not None}
     unit_of, name_of = {"heater": heater_unit, "fan": fan_unit}, {"heater": heater, "fan": fan}
     for what, unit in given.items():
