@@ -754,6 +754,7 @@ def test_init_and_fit_roaster_reach_the_hand_written_examples_on_the_shared_logs
     report = (tmp_path / "cfg" / "report.md").read_text()
     assert "sorted by date" in report and "held out" in report
     assert "| inside the 90 % band |" in report and "lie inside the 90 % prediction band" in report
+    assert "measured and predicted BT, the 90 % prediction band shaded" in report
     assert (tmp_path / "cfg" / "heldout.png").stat().st_size > 20_000
 
 
@@ -946,18 +947,31 @@ def _synthetic_gas_drum_logs(
 
 
 @pytest.mark.slow
-def test_an_unseen_gas_drum_with_burner_events_is_fitted_with_no_hand_edits(cli, tmp_path):
+def test_an_unseen_gas_drum_with_burner_events_is_fitted_with_no_hand_edits(cli, tmp_path, monkeypatch):
     """init + fit-roaster on SYNTHETIC logs of a gas drum whose burner is logged as special
     events (German names), given only its capacity: the burner is found by name, and the
     held-out FIT beats the first-order baseline fed the same inputs."""
+    from roastlab.report import figures
+
     logs = _synthetic_gas_drum_logs(tmp_path)
     code, out, err = cli("init", *logs, "--out", tmp_path / "cfg", "--batch-capacity-kg", "5")
     assert code == 0, err
     text = (tmp_path / "cfg" / "map.toml").read_text()
     # its outlet gas falls far at CHARGE (0.4 of the way from the room to the probe), not to the beans
     assert 'column = "Brenner"' in text and "ET: yes" in out, text
+    drawn = []  # the held-out figure's bands, as fit-roaster hands them to the figure
+    plot_fit = figures.plot_fit
+    monkeypatch.setattr(figures, "plot_fit", lambda result, **kw: drawn.append(kw["bands"]) or plot_fit(result, **kw))
     code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
     assert code == 0, err
+    # the figure shades each held-out log's band, the one the report scores
+    (bands,) = drawn
+    report = (tmp_path / "cfg" / "report.md").read_text()
+    assert "the 90 % prediction band shaded" in report
+    widths = [
+        float(r.split("|")[5]) for r in report.split("its median width °C |")[1].splitlines()[2:] if r.count("|") == 6
+    ]
+    assert [round(b.median_width_C, 1) for b in bands] == widths and len(widths) >= 2, report
     held = printed_percent(out, "held out: FIT ")
     base = printed_percent(out, "baseline: ")
     assert held > 80.0 and held > base + 10.0, out

@@ -389,12 +389,13 @@ def band_report(model, batches, level: float = BAND_LEVEL) -> tuple[dict, list[B
     return doc, bands
 
 
-def held_out_band(model, batches) -> dict | None:
-    """How well the model's 90 % prediction band holds logs it was not fitted on (:func:`band_report`
-    at :data:`BAND_LEVEL`); None when the model file can carry no band (:func:`why_no_band`)."""
+def held_out_band(model, batches) -> tuple[dict | None, list[Band] | None]:
+    """How well the model's 90 % prediction band holds logs it was not fitted on, and the bands, one
+    per batch, to draw (:func:`band_report` at :data:`BAND_LEVEL`); (None, None) when the model file
+    can carry no band (:func:`why_no_band`)."""
     if why_no_band(model) is not None:
-        return None
-    return band_report(model, batches, BAND_LEVEL)[0]
+        return None, None
+    return band_report(model, batches, BAND_LEVEL)
 
 
 def band_coverage(model, batches, level: float = BAND_LEVEL) -> list[dict]:

@@ -1642,14 +1642,15 @@ def fit_roaster(
         lines.append(f"| {name} | {value or how} | {se or ('on a bound' if how == 'fitted' else '-')} | {unit} |")
     lines += ["", "What the fit says in plain words:", ""]
     lines += [f"- {w}" for w in result.warnings] or ["- no warnings"]
+    band, bands = held_out_band(model, val_b)
+    shaded = f", the {100 * band['level']:.0f} % prediction band shaded" if band else ""
     lines += [
         "",
-        "Held-out logs, measured and predicted BT, and their rate of rise (right axis):",
+        f"Held-out logs, measured and predicted BT{shaded}, and their rate of rise (right axis):",
         "",
         f"![held out]({HELD_OUT_FIGURE})",
         "",
     ]
-    band = held_out_band(model, val_b)
     if band is None:
         lines += ["| held-out log | FIT % | MAE °C |", "|---|---|---|"]
         lines += [f"| {n} | {r['FIT']:.1f} | {r['MAE']:.2f} |" for n, r in zip(v_val.names, v_val.rows)]
@@ -1702,11 +1703,11 @@ def fit_roaster(
             lines += ["", f"Refitted (the fit on {sizes.fit_size} alone): {size_refit}."]
         if size_fit.failed:
             lines += ["", f"**The fit on {sizes.fit_size} alone failed**: {size_fit.failed}."]
-    from ..report.figures import figure_bytes
+    from ..report.figures import figure_bytes, plot_fit
     from ..report.markdown import html_document
 
     stage(0, 0, "writing the report and its figures")
-    figures = {d / HELD_OUT_FIGURE: v_val.plot()}
+    figures = {d / HELD_OUT_FIGURE: plot_fit(v_val, bands=bands)}
     if across is not None:
         figures[d / SIZES_FIGURE] = across_sizes_figure(across)
     pngs = {path: figure_bytes(fig, path) for path, fig in figures.items()}

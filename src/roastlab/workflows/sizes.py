@@ -97,7 +97,7 @@ def across_sizes(model, batches, split: SizeSplit) -> dict:
     order = split.reference + split.others
     chosen = [batches[k] for k in order]
     validation = model.validate(chosen)
-    band = held_out_band(model, chosen)
+    band, _ = held_out_band(model, chosen)
     band_rows = band["batches"] if band else None
     second = validation.outputs.get("Tb2", {})  # the model's beans against a second bean reading (an IR)
     beans = dict(zip(second.get("names", []), second.get("rows", [])))
