@@ -160,6 +160,11 @@ def test_results_display_and_plot_without_pyplot():
     sim_fig = result.model.predict(ds.batches[0]).plot()
     assert plt.get_fignums() == before  # not registered: Jupyter shows it once
     assert len(fig.axes) == 6 and len(sim_fig.axes) == 4  # per batch: BT with its RoR axis, residual
+    # one legend for the panels, below them, not one in each panel over its curves
+    (legend,) = fig.legends
+    assert not any(ax.get_legend() for ax in fig.axes[::3]) and not any(ax.get_legend() for ax in fig.axes[2::3])
+    assert [t.get_text() for t in legend.get_texts()] == [
+        "BT predicted (model Ta)", "BT measured (Ta)", "RoR predicted", "RoR measured"]  # fmt: skip
     frame = result.validation.to_frame()
     assert list(frame.index) == ["batch1", "batch2"] and "FIT" in frame
 

@@ -196,14 +196,14 @@ def plot_fit(result, path=None, title=None, max_panels: int = 8, outputs=None, b
     rows = (k + cols - 1) // cols
     fig = new_figure(figsize=(6.5 * cols, 4.6 * rows), layout="constrained")
     grid = fig.add_gridspec(rows * 2, cols, height_ratios=[3, 1] * rows)
+    entries = {}  # one legend for all panels, below them: in a panel it covered the curves' ends or the RoR's peak
     for i in range(k):
         r, c = divmod(i, cols)
         ax = fig.add_subplot(grid[2 * r, c])
         res = fig.add_subplot(grid[2 * r + 1, c], sharex=ax)
-        _profile_panel(ax, result, i)
+        _profile_panel(ax, result, i, legend=False)
         if bands is not None:
             _shade_band(ax, bands[i], "tab:green", "prediction band")
-            ax.legend(fontsize=8)
         t = result.time_s[i] / 60.0
         res.plot(t, result.measured[i] - result.predicted[i], color="tab:purple", lw=1, label="Ta meas − pred")
         second = result.results[i].Tb2_measured_C if i < len(result.results) else None
@@ -213,19 +213,23 @@ def plot_fit(result, path=None, title=None, max_panels: int = 8, outputs=None, b
             ax.plot(t, second, ":", color="tab:brown", lw=1.6, label="second bean reading (Tb2)")
             res.plot(t, second - sim.Tb_C, ":", color="tab:brown", lw=1, label="Tb2 − Tb")
             res.legend(fontsize=7, loc="lower right")
-        _ror_overlay(ax, result.time_s[i], result.measured[i], result.predicted[i])
+        for h, text in zip(*_ror_overlay(ax, result.time_s[i], result.measured[i], result.predicted[i])):
+            entries.setdefault(text, h)  # every panel draws the same curves; a second bean reading on some
         res.axhline(0.0, color="k", lw=0.6)
         res.set_ylabel("residual\nBT meas − pred [°C]", fontsize=8)
         time_axis(res)
         res.grid(alpha=0.3)
+    if entries:
+        fig.legend(list(entries.values()), list(entries), loc="outside lower center", ncol=4, fontsize=8)
     if len(result.names) > k:
         title = f"{title or ''} (first {k} of {len(result.names)} batches)".strip()
     return finish_figure(fig, path, title, outputs)
 
 
-def _ror_overlay(ax, time_s, measured, predicted) -> None:
+def _ror_overlay(ax, time_s, measured, predicted) -> tuple[list, list]:
     """Measured and predicted rate of rise [degC/min] on a right-hand axis of a BT panel, as
-    Artisan draws it (the one RoR definition; the axis clipped past the charge drop)."""
+    Artisan draws it (the one RoR definition; the axis clipped past the charge drop). Returns the
+    handles and labels of both axes, for one legend."""
     ror = ax.twinx()
     t = np.asarray(time_s, dtype=float)
     ror.plot(t / 60.0, rate_of_rise_C_per_min(t, predicted), color="tab:blue", lw=1.0, alpha=0.8,
@@ -234,15 +238,15 @@ def _ror_overlay(ax, time_s, measured, predicted) -> None:
     ror_limits(ror, t, measured, predicted)
     ror.set_ylabel("RoR [°C/min]", color="tab:blue", fontsize=8)
     ror.tick_params(axis="y", labelcolor="tab:blue", labelsize=8)
-    # one legend for both axes, on the BT axis drawn above the RoR axis so no curve covers it
+    # the BT axis drawn above the RoR axis, its curves over the RoR's
     handles, labels = ax.get_legend_handles_labels()
     more, more_labels = ror.get_legend_handles_labels()
     ax.set_zorder(ror.get_zorder() + 1)
     ax.patch.set_visible(False)
-    ax.legend(handles + more, labels + more_labels, fontsize=7, loc="best")
+    return handles + more, labels + more_labels
 
 
-def _profile_panel(ax, result, i, label=None):
+def _profile_panel(ax, result, i, label=None, legend: bool = True):
     t = result.time_s[i] / 60.0
     row = result.rows[i]
     ax.plot(t, result.predicted[i], color="tab:green", lw=2, label="BT predicted (model Ta)")
@@ -250,7 +254,8 @@ def _profile_panel(ax, result, i, label=None):
     ax.set_title(f"{label or result.names[i]}: FIT {row['FIT']:.1f} %, MAE {row['MAE']:.2f} °C", fontsize=10)
     ax.set_ylabel("BT [°C]")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
+    if legend:
+        ax.legend(fontsize=8)
 
 
 def plot_fig2(ident, valid, path, note="synthetic data", outputs=None):
