@@ -117,7 +117,7 @@ def add_parsers(sub) -> None:
         "dimensions, a catalogue entry or the batch capacity, each estimate stated), DIR/fit.toml (what these "
         "logs can determine) and DIR/fleet.toml (what a fleet fit frees per batch under the fitted model), each "
         "commented with what was detected and what was guessed. A LOG that is a folder "
-        "stands for its logs of one format (.alog where it has any, else .json, RoasTime's files without a suffix, .csv). "
+        "stands for its logs of one format (.alog where it has any, else .json, RoasTime's files without a suffix, .csv); the logs of another format in it are counted in a note, not read. "
         "A log that cannot be "
         "read as a roast (an empty or aborted recording), is a copy of another (the same recording start), records no "
         "green weight (nor one in its file name) or no setting the others record is named, and fit-roaster leaves it out. Logs are never modified. "
