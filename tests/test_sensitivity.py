@@ -61,14 +61,33 @@ def _point(rng):
     return x, u
 
 
-def _generated(x, u, p):
+COMBOS = [dict(zip(CODE_VALUES, c)) for c in itertools.product(*CODE_VALUES.values())]
+
+
+def _generated(x, u, p, want=None):
     f = np.zeros(NS)
     Jx, Ju, Jp = np.zeros((NS, NS)), np.zeros((NS, N_INPUTS)), np.zeros((NS, N_PARAMS))
-    RHS_JACOBIAN(*x, *u, p, f, Jx, Ju, Jp)
+    RHS_JACOBIAN(*x, *u, p, np.ones(N_PARAMS, dtype=bool) if want is None else want, f, Jx, Ju, Jp)
     return f, Jx, Ju, Jp
 
 
-COMBOS = [dict(zip(CODE_VALUES, c)) for c in itertools.product(*CODE_VALUES.values())]
+@pytest.mark.parametrize("codes", COMBOS[::5], ids=lambda c: ",".join(f"{k}={v:g}" for k, v in c.items()))
+def test_the_jacobian_computes_the_parameter_columns_asked_for(codes):
+    """Each column of J_p where ``want`` asks for it, the same as with every column asked for, and
+    nothing in the others; f, J_x and J_u whatever is asked."""
+    rng = np.random.default_rng(11)
+    p = _params(codes, rng)
+    x, u = _point(rng)
+    full = _generated(x, u, p)
+    asked = [P[name] for name in ("hgm", "hbm", "Pbm", "bean_swell", "heater_lag_exp")]
+    want = np.zeros(N_PARAMS, dtype=bool)
+    want[asked] = True
+    some = _generated(x, u, p, want)
+    for a, b in zip(full[:3], some[:3]):
+        assert np.array_equal(a, b)
+    assert np.array_equal(some[3][:, asked], full[3][:, asked]) and np.any(full[3][:, asked] != 0)
+    others = np.setdiff1d(np.arange(N_PARAMS), asked)
+    assert not np.any(some[3][:, others]) and np.any(full[3][:, others])
 
 
 @pytest.mark.parametrize("codes", COMBOS, ids=lambda c: ",".join(f"{k}={v:g}" for k, v in c.items()))

@@ -16,10 +16,11 @@ The generated source is cached beside the compiled kernels (:func:`roastlab.sim.
 keyed on the hash of the sources it derives from), so SymPy runs once per source version
 (a few seconds) and later processes read the file.
 
-Generated function ``rhs_jacobian(Tb, Tm, X, He, Ta, H, Gg, Tgi, heater, fan, p, f, Jx, Ju, Jp)``
+Generated function ``rhs_jacobian(Tb, Tm, X, He, Ta, H, Gg, Tgi, heater, fan, p, want, f, Jx, Ju, Jp)``
 writes ``f[i]`` = dx_i/dt (as :func:`~roastlab.model.rhs.derivatives`), ``Jx[i, j]`` =
 d f_i / d x_j, ``Ju[i, k]`` = d f_i / d u_k (u = [Gg, Tgi, heater, fan], the logged inputs before
-:func:`~roastlab.model.rhs.gas_inputs`) and ``Jp[i, q]`` = d f_i / d p_q. Entries that are zero
+:func:`~roastlab.model.rhs.gas_inputs`) and, for each q with ``want[q]`` true, ``Jp[i, q]`` =
+d f_i / d p_q (the other columns are neither written nor computed). Entries that are zero
 for every input are not written: pass arrays that start at zero. Where the right-hand side has
 a kink (``fmax``, ``where``), the derivative is that of the branch taken.
 """
@@ -131,11 +132,37 @@ def _merged(xs, us, psym, csym, target: str):
     return merged
 
 
-#: The generated functions: name, what they differentiate and their output arrays.
+#: The generated functions: name, what they differentiate and their arguments after ``p``. The
+#: right-hand side's takes ``want`` (a flag per parameter-vector entry) and writes the column
+#: ``Jp[:, q]``, and computes the subexpressions only it needs, where ``want[q]`` alone: a fit frees a
+#: few of the 36 continuous entries, and the others' derivatives (the options' powers and logarithms
+#: above all) cost a quarter of an evaluation (docs/performance.md).
 GENERATED = {
-    FUNCTION_NAME: ("rhs", "f, Jx, Ju, Jp"),
+    FUNCTION_NAME: ("rhs", "want, f, Jx, Ju, Jp"),
     OUTLET_FUNCTION_NAME: ("outlet", "g, Gx, Gu, Gp"),
 }
+
+
+def _statements(printer, replacements, subexpressions, rows, indent: str) -> list[str]:
+    """The assignments of ``subexpressions`` (in ``replacements``' order, each after those it uses)
+    and then of ``rows`` ({(array, i, j): expression} items), as lines at ``indent``."""
+    lines = [f"{indent}{sym.name} = {printer.doprint(expr)}" for sym, expr in replacements if sym in subexpressions]
+    for (array, i, j), expr in rows:
+        target = f"{array}[{i}]" if j is None else f"{array}[{i}, {j}]"
+        lines.append(f"{indent}{target} = {printer.doprint(expr)}")
+    return lines
+
+
+def _needed(replacements, symbols) -> set:
+    """The common subexpressions ``symbols`` need, directly or through one another."""
+    deps = {sym: expr.free_symbols for sym, expr in replacements}
+    out, stack = set(), [s for s in symbols if s in deps]
+    while stack:
+        sym = stack.pop()
+        if sym not in out:
+            out.add(sym)
+            stack.extend(s for s in deps[sym] if s in deps)
+    return out
 
 
 def generate_source() -> str:
@@ -168,11 +195,17 @@ def generate_source() -> str:
         for name, sym in {**psym, **csym}.items():
             if sym in used:
                 lines.append(f"    {sym.name} = p[{P[name]}]")
-        for sym, expr in replacements:
-            lines.append(f"    {sym.name} = {printer.doprint(expr)}")
-        for (array, i, j), expr in zip(merged, reduced):
-            target_ = f"{array}[{i}]" if j is None else f"{array}[{i}, {j}]"
-            lines.append(f"    {target_} = {printer.doprint(expr)}")
+        entries = list(zip(merged, reduced))
+        guarded = "want" in arrays  # the parameter columns, each computed where asked for
+        columns = sorted({j for (array, _, j), _ in entries if guarded and array == "Jp"})
+        always = [(key, e) for key, e in entries if not (guarded and key[0] == "Jp")]
+        base = _needed(replacements, set().union(*(e.free_symbols for _, e in always)))
+
+        lines += _statements(printer, replacements, base if guarded else {s for s, _ in replacements}, always, "    ")
+        for q in columns:  # a subexpression two columns share is written in both: each block stands alone
+            rows = [(key, e) for key, e in entries if key[0] == "Jp" and key[2] == q]
+            needed = _needed(replacements, set().union(*(e.free_symbols for _, e in rows))) - base
+            lines += [f"    if want[{q}]:", *_statements(printer, replacements, needed, rows, "        ")]
     return "\n".join(lines) + "\n"
 
 

@@ -94,12 +94,13 @@ def ta_input_jacobian(t, Gg, Tgi, Q, F, which, states, ta_base, p, zoh, h_max, d
 
 
 @compiled
-def _stage(y, g, T, q, f, p, w, k, zoh, du_ptr, du_j, du_c, du_v, Y, pq, pc, pv, nc, fx, Jx, Ju, Jp, K):
+def _stage(y, g, T, q, f, p, w, k, zoh, du_ptr, du_j, du_c, du_v, Y, pq, pc, pv, want, nc, fx, Jx, Ju, Jp, K):
     """One stage at state ``y`` and inputs (g, T, q, f): fx = f(y, u) and, over the first ``nc``
     columns, K = J_x Y + J_u du/dz + J_p dp/dz. du/dz is sample k's sparse rows (held, or
-    blended with sample k + 1's by ``w`` under a linear hold); dp/dz the triplets (pq, pc, pv).
+    blended with sample k + 1's by ``w`` under a linear hold); dp/dz the triplets (pq, pc, pv),
+    whose parameters ``want`` flags (only their columns of J_p are computed).
     Loops run over the contiguous column index, so the compiler can vectorise them."""
-    _rhs_jacobian(y[0], y[1], y[2], y[3], y[4], y[5], g, T, q, f, p, fx, Jx, Ju, Jp)
+    _rhs_jacobian(y[0], y[1], y[2], y[3], y[4], y[5], g, T, q, f, p, want, fx, Jx, Ju, Jp)
     for i in range(NS):
         for c in range(nc):
             K[i, c] = 0.0
@@ -177,6 +178,9 @@ def integrate_sens_into(
     Jx = np.zeros((NS, NS))
     Ju = np.zeros((NS, N_INPUTS))
     Jp = np.zeros((NS, N_PARAMS))
+    want = np.zeros(N_PARAMS, dtype=np.bool_)  # the parameters z moves: J_p's columns to compute
+    for e in range(pq.shape[0]):
+        want[pq[e]] = True
     fx = np.empty(NS)
     h = min(h_max, h0)
     steps = 0
@@ -191,7 +195,30 @@ def integrate_sens_into(
         # its state sensitivity is zero and so is its input's derivative at this sample)
         if zoh or k == 0:
             _stage(
-                x, g0, T0, q0, f0, p, 0.0, k, zoh, du_ptr, du_j, du_c, du_v, S, pq, pc, pv, nc, fx, Jx, Ju, Jp, KS[0]
+                x,
+                g0,
+                T0,
+                q0,
+                f0,
+                p,
+                0.0,
+                k,
+                zoh,
+                du_ptr,
+                du_j,
+                du_c,
+                du_v,
+                S,
+                pq,
+                pc,
+                pv,
+                want,
+                nc,
+                fx,
+                Jx,
+                Ju,
+                Jp,
+                KS[0],
             )
             for i in range(NS):
                 kx[0, i] = fx[i]
@@ -222,7 +249,7 @@ def integrate_sens_into(
                                 Y[i, c] += coef * KS[j, i, c]
                 _stage(
                     y, g0 + dg * a, T0 + dT * a, q0 + dq * a, f0 + df * a, p, a / dt, k, zoh,
-                    du_ptr, du_j, du_c, du_v, Y, pq, pc, pv, nc, fx, Jx, Ju, Jp, KS[st],
+                    du_ptr, du_j, du_c, du_v, Y, pq, pc, pv, want, nc, fx, Jx, Ju, Jp, KS[st],
                 )  # fmt: skip
                 for i in range(NS):
                     kx[st, i] = fx[i]
