@@ -195,31 +195,9 @@ def integrate_sens_into(
         # its state sensitivity is zero and so is its input's derivative at this sample)
         if zoh or k == 0:
             _stage(
-                x,
-                g0,
-                T0,
-                q0,
-                f0,
-                p,
-                0.0,
-                k,
-                zoh,
-                du_ptr,
-                du_j,
-                du_c,
-                du_v,
-                S,
-                pq,
-                pc,
-                pv,
-                want,
-                nc,
-                fx,
-                Jx,
-                Ju,
-                Jp,
+                x, g0, T0, q0, f0, p, 0.0, k, zoh, du_ptr, du_j, du_c, du_v, S, pq, pc, pv, want, nc, fx, Jx, Ju, Jp,
                 KS[0],
-            )
+            )  # fmt: skip
             for i in range(NS):
                 kx[0, i] = fx[i]
         while s < dt:
