@@ -213,14 +213,15 @@ def plot_fit(result, path=None, title=None, max_panels: int = 8, outputs=None, b
             label="residual BT meas − pred (below)",
         )
         second = result.results[i].Tb2_measured_C if i < len(result.results) else None
-        if second is not None and "Tb2" in result.outputs:  # the second bean reading and the model's Tb
+        second = second if "Tb2" in result.outputs else None
+        if second is not None:  # the second bean reading and the model's Tb
             sim = result.results[i]
             ax.plot(t, sim.Tb_C, color="tab:orange", lw=1.2, label="bean predicted (model Tb)")
             ax.plot(t, second, ":", color="tab:brown", lw=1.6, label="second bean reading (Tb2)")
             res.plot(t, second - sim.Tb_C, ":", color="tab:brown", lw=1, label="residual Tb2 − Tb (below)")
         for h, text in zip(*_ror_overlay(ax, result.time_s[i], result.measured[i], result.predicted[i])):
             entries.setdefault(text, h)  # every panel draws the same curves; a second bean reading on some
-        if second is not None and "Tb2" in result.outputs:  # its residual beside BT's, which the axis names
+        if second is not None:  # its residual beside BT's, which the axis names
             for h, text in zip(*res.get_legend_handles_labels()):
                 entries.setdefault(text, h)
         res.axhline(0.0, color="k", lw=0.6)
