@@ -170,6 +170,37 @@ def test_generated_source_is_the_cached_one():
     assert path.read_text() == generate_source()
 
 
+def test_the_printed_powers_shortcut_only_where_pow_is_exact():
+    """A power with an exponent that is not a whole number is printed behind pow's exact cases
+    (x**0 = 1, x**1 = x, 1**y = 1): at bases and exponents that hit them, at their neighbours and
+    at the non-finite values, the printed expression gives pow's bits, NaN where pow gives NaN."""
+    import math
+
+    import sympy as sp
+
+    from roastlab.sim.jacobian import _printer
+
+    x, y = sp.symbols("x y", real=True)
+    printer = _printer()
+    symbolic = printer.doprint(x**y)
+    constant = printer.doprint(x ** sp.Float(1.0 / 3.0))
+    assert "== 1.0" in symbolic and "== 0.0" in symbolic and "== 1.0" in constant
+    assert printer.doprint(x**2) == "x**2" and printer.doprint(x ** sp.Rational(1, 2)) == "math.sqrt(x)"
+    near = [math.nextafter(1.0, 0.0), math.nextafter(1.0, 2.0)]
+    values = [0.0, -0.0, 1.0, 2.5, 1e-6, math.inf, math.nan, *near]
+    exponents = [0.0, -0.0, 1.0, -1.0, 0.5, 1.0 / 3.0, -2.0 / 3.0, math.inf, -math.inf, math.nan, *near]
+    printed = eval(f"lambda x, y: {symbolic}", {"math": math})  # the printer's own text, no user input
+    for a, b in itertools.product(values, exponents):
+        try:
+            want = a**b
+        except ZeroDivisionError:  # Python raises where C's pow gives inf (0 to a negative power)
+            continue
+        got = printed(a, b)
+        assert (math.isnan(want) and math.isnan(got)) or (
+            got == want and math.copysign(1, got) == math.copysign(1, want)
+        ), (a, b)
+
+
 def _case(zoh, heater=False):
     t = np.arange(0.0, 901.0, 10.0)
     n = t.size
