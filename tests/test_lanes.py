@@ -169,6 +169,44 @@ def test_lanes_keep_only_the_asked_columns_and_loosen_tolerance_like_the_scalar_
     _agree(np.stack([ta, tb, tgo], axis=2), out)
 
 
+def test_a_screened_run_that_the_model_makes_stiff_stops_at_the_screening_budget():
+    """At the screening's tolerance (identify's trial points) a run that the parameters make stiff (the
+    120 kg plant's drum at 10 g: every step the stability limit's) stops after step_budget's steps,
+    not MAX_STEPS, with its remaining samples marked as stiff; at the full accuracy it goes on to
+    MAX_STEPS. The lanes stop those runs where the scalar integrator does, and the ordinary runs
+    beside them are unaffected."""
+    from roastlab.fit.identify import SCREENING_TOL_SCALE
+    from roastlab.sim.kernels import I_TGO, MAX_STEPS, integrate_into, step_budget, ta_population_kernel
+
+    t = np.arange(0.0, 901.0, 10.0)
+    n = t.size
+    p = pack_params(as_plant("120kg"), (0.3, 0.3, 0.5))
+    p[P["Mm"]] = 0.01
+    x0 = np.array([25.0, 180.0, 0.1, 0.0, 25.0, 0.0])
+    counts = {}
+    for tol in (1.0, SCREENING_TOL_SCALE):
+        out = np.empty((n, N_OUT))
+        evals = np.zeros(1, dtype=np.int64)
+        integrate_into(t, np.full(n, 0.4), np.full(n, 450.0), np.zeros(n), np.zeros(n), n, x0, p, False, 30.0, out,
+                       5.0, True, tol, evals)  # fmt: skip
+        counts[tol] = int(evals[0])
+        assert np.isinf(out[-1]).all()  # given up on: the last sample marked as stiff
+    # six stages a step and the first one once: the budget's steps, plus the one that found it spent
+    assert counts[SCREENING_TOL_SCALE] == 6 * step_budget(n, SCREENING_TOL_SCALE) + 1 < counts[1.0]
+    assert counts[1.0] == 6 * MAX_STEPS + 1
+    inputs, batch_of, X0, PP = _runs(3, lanes.LANES + 8)
+    PP[::3, P["Mm"]] = 0.01
+    nmax = inputs[0].shape[1]
+    ta, tb, tgo = (np.full((len(batch_of), nmax), np.nan) for _ in range(3))
+    ta_population_kernel(*inputs, batch_of, X0, PP, False, 30.0, ta, tb, tgo, SCREENING_TOL_SCALE)
+    cols = np.array([4, 0, I_TGO], dtype=np.int64)
+    out = np.full((len(batch_of), nmax, 3), np.nan)
+    lanes.simulate_runs(*inputs, batch_of, X0, PP, False, 30.0, cols, out, SCREENING_TOL_SCALE, lanes.law_key(PP))
+    stiff = np.arange(len(batch_of)) % 3 == 0
+    assert np.isinf(ta[stiff]).any() and not np.isinf(ta[~stiff]).any()  # the stiff runs stop, the others run
+    _agree(np.stack([ta, tb, tgo], axis=2), out)
+
+
 def test_lanes_stop_where_the_scalar_integrator_stops():
     """Process constants at their plausible floors and ceilings (stiff corners, issue 27) mixed with
     ordinary runs: the lanes mark the same samples too stiff (inf) or non-finite (NaN), and the

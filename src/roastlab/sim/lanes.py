@@ -63,13 +63,13 @@ from .kernels import (
     _E7,
     H0_S,
     I_TGO,
-    MAX_STEPS,
     NS,
     STIFF_MARK,
     error_share,
     interval_inputs,
     next_step_given,
     rms_error,
+    step_budget,
 )
 
 #: Runs one core integrates together. The compiler takes 8 lanes (one AVX-512 register, two AVX2
@@ -326,7 +326,7 @@ def _lane_group(T, GG, TGI, QQ, FF, N, batch_of, X0, PP, zoh, h_max, cols, out, 
             h = Z[_at(_HS, lane)]
             err = Z[_at(_ERR, lane)]
             done = False
-            if STEPS[lane] > MAX_STEPS or H[lane] < 1e-9 * DTI[lane]:
+            if STEPS[lane] > step_budget(n, tol_scale) or H[lane] < 1e-9 * DTI[lane]:
                 # the step budget spent or the step collapsed: too stiff for an explicit method
                 _mark(out, r, k + 1, n, cols, STIFF_MARK)
                 done = True
