@@ -70,7 +70,9 @@ wheel-check:
 # 2026-11-29 the machine ran the same code about three times slower (the Bullet example's fit 23-25 s
 # with the code of 2026-11-27 and with this one, against 7.9 s then): 69 min for the variants, 98 min
 # to the last step, whose 51 fits at about 22 s each were stopped; run alone later that day (session 38)
-# the last step took 11 min and wrote its JSON and figure byte for byte as before.
+# the last step took 11 min and wrote its JSON and figure byte for byte as before. Rerun whole after
+# the screening's step budget (session 39): 56 min on a machine of middling load, every file byte for
+# byte as committed but the two fit times of real-roaster-results.md (the Bullet's 8.5 s, 19.7 s before).
 SKYWALKER = ../shared/data/real/skywalker
 real-roaster: $(STAMP)
 	$(PY) docs/real_roaster.py
