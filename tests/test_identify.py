@@ -390,3 +390,35 @@ def test_an_output_weighed_by_its_residuals_pulls_the_beans_less_than_at_weight_
     assert f"weight of ET from the residuals: {ratio:.3g} (a first fit at weight 1 missed Ta by" in fit.model.report()
     weighed = fit.model.parameters["hbm"]["value"]
     assert abs(weighed - 0.02) < 0.9 * abs(at_one - 0.02), (at_one, weighed)
+
+
+def test_the_solver_runs_on_one_blas_thread_and_gives_back_the_threads_after(monkeypatch):
+    """The fit's SVDs run on one BLAS thread (roastlab.fit.threads.one_blas_thread): OpenBLAS's
+    threads, left spinning after each, held the cores the model's next simulation ran on (a fit 4x
+    slower on 2 cores). Every polish and held-out refit sees one thread; the limit ends with the fit."""
+    import importlib
+
+    from scipy.optimize import least_squares
+    from threadpoolctl import threadpool_info
+
+    identify_module = importlib.import_module("roastlab.fit.identify")  # roastlab.fit is also a function
+
+    def blas_threads():
+        return {m["num_threads"] for m in threadpool_info() if m["user_api"] == "blas"}
+
+    before = blas_threads()
+    if not before or before == {1}:
+        pytest.skip("no BLAS library with more than one thread here to hold to one")
+    seen = []
+
+    def spy(*args, **kwargs):
+        seen.append(blas_threads())
+        return least_squares(*args, **kwargs)
+
+    monkeypatch.setattr(identify_module, "least_squares", spy)
+    monkeypatch.setattr("scipy.optimize.least_squares", spy)  # the held-out refits import it there
+    ds = read_dataset(default_dataset_root() / "dataset-I")
+    free, fixed = build_free_parameters()
+    identify(pack_batches(ds.batches, ds.plant, THETA_START), free, fixed, seed=0)
+    assert len(seen) > len(ds.batches) and all(s == {1} for s in seen), seen  # polishes and refits alike
+    assert blas_threads() == before

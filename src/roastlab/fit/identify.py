@@ -47,6 +47,7 @@ from ..model.parameters import (
 from ..model.quantities import default
 from ..sim.population import PackedBatches, output_sensitivities, predict_outputs
 from . import uncertainty
+from .threads import one_blas_thread
 from .uncertainty import (  # noqa: F401  (CORRELATION_WARN, LOG_SAMPLED_SPAN: re-exported)
     CORRELATION_WARN,
     LOG_SAMPLED_SPAN,
@@ -527,7 +528,15 @@ def identify(
     weights : {output: weight} over :data:`OUTPUTS` (default Ta 1, Tb2 0: the probe alone)
     held_out : compute ``held_out_Ta``, each batch's probe error had it been left out (one local
         refit per batch, about a third of a fit's time); False leaves it None
+
+    The solver's SVDs run on one BLAS thread (:func:`roastlab.fit.threads.one_blas_thread`).
     """
+    with one_blas_thread():
+        return _identify(packed, free, fixed, method, seed, n_trial, n_starts, progress, weights, held_out)
+
+
+def _identify(packed, free, fixed, method, seed, n_trial, n_starts, progress, weights, held_out):
+    """:func:`identify`'s work."""
     if method not in ("global", "de"):
         raise ParameterError(f"unknown method {method!r} (allowed: global, de)")
     fixed = dict(fixed or {})

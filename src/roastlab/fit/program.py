@@ -42,6 +42,7 @@ from ..model.layout import S_TA, S_TM
 from ..model.limits import check_value
 from ..sim.kernels import H_MAX_S, simulate_one
 from ..sim.sensitivity import program_sensitivity, ta_input_jacobian
+from .threads import one_blas_thread
 
 #: Most knots a program may have (the Jacobian is dense, n x n).
 MAX_KNOTS = 2500
@@ -49,20 +50,6 @@ MAX_KNOTS = 2500
 LEVEL_PENALTY = 30.0
 #: Default smoothness weight lam [-]: a 1 degC step of the program costs like 0.03 degC of error.
 SMOOTHNESS = 0.03
-
-
-_THREADPOOLS = None
-
-
-def _one_blas_thread():
-    """A context holding BLAS to one thread: the solver's small SVDs otherwise compete for the
-    cores with the parallel Jacobian's spinning threads (measured 4x slower on 2 cores)."""
-    global _THREADPOOLS
-    if _THREADPOOLS is None:
-        from threadpoolctl import ThreadpoolController
-
-        _THREADPOOLS = ThreadpoolController()
-    return _THREADPOOLS.limit(limits=1, user_api="blas")
 
 
 #: The inputs a program can decide, with their unit.
@@ -387,7 +374,7 @@ def optimise_program(
             J[3 * n - 1 :] = ror_weight * (ror_rows @ dta)
         return np.where(np.isfinite(J), J, 0.0)
 
-    with _one_blas_thread():
+    with one_blas_thread():
         if solver == "gauss-newton":
             sol = _projected_gauss_newton(residuals, jacobian, z0, lb, ub, max_iterations)
         else:
