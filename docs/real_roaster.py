@@ -35,8 +35,8 @@ DOCS = ROOT / "docs"
 @functools.cache
 def grams(path: Path) -> int | None:
     """A Bullet log's green batch [g] as ``roastlab init`` reads it: the weight the log records, else
-    the grams in its file name (roastlab.workflows.roaster.inspect_log); None if neither."""
-    from roastlab.workflows.roaster import inspect_log
+    the grams in its file name (roastlab.workflows.survey.inspect_log); None if neither."""
+    from roastlab.workflows.survey import inspect_log
 
     kg = inspect_log(path).batch_kg
     return None if kg is None else round(kg * 1000)
@@ -56,8 +56,8 @@ def nominal_size(path: Path) -> bool:
 
 def roasts(paths) -> list[Path]:
     """The logs that are roasts, as ``roastlab init`` reads a folder: a recording that cannot be read
-    as one, or a copy of another, is left out and said on stderr (roastlab.workflows.roaster.readable_logs)."""
-    from roastlab.workflows.roaster import readable_logs
+    as one, or a copy of another, is left out and said on stderr (roastlab.workflows.survey.readable_logs)."""
+    from roastlab.workflows.survey import readable_logs
 
     infos, left_out = readable_logs(paths)
     for why in left_out.values():

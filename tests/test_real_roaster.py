@@ -396,7 +396,7 @@ def test_drum_at_charge_is_the_preheat_where_the_log_starts_after_the_charge(bul
 
 
 def test_init_says_when_the_logs_come_from_several_units(bullet_data):
-    from roastlab.workflows.roaster import survey
+    from roastlab.workflows.survey import survey
 
     s = survey([bullet_data / "bullet_2020-07-31_0152_490g.json", bullet_data / "bullet_2020-07-14_1803_550g.json"])
     assert len(s.notes) == 1 and "2 units" in s.notes[0] and "2779: 1" in s.notes[0] and "1447: 1" in s.notes[0]
@@ -407,7 +407,7 @@ def test_init_offers_the_room_temperature_the_logs_record_and_reads_its_unit(bul
     """The Bullet owner typed the room in degF ("72", "42" in a cold garage; "64 F" on another unit):
     init offers [Tgi] room with room_unit F, and the map, uncommented, reads 72 as 22.2 degC."""
     from roastlab.io.importers import import_log, load_map
-    from roastlab.workflows.roaster import init_roaster
+    from roastlab.workflows.survey import init_roaster
 
     logs = [
         bullet_data / n
@@ -441,7 +441,7 @@ def test_init_and_both_examples_use_the_cross_validated_bed(real_data, bullet_da
     from roastlab.io.plants import load_plant
     from roastlab.model.bed import CROSS_VALIDATED, PROBE_DEPTH_OVER_DIAMETER
     from roastlab.model.quantities import QUANTITIES
-    from roastlab.workflows.roaster import EXOTHERM_LAW, init_roaster
+    from roastlab.workflows.survey import EXOTHERM_LAW, init_roaster
 
     specs = {}
     for folder, log, at_charge in (
@@ -627,7 +627,7 @@ def test_bullet_example_fits_a_later_steeper_exotherm_than_the_papers(bullet_mod
     """The example frees eq. 14's rate law (A, Ha/R; Het held), and three nominal logs already ask for
     a steeper one than Schwartzberg's: about the paper's rate near 150 degC, more near 200 degC, less
     near 100 degC (docs/real-roaster.md, 'The beans' exotherm, fitted'). init frees it where a second bean reading
-    pins it (roastlab.workflows.roaster.EXOTHERM_LAW)."""
+    pins it (roastlab.workflows.survey.EXOTHERM_LAW)."""
     from roastlab.model.layout import N_PARAMS, P
     from roastlab.model.quantities import QUANTITIES
     from roastlab.model.rhs import reaction_heat_rate_kW_kg
@@ -870,7 +870,7 @@ def test_the_first_crack_mark_read_as_the_beans(real_data, tmp_path):
     from roastlab.model.constants import FIRST_CRACK_BEAN_C
     from roastlab.model.parameters import FIRST_CRACK_WEIGHT
     from roastlab.workflows.model import load_log
-    from roastlab.workflows.roaster import init_roaster
+    from roastlab.workflows.survey import init_roaster
 
     cmap = load_map(EXAMPLE / "map.toml")
     assert cmap.first_crack_as_beans

@@ -12,7 +12,7 @@ import pytest
 
 from conftest import REAL_DATA, printed_percent
 from roastlab.errors import InputError
-from roastlab.workflows import roaster
+from roastlab.workflows import roaster, survey
 from test_importers import fake_alog
 
 
@@ -188,7 +188,7 @@ def test_init_without_et_lets_the_heater_heat_the_drum_alone(cli, tmp_path):
     # the drum at CHARGE is BT then, the probe soaked in the empty drum: the share of the drum's rise it
     # shows is fitted, within the quantity table's bounds (roastlab.model.rhs.drum_at_charge_C)
     from roastlab.model.quantities import quantity
-    from roastlab.workflows.roaster import TM0_SHARE_START
+    from roastlab.workflows.survey import TM0_SHARE_START
 
     lo, hi = quantity("Tm0_share").bounds
     assert f"Tm0_share = [{lo:g}, {hi:g}, {TM0_SHARE_START:g}]" in fit
@@ -226,9 +226,9 @@ def _heater_readout_logs(tmp_path, name: str, readings: list, stem: str, k: int 
 def test_a_heater_logged_in_watts_is_read_as_a_power(cli, tmp_path):
     """SYNTHETIC logs whose heater is an extra device reading 450-900 (a power readout, not a
     percent): the map says W with the logs' top, the fit spec bounds the drum's share of it at all of
-    it (roastlab.workflows.roaster.KW_PER_W), and a program labels it in W."""
+    it (roastlab.workflows.survey.KW_PER_W), and a program labels it in W."""
     from roastlab.io.importers.mapping import load_map
-    from roastlab.workflows.roaster import KW_PER_W
+    from roastlab.workflows.survey import KW_PER_W
 
     logs = _heater_readout_logs(tmp_path, "Heater W", [450.0 if i < 60 else 900.0 for i in range(120)], "w")
     code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
@@ -315,7 +315,7 @@ def test_a_fan_logged_in_tens_above_100_is_the_machines_levels(cli, tmp_path):
     the fit's flow per logged unit is bounded a tenth of a step's. A heater in W stays W; a
     percent setting every log moves in whole tens gets 10 % steps (Artisan's slider: 5)."""
     from roastlab.io.importers.mapping import load_map
-    from roastlab.workflows.roaster import _unit_of
+    from roastlab.workflows.survey import _unit_of
 
     assert _unit_of(np.array([10.0, 20.0, 70.0, 120.0])) == "tens"
     assert _unit_of(np.array([0.0, 70.0, 140.0])) == "tens"  # Artisan's Bullet R2 setup: power P0-P14 as 0-140
@@ -987,7 +987,7 @@ def test_an_unseen_gas_drum_with_burner_events_is_fitted_with_no_hand_edits(cli,
     rows += [f"{p},drum,{cfg / 'plant.toml'},2026-01-0{i + 1}T10:00:00,{cfg / 'map.toml'}" for i, p in enumerate(logs)]
     (tmp_path / "m.csv").write_text("\n".join(rows) + "\n")
     assert cli("fleet", "ingest", "--db", tmp_path / "f.duckdb", "--manifest", tmp_path / "m.csv")[0] == 0
-    free = roaster.fleet_spec_text((cfg / "fit.toml").read_text())
+    free = survey.fleet_spec_text((cfg / "fit.toml").read_text())
     assert (cfg / "fleet.toml").read_text() == free and "\nQe_gain_kW = [" in free and "\nKt = [" in free
     code, out, err = cli(
         "fleet",
@@ -1177,7 +1177,7 @@ def test_an_unseen_gas_drum_that_logs_its_inlet_air_and_no_burner_is_driven_by_t
     ],
 )
 def test_catalogue_reads_the_capacity_from_the_model_number(machine, capacity_kg, heat):
-    entry = roaster.catalogue_entry(machine)
+    entry = survey.catalogue_entry(machine)
     if capacity_kg is None:
         assert entry is None
     else:
@@ -1229,7 +1229,7 @@ def test_init_takes_the_capacity_the_logs_state(cli, tmp_path, roastersize, word
     ],
 )
 def test_a_plain_csvs_columns_are_found_by_name(header, want):
-    c = roaster.plain_csv_columns(header)
+    c = survey.plain_csv_columns(header)
     assert (c["time"], c["time_unit"], c["BT"], c["ET"], c["temp_unit"]) == want
 
 
@@ -1262,7 +1262,7 @@ def test_the_examples_fit_specs_bound_the_gas_flow_as_init_does():
     """The examples' hand-written fit specs and init's share one gas-flow range (GAS_FLOW_MIN_KG_S to
     GAS_FLOW_MAX_FLOOR_KG_S for roasters of their size): a change to one is a change to both."""
     from roastlab.io.fitspec import load_fit_spec
-    from roastlab.workflows.roaster import GAS_FLOW_MAX_FLOOR_KG_S, GAS_FLOW_MIN_KG_S
+    from roastlab.workflows.survey import GAS_FLOW_MAX_FLOOR_KG_S, GAS_FLOW_MIN_KG_S
 
     for machine in ("skywalker", "bullet"):
         spec = load_fit_spec(Path(__file__).resolve().parents[1] / "examples" / machine / "fit.toml")
@@ -1463,7 +1463,7 @@ def test_a_fit_on_one_batch_size_holds_the_probe_depth_the_spec_frees():
      ("Exhaust (Hz)", "Hz"), ("Fan", None), ("Fan Hzx", None), ("Gas %", "percent"), ("Fan (pct)", "percent")],
 )  # fmt: skip
 def test_a_control_named_in_a_unit_is_read_in_it(name, unit):
-    assert roaster.named_unit(name) == unit
+    assert survey.named_unit(name) == unit
 
 
 def test_a_gas_burner_logged_as_its_pressure_in_kpa_is_read_in_kpa(cli, tmp_path):
@@ -1500,7 +1500,7 @@ def test_a_decimal_readout_whose_name_gives_no_unit_is_read_over_its_range_and_a
     gains' bounds gave the burner a thirtieth of its heat and programs stepped it 0 or 5), linear, with
     a note naming init --heater-unit; given as kPa, it is the gas pressure the name would have said."""
     from roastlab.io.importers.mapping import load_map
-    from roastlab.workflows.roaster import PERCENT_TOP_ABOVE
+    from roastlab.workflows.survey import PERCENT_TOP_ABOVE
 
     gas = [0.55 if i < 30 else 3.2 if i < 80 else 1.85 for i in range(120)]
     top = max(gas)

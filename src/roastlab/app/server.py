@@ -488,8 +488,9 @@ def create_app(data_dir: str | Path):
         }
 
     def fit_start(session: Session, body: dict) -> dict:
-        from ..workflows.roaster import fit_roaster, init_roaster
+        from ..workflows.roaster import fit_roaster
         from ..workflows.sizes import across_sizes_sentence
+        from ..workflows.survey import init_roaster
 
         logs = body.get("logs") or []
         if not isinstance(logs, list) or len(logs) < 2:

@@ -9,7 +9,7 @@ from .common import failed_fit_status, float_arg, progress
 
 
 def cmd_init(args) -> int:
-    from ..workflows.roaster import init_roaster
+    from ..workflows.survey import init_roaster
 
     r = init_roaster(
         args.logs,
