@@ -73,6 +73,8 @@ wheel-check:
 # the last step took 11 min and wrote its JSON and figure byte for byte as before. Rerun whole after
 # the screening's step budget (session 39): 56 min on a machine of middling load, every file byte for
 # byte as committed but the two fit times of real-roaster-results.md (the Bullet's 8.5 s, 19.7 s before).
+# Rerun whole after a fit's BLAS went to one thread (session 40, at 1affea1): 27 min, every file byte for
+# byte as committed but the same two fit times (the Bullet's 7.8 s, the Skywalker's 5.0 s).
 SKYWALKER = ../shared/data/real/skywalker
 real-roaster: $(STAMP)
 	$(PY) docs/real_roaster.py
