@@ -61,7 +61,7 @@ def add_parsers(sub) -> None:
         "and profile transfer (accuracy on synthetic references, against its baselines and a generic SciPy "
         "solver), exact sensitivities against finite differences, and the MPC against CasADi + IPOPT. Whatever "
         "can use several cores is timed on one thread (the figures targets are checked on) and on all cores; "
-        "timings are medians of repetitions. Takes a few minutes on 2 cores. Needs no MODEL.json: it times the "
+        "timings are medians of repetitions. Takes about a minute on 2 cores once the kernels are compiled. Needs no MODEL.json: it times the "
         "paper's model.",
     )
     p.add_argument(
