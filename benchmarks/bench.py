@@ -514,7 +514,12 @@ def run(quiet: bool = False, baseline_repeats: int = 5, only: str | None = None)
     init = InitialState()
     x0 = init.vector(float(batch.Ta_C[0]))
     res = {
-        "machine": {"cpus": os.cpu_count(), "python": sys.version.split()[0]},
+        "machine": {
+            "cpus": os.cpu_count(),
+            "python": sys.version.split()[0],
+            # the all-core figures depend on it (roastlab.sim.OMP_WAIT_POLICY)
+            "omp_wait_policy": os.environ.get("OMP_WAIT_POLICY"),
+        },
         "batch": {"name": f"dataset-I/{batch.name}", "duration_s": float(t[-1]), "samples": int(batch.n)},
     }
 

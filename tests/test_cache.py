@@ -68,3 +68,28 @@ def test_an_edit_to_the_right_hand_side_reaches_the_cached_kernels(tmp_path):
     after = _run(copy, home)
     assert float(after) < float(before) - 5.0, (before, after)  # twice the heat capacity: cooler beans
     assert len(list((home / "roastlab" / "numba").iterdir())) == 2
+
+
+@pytest.mark.parametrize("given, expected", [(None, "PASSIVE"), ("ACTIVE", "ACTIVE")])
+def test_numba_threads_sleep_between_calls_unless_the_environment_says_otherwise(given, expected):
+    """Importing roastlab sets OpenMP's wait policy for numba's threads (roastlab.sim.OMP_WAIT_POLICY)
+    before the OpenMP runtime loads, which reads it once: spinning workers waited for on a core another
+    process wants made dataset-I's identification on 2 cores 2.7x slower than on one
+    (docs/performance.md). A policy the user's environment names is kept."""
+    import os
+
+    env = {k: v for k, v in os.environ.items() if k != "OMP_WAIT_POLICY"}
+    if given is not None:
+        env["OMP_WAIT_POLICY"] = given
+    code = (
+        "import os, roastlab; "
+        "maps = open('/proc/self/maps').read() if os.path.exists('/proc/self/maps') else ''; "
+        "print(os.environ.get('OMP_WAIT_POLICY'), 'libgomp' in maps)"
+    )
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
+    policy, loaded = out.stdout.split()
+    assert policy == expected
+    assert loaded == "False", "OpenMP was loaded before roastlab.sim could set its wait policy"
+    from roastlab.sim import OMP_WAIT_POLICY
+
+    assert OMP_WAIT_POLICY == "PASSIVE"
