@@ -122,3 +122,37 @@ def test_the_benchmarks_fresh_process_measurement_runs():
 
     out = load_benchmark()._peak_memory_child(3)
     assert out["peak_MB"] > 0 and out["mean_FIT"] > 50
+
+
+def test_the_benchmarks_busy_core_check_stops_its_busy_process(monkeypatch):
+    """``roastlab bench``'s busy-core check (busy_identify) times its call on one thread and on all
+    cores, alternated, beside a second process it starts, and stops that process after, also when
+    the timed call fails."""
+    import os
+    import subprocess
+
+    from roastlab.cli.bench import load_benchmark
+
+    bench = load_benchmark()
+    if (os.cpu_count() or 1) < 2:
+        pytest.skip("one core: the check does not run")
+    started = []
+    popen = subprocess.Popen
+
+    def spy(*args, **kwargs):
+        started.append(popen(*args, **kwargs))
+        return started[-1]
+
+    monkeypatch.setattr(bench.subprocess, "Popen", spy)
+    calls = []
+    out = bench.busy_identify(lambda: calls.append(started[-1].poll()), quiet=True, repeats=3)
+    assert calls == [None] * 6  # every timed call ran beside the running busy process
+    assert started[-1].poll() is not None  # and it is stopped
+    assert out["one_thread_s"] > 0 and out["all_cores_s"] > 0 and out["busy_processes"] == 1
+
+    def fails():
+        raise RuntimeError("the timed call failed")
+
+    with pytest.raises(RuntimeError):
+        bench.busy_identify(fails, quiet=True, repeats=1)
+    assert len(started) == 2 and started[-1].poll() is not None
