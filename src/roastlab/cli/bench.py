@@ -60,7 +60,9 @@ def add_parsers(sub) -> None:
         "identification time on dataset-I, fleet identification scaling (10/100/1,000 batches), the cold CLI "
         "and profile transfer (accuracy on synthetic references, against its baselines and a generic SciPy "
         "solver), exact sensitivities against finite differences, and the MPC against CasADi + IPOPT. Whatever "
-        "can use several cores is timed on one thread (the figures targets are checked on) and on all cores; "
+        "can use several cores is timed on one thread (the figures targets are checked on) and on all cores, "
+        "and the identification also with one core kept busy by another process (all cores at most 1.5x one "
+        "thread); "
         "timings are medians of repetitions. Takes about a minute on 2 cores once the kernels are compiled. Needs no MODEL.json: it times the "
         "paper's model.",
     )
