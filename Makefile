@@ -65,16 +65,8 @@ wheel-check:
 # and on 16 splits of them into 9 fit and 8 held out, and the Skywalker's held-out FIT on 16 halves of
 # its logs, with and without the fan (docs/band_splits.py, 4 + 4 min). Last, the Skywalker's 16
 # logs one by one: the example's bed laws, the same with the probe's depth at the Skywalker's, the paper's
-# probe (3 x 17 fits). All of it: 29 min on 2 cores on 2026-11-27 (on 2026-11-26, with 12 variants:
-# docs/real_roaster.py 5 min, the variants 13, the roasters 3, the bands 5, the Skywalker 2). On
-# 2026-11-29 the machine ran the same code about three times slower (the Bullet example's fit 23-25 s
-# with the code of 2026-11-27 and with this one, against 7.9 s then): 69 min for the variants, 98 min
-# to the last step, whose 51 fits at about 22 s each were stopped; run alone later that day (session 38)
-# the last step took 11 min and wrote its JSON and figure byte for byte as before. Rerun whole after
-# the screening's step budget (session 39): 56 min on a machine of middling load, every file byte for
-# byte as committed but the two fit times of real-roaster-results.md (the Bullet's 8.5 s, 19.7 s before).
-# Rerun whole after a fit's BLAS went to one thread (session 40, at 1affea1): 27 min, every file byte for
-# byte as committed but the same two fit times (the Bullet's 7.8 s, the Skywalker's 5.0 s).
+# probe (3 x 17 fits). All of it: 21 min on 2 cores at ab8774a (2026-11-29); every rerun, its time and
+# what it changed are in CHANGELOG.md.
 SKYWALKER = ../shared/data/real/skywalker
 real-roaster: $(STAMP)
 	$(PY) docs/real_roaster.py

@@ -746,7 +746,6 @@ def busy_identify(ident, quiet: bool = False, repeats: int = 5) -> dict | None:
         "all_cores_s": float(np.median(every)),
         "all_cores_over_one_thread": float(np.median(every) / np.median(one)),
         "spread": {"one_thread_s": _spread(one), "all_cores_s": _spread(every)},
-        "omp_wait_policy": os.environ.get("OMP_WAIT_POLICY"),
     }
 
 
@@ -858,7 +857,7 @@ def table(res: dict) -> str:
                     "  with one core busy",
                     f"{b['all_cores_s']:.3f} s",
                     f"all cores, another process on one; one thread {b['one_thread_s']:.3f} s "
-                    f"(OMP_WAIT_POLICY {b['omp_wait_policy'] or 'unset'})",
+                    f"(OMP_WAIT_POLICY {res['machine']['omp_wait_policy'] or 'unset'})",
                 )
             )
     for key, chk in res["checks"].items():

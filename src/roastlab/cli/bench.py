@@ -62,9 +62,8 @@ def add_parsers(sub) -> None:
         "solver), exact sensitivities against finite differences, and the MPC against CasADi + IPOPT. Whatever "
         "can use several cores is timed on one thread (the figures targets are checked on) and on all cores, "
         "and the identification also with one core kept busy by another process (all cores at most 1.5x one "
-        "thread); "
-        "timings are medians of repetitions. Takes about a minute on 2 cores once the kernels are compiled. Needs no MODEL.json: it times the "
-        "paper's model.",
+        "thread); timings are medians of repetitions. Takes about a minute on 2 cores once the kernels are "
+        "compiled. Needs no MODEL.json: it times the paper's model.",
     )
     p.add_argument(
         "--only",
