@@ -89,6 +89,35 @@ def test_beans_far_from_where_coffee_cracks_at_the_first_crack_mark_are_implausi
     assert implausible_states(roast(140.0, {"FCs": 900.0})) == []  # a mark past the log's end
 
 
+def test_beans_missing_a_fitted_first_crack_mark_say_what_the_logs_lack():
+    """The advice follows what the fit saw: a mark not read as a bean reading -> read it so; a mark the
+    fit had as a bean reading (a map's [Tb2] first_crack) and missed -> with no heater setting logged,
+    the logs lack what heats the drum (log the heater); with one, raise the mark's weight."""
+    from types import SimpleNamespace
+
+    from roastlab.io.importers.mapping import first_crack_reading
+    from roastlab.metrics.profile import implausible_states
+
+    t = np.arange(0.0, 601.0, 5.0)
+    beans = 22.0 + (140.0 - 22.0) * t / 480.0  # 60 degC short of where coffee cracks at the mark
+    events = {"FCs": 480.0}
+    mark, _ = first_crack_reading(t, events)
+
+    def roast(tb2, heater):
+        return SimpleNamespace(time_s=t, Ta_C=beans, Tb_C=beans, Tm_C=beans + 40.0, Tgi_C=np.full(t.size, 22.0),
+                               meta={"events": events}, Tb2_measured_C=tb2, heater=heater)  # fmt: skip
+
+    (unread,) = implausible_states(roast(None, np.full(t.size, 60.0)))
+    (no_heater,) = implausible_states(roast(mark, None))
+    (outweighed,) = implausible_states(roast(mark, np.full(t.size, 60.0)))
+    assert "read the mark as a bean reading" in unread
+    assert "record no heater setting" in no_heater and "read the mark" not in no_heater
+    assert "raise its weight" in outweighed and "heater" not in outweighed
+    # a bean reading elsewhere than at the mark (a sensor that dropped out there) is no reading of the mark
+    elsewhere = np.where(np.arange(t.size) == 10, 60.0, np.nan)
+    assert "read the mark as a bean reading" in implausible_states(roast(elsewhere, None))[0]
+
+
 @pytest.mark.parametrize("seconds", [0.0, 5.0, 59.0, 60.0, 457.0, 3599.0, 3725.0, -5.0, -65.0])
 def test_clock_s_reads_what_mmss_writes(seconds):
     from roastlab.metrics.profile import clock_s, mmss

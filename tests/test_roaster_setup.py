@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import REAL_DATA, printed_percent
+from conftest import REAL_DATA, REPO, printed_percent
 from roastlab.errors import InputError
 from roastlab.workflows import roaster, survey
 from test_importers import fake_alog
@@ -181,7 +181,7 @@ def test_init_without_et_lets_the_heater_heat_the_drum_alone(cli, tmp_path):
         logs.append(tmp_path / f"r{k}.alog")
         logs[-1].write_text(fake_alog(et=[-1.0] * 120, extra=_BURNER_AIR))
     code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
-    assert code == 0 and "ET: no" in out, err
+    assert code == 0 and "ET: no" in out and "no heater setting" not in out, err
     fit = (tmp_path / "cfg" / "fit.toml").read_text()
     assert "Qe_gain_kW" in fit and "Tgi_gain_C" not in fit and "heater heats the drum metal alone" in fit
     assert "[weights]" not in fit
@@ -206,6 +206,9 @@ def test_init_leaves_the_drum_start_as_read_where_et_drives_the_model(cli, tmp_p
     assert code == 0, err
     assert 'column = "ET"' in (tmp_path / "cfg" / "map.toml").read_text()
     assert "Tm0_share" not in (tmp_path / "cfg" / "fit.toml").read_text()
+    # and init says, before any fit, that such logs make a weak model and what to log instead
+    assert "no heater setting in the logs" in out and '"No heater in the logs"' in out, out
+    assert "### No heater in the logs" in (REPO / "docs" / "your-roaster.md").read_text()  # where it points
 
 
 def _heater_readout_logs(tmp_path, name: str, readings: list, stem: str, k: int = 2) -> list:

@@ -412,19 +412,47 @@ def beans_at_first_crack(result) -> tuple[float, float] | None:
 
 def _beans_at_first_crack(result) -> list[str]:
     """The beans far from :data:`~roastlab.model.constants.FIRST_CRACK_BEAN_C` at the log's FCs mark
-    (:func:`beans_at_first_crack`), by more than :data:`FIRST_CRACK_TOLERANCE_C`."""
+    (:func:`beans_at_first_crack`), by more than :data:`FIRST_CRACK_TOLERANCE_C`, with what to do: read
+    the mark as a bean reading where the fit did not (:func:`_mark_fitted`); where it did and still
+    missed it, the logs lack what heats the beans (no heater setting: ``result.heater`` None) or the
+    mark's weight is too low."""
     mark = beans_at_first_crack(result)
     if mark is None:
         return []
     fc_s, tb = mark
     if abs(tb - FIRST_CRACK_BEAN_C) <= FIRST_CRACK_TOLERANCE_C:
         return []
-    return [
+    where = (
         f"beans at {tb:.0f} °C at the log's first crack ({mmss(fc_s)}), where coffee cracks at about "
-        f"{FIRST_CRACK_BEAN_C:.0f} °C: the fit has placed the beans' temperature wrong, the probe alone cannot "
-        "tell the beans from the air around it; read the mark as a bean reading ([Tb2] first_crack = true in the "
-        "map, weighed in the fit spec's [weights] as Tb2)"
+        f"{FIRST_CRACK_BEAN_C:.0f} °C: "
+    )
+    if not _mark_fitted(result, fc_s):
+        return [
+            where + "the fit has placed the beans' temperature wrong, the probe alone cannot tell the beans "
+            "from the air around it; read the mark as a bean reading ([Tb2] first_crack = true in the map, "
+            "weighed in the fit spec's [weights] as Tb2)"
+        ]
+    if getattr(result, "heater", None) is None:
+        return [
+            where + "the fit had a bean reading there and could not reach it: the logs record no heater setting, "
+            "so nothing the model is given heats the drum as the roaster's heater does (it has only a logged "
+            "air temperature to go by); log the heater's setting (Artisan's event sliders or an extra device) and set the "
+            "roaster up again with roastlab init"
+        ]
+    return [
+        where + "the fit had a bean reading there and did not follow it: raise its weight (Tb2 under the fit "
+        "spec's [weights])"
     ]
+
+
+def _mark_fitted(result, fc_s: float) -> bool:
+    """Whether the simulated log carried a bean reading at its first-crack mark ``fc_s`` [s] (the mark
+    read as one, a map's ``[Tb2] first_crack``, or a bean sensor's sample): the fit then saw it."""
+    tb2 = getattr(result, "Tb2_measured_C", None)
+    if tb2 is None:
+        return False
+    t = np.asarray(result.time_s, dtype=float)
+    return bool(np.isfinite(np.asarray(tb2, dtype=float)[int(np.argmin(np.abs(t - fc_s)))]))
 
 
 def _metal_below_beans(result) -> list[str]:

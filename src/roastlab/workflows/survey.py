@@ -808,6 +808,14 @@ def survey(paths, batch_kg: float | None = None, units: dict | None = None) -> S
             f"about {FIRST_CRACK_BEAN_C:.0f} degC: the map reads each mark as the beans' temperature then ([Tb2] "
             "first_crack), so the fit cannot put the beans where coffee does not crack"
         )
+    has_et = all(i.has_et for i in infos) and not et_is_bean and not et_below_bt
+    if not heater and inlet is None and has_et:  # map_text: ET then drives the model as the inlet air
+        notes.append(
+            "no heater setting in the logs: ET drives the model as the inlet air, but a burner or element also "
+            "heats the drum itself, which the air does not show, so the fit is weak or fails (docs/your-roaster.md, "
+            "\"No heater in the logs\"); log the heater's setting (Artisan's event sliders or an extra device) "
+            "for a model that follows the roaster"
+        )
     fan_at = _one_setting(pooled.get("fan")) if fan else None
     if fan_at is not None:
         notes.append(
@@ -823,7 +831,7 @@ def survey(paths, batch_kg: float | None = None, units: dict | None = None) -> S
         fan,
         fan_unit,
         second_bean,
-        all(i.has_et for i in infos) and not et_is_bean and not et_below_bt,
+        has_et,
         max(i.heater_max for i in infos),
         max(i.fan_max for i in infos),
         {k: v for i in infos for k, v in i.unused.items()},
