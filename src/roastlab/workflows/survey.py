@@ -54,7 +54,14 @@ from ..errors import InputError
 from ..evaluate.metrics import size_labels
 from ..io.batch import first_of_each_roast
 from ..io.importers.artisan import DRUM_AT_CHARGE as ARTISAN_DRUM_AT_CHARGE
-from ..io.importers.artisan import ET_BEFORE_CHARGE, WEIGHT_UNITS, RoomReading, read_alog, read_artisan_csv
+from ..io.importers.artisan import (
+    ET_BEFORE_CHARGE,
+    WEIGHT_UNITS,
+    RoomReading,
+    named_as_temperature,
+    read_alog,
+    read_artisan_csv,
+)
 from ..io.importers.mapping import (
     SECOND_BEAN_START_S,
     bare_room_unit,
@@ -474,7 +481,7 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
             path,
         )
     others = [n for n in names if n not in ("BT", "ET", "beanTemperature", "drumTemperature", "exitTemperature")]
-    temps = [n for n in others if ("temp" in n.lower() or "°" in n if fmt == "csv" else n in log.temperature_channels)]
+    temps = [n for n in others if (named_as_temperature(n) if fmt == "csv" else n in log.temperature_channels)]
     inlet = find_name([n for n in temps if np.isfinite(log.channels[n]).any()], INLET_NAMES)
     if fmt == "csv":  # a CSV's other temperatures ("inlet temp", "air temp") are not settings
         others = [n for n in others if n not in temps]

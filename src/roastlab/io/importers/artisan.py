@@ -636,6 +636,21 @@ def epoch_or_none(value) -> float | None:
     return v if 6.3e8 < v < 4.1e9 else None
 
 
+#: The marks of an Artisan CSV export's first line kept as the log's events (the export's name ->
+#: :data:`EVENT_NAMES`' name); CHARGE and DROP are read apart, the turning point is computed, not kept.
+CSV_EVENTS = {"DRYe": "DRY", "FCs": "FCs", "FCe": "FCe", "SCs": "SCs", "SCe": "SCe"}
+
+
+def named_as_temperature(name: str) -> bool:
+    """Whether a channel's name says it is a temperature ("Inlet temp", "Exhaust °C"): a CSV does not
+    mark its temperature columns, as an Artisan log's ``extraNoneTempHint`` does.
+
+    >>> [named_as_temperature(n) for n in ("Inlet Temp", "Abluft °C", "Burner", "Fan")]
+    [True, True, False, False]
+    """
+    return "temp" in name.lower() or "°" in name
+
+
 def _mmss(text: str) -> float:
     """An Artisan CSV time cell (m:ss) [s]; NaN when empty (:func:`roastlab.metrics.profile.clock_s`)."""
     return clock_s(text) if text.strip() else float("nan")
@@ -662,8 +677,15 @@ def _merge_repeated_times(time_s: np.ndarray, columns):
 
 def read_artisan_csv(path: str | Path, keep_after_drop: bool = False) -> ArtisanLog:
     """Parse Artisan's CSV export: a first line with ``Unit:C``/``Unit:F`` and the event clock
-    times (CHARGE, DROP, ... on the Time1 axis), a header ``Time1, Time2, ET, BT, Event`` (tab-
-    or comma-separated), rows with mm:ss times (Time2 counts from CHARGE, empty before it)."""
+    times (CHARGE, DRYe, FCs, FCe, SCs, SCe, DROP, COOL on the Time1 axis; kept as the events of
+    :data:`CSV_EVENTS`), a header ``Time1, Time2, ET, BT, Event`` (tab- or comma-separated) and
+    then two columns per extra device (its two channels' names, Artisan's ``{n}`` fields filled from
+    its default event types, :data:`DEFAULT_ETYPES`: the export does not carry the log's own), rows
+    with mm:ss times (Time2 counts from CHARGE, empty before it), -1 or empty for a missing sample.
+
+    The export does not say which extra channels are temperatures (the log's ``extraNoneTempHint``):
+    a channel is one where its name says so (:func:`named_as_temperature`), and only those are
+    converted from degF; the others (a burner, a fan) are read as written."""
     path = Path(path)
     from ..batch import read_text
 
@@ -687,6 +709,13 @@ def read_artisan_csv(path: str | Path, keep_after_drop: bool = False) -> Artisan
         if col not in header:
             raise InputError(f"missing column {col} (header has: {', '.join(header)})", path, "line 2")
     idx = {c: header.index(c) for c in header}
+    start = header.index("Event") + 1 if "Event" in header else len(header)
+    extras = {}  # column index -> channel name: the extra devices' columns after Event
+    for k in range(start, len(header)):
+        name = extra_name(header[k], list(DEFAULT_ETYPES), set())
+        if name and name not in ("Time1", "Time2", "ET", "BT", "Event") and name not in extras.values():
+            extras[k] = name
+    extra_values = {k: array("d") for k in extras}
     t1, t2, et, bt = array("d"), array("d"), array("d"), array("d")
     for line_no, ln in lines:
         cells = ln.rstrip("\r\n").split(sep)
@@ -706,13 +735,24 @@ def read_artisan_csv(path: str | Path, keep_after_drop: bool = False) -> Artisan
             except ValueError:
                 raise InputError(f"not a number: {cell[:20]!r}", path, f"line {line_no}, column {col}") from None
             dest.append(float("nan") if v == -1 else v)
+        for k, dest in extra_values.items():
+            cell = cells[k].strip() if k < len(cells) else ""
+            try:
+                v = float(cell) if cell else float("nan")
+            except ValueError:
+                raise InputError(f"not a number: {cell[:20]!r}", path, f"line {line_no}, column {extras[k]}") from None
+            dest.append(float("nan") if v == -1 else v)
     if not t1:
         raise InputError("too short for an Artisan CSV export (meta line, header, data)", path)
     t1, t2 = np.array(t1), np.array(t2)
     et, bt = np.array(et), np.array(bt)
+    extra = {extras[k]: np.array(v) for k, v in extra_values.items()}
+    temps = {"ET", "BT", *(name for name in extra if named_as_temperature(name))}
     if mode == "F":
         et, bt = f_to_c(et), f_to_c(bt)
-    t1, (t2, et, bt), repeats = _merge_repeated_times(t1, (t2, et, bt))
+        extra = {name: f_to_c(v) if name in temps else v for name, v in extra.items()}
+    t1, (t2, et, bt, *merged), repeats = _merge_repeated_times(t1, (t2, et, bt, *extra.values()))
+    extra = dict(zip(extra, merged))
     charged = np.flatnonzero(np.isfinite(t2))
     drop = None
     if meta.get("DROP"):
@@ -728,13 +768,21 @@ def read_artisan_csv(path: str | Path, keep_after_drop: bool = False) -> Artisan
     end = len(time_s) if (keep_after_drop or drop is None) else drop + 1
     sl = slice(charge, end)
     events = {"CHARGE": 0.0}
+    for key, name in CSV_EVENTS.items():  # the meta line's marks, clock times on the Time1 axis like CHARGE's
+        if meta.get(key):
+            try:
+                at = _mmss(meta[key]) - t1[charge]
+            except ValueError:
+                raise InputError(f"{key} time {meta[key][:20]!r} is not mm:ss", path, "line 1") from None
+            if 0.0 < at <= time_s[end - 1]:
+                events[name] = float(at)
     if drop is not None:
         events["DROP"] = float(time_s[drop])
     return ArtisanLog(
         str(path),
         time_s[sl],
-        {"ET": et[sl], "BT": bt[sl]},
-        {"ET", "BT"},
+        {"ET": et[sl], "BT": bt[sl], **{name: v[sl] for name, v in extra.items()}},
+        temps,
         mode,
         charge,
         drop,
