@@ -281,11 +281,14 @@ def test_artisan_csv_export(tmp_path):
     assert read_artisan_csv(p).fields == {ET_BEFORE_CHARGE: pytest.approx(150.4)}
 
 
-def _csv_export_with_extras(path, mode="F"):
+def _csv_export_with_extras(path, mode="F", clock="14:05"):
     """SYNTHETIC Artisan CSV export (the layout of Artisan's exportCSV) with its first line's marks and
     two extra devices: "{3}"/"{0}" (the Burner and Air event types' names, as Artisan's Kaleido setup
     names its extra device) and "Inlet Temp"/"Drum RPM"; CHARGE at 0:06 on the Time1 axis."""
-    head = f"Date:01.01.2026\tUnit:{mode}\tCHARGE:00:06\tTP:01:00\tDRYe:04:06\tFCs:07:36\tFCe:\tSCs:\tSCe:\tDROP:09:06"
+    head = (
+        f"Date:01.01.2026\tUnit:{mode}\tCHARGE:00:06\tTP:01:00\tDRYe:04:06\tFCs:07:36\tFCe:\tSCs:\tSCe:\tDROP:09:06"
+        f"\tCOOL:\tTime:{clock}"
+    )
     rows = [head, "Time1\tTime2\tET\tBT\tEvent\t{3}\t{0}\tInlet Temp\tDrum RPM"]
     for i in range(0, 560, 2):
         t2 = "" if i < 6 else f"{(i - 6) // 60:02d}:{(i - 6) % 60:02d}"
@@ -303,13 +306,14 @@ def test_an_artisan_csv_export_keeps_its_marks_and_extra_devices(cli, tmp_path):
     temperature, and leaves a burner's percent as written (-1: a missing sample)."""
     log = read_artisan_csv(_csv_export_with_extras(tmp_path / "e.csv"))
     assert log.events == {"CHARGE": 0.0, "DRY": 240.0, "FCs": 450.0, "DROP": 540.0}
+    assert log.started_epoch_s == 1767276300.0  # Date and Time on its first line: 2026-01-01 14:05
     assert log.channels["Burner"][0] == 70.0 and log.channels["Burner"][-1] == 55.0
     assert log.channels["Air"][0] == 30.0 and np.isnan(log.channels["Air"][-1])
     assert log.channels["Inlet Temp"][0] == pytest.approx(300.0)  # 572 degF
     assert log.channels["BT"][0] == pytest.approx((251.8 - 32.0) / 1.8)
     assert log.temperature_channels == {"ET", "BT", "Inlet Temp"} and log.channels["Drum RPM"][0] == 60.0
     # the reader's marks serve init as an .alog's do: the burner and air are found, first crack is read
-    f = _csv_export_with_extras(tmp_path / "f.csv")
+    f = _csv_export_with_extras(tmp_path / "f.csv", clock="15:20")  # another roast: recorded later
     code, out, err = cli("init", log.path, f, "--out", tmp_path / "cfg", "--batch-kg", "0.2")
     assert code == 0 and "heater: Burner (percent); fan: Air (percent)" in out, err
     assert "2 of 2 log(s) mark first crack" in out, out

@@ -641,6 +641,25 @@ def epoch_or_none(value) -> float | None:
 CSV_EVENTS = {"DRYe": "DRY", "FCs": "FCs", "FCe": "FCe", "SCs": "SCs", "SCe": "SCe"}
 
 
+def csv_started_epoch_s(meta: dict) -> float | None:
+    """When an Artisan CSV export's roast was recorded, from its first line's ``Date`` (dd.MM.yyyy, the
+    export's own format) and ``Time`` (hh:mm) [s since 1970, the clock as written, to the minute], for
+    ordering logs; None where either is missing or not so written.
+
+    >>> csv_started_epoch_s({"Date": "27.09.2025", "Time": "12:36"})
+    1758976560.0
+    >>> csv_started_epoch_s({"Date": "2025-09-27"}) is None
+    True
+    """
+    import datetime
+
+    try:
+        when = datetime.datetime.strptime(f"{meta.get('Date', '')} {meta.get('Time', '')}", "%d.%m.%Y %H:%M")
+    except ValueError:
+        return None
+    return epoch_or_none(when.replace(tzinfo=datetime.UTC).timestamp())
+
+
 def named_as_temperature(name: str) -> bool:
     """Whether a channel's name says it is a temperature ("Inlet temp", "Exhaust °C"): a CSV does not
     mark its temperature columns, as an Artisan log's ``extraNoneTempHint`` does.
@@ -788,5 +807,6 @@ def read_artisan_csv(path: str | Path, keep_after_drop: bool = False) -> Artisan
         drop,
         events,
         fields=et_before_charge(t1, et, charge),
+        started_epoch_s=csv_started_epoch_s(meta),
         notes=notes,
     )
