@@ -734,8 +734,9 @@ def read_artisan_csv(path: str | Path, keep_after_drop: bool = False) -> Artisan
         name = extra_name(header[k], list(DEFAULT_ETYPES), set())
         if name and name not in ("Time1", "Time2", "ET", "BT", "Event") and name not in extras.values():
             extras[k] = name
-    extra_values = {k: array("d") for k in extras}
     t1, t2, et, bt = array("d"), array("d"), array("d"), array("d")
+    extra_values = {k: array("d") for k in extras}
+    readings = [(idx["ET"], "ET", et), (idx["BT"], "BT", bt), *((k, extras[k], extra_values[k]) for k in extras)]
     for line_no, ln in lines:
         cells = ln.rstrip("\r\n").split(sep)
         if len(cells) < len(header) - 1:
@@ -747,19 +748,12 @@ def read_artisan_csv(path: str | Path, keep_after_drop: bool = False) -> Artisan
             t2.append(_mmss(cells[idx["Time2"]]) if "Time2" in idx and idx["Time2"] < len(cells) else float("nan"))
         except ValueError as exc:
             raise InputError(f"not a mm:ss time: {str(exc)[:20]!r}", path, f"line {line_no}, column Time1") from None
-        for col, dest in (("ET", et), ("BT", bt)):
-            cell = cells[idx[col]].strip() if idx[col] < len(cells) else ""
-            try:
-                v = float(cell) if cell else float("nan")
-            except ValueError:
-                raise InputError(f"not a number: {cell[:20]!r}", path, f"line {line_no}, column {col}") from None
-            dest.append(float("nan") if v == -1 else v)
-        for k, dest in extra_values.items():
+        for k, col, dest in readings:  # -1 or an empty cell: a sample not taken
             cell = cells[k].strip() if k < len(cells) else ""
             try:
                 v = float(cell) if cell else float("nan")
             except ValueError:
-                raise InputError(f"not a number: {cell[:20]!r}", path, f"line {line_no}, column {extras[k]}") from None
+                raise InputError(f"not a number: {cell[:20]!r}", path, f"line {line_no}, column {col}") from None
             dest.append(float("nan") if v == -1 else v)
     if not t1:
         raise InputError("too short for an Artisan CSV export (meta line, header, data)", path)
