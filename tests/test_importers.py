@@ -319,6 +319,26 @@ def test_an_artisan_csv_export_keeps_its_marks_and_extra_devices(cli, tmp_path):
     assert "2 of 2 log(s) mark first crack" in out, out
 
 
+def test_a_map_of_artisan_logs_reads_their_csv_exports_and_one_rule_tells_logs_from_batch_csvs(tmp_path):
+    """A map written for .alog files (format "alog", as init writes it) reads Artisan's CSV export of the
+    same roaster too, the channels being Artisan's names in both; reads_as_log, the one rule that
+    validate, simulate and whatif use, tells such a log, a plain CSV log and a batch CSV apart."""
+    from roastlab.io.importers.mapping import reads_as_log
+
+    export = _csv_export_with_extras(tmp_path / "e.csv")
+    alog_map = load_map(write_map(tmp_path, 'format = "alog"\n' + ROOM_AIR_MAP + '[heater]\ncolumn = "Burner"\n'))
+    b = import_log(export, alog_map)
+    assert b.heater[0] == 70.0 and b.heater[-1] == 55.0 and b.events["FCs"] == 450.0
+    batch = tmp_path / "batch.csv"
+    batch.write_text("time_s,Gg_kg_s,Tgi_C,Ta_C\n0,0.4,200,120\n5,0.4,200,118\n")
+    plain = tmp_path / "plain.csv"
+    plain.write_text("seconds,bean temp,burner\n0,120,70\n5,118,70\n")
+    csv_map = load_map(write_map(tmp_path, 'format = "csv"\n' + SKY_MAP, "csv.toml"))
+    assert reads_as_log(export, alog_map) and not reads_as_log(batch, alog_map)
+    assert reads_as_log(plain, csv_map) and not reads_as_log(batch, csv_map)
+    assert reads_as_log(tmp_path / "r.alog", None) and not reads_as_log(export, None)
+
+
 def test_an_artisan_csv_export_with_repeated_whole_seconds_is_averaged(tmp_path):
     """SYNTHETIC export sampled every 0.5 s: the export's whole seconds repeat each time twice; the rows
     sharing a time are averaged (it was refused: time not strictly increasing)."""

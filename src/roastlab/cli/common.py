@@ -428,13 +428,14 @@ def range_arg(text: str, label: str) -> tuple[float, float]:
 def load_batches(args, model=None):
     """The BATCH arguments as batches, and the plant spec to use (--plant, else the dataset's)."""
     from ..io.batch import expand_batch_args
+    from ..io.importers.mapping import reads_as_log
     from ..workflows.model import load_log
 
     if getattr(args, "map", None) or (
         model is not None and model.column_map is not None and not any(Path(p).is_dir() for p in args.batches)
     ):
         cmap = args.map if args.map else model.column_map
-        if all(Path(p).suffix.lower() == ".csv" for p in args.batches) and not args.map:
+        if not args.map and not any(reads_as_log(p, cmap) for p in args.batches):  # batch CSVs
             batches, dataset_plant = expand_batch_args(args.batches, require_Ta=True)
         else:
             batches, dataset_plant = [load_log(p, cmap) for p in args.batches], None
@@ -486,14 +487,13 @@ def add_batch_options(p, baseline_help: str) -> None:
 
 def read_inputs(path, map_path, model):
     """A batch CSV, or a raw log read with --map or with the map the model was fitted with."""
+    from ..io.importers.mapping import reads_as_log
     from ..workflows.model import load_log
 
     if map_path:
         return load_log(path, map_path)
     cmap = None if model is None else model.column_map
-    suffix = Path(path).suffix.lower()
-    raw_csv = suffix == ".csv" and cmap is not None and cmap.format in ("artisan-csv", "csv")
-    if raw_csv or suffix in (".alog", ".json", ".parquet", ".pq"):
+    if reads_as_log(path, cmap):
         if cmap is None:
             raise InputError("a raw log needs a column map: the model has none, pass --map MAP.toml", path)
         return load_log(path, cmap)

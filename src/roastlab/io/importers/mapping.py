@@ -81,7 +81,7 @@ from ...model.constants import FIRST_CRACK_BEAN_C
 from ...model.limits import check_value
 from ...model.pitot import gas_flow_pitot_kg_s
 from ...model.quantities import default
-from ..batch import Batch, csv_log_text, read_table
+from ..batch import REQUIRED_COLUMNS, Batch, csv_log_text, read_table
 from ..files import as_path, finite_number, read_input_bytes, read_toml
 from .artisan import ArtisanLog, f_to_c, read_alog, read_artisan_csv, time_follows
 from .roastime import DRUM_AT_CHARGE, read_roastime
@@ -662,6 +662,41 @@ def roastime_default_map(log: ArtisanLog) -> ColumnMap:
     )
 
 
+#: Artisan's two files of a roast: its profile (``.alog``) and its CSV export. Their channels carry the same
+#: names (BT, ET, the extra devices'), so a column map written for one reads the other (:func:`log_format`).
+ARTISAN_FORMATS = ("alog", "artisan-csv")
+
+
+def log_format(path: Path, map_format: str) -> str:
+    """The format ``path`` is read in under a map of ``map_format`` (:func:`detect_format`): the map's,
+    but where the map's is one of :data:`ARTISAN_FORMATS` and the file is the other (by its suffix and
+    first line), the file's own."""
+    fmt = detect_format(path, map_format)
+    if fmt in ARTISAN_FORMATS and path.suffix.lower() in (".alog", ".csv", ".txt", ".tsv"):
+        own = detect_format(path, "auto")
+        return own if own in ARTISAN_FORMATS else fmt
+    return fmt
+
+
+def reads_as_log(path: str | Path, cmap: ColumnMap | None) -> bool:
+    """Whether ``path`` is a roast log that the column map ``cmap`` reads, rather than a batch CSV (the
+    canonical columns): a file by its suffix (.alog, RoasTime's .json, Parquet); a ``.csv`` where the map
+    reads plain CSV logs and its header is not a batch CSV's (:data:`~roastlab.io.batch.REQUIRED_COLUMNS`),
+    or the map is an Artisan map and the file Artisan's CSV export (:func:`log_format`)."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix in (".alog", ".json", ".parquet", ".pq"):
+        return True
+    if suffix != ".csv" or cmap is None:
+        return False
+    if not path.is_file():
+        return cmap.format in ("artisan-csv", "csv")  # the reader then says the file is missing
+    if cmap.format == "csv":  # a plain CSV log, unless its header is a batch CSV's
+        first = read_input_bytes(path)[:4096].split(b"\n", 1)[0].decode("utf-8", "replace")
+        return not set(REQUIRED_COLUMNS) <= {c.strip().strip('"') for c in re.split(r"[,;\t]", first)}
+    return cmap.format in ARTISAN_FORMATS and detect_format(path, "auto") == "artisan-csv"
+
+
 def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None) -> Batch:
     """Read any supported log with a column map into a validated canonical :class:`Batch`."""
     path = as_path(path, "path")
@@ -700,7 +735,7 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
             )
     if not path.exists():
         raise InputError("file not found", path)
-    fmt = detect_format(path, cmap.format)
+    fmt = log_format(path, cmap.format)
     gg = cmap.Gg
     Mb = None
     initial: dict = {}
