@@ -337,6 +337,17 @@ def test_a_map_of_artisan_logs_reads_their_csv_exports_and_one_rule_tells_logs_f
     assert reads_as_log(export, alog_map) and not reads_as_log(batch, alog_map)
     assert reads_as_log(plain, csv_map) and not reads_as_log(batch, csv_map)
     assert reads_as_log(tmp_path / "r.alog", None) and not reads_as_log(export, None)
+    # a model reads each as the rule says (the CLI's read_inputs and the page use it): the export through
+    # its map, a batch CSV as it is, and a raw log it has no map for is one line saying so
+    from types import SimpleNamespace
+
+    from roastlab.workflows.model import load_log_for
+
+    model = SimpleNamespace(column_map=alog_map)
+    assert load_log_for(export, model).events["FCs"] == 450.0
+    assert load_log_for(batch, model).Ta_C.tolist() == [120.0, 118.0]
+    with pytest.raises(InputError, match="a raw log needs a column map"):
+        load_log_for(tmp_path / "r.alog", SimpleNamespace(column_map=None))
 
 
 def test_an_artisan_csv_export_with_repeated_whole_seconds_is_averaged(tmp_path):

@@ -341,14 +341,14 @@ def create_app(data_dir: str | Path):
     def open_log(session: Session, body: dict) -> dict:
         from ..metrics.profile import phases
         from ..model.quantities import QUANTITIES
-        from ..workflows.model import load_log, load_model
+        from ..workflows.model import load_log_for, load_model
         from ..workflows.transfer import default_limits, et_source
         from ..workflows.whatif import whatif
 
         model_path = inside(data, body.get("model", ""))
         model = load_model(model_path)
         log_path = inside(data, body.get("log", ""))
-        batch = load_log(log_path, model.column_map) if model.column_map else load_log(log_path)
+        batch = load_log_for(log_path, model)
         w = whatif(model, batch)
         session.batch, session.model, session.log = batch, model, body["log"]
         session.model_path, session.as_run = body["model"], w.as_run
@@ -537,7 +537,7 @@ def create_app(data_dir: str | Path):
         return {k: v for k, v in session.fit.items()}
 
     async def upload(request: Request):
-        from ..workflows.model import load_log
+        from ..workflows.model import load_log_for, load_model
 
         try:
             sessions.get(request.headers.get("x-session"))
@@ -560,13 +560,7 @@ def create_app(data_dir: str | Path):
                 out.write_bytes(target, b"".join(chunks))
             model_rel = request.query_params.get("model")
             try:  # read it as the model would, so a bad file is refused now, not later
-                if model_rel:
-                    from ..workflows.model import load_model
-
-                    m = load_model(inside(data, model_rel))
-                    load_log(target, m.column_map) if m.column_map else load_log(target)
-                else:
-                    load_log(target)
+                load_log_for(target, load_model(inside(data, model_rel)) if model_rel else None)
             except RoastlabError:
                 target.unlink(missing_ok=True)
                 raise

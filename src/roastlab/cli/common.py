@@ -487,14 +487,6 @@ def add_batch_options(p, baseline_help: str) -> None:
 
 def read_inputs(path, map_path, model):
     """A batch CSV, or a raw log read with --map or with the map the model was fitted with."""
-    from ..io.importers.mapping import reads_as_log
-    from ..workflows.model import load_log
+    from ..workflows.model import load_log, load_log_for
 
-    if map_path:
-        return load_log(path, map_path)
-    cmap = None if model is None else model.column_map
-    if reads_as_log(path, cmap):
-        if cmap is None:
-            raise InputError("a raw log needs a column map: the model has none, pass --map MAP.toml", path)
-        return load_log(path, cmap)
-    return load_log(path)
+    return load_log(path, map_path) if map_path else load_log_for(path, model)

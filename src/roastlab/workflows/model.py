@@ -529,6 +529,23 @@ def load_log(path, map=None, name: str | None = None) -> Batch:  # noqa: A002 - 
     return import_log(path, cmap, name=name)
 
 
+def load_log_for(path, model: FittedModel | None, name: str | None = None) -> Batch:
+    """A log as ``model`` reads it: a raw log through the column map the model was fitted with, a batch
+    CSV as it is (:func:`roastlab.io.importers.mapping.reads_as_log` tells them apart)."""
+    from ..io.importers.mapping import reads_as_log
+
+    cmap = None if model is None else model.column_map
+    if not reads_as_log(path, cmap):
+        return load_log(path, name=name)
+    if cmap is None:
+        raise InputError(
+            "a raw log needs a column map, and the model has none (it was fitted on batch CSVs): "
+            "give one (--map MAP.toml)",
+            path,
+        )
+    return load_log(path, cmap, name=name)
+
+
 def provenance(roles: dict[str, list]) -> dict:
     """Provenance of a fit: version, date and every input file with its SHA-256."""
     inputs = []
