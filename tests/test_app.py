@@ -100,6 +100,11 @@ def test_open_gives_phases_band_fit_figures_and_the_machines_controls(client, da
     assert r["actuators"]["heater"]["unit"] == "level" and r["actuators"]["heater"]["step"] == 1
     assert r["metrics"]["fitted_on"] is False
     assert r["model"] == "bullet-model.json"  # the page names the model its figures are from
+    # the IR curve is named as the figures name it (report.figures.second_bean_reading), not as a mark
+    assert (r["curves"]["beans_measured_label"], r["curves"]["beans_measured_few"]) == (
+        "beans measured (second reading)",
+        False,
+    )
     # a roast the model was fitted on, under another name: its figures are said not to be held out
     f = client.post("/api/open", json={"log": "logs/renamed-fitted-490g.json", "model": "bullet-model.json"}, headers=H)
     assert f.json()["metrics"]["fitted_on"] is True
@@ -600,3 +605,20 @@ def test_the_what_ifs_changed_settings_are_written_as_artisan_alarms(client, dat
     assert all(v % 10 == 0 for _, v in burner)
     before = [v for s, v in burner if s < 240][-1]
     assert [v for s, v in burner if s == 240] == [before - 10]
+
+
+def test_a_second_bean_reading_is_named_as_what_it_is():
+    """One rule names a batch's second bean reading on the figures and the page: a curve of readings (an
+    IR sensor), the first-crack mark read as the beans (a map's [Tb2] first_crack), or none."""
+    from types import SimpleNamespace
+
+    from roastlab.model.constants import FIRST_CRACK_BEAN_C
+    from roastlab.report.figures import second_bean_reading
+
+    t = np.arange(0.0, 600.0, 5.0)
+    mark = np.where(t == 480.0, FIRST_CRACK_BEAN_C, np.nan)
+    ir = 30.0 + 0.3 * t
+    assert second_bean_reading(SimpleNamespace(Tb2_C=ir, events={})) == ("beans measured (second reading)", False)
+    label, few = second_bean_reading(SimpleNamespace(Tb2_C=mark, events={"FCs": 480.0}))
+    assert few and label.startswith("beans at first crack") and "FCs" in label
+    assert second_bean_reading(SimpleNamespace(Tb2_C=None, events={})) is None

@@ -145,7 +145,11 @@ function draw() {
   const T = (a) => (a ? a.map(temp) : null);
   const traces = [];
   if (c.BT_measured) traces.push({ x, y: T(c.BT_measured), name: "BT measured", mode: "markers", marker: { size: 3, color: "#333" } });
-  if (c.beans_measured) traces.push({ x, y: T(c.beans_measured), name: "beans measured (IR)", mode: "markers", marker: { size: 2, color: "#a0785a" } });
+  if (c.beans_measured) {  // a curve of readings, or the first-crack mark read as the beans (the server names it)
+    const few = c.beans_measured_few;
+    traces.push({ x, y: T(c.beans_measured), name: c.beans_measured_label, mode: "markers",
+      marker: few ? { size: 9, symbol: "diamond-open", color: "#a0785a", line: { width: 2 } } : { size: 2, color: "#a0785a" } });
+  }
   if (c.ET_measured) traces.push({ x, y: T(c.ET_measured), name: "ET measured", mode: "markers", marker: { size: 2, color: "#9467bd" } });
   const b = o.band || {};
   if (b.lower) {  // the as-run band: parameters and roast-to-roast spread (roastlab.evaluate.bands)

@@ -144,6 +144,7 @@ def curves(batch, result, et: str = "Tm") -> dict:
     reads the machine's map), the settings and the rate of rise [degC/min] (the one RoR of
     :mod:`roastlab.metrics.profile`); with ``batch`` the measured BT, ET and a second bean
     reading too."""
+    from ..report.figures import second_bean_reading
     from ..workflows.transfer import model_et_C
 
     t = result.time_s
@@ -159,8 +160,9 @@ def curves(batch, result, et: str = "Tm") -> dict:
     if batch is not None and batch.Ta_C is not None:
         out["BT_measured"] = _series(batch.Ta_C)
         out["RoR_measured"] = _series(rate_of_rise_C_per_min(batch.time_s, batch.Ta_C))
-    if batch is not None and batch.Tb2_C is not None:
+    if batch is not None and (reading := second_bean_reading(batch)) is not None:
         out["beans_measured"] = _series(batch.Tb2_C)
+        out["beans_measured_label"], out["beans_measured_few"] = reading
     if batch is not None and batch.ET_C is not None:
         out["ET_measured"] = _series(batch.ET_C)
     return out

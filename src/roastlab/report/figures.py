@@ -316,6 +316,20 @@ def setting_axis_label(name: str, unit: str) -> str:
     return f"{name} [{ {'percent': '%', 'tens': 'level x10'}.get(unit, unit) }]"
 
 
+def second_bean_reading(b) -> tuple[str, bool] | None:
+    """How a batch's second bean reading is named on a figure or the page: ``(label, few)``, ``few``
+    where it is a few readings (drawn as markers that stand out), or None where it has none. A curve
+    of readings (the Bullet's IR) is "beans measured (second reading)"; the first-crack mark read as
+    the beans (a map's ``[Tb2] first_crack``) says so."""
+    if b.Tb2_C is None or not np.isfinite(b.Tb2_C).any():
+        return None
+    marked = np.isfinite(b.Tb2_C)
+    if np.count_nonzero(marked) > 3:
+        return "beans measured (second reading)", False
+    at_crack = np.all(b.Tb2_C[marked] == FIRST_CRACK_BEAN_C) and "FCs" in b.events
+    return (f"beans at first crack ({FIRST_CRACK_BEAN_C:g} °C, the FCs mark)" if at_crack else "beans measured"), True
+
+
 def plot_whatif(w, path=None, outputs=None):
     """Artisan-style: measured BT, the model's probe BT and bean temperature as run and with the
     changes, the log's event marks; below, BT's rate of rise (clipped to the roast after the
@@ -330,14 +344,13 @@ def plot_whatif(w, path=None, outputs=None):
     ax, ax_r, ax2 = fig.subplots(3, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1.3, 1.1]})
     if b.Ta_C is not None:
         ax.plot(t_min, b.Ta_C, ".", ms=3, color="0.3", label="BT measured (probe)")
-    if b.Tb2_C is not None:
+    if (reading := second_bean_reading(b)) is not None:
+        label, few = reading
         marked = np.isfinite(b.Tb2_C)
-        if np.count_nonzero(marked) > 3:
-            ax.plot(t_min, b.Tb2_C, ".", ms=2, color="tab:brown", alpha=0.5, label="beans measured (second reading)")
-        elif marked.any():  # a few readings, such as the first-crack mark read as the beans ([Tb2] first_crack)
-            at_crack = np.all(b.Tb2_C[marked] == FIRST_CRACK_BEAN_C) and "FCs" in b.events
-            label = f"beans at first crack ({FIRST_CRACK_BEAN_C:g} °C, the FCs mark)" if at_crack else "beans measured"
+        if few:  # the first-crack mark read as the beans: a marker that stands out
             ax.plot(t_min[marked], b.Tb2_C[marked], "D", ms=6, mfc="none", color="tab:brown", label=label)
+        else:
+            ax.plot(t_min, b.Tb2_C, ".", ms=2, color="tab:brown", alpha=0.5, label=label)
     if b.ET_C is not None:
         ax.plot(t_min, b.ET_C, ".", ms=2, color="tab:purple", alpha=0.6, label="ET measured (log)")
     change = "; ".join(w.changes) or "no change"
