@@ -281,12 +281,13 @@ def test_artisan_csv_export(tmp_path):
     assert read_artisan_csv(p).fields == {ET_BEFORE_CHARGE: pytest.approx(150.4)}
 
 
-def _csv_export_with_extras(path, mode="F", clock="14:05"):
+def _csv_export_with_extras(path, clock="14:05"):
     """SYNTHETIC Artisan CSV export (the layout of Artisan's exportCSV) with its first line's marks and
     two extra devices: "{3}"/"{0}" (the Burner and Air event types' names, as Artisan's Kaleido setup
-    names its extra device) and "Inlet Temp"/"Drum RPM"; CHARGE at 0:06 on the Time1 axis."""
+    names its extra device) and "Inlet Temp"/"Drum RPM", in degF; CHARGE at 0:06 on the Time1 axis, the
+    recording started at ``clock``."""
     head = (
-        f"Date:01.01.2026\tUnit:{mode}\tCHARGE:00:06\tTP:01:00\tDRYe:04:06\tFCs:07:36\tFCe:\tSCs:\tSCe:\tDROP:09:06"
+        "Date:01.01.2026\tUnit:F\tCHARGE:00:06\tTP:01:00\tDRYe:04:06\tFCs:07:36\tFCe:\tSCs:\tSCe:\tDROP:09:06"
         f"\tCOOL:\tTime:{clock}"
     )
     rows = [head, "Time1\tTime2\tET\tBT\tEvent\t{3}\t{0}\tInlet Temp\tDrum RPM"]
