@@ -336,6 +336,9 @@ def test_a_map_of_artisan_logs_reads_their_csv_exports_and_one_rule_tells_logs_f
     plain.write_text("seconds,bean temp,burner\n0,120,70\n5,118,70\n")
     csv_map = load_map(write_map(tmp_path, 'format = "csv"\n' + SKY_MAP, "csv.toml"))
     assert reads_as_log(export, alog_map) and not reads_as_log(batch, alog_map)
+    tsv = tmp_path / "e.tsv"  # the same export saved as .tsv (or .txt): a text table like a .csv
+    tsv.write_bytes(export.read_bytes())
+    assert reads_as_log(tsv, alog_map) and import_log(tsv, alog_map).events["FCs"] == 450.0
     assert reads_as_log(plain, csv_map) and not reads_as_log(batch, csv_map)
     assert reads_as_log(tmp_path / "r.alog", None) and not reads_as_log(export, None)
     # a model reads each as the rule says (the CLI's read_inputs and the page use it): the export through

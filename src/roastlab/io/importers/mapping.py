@@ -480,6 +480,10 @@ def grams_in_name(path: Path) -> tuple[float, str] | None:
     return (int(m.group(1)) / 1000.0, m.group(0)) if m else None
 
 
+#: The suffixes of a text table: a plain CSV log, Artisan's CSV export, or a batch CSV (by content).
+CSV_SUFFIXES = (".csv", ".txt", ".tsv")
+
+
 def detect_format(path: Path, fmt: str = "auto") -> str:
     """The log format of ``path``: ``fmt`` unless "auto", else by suffix and content (a file without a
     suffix, as RoasTime keeps its logs, by its content alone: a JSON object with RoasTime's series, or
@@ -495,7 +499,7 @@ def detect_format(path: Path, fmt: str = "auto") -> str:
             return "roastime"
     if suffix in (".parquet", ".pq"):
         return "parquet"
-    if suffix in (".csv", ".txt", ".tsv"):
+    if suffix in CSV_SUFFIXES:
         first = read_input_bytes(path)[:4096].split(b"\n", 1)[0]  # through the guard: never a FIFO
         return "artisan-csv" if b"Unit:" in first else "csv"
     if suffix == "":  # RoasTime keeps its logs without a suffix; an Artisan log can lose its own
@@ -672,7 +676,7 @@ def log_format(path: Path, map_format: str) -> str:
     but where the map's is one of :data:`ARTISAN_FORMATS` and the file is the other (by its suffix and
     first line), the file's own."""
     fmt = detect_format(path, map_format)
-    if fmt in ARTISAN_FORMATS and path.suffix.lower() in (".alog", ".csv", ".txt", ".tsv"):
+    if fmt in ARTISAN_FORMATS and path.suffix.lower() in (".alog", *CSV_SUFFIXES):
         own = detect_format(path, "auto")
         return own if own in ARTISAN_FORMATS else fmt
     return fmt
@@ -680,14 +684,15 @@ def log_format(path: Path, map_format: str) -> str:
 
 def reads_as_log(path: str | Path, cmap: ColumnMap | None) -> bool:
     """Whether ``path`` is a roast log that the column map ``cmap`` reads, rather than a batch CSV (the
-    canonical columns): a file by its suffix (.alog, RoasTime's .json, Parquet); a ``.csv`` where the map
-    reads plain CSV logs and its header is not a batch CSV's (:data:`~roastlab.io.batch.REQUIRED_COLUMNS`),
-    or the map is an Artisan map and the file Artisan's CSV export (:func:`log_format`)."""
+    canonical columns): a file by its suffix (.alog, RoasTime's .json, Parquet); a text table
+    (:data:`CSV_SUFFIXES`) where the map reads plain CSV logs and its header is not a batch CSV's
+    (:data:`~roastlab.io.batch.REQUIRED_COLUMNS`), or the map is an Artisan map and the file Artisan's
+    CSV export (:func:`log_format`)."""
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix in (".alog", ".json", ".parquet", ".pq"):
         return True
-    if suffix != ".csv" or cmap is None:
+    if suffix not in CSV_SUFFIXES or cmap is None:
         return False
     if not path.is_file():
         return cmap.format in ("artisan-csv", "csv")  # the reader then says the file is missing
