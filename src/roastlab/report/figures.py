@@ -321,9 +321,9 @@ def second_bean_reading(b) -> tuple[str, bool] | None:
     where it is a few readings (drawn as markers that stand out), or None where it has none. A curve
     of readings (the Bullet's IR) is "beans measured (second reading)"; the first-crack mark read as
     the beans (a map's ``[Tb2] first_crack``) says so."""
-    if b.Tb2_C is None or not np.isfinite(b.Tb2_C).any():
+    marked = np.isfinite(b.Tb2_C) if b.Tb2_C is not None else np.zeros(0, dtype=bool)
+    if not marked.any():
         return None
-    marked = np.isfinite(b.Tb2_C)
     if np.count_nonzero(marked) > 3:
         return "beans measured (second reading)", False
     at_crack = np.all(b.Tb2_C[marked] == FIRST_CRACK_BEAN_C) and "FCs" in b.events

@@ -729,14 +729,14 @@ def read_artisan_csv(path: str | Path, keep_after_drop: bool = False) -> Artisan
             raise InputError(f"missing column {col} (header has: {', '.join(header)})", path, "line 2")
     idx = {c: header.index(c) for c in header}
     start = header.index("Event") + 1 if "Event" in header else len(header)
-    extras = {}  # column index -> channel name: the extra devices' columns after Event
+    extras = {}  # channel name -> column index: the extra devices' columns after Event
     for k in range(start, len(header)):
         name = extra_name(header[k], list(DEFAULT_ETYPES), set())
-        if name and name not in ("Time1", "Time2", "ET", "BT", "Event") and name not in extras.values():
-            extras[k] = name
+        if name and name not in ("Time1", "Time2", "ET", "BT", "Event") and name not in extras:
+            extras[name] = k
     t1, t2, et, bt = array("d"), array("d"), array("d"), array("d")
-    extra_values = {k: array("d") for k in extras}
-    readings = [(idx["ET"], "ET", et), (idx["BT"], "BT", bt), *((k, extras[k], extra_values[k]) for k in extras)]
+    extra_values = {name: array("d") for name in extras}
+    readings = [(idx["ET"], "ET", et), (idx["BT"], "BT", bt), *((k, n, extra_values[n]) for n, k in extras.items())]
     for line_no, ln in lines:
         cells = ln.rstrip("\r\n").split(sep)
         if len(cells) < len(header) - 1:
@@ -759,7 +759,7 @@ def read_artisan_csv(path: str | Path, keep_after_drop: bool = False) -> Artisan
         raise InputError("too short for an Artisan CSV export (meta line, header, data)", path)
     t1, t2 = np.array(t1), np.array(t2)
     et, bt = np.array(et), np.array(bt)
-    extra = {extras[k]: np.array(v) for k, v in extra_values.items()}
+    extra = {name: np.array(v) for name, v in extra_values.items()}
     temps = {"ET", "BT", *(name for name in extra if named_as_temperature(name))}
     if mode == "F":
         et, bt = f_to_c(et), f_to_c(bt)
