@@ -320,6 +320,37 @@ def test_an_artisan_csv_export_keeps_its_marks_and_extra_devices(cli, tmp_path):
     assert "2 of 2 log(s) mark first crack" in out, out
 
 
+def test_an_artisan_csv_export_marked_wrong_or_without_settings_is_one_line_naming_why(tmp_path):
+    """SYNTHETIC exports: DROP marked before CHARGE is refused as an .alog's is (it was an IndexError
+    with a map that reads the drum at CHARGE from a channel); a heater column with no finite reading
+    names the column that left no complete sample."""
+    good = _csv_export_with_extras(tmp_path / "e.csv")
+    text = good.read_text()
+    early = tmp_path / "early.csv"
+    early.write_text(text.replace("DROP:09:06", "DROP:00:02"))
+    with pytest.raises(InputError, match=r"DROP \(00:02\) is marked at or before CHARGE \(0:06"):
+        read_artisan_csv(early)
+    heater_map = load_map(
+        write_map(
+            tmp_path, 'format = "alog"\n' + ROOM_AIR_MAP + '[heater]\ncolumn = "Burner"\n[initial]\nTm0_C = "ET"\n'
+        )
+    )
+    with pytest.raises(InputError, match="DROP"):
+        import_log(early, heater_map)
+    lines = text.splitlines()
+    blank = tmp_path / "noburner.csv"  # the Burner's cells all infinite: no reading
+    blank.write_text("\n".join(lines[:2] + [_with_cell(row, 5, "inf") for row in lines[2:]]) + "\n")
+    with pytest.raises(InputError, match=r"no readings in heater \(column Burner\)"):
+        import_log(blank, heater_map)
+
+
+def _with_cell(row: str, k: int, value: str) -> str:
+    """A tab-separated ``row`` with its cell ``k`` replaced by ``value``."""
+    cells = row.split("\t")
+    cells[k] = value
+    return "\t".join(cells)
+
+
 def test_a_map_of_artisan_logs_reads_their_csv_exports_and_one_rule_tells_logs_from_batch_csvs(tmp_path):
     """A map written for .alog files (format "alog", as init writes it) reads Artisan's CSV export of the
     same roaster too, the channels being Artisan's names in both; reads_as_log, the one rule that

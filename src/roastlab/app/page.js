@@ -310,7 +310,7 @@ async function whatifBackground() {
 // The fit report (fit-roaster's report.md), rendered by the server with raw HTML in it escaped.
 function showReport(html) {
   if (html) $("fit-report").innerHTML = html;
-  else $("fit-report").textContent = "(this model has no fit report: fit a model on your logs here, or with roastlab init + fit-roaster)";
+  else $("fit-report").textContent = "(no fit report beside this model: fit-roaster writes model.json with its report.md in one folder; fit a model on your logs here, or with roastlab init + fit-roaster)";
 }
 
 async function openLog() {
@@ -440,7 +440,8 @@ async function runTransfer() {
       xaxis: { title: { text: "time after CHARGE [m:ss]" }, ...mmssTicks(x) }, yaxis: { title: { text: `BT [${unit()}]` } },
       yaxis2: { title: { text: `${r.decide} [${shownUnit(r.unit)}]` }, overlaying: "y", side: "right", showgrid: false,
                 range: [r.low - (r.step || (r.high - r.low) / 20), r.high + (r.step || (r.high - r.low) / 20)],
-                ...(r.step ? { dtick: r.step, tickformat: "d" } : {}) },
+                // on the machine's steps, a tick every step or every few (at most about ten ticks)
+                ...(r.step ? { dtick: r.step * Math.max(1, Math.ceil((r.high - r.low) / r.step / 10)), tickformat: "d" } : {}) },
     });
     say("");
     document.body.dataset.transfer = "done";

@@ -774,6 +774,13 @@ def read_artisan_csv(path: str | Path, keep_after_drop: bool = False) -> Artisan
             drop = int(np.argmin(np.abs(t1 - _mmss(meta["DROP"]))))
         except ValueError:
             raise InputError(f"DROP time {meta['DROP'][:20]!r} is not mm:ss", path, "line 1") from None
+    if drop is not None and charged.size and drop <= charged[0]:  # as read_alog refuses such marks
+        raise InputError(
+            f"DROP ({meta['DROP'][:20]}) is marked at or before CHARGE ({mmss(t1[charged[0]])} on the Time1 axis): "
+            "mark them again in Artisan",
+            path,
+            "line 1",
+        )
     charge, drop, notes = marks_or_bt(t1, bt, int(charged[0]) if charged.size else None, drop, keep_after_drop)
     if repeats:
         notes.insert(0, f"{repeats} time stamp(s) repeat (the export writes whole seconds): their rows averaged")

@@ -702,6 +702,13 @@ def reads_as_log(path: str | Path, cmap: ColumnMap | None) -> bool:
     return cmap.format in ARTISAN_FORMATS and detect_format(path, "auto") == "artisan-csv"
 
 
+def _named_input(k: str, cmap, settings: dict) -> str:
+    """An input of the map as a message names it: ``k`` and, where the map names one, its column."""
+    spec = settings.get(k) or getattr(cmap, k, None) or {}
+    column = spec.get("column") if isinstance(spec, dict) else None
+    return f"{k} (column {column})" if isinstance(column, str) else k
+
+
 def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None) -> Batch:
     """Read any supported log with a column map into a validated canonical :class:`Batch`."""
     path = as_path(path, "path")
@@ -944,8 +951,11 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
         series["Tb2"] = np.where(time_s >= settings["Tb2"].get("start_s", 0.0), series["Tb2"], np.nan)
     if "ET" in series:  # Artisan writes -1 where a channel read nothing
         series["ET"] = np.where(series["ET"] > -1.0 + 1e-9, series["ET"], np.nan)
-    if ok.sum() < 2:
-        raise InputError("fewer than 2 complete samples after dropping missing values", path)
+    if ok.sum() < 2:  # name the inputs that have (next to) no readings, where that is why
+        required = {"Ta": Ta, "Tgi": Tgi, "Gg": Gg, **{k: series[k] for k in ("heater", "fan") if k in series}}
+        empty = [_named_input(k, cmap, settings) for k, v in required.items() if np.isfinite(v).sum() < 2]
+        why = f": no readings in {', '.join(empty)}" if empty else ": no sample has every input"
+        raise InputError(f"fewer than 2 complete samples after dropping missing values{why}", path)
 
     def select(which):
         """The samples ``which`` (a mask or a slice) of every series."""
