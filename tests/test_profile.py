@@ -153,6 +153,19 @@ def test_a_whatif_time_is_read_by_the_same_clock():
         parse_setting_change("heater", "+1@4:75")  # was read as 5:15
 
 
+@pytest.mark.parametrize("text", ["+1e400@1:00", "x1e400", "-1e999"])
+def test_a_whatif_change_beyond_floating_point_is_refused(text):
+    """A shift or factor written past floating point reads as inf: refused (it ran, clipped to the
+    machine's highest setting, and printed "heater +inf %")."""
+    from roastlab.errors import ParameterError
+    from roastlab.workflows.whatif import parse_set, parse_setting_change
+
+    with pytest.raises(ParameterError, match="not a finite number"):
+        parse_setting_change("heater", text)
+    with pytest.raises(ParameterError, match="not a finite number"):
+        parse_set("heater=1e400@2:00")
+
+
 def test_a_whatif_change_from_after_the_log_ends_is_refused():
     """SYNTHETIC 10-minute batch with a heater series: a change from 12:00 on changes nothing, and
     says so instead of printing a table of zeros; one from the last sample on still runs."""

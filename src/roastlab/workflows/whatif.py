@@ -109,6 +109,13 @@ def parse_time_s(text: str | None) -> float:
         raise ParameterError(str(exc)) from None
 
 
+def _finite(value: float, what: str) -> float:
+    """``value``, refused where the text wrote a number beyond floating point (1e400 reads as inf)."""
+    if not np.isfinite(value):
+        raise ParameterError(f"{what}: {value} is not a finite number")
+    return value
+
+
 def parse_setting_change(setting: str, text: str, unit: str = "") -> SettingChange:
     """``"+1"``, ``"-2"`` (shift), ``"x1.1"`` (scale), each optionally from a time: ``"+1@4:00"``
     (m:ss) or ``"+1@240"`` (s). A number with no sign or ``x`` is refused: a relative change
@@ -120,7 +127,7 @@ def parse_setting_change(setting: str, text: str, unit: str = "") -> SettingChan
             "optionally from a time: +1@4:00 (to set a value use --set)"
         )
     sign = m.group(1)
-    value = float(m.group(2))
+    value = _finite(float(m.group(2)), f"--{setting} {text!r}")
     if sign in ("x", "*"):
         return SettingChange(setting, "scale", value, parse_time_s(m.group(3)), unit)
     return SettingChange(setting, "shift", -value if sign == "-" else value, parse_time_s(m.group(3)), unit)
@@ -135,7 +142,7 @@ def parse_set(text: str, units: dict | None = None) -> SettingChange:
             f"--set {text!r}: expected SETTING=VALUE@TIME, e.g. heater=6@2:00 (absolute) or heater=+1@4:00 "
             "(relative; heater or fan, TIME as m:ss or seconds)"
         )
-    name, sign, value = m.group(1), m.group(2), float(m.group(3))
+    name, sign, value = m.group(1), m.group(2), _finite(float(m.group(3)), f"--set {text!r}")
     unit = (units or {}).get(name, "")
     when = parse_time_s(m.group(4))
     if sign:
