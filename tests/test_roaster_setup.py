@@ -1198,6 +1198,21 @@ def test_init_states_a_capacity_read_from_the_catalogue(cli, tmp_path):
     assert code == 0, err
     plant = (tmp_path / "cfg" / "plant.toml").read_text()
     assert "batch capacity 6 kg: the catalogue: Giesen" in plant and "Mm_kg = 18" in plant  # 3 kg per kg
+    assert 'name = "giesen-w6a"' in plant  # the make the logs record names the roaster
+
+
+def test_init_names_the_roaster_as_asked_else_by_its_make_else_by_its_folder(cli, tmp_path):
+    """SYNTHETIC .alog files that record no make: the plant (and so the model and report) takes --name,
+    else the output folder's name; the page passes the name the roaster typed."""
+    logs = []
+    for k in range(2):
+        p = tmp_path / f"r{k}.alog"
+        p.write_text(fake_alog(extra={"weight": [200.0, 0.0, "g"]}))
+        logs.append(p)
+    assert cli("init", *logs, "--out", tmp_path / "garage-drum")[0] == 0
+    assert 'name = "garage-drum"' in (tmp_path / "garage-drum" / "plant.toml").read_text()
+    assert cli("init", *logs, "--out", tmp_path / "cfg", "--name", "Probat L12 (shop)")[0] == 0
+    assert 'name = "probat-l12-shop"' in (tmp_path / "cfg" / "plant.toml").read_text()
 
 
 @pytest.mark.parametrize(
@@ -1425,7 +1440,8 @@ def test_a_roaster_logging_in_fahrenheit_gets_the_fit_it_gets_in_celsius(cli, tm
     logs_F = [_as_fahrenheit(p, tmp_path / "F") for p in logs]
     held, mae = {}, {}
     for unit, paths in (("C", logs), ("F", logs_F)):
-        assert cli("init", *paths, "--out", tmp_path / f"cfg{unit}")[0] == 0
+        # one name for both (by default each would take its folder's: the logs name no make)
+        assert cli("init", *paths, "--out", tmp_path / f"cfg{unit}", "--name", "Skywalker")[0] == 0
         map_toml = tmp_path / f"cfg{unit}" / "map.toml"  # the inlet air from the room each log records
         assert "# room = true" in map_toml.read_text()
         map_toml.write_text(map_toml.read_text().replace("# room = true", "room = true"))
@@ -1435,6 +1451,7 @@ def test_a_roaster_logging_in_fahrenheit_gets_the_fit_it_gets_in_celsius(cli, tm
         mae[unit] = float(out.split("held out: FIT")[1].split("MAE ")[1].split(" °C")[0])
     for name in ("plant.toml", "fit.toml"):
         assert (tmp_path / "cfgC" / name).read_text() == (tmp_path / "cfgF" / name).read_text(), name
+    assert 'name = "skywalker"' in (tmp_path / "cfgC" / "plant.toml").read_text()
     # the map names the files it was written from, the same names in both folders
     assert (tmp_path / "cfgC" / "map.toml").read_text() == (tmp_path / "cfgF" / "map.toml").read_text()
     assert abs(held["C"] - held["F"]) < 0.2 and abs(mae["C"] - mae["F"]) < 0.05, (held, mae)

@@ -19,6 +19,7 @@ def cmd_init(args) -> int:
         diameter_m=args.drum_diameter_m,
         length_m=args.drum_length_m,
         units={"heater": args.heater_unit, "fan": args.fan_unit},
+        name=args.name,
     )
     s = r["survey"]
     aside = f" (and {len(s.unweighed)} without a green weight, below)" if s.unweighed else ""
@@ -130,6 +131,10 @@ def add_parsers(sub) -> None:
     )
     p.add_argument("logs", nargs="+", metavar="LOG", help="roast logs of one roaster, or a folder of them")
     p.add_argument("--out", required=True, metavar="DIR", help="folder for map.toml, plant.toml, fit.toml, fleet.toml")
+    p.add_argument(
+        "--name",
+        help="the roaster's name in its plant, model and report (default: the make its logs record, else DIR's name)",
+    )
     p.add_argument(
         "--batch-kg",
         type=float_arg("--batch-kg"),

@@ -908,8 +908,32 @@ def batch_capacity(s: Survey, capacity_kg=None) -> tuple[float, str]:
     return 2.0 * largest, "ESTIMATED as twice the largest logged batch (pass --batch-capacity-kg)"
 
 
-def estimate_plant(s: Survey, capacity_kg=None, diameter_m=None, length_m=None) -> tuple[dict, list[str]]:
-    """The plant's geometry and the comment lines that say where each number comes from."""
+#: A roaster's name where neither the roaster nor its logs give one.
+DEFAULT_ROASTER_NAME = "my-roaster"
+
+
+def roaster_name(given: str | None, machine: str | None, folder: str | Path | None = None) -> str:
+    """The plant's name: ``given`` (the roaster's choice), else the make the logs record (``machine``),
+    else the output ``folder``'s name, else :data:`DEFAULT_ROASTER_NAME`; lower case, runs of anything
+    but letters and digits as one "-".
+
+    >>> roaster_name(None, "Aillio Bullet", "out/mybullet"), roaster_name("Probat L12", "Aillio Bullet")
+    ('aillio-bullet', 'probat-l12')
+    >>> roaster_name(None, None, "roasters/mysky"), roaster_name("", None, "..")
+    ('mysky', 'my-roaster')
+    """
+    for text in (given, machine, Path(folder).name if folder else None):
+        name = re.sub(r"[^a-z0-9]+", "-", (text or "").lower()).strip("-")
+        if name:
+            return name
+    return DEFAULT_ROASTER_NAME
+
+
+def estimate_plant(
+    s: Survey, capacity_kg=None, diameter_m=None, length_m=None, name: str | None = None
+) -> tuple[dict, list[str]]:
+    """The plant's geometry and the comment lines that say where each number comes from; ``name``: the
+    plant's (:func:`roaster_name`; default the make the logs record, else :data:`DEFAULT_ROASTER_NAME`)."""
     masses = [i.batch_kg for i in s.logs]
     cap, why = batch_capacity(s, capacity_kg)
     notes = [f"batch capacity {cap:g} kg: {why}"]
@@ -928,7 +952,7 @@ def estimate_plant(s: Survey, capacity_kg=None, diameter_m=None, length_m=None) 
         f"{METAL_KG_PER_KG:g} kg per kg of capacity (drum, vanes and front plate in thermal contact)"
     )
     plant = {
-        "name": re.sub(r"[^a-z0-9-]+", "-", (s.machine or "my-roaster").lower()).strip("-") or "my-roaster",
+        "name": name or roaster_name(None, s.machine),
         "Mb_kg": round(float(np.median(masses)), 4),
         "Dch_m": round(diameter_m, 4),
         "Lch_m": round(length_m, 4),
@@ -1328,15 +1352,16 @@ def plant_text(plant: dict, notes: list[str]) -> str:
 
 
 def init_roaster(
-    paths, out_dir, *, batch_kg=None, capacity_kg=None, diameter_m=None, length_m=None, units=None
+    paths, out_dir, *, batch_kg=None, capacity_kg=None, diameter_m=None, length_m=None, units=None, name=None
 ) -> dict:
     """Survey the logs and write ``out_dir``/map.toml, plant.toml, fit.toml and fleet.toml; returns a summary.
-    ``units``: a control's unit as the roaster gives it (:func:`survey`)."""
+    ``units``: a control's unit as the roaster gives it (:func:`survey`); ``name``: the roaster's, in its
+    plant, model and report (:func:`roaster_name`: default the make its logs record, else ``out_dir``'s name)."""
     from ..io.files import Outputs
 
     s = survey(paths, batch_kg, units)
     paths = log_paths(paths)
-    plant, notes = estimate_plant(s, capacity_kg, diameter_m, length_m)
+    plant, notes = estimate_plant(s, capacity_kg, diameter_m, length_m, roaster_name(name, s.machine, out_dir))
     cap, _ = batch_capacity(s, capacity_kg)
     out = Path(out_dir)
     with Outputs(list(paths)) as o:
