@@ -10,6 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from roastlab.io.plants import load_plant
+
 duckdb = pytest.importorskip("duckdb")
 
 from roastlab.fleet import fit_fleet, fleet_report, fleet_spec, ingest  # noqa: E402
@@ -193,11 +195,22 @@ def test_probe_faults_are_outliers_not_drift(tmp_path):
         make_fleet(tmp_path / "data", 40, seed=8, machines=syn.MACHINES[:1])
     finally:
         syn.PROBE_FAULT_RATE = old
+    # the machine's plant as a file (its 120kg geometry) whose name is not the file's: the report names
+    # the plant by its own name (the figure's title was the file name, "plant.toml" for every init folder)
+    preset = load_plant(syn.MACHINES[0].plant)
+    shop = tmp_path / "data" / "plant.toml"
+    shop.write_text(
+        'name = "shop-drum"\n'
+        + "".join(f"{k} = {getattr(preset, k)}\n" for k in ("Mb_kg", "Dch_m", "Lch_m", "Hflap_m", "Sflap_m", "Mm_kg"))
+    )
+    manifest = tmp_path / "data" / "manifest.csv"
+    manifest.write_text(manifest.read_text().replace(f",{syn.MACHINES[0].plant},", f",{shop},"))
     db = tmp_path / "f.duckdb"
-    ingest(db, tmp_path / "data" / "manifest.csv")
+    ingest(db, manifest)
     fit_fleet(db)
     m = fleet_report(db).to_json_dict()["machines"][0]
     assert len(m["outliers"]) >= 4 and m["alarms"] == []
+    assert m["plant"] == str(shop) and m["plant_name"] == "shop-drum"
     assert all("fit" in o["reason"] or "residual" in o["reason"] for o in m["outliers"])
 
 

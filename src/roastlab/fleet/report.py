@@ -11,7 +11,7 @@ import numpy as np
 from ..errors import InputError
 from ..report.result import Result
 from .drift import CLIP_Z, CUSUM_H, CUSUM_K, OUTLIER_FIT, OUTLIER_RATIO, WARMUP, analyse, machine_history, robust_stats
-from .store import open_store, store_errors
+from .store import open_store, plant_of, store_errors
 
 
 @dataclass
@@ -25,6 +25,7 @@ class MachineHistory:
     wide: object
     stderr: object
     analysis: dict
+    plant_name: str = ""  # the plant's own name (its file's ``name``, a preset's), "" where unknown
 
     @property
     def params(self) -> list[str]:
@@ -48,6 +49,7 @@ class MachineHistory:
         return {
             "machine": self.name,
             "plant": self.plant,
+            "plant_name": self.plant_name,
             "spec_id": self.spec_id,
             "batches": int(len(self.frame)),
             "first_started_at": self.frame["started_at"].iloc[0].isoformat() if len(self.frame) else None,
@@ -172,21 +174,24 @@ def fleet_report(db) -> FleetReport:
     with store_errors(db):
         try:
             rows = con.execute(
-                "SELECT m.machine_id, m.name, m.plant, "
+                "SELECT m.machine_id, m.name, m.plant, m.plant_toml, "
                 "(SELECT f.spec_id FROM fits f JOIN batches b USING (batch_id) WHERE b.machine_id = m.machine_id "
                 " ORDER BY f.fitted_at DESC LIMIT 1) FROM machines m ORDER BY m.machine_id"
             ).fetchall()
-            if not any(r[3] for r in rows):
+            if not any(r[4] for r in rows):
                 raise InputError("no fits in the store yet: run 'roastlab fleet fit' first", db)
             machines = []
-            for mid, name, plant, sid in rows:
+            for mid, name, plant, plant_toml, sid in rows:
                 if sid is None:
                     continue
                 frame, vals = machine_history(con, mid, sid)
                 params = list(dict.fromkeys(vals["parameter"]))
                 res = analyse(frame, vals, params)
                 err = vals.pivot(index="batch_id", columns="parameter", values="stderr").reindex(frame["batch_id"])
-                machines.append(MachineHistory(name, plant, sid, frame, res["wide"][params], err[params], res))
+                plant_name = plant_of(name, plant, plant_toml).name
+                machines.append(
+                    MachineHistory(name, plant, sid, frame, res["wide"][params], err[params], res, plant_name)
+                )
         finally:
             con.close()
     return FleetReport(machines, str(db))

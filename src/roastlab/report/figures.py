@@ -635,5 +635,5 @@ def plot_fleet_history(m, path=None, outputs=None):
         uniq = dict(zip(labels, handles))
         ax.legend(uniq.values(), uniq.keys(), fontsize=7, loc="upper right")
     axes[-1].set_xlabel("batch (in order of started_at)")
-    title = f"{m.name} ({Path(m.plant).name}): {len(idx)} batches, {len(a['alarms'])} alarm(s), {len(a['outliers'])} outlier(s)"
+    title = f"{m.name} ({m.plant_name or Path(m.plant).name}): {len(idx)} batches, {len(a['alarms'])} alarm(s), {len(a['outliers'])} outlier(s)"
     return finish_figure(fig, path, title, outputs)
