@@ -492,27 +492,24 @@ def create_app(data_dir: str | Path):
     def fit_start(session: Session, body: dict) -> dict:
         from ..workflows.roaster import fit_roaster
         from ..workflows.sizes import across_sizes_sentence
-        from ..workflows.survey import DEFAULT_ROASTER_NAME, init_roaster
+        from ..workflows.survey import init_roaster, roaster_name
 
         logs = body.get("logs") or []
         if not isinstance(logs, list) or len(logs) < 2:
             raise InputError("choose at least two logs of one roaster to fit (one to fit, one to hold out)", "fit")
         paths = [inside(data, rel) for rel in logs]
-        given = str(body.get("name") or DEFAULT_ROASTER_NAME)
-        name = re.sub(r"[^A-Za-z0-9_-]+", "-", given)[:40].strip("-") or DEFAULT_ROASTER_NAME
-        folder = data / "roasters" / name
+        given = str(body.get("name") or "")[:40] or None  # none typed: the make its logs record names it
+        folder = data / "roasters" / roaster_name(given, None)
         if session.fit.get("running"):
             raise InputError("a fit is already running in this tab", "fit")
-        session.fit = {"running": True, "done": 0, "total": 1, "text": "reading the logs", "name": name}
+        session.fit = {"running": True, "done": 0, "total": 1, "text": "reading the logs", "name": folder.name}
 
         def progress(done, total, text=""):
             session.fit.update(done=done, total=total, text=text)
 
         def work():
             try:
-                # the name the roaster typed names the roaster too; the field's default leaves it to the logs' make
-                named = None if given == DEFAULT_ROASTER_NAME else name
-                init_roaster(paths, folder, batch_kg=body.get("batch_kg") or None, name=named)
+                init_roaster(paths, folder, batch_kg=body.get("batch_kg") or None, name=given)
                 r = fit_roaster(
                     folder,
                     paths,
