@@ -622,3 +622,31 @@ def test_a_second_bean_reading_is_named_as_what_it_is():
     label, few = second_bean_reading(SimpleNamespace(Tb2_C=mark, events={"FCs": 480.0}))
     assert few and label.startswith("beans at first crack") and "FCs" in label
     assert second_bean_reading(SimpleNamespace(Tb2_C=None, events={})) is None
+
+
+def test_the_validation_figure_draws_each_second_bean_reading_as_it_is():
+    """SYNTHETIC batches (the paper's model's own probe as the measurement): validate --plot drew the
+    model's beans and a second reading only where that reading was scored as an output, so a first-crack
+    mark read as the beans (one sample, too few to score) was missing from the figure the page and the
+    what-if figure show it on. It is now a marker under the shared name; a curve of readings stays a curve."""
+    from roastlab import FittedModel
+    from roastlab.io.batch import Batch
+    from roastlab.model.constants import FIRST_CRACK_BEAN_C
+    from roastlab.report.figures import plot_fit
+
+    model = FittedModel.paper()
+    t = np.arange(0.0, 901.0, 30.0)
+    base = Batch("fc", t, np.full_like(t, 0.4), np.full_like(t, 450.0))
+    ta = model.predict(base).Ta_C
+    mark = np.where(t == 600.0, FIRST_CRACK_BEAN_C, np.nan)
+    marked = Batch("fc", t, base.Gg_kg_s, base.Tgi_C, Ta_C=ta, Tb2_C=mark, events={"FCs": 600.0})
+    curve = Batch("ir", t, base.Gg_kg_s, base.Tgi_C, Ta_C=ta, Tb2_C=ta + 10.0)
+    for batch, wanted, style in (
+        (marked, "beans at first crack", "D"),
+        (curve, "beans measured (second reading)", "None"),
+    ):
+        fig = plot_fit(model.validate([batch]))
+        labels = [text.get_text() for text in fig.legends[0].get_texts()]
+        assert "bean predicted (model Tb)" in labels and any(s.startswith(wanted) for s in labels), labels
+        line = next(ln for ln in fig.axes[0].get_lines() if ln.get_label().startswith(wanted))
+        assert line.get_marker() == style

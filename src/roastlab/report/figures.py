@@ -7,6 +7,7 @@ so a notebook shows each once. Saving goes through the output guard (:mod:`roast
 from __future__ import annotations
 
 import io
+import types
 from pathlib import Path
 
 import numpy as np
@@ -212,13 +213,19 @@ def plot_fit(result, path=None, title=None, max_panels: int = 8, outputs=None, b
             lw=1,
             label="residual BT meas − pred (below)",
         )
-        second = result.results[i].Tb2_measured_C if i < len(result.results) else None
-        second = second if "Tb2" in result.outputs else None
-        if second is not None:  # the second bean reading and the model's Tb
-            sim = result.results[i]
+        sim = result.results[i] if i < len(result.results) else None
+        second = None if sim is None else sim.Tb2_measured_C
+        # named and drawn as the page and the what-if figure do: a curve, or the first-crack mark as a marker
+        reading = None if second is None else second_bean_reading(_readings_of(sim))
+        if reading is not None:  # the second bean reading and the model's Tb
+            label, few = reading
             ax.plot(t, sim.Tb_C, color="tab:orange", lw=1.2, label="bean predicted (model Tb)")
-            ax.plot(t, second, ":", color="tab:brown", lw=1.6, label="second bean reading (Tb2)")
-            res.plot(t, second - sim.Tb_C, ":", color="tab:brown", lw=1, label="residual Tb2 − Tb (below)")
+            style = {"ls": "none", "marker": "D", "ms": 6, "mfc": "none"} if few else {"ls": ":", "lw": 1.6}
+            ax.plot(t, second, color="tab:brown", label=label, **style)
+            res.plot(t, second - sim.Tb_C, color="tab:brown", label="residual beans meas − model Tb (below)",
+                     **({"ls": "none", "marker": "D", "ms": 5, "mfc": "none"} if few else {"ls": ":", "lw": 1}))  # fmt: skip
+        else:
+            second = None
         for h, text in zip(*_ror_overlay(ax, result.time_s[i], result.measured[i], result.predicted[i])):
             entries.setdefault(text, h)  # every panel draws the same curves; a second bean reading on some
         if second is not None:  # its residual beside BT's, which the axis names
@@ -314,6 +321,12 @@ def setting_axis_label(name: str, unit: str) -> str:
     if unit == "reading":
         return f"{name} (as logged)"
     return f"{name} [{ {'percent': '%', 'tens': 'level x10'}.get(unit, unit) }]"
+
+
+def _readings_of(sim):
+    """A simulated batch's measured second bean reading and events as :func:`second_bean_reading` reads
+    a batch's."""
+    return types.SimpleNamespace(Tb2_C=sim.Tb2_measured_C, events=(getattr(sim, "meta", None) or {}).get("events", {}))
 
 
 def second_bean_reading(b) -> tuple[str, bool] | None:
