@@ -383,6 +383,8 @@ def test_a_map_of_artisan_logs_reads_their_csv_exports_and_one_rule_tells_logs_f
     assert load_log_for(batch, model).Ta_C.tolist() == [120.0, 118.0]
     with pytest.raises(InputError, match="a raw log needs a column map"):
         load_log_for(tmp_path / "r.alog", SimpleNamespace(column_map=None))
+    with pytest.raises(InputError, match="choose a model fitted on this roaster's logs"):  # the page, none chosen
+        load_log_for(tmp_path / "r.alog", None)
 
 
 def test_an_artisan_csv_export_with_repeated_whole_seconds_is_averaged(tmp_path):

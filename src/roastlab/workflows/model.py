@@ -538,11 +538,11 @@ def load_log_for(path, model: FittedModel | None, name: str | None = None) -> Ba
     if not reads_as_log(path, cmap):
         return load_log(path, name=name)
     if cmap is None:
-        raise InputError(
-            "a raw log needs a column map, and the model has none (it was fitted on batch CSVs): "
-            "give one (--map MAP.toml)",
-            path,
-        )
+        if model is None:
+            why = "a raw log is read with a column map: choose a model fitted on this roaster's logs, or give a map"
+        else:
+            why = "a raw log needs a column map, and the model has none (it was fitted on batch CSVs): give one"
+        raise InputError(f"{why} (--map MAP.toml)", path)
     return load_log(path, cmap, name=name)
 
 
