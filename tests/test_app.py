@@ -227,6 +227,21 @@ def test_a_bad_upload_is_a_message_and_is_not_kept(client, data_dir):
     assert client.get("/api/files", headers=H).status_code == 200  # still answering
 
 
+def test_a_log_uploaded_before_any_model_is_kept_for_a_fit(client, data_dir):
+    """A roaster's first visit: no model chosen yet, a log uploaded to fit one. It is read as `init` reads
+    a log, kept and listed (it was refused: "the model has none (it was fitted on batch CSVs)"); a file
+    that is no roast is still refused."""
+    sky = REAL_DATA / "skywalker"
+    if not sky.is_dir():
+        pytest.skip("../shared/data/real is absent")
+    log = sorted(sky.glob("*.alog"))[0]
+    r = client.post(f"/api/upload?name={log.name}", content=log.read_bytes(), headers=H)
+    assert r.status_code == 200, r.json()
+    assert r.json()["path"] in client.get("/api/files", headers=H).json()["logs"]
+    r = client.post("/api/upload?name=bad.alog", content=b"not a roast", headers=H)
+    assert r.status_code == 400 and not (data_dir / "uploads" / "bad.alog").exists()
+
+
 # ------------------------------------------------------------------------------- in a browser
 def _free_port() -> int:
     with socket.socket() as s:

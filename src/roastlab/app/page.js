@@ -313,7 +313,12 @@ function showReport(html) {
   else $("fit-report").textContent = "(no fit report beside this model: fit-roaster writes model.json with its report.md in one folder; fit a model on your logs here, or with roastlab init + fit-roaster)";
 }
 
+// A folder with logs and no model yet: what to do first (the fit writes one, then opens the log with it).
+const NO_MODEL = "no model in this folder yet: choose logs of one roaster under \"Fit a model\" (left) and fit one; " +
+  "then Open shows a log with it";
+
 async function openLog() {
+  if (!$("model").value) { say(NO_MODEL); return; }
   say("opening ...");
   $("whatif_downloads").innerHTML = "";
   try {
@@ -474,6 +479,7 @@ window.addEventListener("DOMContentLoaded", async () => {
   try {
     await refreshFiles();
     if ($("log").value && $("model").value) await openLog();
+    else if ($("log").value) say(NO_MODEL);
   } catch (e) {
     say(e.message);
   }

@@ -540,6 +540,7 @@ def create_app(data_dir: str | Path):
 
     async def upload(request: Request):
         from ..workflows.model import load_log_for, load_model
+        from ..workflows.survey import inspect_log
 
         try:
             sessions.get(request.headers.get("x-session"))
@@ -561,8 +562,8 @@ def create_app(data_dir: str | Path):
                 out.folder(folder)
                 out.write_bytes(target, b"".join(chunks))
             model_rel = request.query_params.get("model")
-            try:  # read it as the model would, so a bad file is refused now, not later
-                load_log_for(target, load_model(inside(data, model_rel)) if model_rel else None)
+            try:  # read it as the model would (with none chosen, as `init` reads a log), so a bad file is refused now
+                load_log_for(target, load_model(inside(data, model_rel))) if model_rel else inspect_log(target)
             except RoastlabError:
                 target.unlink(missing_ok=True)
                 raise
