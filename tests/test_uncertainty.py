@@ -221,3 +221,22 @@ def test_held_out_residuals_equal_refits_without_each_group_for_a_linear_model()
     for g in range(5):
         rows = groups == g
         assert np.allclose(only_mean[rows], r[rows] + (r[rows].sum() / (~rows).sum()), atol=1e-12)
+
+
+def test_a_value_the_data_leave_open_is_said_so_and_not_printed_as_a_number():
+    """A column of J nearly zero (a term all but switched off at the fitted value: the probe's depth scale
+    near 0 on a few logs gave a standard error of 4e+57 m on a 0-0.5 m range, printed as such): the
+    warning says the data leave it open and the model's table shows no number; one of a correlated pair
+    is the pair's warning instead."""
+    from roastlab import FittedModel
+
+    rng = np.random.default_rng(1)
+    J = np.column_stack([rng.normal(size=30), 1e-30 * rng.normal(size=30)])
+    u = uncertainty.from_jacobian(J, [0.5, 1e-3], np.zeros(2), np.array([1.0, 0.5]), 2.0, ["hbm", "h_probe_m"])
+    assert u.unpinned.tolist() == [False, True]
+    assert any(w.startswith("h_probe_m = 0.001 is not determined by these data") for w in u.warnings())
+    model = FittedModel.paper()
+    model.parameters["h_probe_m"] = {"value": 1e-3, "stderr": float(u.stderr[1]), "bounds": [0.0, 0.5],
+                                     "how": "fitted", "unit": "m"}  # fmt: skip
+    row = next(r for r in model.table() if r[0] == "h_probe_m")
+    assert row[2] == "wider than its range"

@@ -138,6 +138,17 @@ def standard_errors(cov: np.ndarray) -> np.ndarray:
         return np.where(d >= 0.0, np.sqrt(np.where(d >= 0.0, d, 0.0)), np.nan)
 
 
+def unpinned(stderr, lower, upper) -> np.ndarray:
+    """Where a standard error is wider than its parameter's bounds' span (:attr:`Uncertainty.unpinned`).
+
+    >>> unpinned(np.array([0.1, 4e57, np.nan]), np.zeros(3), np.full(3, 0.5)).tolist()
+    [False, True, False]
+    """
+    se, lo, hi = (np.asarray(a, dtype=float) for a in (stderr, lower, upper))
+    with np.errstate(invalid="ignore"):
+        return np.isfinite(se) & np.isfinite(hi - lo) & (se > hi - lo)
+
+
 def information_criteria(ssr: float, n_residuals: int, k_free: int) -> tuple[float, float]:
     """(AIC, BIC) of a least-squares fit (module docstring); NaN when SSR or n is 0."""
     n = int(n_residuals)
@@ -191,6 +202,17 @@ class Uncertainty:
     def on_bound(self) -> np.ndarray:
         return self.at_lower | self.at_upper
 
+    @property
+    def unpinned(self) -> np.ndarray:
+        """Determined by the rules above, yet with a standard error wider than its bounds' span and no
+        strong correlation that would explain it: the residuals barely move with it there (a term all but
+        switched off), so the linearised interval covers the whole range many times over and says only
+        that the data leave the value open. (One of a correlated pair is the pair's warning instead: the
+        data pin their combination.)"""
+        c = np.where(np.eye(self.k_free, dtype=bool), 0.0, np.nan_to_num(self.correlation))
+        paired = np.any(np.abs(c) > CORRELATION_WARN, axis=1)
+        return unpinned(self.stderr, self.lower, self.upper) & ~paired
+
     def warnings(self) -> list[str]:
         """Plain-words warnings: parameters on a bound, without effect, or strongly correlated; the
         parameters on a bound in one line, the correlated pairs in another."""
@@ -204,6 +226,13 @@ class Uncertainty:
                 out.append(
                     f"{lab} = {self.values[k]:.6g} has no effect on the fit there (its term is off or saturated): the "
                     "data do not determine it; no standard error (try more starts or another start value)"
+                )
+            elif self.unpinned[k]:
+                out.append(
+                    f"{lab} = {self.values[k]:.6g} is not determined by these data: the fit barely moves with it "
+                    f"there (its standard error, {self.stderr[k]:.2g}, is wider than its whole range, "
+                    f"{self.lower[k]:g} to {self.upper[k]:g}), so its value says little; hold it at a value, or add "
+                    "logs that move it"
                 )
         why = "the optimum may lie outside; no standard error (held by the bound, not the data)"
         if len(held) == 1:

@@ -28,6 +28,7 @@ import numpy as np
 
 from ..errors import InputError, ParameterError
 from ..evaluate.validate import ValidationResult, score
+from ..fit import uncertainty
 from ..io.batch import Batch, first_of_each_roast, recording_second
 from ..io.files import Outputs, input_digest
 from ..io.importers.mapping import ColumnMap, map_from_mapping
@@ -426,12 +427,7 @@ class FittedModel:
         for name, e in self.parameters.items():
             se, value = e.get("stderr"), e["value"]
             bounds = e.get("bounds")  # a user's file: used only where it is a pair of finite numbers
-            if (
-                se is None
-                and isinstance(bounds, list)
-                and len(bounds) == 2
-                and all(isinstance(b, (int, float)) and not isinstance(b, bool) and math.isfinite(b) for b in bounds)
-            ):
+            if se is None and _is_bounds(bounds):
                 # a value the fit left on a bound to rounding (1.08e-16 on a floor of 0) reads as that bound
                 value = next(
                     (
@@ -441,9 +437,10 @@ class FittedModel:
                     ),
                     value,
                 )
-            rows.append(
-                (name, f"{value:.5g}", "" if se is None else f"{se:.2g}", REGISTRY[name].unit, e.get("how", ""))
-            )
+            shown = "" if se is None else f"{se:.2g}"
+            if se is not None and _is_bounds(bounds) and uncertainty.unpinned([se], [bounds[0]], [bounds[1]])[0]:
+                shown = "wider than its range"  # the data leave it open (uncertainty.unpinned): no number to read
+            rows.append((name, f"{value:.5g}", shown, REGISTRY[name].unit, e.get("how", "")))
         for name, e in self.initial.items():
             if e["how"] == "fitted per batch":
                 vals = list(e["per_batch"].values())
@@ -527,6 +524,15 @@ def load_log(path, map=None, name: str | None = None) -> Batch:  # noqa: A002 - 
         return read_batch_csv(path, name=name)
     cmap = map if isinstance(map, ColumnMap) else load_map(map)
     return import_log(path, cmap, name=name)
+
+
+def _is_bounds(bounds) -> bool:
+    """Whether a model file's ``bounds`` entry is a pair of finite numbers (a user's file: used only then)."""
+    return (
+        isinstance(bounds, list)
+        and len(bounds) == 2
+        and all(isinstance(b, (int, float)) and not isinstance(b, bool) and math.isfinite(b) for b in bounds)
+    )
 
 
 def load_log_for(path, model: FittedModel | None, name: str | None = None) -> Batch:
