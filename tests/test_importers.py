@@ -351,6 +351,23 @@ def _with_cell(row: str, k: int, value: str) -> str:
     return "\t".join(cells)
 
 
+def test_a_log_of_another_program_than_the_maps_is_one_line_naming_both(tmp_path):
+    """SYNTHETIC logs: a RoasTime log under a map of Artisan logs (a Skywalker model given a Bullet's log)
+    said "key timex: missing key", an .alog under a RoasTime map "not valid JSON"; each now names both
+    programs. An Artisan CSV export under an .alog map still reads (one program, two formats)."""
+    roastime = tmp_path / "bullet.json"
+    roastime.write_text('{"beanTemperature": [20.0, 21.0], "sampleRate": 2}')
+    alog = tmp_path / "sky.alog"
+    alog.write_text(fake_alog())
+    alog_map = load_map(write_map(tmp_path, 'format = "alog"\n' + ROOM_AIR_MAP))
+    rt_map = load_map(write_map(tmp_path, 'format = "roastime"\n' + ROOM_AIR_MAP, "rt.toml"))
+    with pytest.raises(InputError, match="a RoasTime log, and the column map reads Artisan logs"):
+        import_log(roastime, alog_map)
+    with pytest.raises(InputError, match="an Artisan log, and the column map reads RoasTime logs"):
+        import_log(alog, rt_map)
+    assert import_log(_csv_export_with_extras(tmp_path / "e.csv"), alog_map).n > 2
+
+
 def test_a_map_of_artisan_logs_reads_their_csv_exports_and_one_rule_tells_logs_from_batch_csvs(tmp_path):
     """A map written for .alog files (format "alog", as init writes it) reads Artisan's CSV export of the
     same roaster too, the channels being Artisan's names in both; reads_as_log, the one rule that

@@ -671,14 +671,32 @@ def roastime_default_map(log: ArtisanLog) -> ColumnMap:
 ARTISAN_FORMATS = ("alog", "artisan-csv")
 
 
+#: The roasting programs whose own log formats a map reads, by format (how a mismatch is named).
+LOG_SOFTWARE = {"alog": "Artisan", "artisan-csv": "Artisan", "roastime": "RoasTime"}
+
+
 def log_format(path: Path, map_format: str) -> str:
     """The format ``path`` is read in under a map of ``map_format`` (:func:`detect_format`): the map's,
     but where the map's is one of :data:`ARTISAN_FORMATS` and the file is the other (by its suffix and
-    first line), the file's own."""
+    first line), the file's own. A log of another program than the map's (a RoasTime log under a map of
+    Artisan logs, or the other way round) is refused in one line naming both, not read as the map's
+    format (which failed on a key the other program does not write)."""
     fmt = detect_format(path, map_format)
     if fmt in ARTISAN_FORMATS and path.suffix.lower() in (".alog", *CSV_SUFFIXES):
         own = detect_format(path, "auto")
         return own if own in ARTISAN_FORMATS else fmt
+    if fmt in LOG_SOFTWARE and path.is_file():
+        try:
+            own = detect_format(path, "auto")
+        except InputError:  # the content names no program: read as the map says, whose reader says what is wrong
+            return fmt
+        if own in LOG_SOFTWARE and LOG_SOFTWARE[own] != LOG_SOFTWARE[fmt]:
+            article = "an" if LOG_SOFTWARE[own][0] in "AEIOU" else "a"
+            raise InputError(
+                f"{article} {LOG_SOFTWARE[own]} log, and the column map reads {LOG_SOFTWARE[fmt]} logs: a log of another "
+                "roaster than the map's (or the model's), or give a map for it (--map MAP.toml)",
+                path,
+            )
     return fmt
 
 
