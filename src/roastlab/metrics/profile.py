@@ -410,6 +410,10 @@ def beans_at_first_crack(result) -> tuple[float, float] | None:
     return None if fc_s is None else (fc_s, float(np.interp(fc_s, result.time_s, result.Tb_C)))
 
 
+#: What a roaster whose logs record no heater setting does about it (this check's advice and `init`'s note).
+LOG_THE_HEATER = "log the heater's setting (Artisan's event sliders or an extra device)"
+
+
 def _beans_at_first_crack(result) -> list[str]:
     """The beans far from :data:`~roastlab.model.constants.FIRST_CRACK_BEAN_C` at the log's FCs mark
     (:func:`beans_at_first_crack`), by more than :data:`FIRST_CRACK_TOLERANCE_C`, with what to do: read
@@ -436,8 +440,7 @@ def _beans_at_first_crack(result) -> list[str]:
         return [
             where + "the fit had a bean reading there and could not reach it: the logs record no heater setting, "
             "so nothing the model is given heats the drum as the roaster's heater does (it has only a logged "
-            "air temperature to go by); log the heater's setting (Artisan's event sliders or an extra device) and set the "
-            "roaster up again with roastlab init"
+            f"air temperature to go by); {LOG_THE_HEATER} and set the roaster up again with roastlab init"
         ]
     return [
         where + "the fit had a bean reading there and did not follow it: raise its weight (Tb2 under the fit "

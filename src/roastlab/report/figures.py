@@ -214,21 +214,19 @@ def plot_fit(result, path=None, title=None, max_panels: int = 8, outputs=None, b
             label="residual BT meas − pred (below)",
         )
         sim = result.results[i] if i < len(result.results) else None
-        second = None if sim is None else sim.Tb2_measured_C
         # named and drawn as the page and the what-if figure do: a curve, or the first-crack mark as a marker
-        reading = None if second is None else second_bean_reading(_readings_of(sim))
+        reading = None if sim is None else second_bean_reading(_readings_of(sim))
         if reading is not None:  # the second bean reading and the model's Tb
             label, few = reading
+            second = sim.Tb2_measured_C
             ax.plot(t, sim.Tb_C, color="tab:orange", lw=1.2, label="bean predicted (model Tb)")
             style = {"ls": "none", "marker": "D", "ms": 6, "mfc": "none"} if few else {"ls": ":", "lw": 1.6}
             ax.plot(t, second, color="tab:brown", label=label, **style)
             res.plot(t, second - sim.Tb_C, color="tab:brown", label="residual beans meas − model Tb (below)",
                      **({"ls": "none", "marker": "D", "ms": 5, "mfc": "none"} if few else {"ls": ":", "lw": 1}))  # fmt: skip
-        else:
-            second = None
         for h, text in zip(*_ror_overlay(ax, result.time_s[i], result.measured[i], result.predicted[i])):
             entries.setdefault(text, h)  # every panel draws the same curves; a second bean reading on some
-        if second is not None:  # its residual beside BT's, which the axis names
+        if reading is not None:  # its residual beside BT's, which the axis names
             for h, text in zip(*res.get_legend_handles_labels()):
                 entries.setdefault(text, h)
         res.axhline(0.0, color="k", lw=0.6)

@@ -427,7 +427,8 @@ class FittedModel:
         for name, e in self.parameters.items():
             se, value = e.get("stderr"), e["value"]
             bounds = e.get("bounds")  # a user's file: used only where it is a pair of finite numbers
-            if se is None and _is_bounds(bounds):
+            bounded = _is_bounds(bounds)
+            if se is None and bounded:
                 # a value the fit left on a bound to rounding (1.08e-16 on a floor of 0) reads as that bound
                 value = next(
                     (
@@ -438,7 +439,7 @@ class FittedModel:
                     value,
                 )
             shown = "" if se is None else f"{se:.2g}"
-            if se is not None and _is_bounds(bounds) and uncertainty.unpinned([se], [bounds[0]], [bounds[1]])[0]:
+            if se is not None and bounded and uncertainty.unpinned([se], [bounds[0]], [bounds[1]])[0]:
                 shown = "wider than its range"  # the data leave it open (uncertainty.unpinned): no number to read
             rows.append((name, f"{value:.5g}", shown, REGISTRY[name].unit, e.get("how", "")))
         for name, e in self.initial.items():

@@ -74,6 +74,7 @@ from ..io.importers.mapping import (
 )
 from ..io.importers.roastime import DRUM_AT_CHARGE, read_roastime
 from ..metrics.profile import (
+    LOG_THE_HEATER,
     SHORTEST_ROAST_S,
     et_below_bt_on_every_log,
     et_minus_bt_C,
@@ -820,8 +821,7 @@ def survey(paths, batch_kg: float | None = None, units: dict | None = None) -> S
         notes.append(
             "no heater setting in the logs: ET drives the model as the inlet air, but a burner or element also "
             "heats the drum itself, which the air does not show, so the fit is weak or fails (docs/your-roaster.md, "
-            "\"No heater in the logs\"); log the heater's setting (Artisan's event sliders or an extra device) "
-            "for a model that follows the roaster"
+            f'"No heater in the logs"); {LOG_THE_HEATER} for a model that follows the roaster'
         )
     fan_at = _one_setting(pooled.get("fan")) if fan else None
     if fan_at is not None:

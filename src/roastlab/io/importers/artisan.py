@@ -675,6 +675,17 @@ def _mmss(text: str) -> float:
     return clock_s(text) if text.strip() else float("nan")
 
 
+def _meta_clock_s(meta: dict, key: str, path) -> float | None:
+    """An Artisan CSV export's first-line mark ``key`` (DROP, FCs, ...) as a clock time on the Time1
+    axis [s], as CHARGE's; None where the line leaves it empty."""
+    if not meta.get(key):
+        return None
+    try:
+        return _mmss(meta[key])
+    except ValueError:
+        raise InputError(f"{key} time {meta[key][:20]!r} is not mm:ss", path, "line 1") from None
+
+
 def _merge_repeated_times(time_s: np.ndarray, columns):
     """Rows that share a time stamp merged into one, each column the mean of its readings there
     (NaN where none): Artisan's CSV export writes whole seconds, so a log sampled faster than once a
@@ -768,12 +779,8 @@ def read_artisan_csv(path: str | Path, keep_after_drop: bool = False) -> Artisan
     extra = dict(zip(extra, merged))
     charged = np.flatnonzero(np.isfinite(t2))
     drop = None
-    if meta.get("DROP"):
-        # the meta line's event times are clock times on the Time1 axis, like CHARGE's
-        try:
-            drop = int(np.argmin(np.abs(t1 - _mmss(meta["DROP"]))))
-        except ValueError:
-            raise InputError(f"DROP time {meta['DROP'][:20]!r} is not mm:ss", path, "line 1") from None
+    if (drop_at := _meta_clock_s(meta, "DROP", path)) is not None:
+        drop = int(np.argmin(np.abs(t1 - drop_at)))
     if drop is not None and charged.size and drop <= charged[0]:  # as read_alog refuses such marks
         raise InputError(
             f"DROP ({meta['DROP'][:20]}) is marked at or before CHARGE ({mmss(t1[charged[0]])} on the Time1 axis): "
@@ -788,14 +795,9 @@ def read_artisan_csv(path: str | Path, keep_after_drop: bool = False) -> Artisan
     end = len(time_s) if (keep_after_drop or drop is None) else drop + 1
     sl = slice(charge, end)
     events = {"CHARGE": 0.0}
-    for key, name in CSV_EVENTS.items():  # the meta line's marks, clock times on the Time1 axis like CHARGE's
-        if meta.get(key):
-            try:
-                at = _mmss(meta[key]) - t1[charge]
-            except ValueError:
-                raise InputError(f"{key} time {meta[key][:20]!r} is not mm:ss", path, "line 1") from None
-            if 0.0 < at <= time_s[end - 1]:
-                events[name] = float(at)
+    for key, name in CSV_EVENTS.items():
+        if (at := _meta_clock_s(meta, key, path)) is not None and 0.0 < at - t1[charge] <= time_s[end - 1]:
+            events[name] = float(at - t1[charge])
     if drop is not None:
         events["DROP"] = float(time_s[drop])
     return ArtisanLog(

@@ -666,13 +666,11 @@ def roastime_default_map(log: ArtisanLog) -> ColumnMap:
     )
 
 
-#: Artisan's two files of a roast: its profile (``.alog``) and its CSV export. Their channels carry the same
-#: names (BT, ET, the extra devices'), so a column map written for one reads the other (:func:`log_format`).
-ARTISAN_FORMATS = ("alog", "artisan-csv")
-
-
 #: The roasting programs whose own log formats a map reads, by format (how a mismatch is named).
 LOG_SOFTWARE = {"alog": "Artisan", "artisan-csv": "Artisan", "roastime": "RoasTime"}
+#: Artisan's two files of a roast: its profile (``.alog``) and its CSV export. Their channels carry the same
+#: names (BT, ET, the extra devices'), so a column map written for one reads the other (:func:`log_format`).
+ARTISAN_FORMATS = tuple(fmt for fmt, program in LOG_SOFTWARE.items() if program == "Artisan")
 
 
 def log_format(path: Path, map_format: str) -> str:
@@ -682,22 +680,22 @@ def log_format(path: Path, map_format: str) -> str:
     Artisan logs, or the other way round) is refused in one line naming both, not read as the map's
     format (which failed on a key the other program does not write)."""
     fmt = detect_format(path, map_format)
-    if fmt in ARTISAN_FORMATS and path.suffix.lower() in (".alog", *CSV_SUFFIXES):
+    if fmt not in LOG_SOFTWARE or not path.is_file():
+        return fmt
+    try:
         own = detect_format(path, "auto")
-        return own if own in ARTISAN_FORMATS else fmt
-    if fmt in LOG_SOFTWARE and path.is_file():
-        try:
-            own = detect_format(path, "auto")
-        except InputError:  # the content names no program: read as the map says, whose reader says what is wrong
-            return fmt
-        if own in LOG_SOFTWARE and LOG_SOFTWARE[own] != LOG_SOFTWARE[fmt]:
-            article = "an" if LOG_SOFTWARE[own][0] in "AEIOU" else "a"
-            raise InputError(
-                f"{article} {LOG_SOFTWARE[own]} log, and the column map reads {LOG_SOFTWARE[fmt]} logs: a log of another "
-                "roaster than the map's (or the model's), or give a map for it (--map MAP.toml)",
-                path,
-            )
-    return fmt
+    except InputError:  # the content names no program: read as the map says, whose reader says what is wrong
+        return fmt
+    if own not in LOG_SOFTWARE:  # a plain CSV under an Artisan map: the map's reader says what is wrong
+        return fmt
+    if LOG_SOFTWARE[own] != LOG_SOFTWARE[fmt]:
+        article = "an" if LOG_SOFTWARE[own][0] in "AEIOU" else "a"
+        raise InputError(
+            f"{article} {LOG_SOFTWARE[own]} log, and the column map reads {LOG_SOFTWARE[fmt]} logs: a log of another "
+            "roaster than the map's (or the model's), or give a map for it (--map MAP.toml)",
+            path,
+        )
+    return own  # the same program: the file's own format (an Artisan export under a map of .alog files)
 
 
 def reads_as_log(path: str | Path, cmap: ColumnMap | None) -> bool:
