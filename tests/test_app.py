@@ -426,6 +426,32 @@ def test_the_page_saves_the_what_if_as_an_artisan_background(page, tmp_path):
 
 
 @pytest.mark.slow
+def test_the_page_fits_a_tablet_beside_the_roaster(browser, server):
+    """At a tablet's width (820 px, portrait) the page fits the screen: nothing runs off its right edge,
+    the curves take the screen's width under the controls, the legend lies below the time axis's title,
+    and on a wider screen (a window made wider) the figure follows the new width."""
+    context = browser.new_context(viewport={"width": 820, "height": 1180})
+    page = context.new_page()
+    try:
+        page.goto(server + "/")
+        _open(page, "batch1.csv", "paper-model.json")
+        assert page.evaluate("document.documentElement.scrollWidth") <= 820
+        width = page.evaluate("document.getElementById('plot').clientWidth")
+        assert width > 0.9 * 820
+        box = "(s) => { const r = document.querySelector(s).getBoundingClientRect(); return [r.top, r.bottom]; }"
+        title = page.evaluate(f"({box})('#plot .xtitle')")
+        legend = page.evaluate(f"({box})('#plot .legend')")
+        assert legend[0] >= title[1]
+        page.set_viewport_size({"width": 1400, "height": 1000})
+        page.wait_for_function(
+            "Math.abs(document.querySelector('#plot .main-svg').getBoundingClientRect().width"
+            f" - document.getElementById('plot').clientWidth) < 2 && document.getElementById('plot').clientWidth > {width + 100}"
+        )
+    finally:
+        context.close()
+
+
+@pytest.mark.slow
 def test_a_bad_upload_shows_a_message_and_the_page_keeps_working(page, tmp_path):
     _open(page, "batch1.csv", "paper-model.json")
     bad = tmp_path / "broken.alog"

@@ -24,6 +24,7 @@ const F = () => $("units").value === "F";
 const temp = (v) => (v === null || v === undefined ? null : F() ? v * 9 / 5 + 32 : v);
 const dtemp = (v) => (v === null || v === undefined ? null : F() ? v * 9 / 5 : v);
 const unit = () => (F() ? "°F" : "°C");
+const narrow = () => $("plot").clientWidth < 900;  // the figure's legend wraps into more rows
 function mmss(s) {
   if (s === null || s === undefined || !isFinite(s)) return "-";
   const n = Math.round(Math.abs(s));
@@ -177,7 +178,8 @@ function draw() {
   const rorTop = rorAfter.length ? Math.max(...rorAfter) * 1.2 + 2 : 30;
   const t0 = performance.now();
   Plotly.react("plot", traces, {
-    margin: { t: 30, r: 60, l: 60, b: 40 }, legend: { orientation: "h", y: -0.12, font: { size: 10 } },
+    // a narrow screen (a tablet beside the roaster) wraps the legend into more rows: below the time axis's title
+    margin: { t: 30, r: 60, l: 60, b: 40 }, legend: { orientation: "h", y: narrow() ? -0.2 : -0.12, font: { size: 10 } },
     xaxis: { title: { text: "time after CHARGE [m:ss]" }, domain: [0, 1], anchor: "y3", ...mmssTicks(x) },
     yaxis: { title: { text: `temperature [${unit()}]` }, domain: [0.42, 1] },
     yaxis2: { title: { text: `RoR [${unit()}/min]` }, overlaying: "y", side: "right", range: [dtemp(-2), rorTop], showgrid: false,
@@ -187,7 +189,7 @@ function draw() {
     ...(twoScales() ? { yaxis4: { title: { text: `fan [${unitName("fan")}]`, font: { color: STEP_COLORS.fan } },
                                   overlaying: "y3", side: "right", showgrid: false, tickmode: "auto", nticks: 5 } } : {}),
     shapes: [...ph.shapes, ...ev.shapes, ...programShapes()], annotations: [...ph.notes, ...ev.notes], uirevision: "keep",
-  }, { displaylogo: false }).then(() => {
+  }, { displaylogo: false, responsive: true }).then(() => {
     if (!state.hooked) { $("plot").on("plotly_relayout", onRelayout); state.hooked = true; }
     state.lastDrawMs = performance.now() - t0;
     if (state.tInput !== null) {  // from the input change to this curve on screen
@@ -441,13 +443,13 @@ async function runTransfer() {
       { x, y: r.predicted.map(temp), name: "predicted BT with the program", line: { color: "#1f77b4" } },
       { x, y: r.program, name: `program: ${r.decide} [${shownUnit(r.unit)}]`, yaxis: "y2", line: { shape: "hv", color: "#d62728" } },
     ], {
-      margin: { t: 20, r: 60, l: 60, b: 40 }, legend: { orientation: "h", y: -0.2 },
+      margin: { t: 20, r: 60, l: 60, b: 40 }, legend: { orientation: "h", y: narrow() ? -0.3 : -0.2 },
       xaxis: { title: { text: "time after CHARGE [m:ss]" }, ...mmssTicks(x) }, yaxis: { title: { text: `BT [${unit()}]` } },
       yaxis2: { title: { text: `${r.decide} [${shownUnit(r.unit)}]` }, overlaying: "y", side: "right", showgrid: false,
                 range: [r.low - (r.step || (r.high - r.low) / 20), r.high + (r.step || (r.high - r.low) / 20)],
                 // on the machine's steps, a tick every step or every few (at most about ten ticks)
                 ...(r.step ? { dtick: r.step * Math.max(1, Math.ceil((r.high - r.low) / r.step / 10)), tickformat: "d" } : {}) },
-    });
+    }, { displaylogo: false, responsive: true });
     say("");
     document.body.dataset.transfer = "done";
   } catch (e) {
