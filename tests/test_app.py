@@ -428,7 +428,7 @@ def test_the_page_saves_the_what_if_as_an_artisan_background(page, tmp_path):
 @pytest.mark.slow
 def test_the_page_fits_a_tablet_beside_the_roaster(browser, server):
     """At a tablet's width (820 px, portrait) the page fits the screen: nothing runs off its right edge,
-    the curves take the screen's width under the controls, the legend lies below the time axis's title,
+    the curves take the screen's width under the what-if's controls, the legend lies below the time axis's title,
     and on a wider screen (a window made wider) the figure follows the new width."""
     context = browser.new_context(viewport={"width": 820, "height": 1180})
     page = context.new_page()
@@ -442,6 +442,22 @@ def test_the_page_fits_a_tablet_beside_the_roaster(browser, server):
         title = page.evaluate(f"({box})('#plot .xtitle')")
         legend = page.evaluate(f"({box})('#plot .legend')")
         assert legend[0] >= title[1]
+        # the what-if's controls above the curves they move, both on the first screen; the fit's and
+        # the transfer's controls below, each above its own output
+        top = "(s) => document.querySelector(s).getBoundingClientRect().top"
+        where = {
+            s: page.evaluate(f"({top})('{s}')")
+            for s in (
+                "#whatif-controls",
+                "#plot",
+                "#fit-controls",
+                "#fit-output",
+                "#transfer-controls",
+                "#transfer-output",
+            )
+        }
+        assert list(where) == sorted(where, key=where.get)
+        assert where["#plot"] < 1180 - 400
         page.set_viewport_size({"width": 1400, "height": 1000})
         page.wait_for_function(
             "Math.abs(document.querySelector('#plot .main-svg').getBoundingClientRect().width"
