@@ -576,6 +576,22 @@ def test_a_log_without_a_suffix_is_read_by_its_content(tmp_path):
         detect_format(other)
 
 
+def test_a_log_of_another_program_is_told_the_way_in_through_artisan(tmp_path, capsys):
+    """A Cropster export (.xlsx) or another program's log given to init: exit 2 with one line that says
+    what roastlab reads and that Artisan imports the others and saves them as .alog (not "set format in
+    the map", which init has none of)."""
+    from roastlab.cli.main import main
+
+    xlsx = tmp_path / "roast.xlsx"
+    xlsx.write_bytes(b"PK\x03\x04 a spreadsheet")
+    assert main(["init", str(xlsx), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1
+    assert "roast.xlsx: cannot tell the log format from suffix '.xlsx'" in err
+    assert "Artisan (File > Import)" in err and ".alog" in err
+    assert not (tmp_path / "out").exists()
+
+
 def test_a_csv_of_a_european_spreadsheet_reads_as_any_other():
     from roastlab.io.batch import as_comma_separated
 

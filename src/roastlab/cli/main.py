@@ -112,7 +112,7 @@ def main(argv: list[str] | None = None) -> int:
             signal.signal(signal.SIGTERM, previous)
 
 
-def _one_line(text: str, limit: int = 300) -> str:
+def _one_line(text: str, limit: int = 400) -> str:
     """An error message as one printable line of at most ``limit`` characters."""
     flat = "".join(c if c.isprintable() else "?" for c in text.replace("\n", " "))
     return flat if len(flat) <= limit else flat[: limit - 1] + "…"

@@ -484,6 +484,15 @@ def grams_in_name(path: Path) -> tuple[float, str] | None:
 CSV_SUFFIXES = (".csv", ".txt", ".tsv")
 
 
+#: What a log of unknown format is told: the formats read, and the way in for another program's logs
+#: (Artisan imports Cropster, IKAWA, Giesen, Loring, RoastPATH and more, and saves them as .alog).
+READS = (
+    "roastlab reads Artisan (.alog, its CSV export), RoasTime (.json) and CSV logs (a map's format key names one "
+    "for another suffix); another program's log (Cropster .xlsx, IKAWA, Loring, ...) opens in Artisan (File > "
+    "Import) and saves there as .alog"
+)
+
+
 def detect_format(path: Path, fmt: str = "auto") -> str:
     """The log format of ``path``: ``fmt`` unless "auto", else by suffix and content (a file without a
     suffix, as RoasTime keeps its logs, by its content alone: a JSON object with RoasTime's series, or
@@ -509,10 +518,8 @@ def detect_format(path: Path, fmt: str = "auto") -> str:
                 return "roastime"
             if b"'timex'" in head:
                 return "alog"
-        raise InputError(
-            "no suffix, and the content is neither a RoasTime nor an Artisan log; set format in the map", path
-        )
-    raise InputError(f"cannot tell the log format from suffix {suffix!r}; set format in the map", path)
+        raise InputError(f"no suffix, and the content is neither a RoasTime nor an Artisan log: {READS}", path)
+    raise InputError(f"cannot tell the log format from suffix {suffix!r}: {READS}", path)
 
 
 def is_log_by_content(path: Path) -> bool:
