@@ -67,7 +67,6 @@ wheel-check:
 # logs one by one: the example's bed laws, the same with the probe's depth at the Skywalker's, the paper's
 # probe (3 x 17 fits). All of it: 21 min on 2 cores at ab8774a (2026-11-29); every rerun, its time and
 # what it changed are in CHANGELOG.md.
-SKYWALKER = ../shared/data/real/skywalker
 real-roaster: $(STAMP)
 	$(PY) docs/real_roaster.py
 	$(VENV)/bin/roastlab compare-models --plant examples/bullet/plant.toml --map examples/bullet/map.toml \
@@ -88,7 +87,7 @@ real-roaster: $(STAMP)
 	  --variant $(BED_EXAMPLE) --json docs/real-roaster-logs.json --plot docs/real-roaster-logs.png
 	$(PY) docs/band_splits.py
 	$(VENV)/bin/roastlab compare-models --plant examples/skywalker/plant.toml --map examples/skywalker/map.toml \
-	  --spec examples/skywalker/fit.toml $(SKYWALKER)/*.alog --group-by log \
+	  --spec examples/skywalker/fit.toml $(SKYWALKER_LOGS) --group-by log \
 	  --variant $(BED_EXAMPLE) --variant $(BED_EXAMPLE),h_probe_m=$(SKYWALKER_DEPTH_M) --variant paper,h_probe_m=0 \
 	  --json docs/real-roaster-skywalker.json --plot docs/real-roaster-skywalker.png
 # the beans' swelling the Skywalker example holds, tried on the Bullet's sizes (docs/real-roaster.md, "Skywalker: the beans swell")
@@ -101,6 +100,8 @@ BED_VARIANTS = paper probe=tumbling contact=wall probe=tumbling,probe_gas=mean c
 BED_EXAMPLE = $(shell $(PY) -c "from roastlab.model.bed import CROSS_VALIDATED as b; print(b.name)")
 # the Bullet's logs that record their green weight (docs/real_roaster.py's bullet_logs, as init reads a batch)
 BULLET_WEIGHED = $(shell cd docs && ../$(PY) -c "from real_roaster import bullet_logs; print(*bullet_logs())")
+# the Skywalker's logs the example's files can drive (docs/real_roaster.py's skywalker_logs)
+SKYWALKER_LOGS = $(shell cd docs && ../$(PY) -c "from real_roaster import skywalker_logs; print(*skywalker_logs())")
 # the Bullet's logs of the fit's batch size (docs/real_roaster.py's NOMINAL_G)
 BULLET_NOMINAL = $(shell cd docs && ../$(PY) -c "from real_roaster import nominal_logs; print(*nominal_logs())")
 # the paper's exothermic rate law (Schwartzberg's A and Ha/R, the quantity table's defaults), held in the

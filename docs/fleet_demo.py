@@ -46,7 +46,7 @@ def main() -> int:
     (tmp / "manifest.csv").write_text("\n".join(rows) + "\n")
     exe = str(Path(sys.executable).parent / "roastlab")
     fit_logs = {
-        "skywalker": real_roaster.split(real_roaster.roasts(sorted((DATA / "skywalker").glob("*.alog"))))[0],
+        "skywalker": real_roaster.split(real_roaster.skywalker_logs())[0],
         "bullet": real_roaster.split(real_roaster.nominal_logs())[0],
     }
     for name, example in (("skywalker", sky), ("bullet", bul)):

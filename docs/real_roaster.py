@@ -54,25 +54,31 @@ def nominal_size(path: Path) -> bool:
     return g is not None and NOMINAL_G[0] <= g <= NOMINAL_G[1]
 
 
-def roasts(paths) -> list[Path]:
-    """The logs that are roasts, as ``roastlab init`` reads a folder: a recording that cannot be read
-    as one, or a copy of another, is left out and said on stderr (roastlab.workflows.survey.readable_logs)."""
-    from roastlab.workflows.survey import readable_logs
+def roasts(paths, example: str) -> list[Path]:
+    """The logs that are roasts the example's files can drive, as ``roastlab fit-roaster`` takes a folder:
+    a recording that cannot be read as one, or a copy of another (roastlab.workflows.survey.readable_logs),
+    or one that records no setting the example's map drives the model with (a log whose heater never
+    moved, logs_without_controls) is left out and said on stderr. ``example``: its folder under examples/."""
+    from roastlab.io.importers.mapping import load_map
+    from roastlab.workflows.survey import logs_without_controls, readable_logs
 
     infos, left_out = readable_logs(paths)
+    cmap = load_map(ROOT / "examples" / example / "map.toml")
+    controls = {k: (getattr(cmap, k) or {}).get("column") for k in ("heater", "fan")}
+    left_out |= (unusable := logs_without_controls(infos, controls))
     for why in left_out.values():
         print(f"left out: {why}", file=sys.stderr)
-    return [i.path for i in infos]
+    return [i.path for i in infos if i.path.name not in unusable]
 
 
 def bullet_logs() -> list[Path]:
     """The Bullet logs that are roasts (:func:`roasts`) and record their green weight (:func:`grams`), by name."""
-    return [p for p in roasts(sorted((DATA / "bullet").glob("*.json"))) if grams(p) is not None]
+    return [p for p in roasts(sorted((DATA / "bullet").glob("*.json")), "bullet") if grams(p) is not None]
 
 
 def skywalker_logs() -> list[Path]:
     """The Skywalker's Artisan logs that are roasts (:func:`roasts`), by name."""
-    return roasts(sorted((DATA / "skywalker").glob("*.alog")))
+    return roasts(sorted((DATA / "skywalker").glob("*.alog")), "skywalker")
 
 
 def nominal_logs() -> list[Path]:

@@ -918,3 +918,16 @@ def test_skywalker_example_fits_the_probe_half_in_the_bed(real_data):
     for b in batches:  # eq. 17 extended, the tumbling bed: c = 1 - exp(-h_bed / h_probe)
         h_bed = dataclasses.replace(plant, Mb_kg=b.Mb_kg).bed_depth_m
         assert 0.3 < 1.0 - math.exp(-h_bed / h_probe) < 0.8, (b.name, b.Mb_kg)
+
+
+def test_the_report_leaves_out_a_log_the_examples_map_cannot_drive(real_data, tmp_path, monkeypatch, capsys):
+    """More logs of the same machines may lie beside the shared ones: docs/real_roaster.py (make real-roaster)
+    takes a folder as fit-roaster does. A log whose heater never moved records no Burner event, so the
+    example's map cannot drive the model with it: it is left out and named, not a stop of the whole report."""
+    monkeypatch.syspath_prepend(str(Path(__file__).resolve().parents[1] / "docs"))
+    import real_roaster as rr
+
+    *good, other = sorted(real_data.glob("*.alog"))[:3]
+    still = rewritten_alog(other, tmp_path / "still_heater.alog", lambda doc: drop_events(doc, 3))  # 3: Burner
+    assert rr.roasts([*good, still], "skywalker") == good
+    assert "left out: still_heater.alog records no Burner" in capsys.readouterr().err
