@@ -58,27 +58,42 @@ def roasts(paths, example: str) -> list[Path]:
     """The logs that are roasts the example's files can drive, as ``roastlab fit-roaster`` takes a folder:
     a recording that cannot be read as one, or a copy of another (roastlab.workflows.survey.readable_logs),
     or one that records no setting the example's map drives the model with (a log whose heater never
-    moved, logs_without_controls) is left out and said on stderr. ``example``: its folder under examples/."""
+    moved, logs_without_controls) or that the example's map refuses for another reason is left out and said on
+    stderr. ``example``: its folder under examples/."""
     from roastlab.io.importers.mapping import load_map
     from roastlab.workflows.survey import logs_without_controls, readable_logs
+
+    from roastlab.errors import InputError
 
     infos, left_out = readable_logs(paths)
     cmap = load_map(ROOT / "examples" / example / "map.toml")
     controls = {k: (getattr(cmap, k) or {}).get("column") for k in ("heater", "fan")}
-    left_out |= (unusable := logs_without_controls(infos, controls))
+    left_out |= logs_without_controls(infos, controls)
+    for info in infos:  # anything else the example's map refuses in a log (the import's one line)
+        if info.path.name not in left_out:
+            try:
+                roastlab.load_log(info.path, cmap)
+            except InputError as exc:
+                left_out[info.path.name] = str(exc)
     for why in left_out.values():
         print(f"left out: {why}", file=sys.stderr)
-    return [i.path for i in infos if i.path.name not in unusable]
+    return [i.path for i in infos if i.path.name not in left_out]
 
 
 def bullet_logs() -> list[Path]:
     """The Bullet logs that are roasts (:func:`roasts`) and record their green weight (:func:`grams`), by name."""
-    return [p for p in roasts(sorted((DATA / "bullet").glob("*.json")), "bullet") if grams(p) is not None]
+    return list(_logs("bullet", "*.json"))
 
 
 def skywalker_logs() -> list[Path]:
     """The Skywalker's Artisan logs that are roasts (:func:`roasts`), by name."""
-    return roasts(sorted((DATA / "skywalker").glob("*.alog")), "skywalker")
+    return list(_logs("skywalker", "*.alog"))
+
+
+@functools.cache
+def _logs(example: str, pattern: str) -> tuple[Path, ...]:
+    """One example's logs as :func:`roasts` takes them, read once (what is left out is said once)."""
+    return tuple(p for p in roasts(sorted((DATA / example).glob(pattern)), example) if grams(p) is not None)
 
 
 def nominal_logs() -> list[Path]:
