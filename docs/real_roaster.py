@@ -60,10 +60,9 @@ def roasts(paths, example: str) -> list[Path]:
     or one that records no setting the example's map drives the model with (a log whose heater never
     moved, logs_without_controls) or that the example's map refuses for another reason is left out and said on
     stderr. ``example``: its folder under examples/."""
+    from roastlab.errors import InputError
     from roastlab.io.importers.mapping import load_map
     from roastlab.workflows.survey import logs_without_controls, readable_logs
-
-    from roastlab.errors import InputError
 
     infos, left_out = readable_logs(paths)
     cmap = load_map(ROOT / "examples" / example / "map.toml")
