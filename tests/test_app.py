@@ -427,7 +427,7 @@ def test_the_page_saves_the_what_if_as_an_artisan_background(page, tmp_path):
 
 @pytest.mark.slow
 def test_the_page_fits_a_tablet_beside_the_roaster(browser, server):
-    """At a tablet's width (820 px, portrait) the page fits the screen: nothing runs off its right edge,
+    """At a tablet's width (820 px, portrait) the page fits the screen, and at a phone's (390 px): nothing runs off its right edge,
     the curves take the screen's width under the what-if's controls, the legend lies below the time axis's title,
     and on a wider screen (a window made wider) the figure follows the new width."""
     context = browser.new_context(viewport={"width": 820, "height": 1180})
@@ -463,6 +463,9 @@ def test_the_page_fits_a_tablet_beside_the_roaster(browser, server):
             "Math.abs(document.querySelector('#plot .main-svg').getBoundingClientRect().width"
             f" - document.getElementById('plot').clientWidth) < 2 && document.getElementById('plot').clientWidth > {width + 100}"
         )
+        # a phone: still nothing off the right edge (a fieldset's and a grid column's own minimum widths)
+        page.set_viewport_size({"width": 390, "height": 844})
+        page.wait_for_function("document.documentElement.scrollWidth <= 390")
     finally:
         context.close()
 

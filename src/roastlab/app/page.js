@@ -25,6 +25,7 @@ const temp = (v) => (v === null || v === undefined ? null : F() ? v * 9 / 5 + 32
 const dtemp = (v) => (v === null || v === undefined ? null : F() ? v * 9 / 5 : v);
 const unit = () => (F() ? "°F" : "°C");
 const narrow = () => $("plot").clientWidth < 900;  // the figure's legend wraps into more rows
+const phone = () => $("plot").clientWidth < 600;
 function mmss(s) {
   if (s === null || s === undefined || !isFinite(s)) return "-";
   const n = Math.round(Math.abs(s));
@@ -184,7 +185,8 @@ function draw() {
     yaxis: { title: { text: `temperature [${unit()}]` }, domain: [0.42, 1] },
     yaxis2: { title: { text: `RoR [${unit()}/min]` }, overlaying: "y", side: "right", range: [dtemp(-2), rorTop], showgrid: false,
               tickmode: "auto", nticks: 6, tickformat: ".0f" },
-    yaxis3: { title: { text: twoScales() ? `heater [${unitName("heater")}] (drag a step)` : "setting (drag a step)" },
+    // "(drag a step)" on a phone would run past its short axis into the temperature's title
+    yaxis3: { title: { text: (twoScales() ? `heater [${unitName("heater")}]` : "setting") + (phone() ? "" : " (drag a step)") },
               domain: [0, 0.32] },
     ...(twoScales() ? { yaxis4: { title: { text: `fan [${unitName("fan")}]`, font: { color: STEP_COLORS.fan } },
                                   overlaying: "y3", side: "right", showgrid: false, tickmode: "auto", nticks: 5 } } : {}),
