@@ -471,6 +471,26 @@ def test_the_page_fits_a_tablet_beside_the_roaster(browser, server):
 
 
 @pytest.mark.slow
+def test_a_fit_report_fits_a_phone(browser, tmp_path):
+    """fit-roaster's report.html, opened on a phone (390 px): its wide tables scroll in place and the page
+    is no wider than the screen (the viewport is the device's, not a desktop's 980 px zoomed out)."""
+    from roastlab.report.markdown import html_document
+
+    head = "| log | " + " | ".join(f"a long column heading {k}" for k in range(8)) + " |"
+    rows = ["|---" * 9 + "|", "| roast_25-10-04_1155.alog | " + " | ".join(["85.4"] * 8) + " |"]
+    (tmp_path / "report.html").write_text(html_document("report", "\n".join(["# a report", "", head, *rows]), {}))
+    context = browser.new_context(viewport={"width": 390, "height": 844}, is_mobile=True)
+    try:
+        page = context.new_page()
+        page.goto((tmp_path / "report.html").as_uri())
+        assert page.evaluate("window.innerWidth") == 390  # the page says it fits the device's width
+        assert page.evaluate("document.documentElement.scrollWidth") <= 390
+        assert page.evaluate("document.querySelector('table').scrollWidth") > 390  # the table scrolls in place
+    finally:
+        context.close()
+
+
+@pytest.mark.slow
 def test_a_bad_upload_shows_a_message_and_the_page_keeps_working(page, tmp_path):
     _open(page, "batch1.csv", "paper-model.json")
     bad = tmp_path / "broken.alog"

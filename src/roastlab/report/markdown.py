@@ -18,7 +18,8 @@ from markdown_it import MarkdownIt
 #: The page's look for a standalone report: tables ruled like the page's, figures at most the width.
 _STYLE = (
     "body { font-family: system-ui, sans-serif; color: #222; max-width: 1100px; margin: 16px auto; padding: 0 12px; }"
-    " table { border-collapse: collapse; font-size: 13px; margin: 6px 0; }"
+    # a table wider than a phone scrolls in place rather than widening the page
+    " table { border-collapse: collapse; font-size: 13px; margin: 6px 0; display: block; overflow-x: auto; }"
     " th, td { border-bottom: 1px solid #e5e5e5; padding: 2px 8px; text-align: right; }"
     " th:first-child, td:first-child { text-align: left; } th { background: #f2ece6; }"
     " img { max-width: 100%; } code { font-size: 12px; }"
@@ -48,9 +49,10 @@ def markdown_html(text: str, pictures: dict[str, bytes]) -> str:
 
 def html_document(title: str, text: str, pictures: dict[str, bytes]) -> str:
     """A standalone HTML page of ``text`` (:func:`markdown_html`), titled ``title``, that needs no
-    other file and no network."""
+    other file and no network, and fits a phone's screen as a desktop's."""
     return (
         '<!doctype html>\n<html lang="en">\n<head>\n<meta charset="utf-8">\n'
+        '<meta name="viewport" content="width=device-width, initial-scale=1">\n'
         f"<title>{html.escape(title)}</title>\n<style>{_STYLE}</style>\n</head>\n<body>\n"
         f"{markdown_html(text, pictures)}</body>\n</html>\n"
     )
