@@ -389,6 +389,44 @@ def test_whatif_figure_shows_the_first_crack_mark_and_no_mark_past_the_curves(sk
     assert [a.get_ylabel() for a in fig.axes[2:]] == ["heater [kPa]", "fan [%]"]
 
 
+def _in_fahrenheit(doc: dict) -> None:
+    """An Artisan profile recorded in degF: its mode, BT, ET and room in degF (the same roast)."""
+    f = lambda c: c if c == -1 else c * 9.0 / 5.0 + 32.0  # noqa: E731 - Artisan's -1: no sample
+    doc["mode"], doc["temp1"], doc["temp2"] = "F", [f(v) for v in doc["temp1"]], [f(v) for v in doc["temp2"]]
+    if doc.get("ambientTemp"):
+        doc["ambientTemp"] = f(doc["ambientTemp"])
+
+
+def test_whatif_speaks_the_unit_the_log_was_recorded_in(cli, sky_model, tmp_path):
+    """The same roast logged in degF: whatif's table and figure are in degF without being told (the
+    figure's temperatures on a degF scale), --units C gives them in degC, and the numbers are the same
+    roast's either way."""
+    from conftest import rewritten_alog
+
+    model_path, log = sky_model
+    f_log = rewritten_alog(log, tmp_path / "in_F.alog", _in_fahrenheit)
+    code, out_f, err = cli("whatif", f_log, "--model", model_path, "--heater", "+5@3:00", "--plot", tmp_path / "f.png")
+    assert code == 0, err
+    code, out_c, err = cli("whatif", f_log, "--model", model_path, "--heater", "+5@3:00", "--units", "C")
+    assert code == 0, err
+    assert "temperature at DROP [°F]" in out_f and "[°C]" not in out_f and "temperature at DROP [°C]" in out_c
+
+    def at_drop(text):
+        line = next(ln for ln in text.splitlines() if ln.strip().startswith("temperature at DROP"))
+        return float(line.split()[-3])  # the changed column
+
+    assert at_drop(out_f) == pytest.approx(at_drop(out_c) * 9 / 5 + 32, abs=0.06)
+    from roastlab.report.figures import plot_whatif
+    from roastlab.workflows.whatif import parse_setting_change, whatif
+
+    model = roastlab.load_model(model_path)
+    w = whatif(model, roastlab.load_log(f_log, model.column_map), [parse_setting_change("heater", "+5@3:00")])
+    fig = plot_whatif(w, units=w.batch.temp_unit)
+    labels = [a.get_ylabel() for ax in fig.axes for a in (ax, *ax.child_axes)]  # the degF scales: child axes
+    assert "temperature [°F]" in labels and any(s.startswith("RoR [°F/min]") for s in labels)
+    assert (tmp_path / "f.png").stat().st_size > 20_000
+
+
 def _whatif_written(cli, sky_model, heater: str, option: str, path):
     """``roastlab whatif LOG --heater HEATER OPTION PATH`` on the Skywalker model (exit 0), and the same
     what-if as a library call, to compare the written file with."""

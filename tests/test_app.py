@@ -470,6 +470,53 @@ def test_the_page_fits_a_tablet_beside_the_roaster(browser, server):
         context.close()
 
 
+def _fahrenheit_log(folder: Path) -> tuple[str, str]:
+    """SYNTHETIC: an Artisan log recorded in degF of a 120 kg batch (fake_alog's BT and ET), and the paper's
+    model with a map that reads it (BT the probe, ET the inlet gas); their paths under ``folder``'s parent."""
+    import ast
+
+    from test_importers import fake_alog
+
+    folder.mkdir(exist_ok=True)
+    doc = ast.literal_eval(
+        fake_alog(
+            "F", n=600, bt=[260.0 - 0.3 * i if i < 30 else 251.0 + 0.3 * (i - 30) for i in range(600)], et=[842.0] * 600
+        )
+    )
+    doc["weight"] = [120.0, 100.0, "Kg"]
+    (folder / "roast-F.alog").write_text(repr(doc))
+    FittedModel.paper("120kg").save(folder / "paper-F.json")
+    model = json.loads((folder / "paper-F.json").read_text())
+    model["map"] = {"format": "alog", "Ta": {"column": "BT"}, "Tgi": {"column": "ET"}, "Gg": {"constant_kg_s": 3.5}}
+    (folder / "paper-F.json").write_text(json.dumps(model))
+    return f"{folder.name}/roast-F.alog", f"{folder.name}/paper-F.json"
+
+
+@pytest.mark.slow
+def test_a_log_in_fahrenheit_opens_in_fahrenheit_and_its_fields_speak_it(page, data_dir):
+    """An Artisan log recorded in degF opens with the page in degF: the curves, the table and the what-if's
+    temperature fields (the drum at CHARGE shown in degF, asked of the server in degC); switched to degC
+    the fields keep what they hold, and a log in degC opened after keeps the unit the roaster chose."""
+    log, model = _fahrenheit_log(data_dir / "fahrenheit")
+    page.reload()  # the page lists the folder's files as it loads
+    _open(page, log, model)
+    assert page.input_value("#units") == "F" and "[°F]" in page.inner_text("label:has(#Tm0_C)")
+    opened = page.evaluate("state.open")
+    assert float(page.input_value("#Tm0_C")) == pytest.approx(opened["Tm0_C"] * 9 / 5 + 32, abs=0.05)
+    assert page.evaluate("document.getElementById('plot').layout.yaxis.title.text") == "temperature [°F]"
+    # 18 degF more drum at CHARGE is 10 degC more for the model
+    n = page.evaluate("Number(document.body.dataset.updates || 0)")
+    page.fill("#Tm0_C", str(float(page.input_value("#Tm0_C")) + 18.0))
+    page.dispatch_event("#Tm0_C", "input")
+    page.wait_for_function(f"Number(document.body.dataset.updates || 0) > {n}")
+    assert page.evaluate("changes().Tm0_C") == pytest.approx(opened["Tm0_C"] + 10.0, abs=0.05)
+    page.select_option("#units", "C")
+    assert float(page.input_value("#Tm0_C")) == pytest.approx(opened["Tm0_C"] + 10.0, abs=0.05)
+    assert "[°C]" in page.inner_text("label:has(#Tm0_C)")
+    _open(page, "batch1.csv", "paper-model.json")
+    assert page.input_value("#units") == "C"
+
+
 @pytest.mark.slow
 def test_a_fit_report_fits_a_phone(browser, tmp_path):
     """fit-roaster's report.html, opened on a phone (390 px): its wide tables scroll in place and the page

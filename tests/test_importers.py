@@ -191,6 +191,16 @@ def test_fahrenheit_log_converted_but_not_non_temperature_extras(tmp_path):
     assert log.weight_in_kg == pytest.approx(0.2)
 
 
+def test_a_batch_keeps_the_unit_its_log_was_recorded_in(tmp_path):
+    """Artisan's profile mode goes with the batch (its values are degC either way): a roaster who logs in
+    degF gets degF tables and figures by default (whatif, the page)."""
+    for mode in ("C", "F"):
+        p = tmp_path / f"{mode}.alog"
+        p.write_text(fake_alog(mode))
+        b = import_log(p, None)  # Artisan's defaults: BT the probe
+        assert b.temp_unit == mode
+
+
 #: SYNTHETIC extra devices laid out as Artisan's Aillio R1 setup writes them: ``{3}``/``{0}`` are the
 #: heater and fan readouts named after the event types, beside a fan speed in rpm.
 AILLIO_LIKE_EXTRAS = {
@@ -432,6 +442,7 @@ def test_generic_csv_with_units_and_pitot(tmp_path):
         '[Gg.pitot]\ndp_column = "dp_Pa"\nT_column = "pitotT_C"\nsection_m2 = 0.05\n',
     )
     b = import_log(p, load_map(m))
+    assert b.temp_unit == "F"  # the unit the log recorded BT in, what a roaster's tables show by default
     np.testing.assert_allclose(b.time_s, t)
     np.testing.assert_allclose(b.Ta_C, 30 + t * 0.3, atol=1e-9)
     np.testing.assert_allclose(b.Tgi_C, 450.0)

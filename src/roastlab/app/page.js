@@ -24,6 +24,18 @@ const F = () => $("units").value === "F";
 const temp = (v) => (v === null || v === undefined ? null : F() ? v * 9 / 5 + 32 : v);
 const dtemp = (v) => (v === null || v === undefined ? null : F() ? v * 9 / 5 : v);
 const unit = () => (F() ? "°F" : "°C");
+// The what-if's temperature fields show the page's unit; the server is asked in degC. A level (the drum
+// or the beans at CHARGE) converts with Fahrenheit's offset, a difference (the inlet gas offset) without.
+const TEMP_FIELDS = { Tm0_C: "level", Tm0_C_range: "level", Tb0_C: "level", tgi: "delta" };
+const shown = (c, kind, f = F()) => (!f ? c : kind === "level" ? c * 9 / 5 + 32 : c * 9 / 5);
+const celsius = (v, kind, f = F()) => (!f ? v : kind === "level" ? (v - 32) * 5 / 9 : v * 5 / 9);
+const round1 = (v) => Math.round(v * 10) / 10;
+function fieldC(id) {  // a temperature field's value in degC, or "" when empty
+  const v = $(id).value.trim();
+  return v === "" ? "" : celsius(Number(v), TEMP_FIELDS[id]);
+}
+function setFieldC(id, c) { $(id).value = c === null || c === undefined || c === "" ? "" : round1(shown(c, TEMP_FIELDS[id])); }
+function unitLabels() { for (const e of document.querySelectorAll(".tunit")) e.textContent = unit(); }
 const narrow = () => $("plot").clientWidth < 900;  // the figure's legend wraps into more rows
 const phone = () => $("plot").clientWidth < 600;
 function mmss(s) {
@@ -149,7 +161,7 @@ function draw() {
   if (c.BT_measured) traces.push({ x, y: T(c.BT_measured), name: "BT measured", mode: "markers", marker: { size: 3, color: "#333" } });
   if (c.beans_measured) {  // a curve of readings, or the first-crack mark read as the beans (the server names it)
     const few = c.beans_measured_few;
-    traces.push({ x, y: T(c.beans_measured), name: c.beans_measured_label, mode: "markers",
+    traces.push({ x, y: T(c.beans_measured), name: F() ? c.beans_measured_label_F : c.beans_measured_label, mode: "markers",
       marker: few ? { size: 9, symbol: "diamond-open", color: "#a0785a", line: { width: 2 } } : { size: 2, color: "#a0785a" } });
   }
   if (c.ET_measured) traces.push({ x, y: T(c.ET_measured), name: "ET measured", mode: "markers", marker: { size: 2, color: "#9467bd" } });
@@ -240,12 +252,14 @@ function drawTable() {
 
 function changes() {
   const v = (id) => $(id).value.trim();
-  const body = { heater: v("heater"), fan: v("fan"), tgi: v("tgi") };
+  const body = { heater: v("heater"), fan: v("fan"), tgi: v("tgi") === "" ? "" : String(fieldC("tgi")) };
   const o = state.open;
-  if (o && v("Tm0_C") !== "" && Number(v("Tm0_C")) !== o.Tm0_C) body.Tm0_C = Number(v("Tm0_C"));
+  // a field shown in degF and read back differs from the log's degC value by its rounding to 0.1 degF
+  const moved = (c, was) => c !== "" && Math.abs(c - was) > (F() ? 0.05 : 1e-9);
+  if (o && moved(fieldC("Tm0_C"), o.Tm0_C)) body.Tm0_C = fieldC("Tm0_C");
   if (o && v("batch_kg") !== "" && Number(v("batch_kg")) !== o.batch_kg) body.batch_kg = Number(v("batch_kg"));
   if (v("X0") !== "" && o && Number(v("X0")) !== o.X0) body.X0 = Number(v("X0"));
-  if (v("Tb0_C") !== "" && o && Number(v("Tb0_C")) !== o.Tb0_C) body.Tb0_C = Number(v("Tb0_C"));
+  if (o && moved(fieldC("Tb0_C"), o.Tb0_C)) body.Tb0_C = fieldC("Tb0_C");
   const program = programBody();
   if (program.length) body.program = program;
   return body;
@@ -321,6 +335,15 @@ function showReport(html) {
 const NO_MODEL = "no model in this folder yet: choose logs of one roaster under \"Fit a model\" (left) and fit one; " +
   "then Open shows a log with it";
 
+// The what-if's temperature fields and their ranges from degC values, in the page's unit.
+function setTempFields(valuesC) {
+  for (const k of ["Tm0_C", "Tb0_C"]) {  // the ranges first: a slider clamps a value to the range it has
+    const r = (state.ranges || {})[k];
+    if (r) for (const id of [k, `${k}_range`]) if ($(id)) { $(id).min = round1(shown(r[0], "level")); $(id).max = round1(shown(r[1], "level")); }
+  }
+  for (const [id, c] of Object.entries(valuesC)) setFieldC(id, c);
+}
+
 async function openLog() {
   if (!$("model").value) { say(NO_MODEL); return; }
   say("opening ...");
@@ -335,13 +358,11 @@ async function openLog() {
       if (steps.length) state.program[name] = steps;
     }
     state.table = r.table;
-    $("Tm0_C").value = r.Tm0_C ?? "";
-    $("Tm0_C_range").value = r.Tm0_C ?? 200;
+    if (!state.unitsChosen && r.temp_unit) { $("units").value = r.temp_unit; unitLabels(); }  // the log's own unit
+    state.ranges = r.ranges || {};
+    setTempFields({ Tm0_C: r.Tm0_C, Tm0_C_range: r.Tm0_C ?? 200, Tb0_C: r.Tb0_C, tgi: 0 });
     $("X0").value = r.X0 ?? "";
-    $("Tb0_C").value = r.Tb0_C ?? "";
-    for (const [k, [lo, hi]] of Object.entries(r.ranges || {})) {
-      for (const id of [k, `${k}_range`]) if ($(id)) { $(id).min = lo; $(id).max = hi; }
-    }
+    if (state.ranges.X0) { $("X0").min = state.ranges.X0[0]; $("X0").max = state.ranges.X0[1]; }
     const lim = r.transfer_limits;
     $("tr_limits_label").textContent = `${lim.decide} lowest / highest [${shownUnit(lim.unit)}]`;
     $("tr_low").placeholder = lim.low; $("tr_high").placeholder = lim.high;
@@ -352,7 +373,6 @@ async function openLog() {
     $("batch_kg_range").value = r.batch_kg || 1;
     $("tr_batch_kg").value = r.batch_kg ?? "";
     for (const id of ["heater", "fan"]) $(id).value = "";
-    $("tgi").value = 0;
     $("notes").textContent = (r.notes || []).join("\n");
     showReport(r.report_html);
     draw();
@@ -471,7 +491,17 @@ function link(numberId, rangeId) {
 window.addEventListener("DOMContentLoaded", async () => {
   $("open").addEventListener("click", openLog);
   $("upload").addEventListener("change", upload);
-  $("units").addEventListener("change", () => { draw(); drawTable(); });
+  $("units").addEventListener("change", () => {  // the fields keep what they hold, in the new unit
+    state.unitsChosen = true;
+    const was = $("units").value === "F" ? "C" : "F";
+    const held = Object.fromEntries(Object.entries(TEMP_FIELDS).map(([id, kind]) => {
+      const v = $(id).value.trim();
+      return [id, v === "" ? "" : celsius(Number(v), kind, was === "F")];
+    }));
+    setTempFields(held);
+    unitLabels();
+    draw(); drawTable();
+  });
   $("reset").addEventListener("click", openLog);
   $("run-transfer").addEventListener("click", runTransfer);
   $("whatif-background").addEventListener("click", whatifBackground);

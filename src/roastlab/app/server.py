@@ -163,6 +163,7 @@ def curves(batch, result, et: str = "Tm") -> dict:
     if batch is not None and (reading := second_bean_reading(batch)) is not None:
         out["beans_measured"] = _series(batch.Tb2_C)
         out["beans_measured_label"], out["beans_measured_few"] = reading
+        out["beans_measured_label_F"] = second_bean_reading(batch, "F")[0]  # the page in degF
     if batch is not None and batch.ET_C is not None:
         out["ET_measured"] = _series(batch.ET_C)
     return out
@@ -370,6 +371,7 @@ def create_app(data_dir: str | Path):
             "log": batch.name,
             "model": body["model"],  # the model file the curves and figures are from, as chosen
             "batch_kg": batch.Mb_kg,
+            "temp_unit": batch.temp_unit,  # the unit the log was recorded in: the page shows it unless told otherwise
             "Tm0_C": round(float(w.as_run.Tm_C[0]), 1),  # the drum at CHARGE the model starts from
             "X0": round(float(w.as_run.X_kg_kg[0]), 4),
             "Tb0_C": round(float(w.as_run.Tb_C[0]), 1),

@@ -195,12 +195,13 @@ def check_targets(outputs, *targets, plot=None) -> None:
         check_figure_path(plot)
 
 
-def write_json_and_plot(out, args, doc, figure) -> None:
-    """Write ``--json`` (``doc``) and ``--plot`` (``figure.plot``) through ``out`` when asked for."""
+def write_json_and_plot(out, args, doc, figure, **options) -> None:
+    """Write ``--json`` (``doc``) and ``--plot`` (``figure.plot``, given ``options``) through ``out`` when
+    asked for."""
     if args.json:
         out.write_text(args.json, json_text(doc))
     if args.plot:
-        figure.plot(args.plot, outputs=out)
+        figure.plot(args.plot, outputs=out, **options)
 
 
 def write_artisan_files(out, args, result) -> None:

@@ -50,9 +50,10 @@ def cmd_whatif(args) -> int:
     say(batch.notes)
     actuators = {k: cmap.actuator(k) for k in ("heater", "fan") if cmap is not None and getattr(cmap, k)}
     result = whatif(model, batch, setting_changes, actuators=actuators, band_level=args.band, **changes)
-    print(result.table(units=args.units))
+    units = args.units or batch.temp_unit  # the log's own unit unless asked otherwise
+    print(result.table(units=units))
     with outputs as out:
-        write_json_and_plot(out, args, result.to_json_dict(), result)
+        write_json_and_plot(out, args, result.to_json_dict(), result, units=units)
         write_artisan_files(out, args, result)
     return 0
 
@@ -105,7 +106,12 @@ def add_parsers(sub) -> None:
     add_initial_options(p)
     add_band_option(p, "the changed probe BT's prediction band", "its median width and BT at DROP in the table, "
                     "shaded in --plot, in --json")  # fmt: skip
-    p.add_argument("--units", choices=("C", "F"), default="C", help="temperatures in the table in C or F (default C)")
+    p.add_argument(
+        "--units",
+        choices=("C", "F"),
+        help="temperatures in the table and the figure in C or F (default: the log's own, as Artisan recorded it; "
+        "--tm0, --tb0 and --tgi stay in degC)",
+    )
     p.add_argument("--json", metavar="WHATIF.json", help="write the table as JSON (temperatures in degC, times in s)")
     p.add_argument("--plot", metavar="FIG.png", help="overlay measured BT and both predictions (.png/.svg/.pdf)")
     p.add_argument(

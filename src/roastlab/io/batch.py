@@ -56,6 +56,9 @@ class Batch:
         measures depends on the machine: the drum, the air in it or the exhaust); shown beside
         the model's temperatures, never an input; NaN where not measured
     events : {event name: time after CHARGE [s]} from the log (e.g. ``FCs``, ``DROP``)
+    temp_unit : "C" or "F", the unit the log recorded its temperatures in (Artisan's mode, a map's
+        ``[Ta] unit``); every temperature here is in degC whatever it says, and it is what a roaster's
+        tables and figures show by default
     """
 
     name: str
@@ -74,6 +77,7 @@ class Batch:
     ET_C: np.ndarray | None = None
     unit: str = ""  # which roaster of its make recorded it (RoasTime serial number), empty if unknown
     started_epoch_s: float | None = None  # when its recording started (a copy keeps it: first_of_each_roast)
+    temp_unit: str = "C"  # the unit the log was recorded in ("C" or "F"); the values are degC
 
     @property
     def n(self) -> int:

@@ -269,6 +269,16 @@ def display_temp_delta(delta_C: float, units: str = "C") -> float:
     return delta_C * 9.0 / 5.0 if units == "F" else delta_C
 
 
+def celsius_of(temp, units: str = "C"):
+    """A temperature in the display unit ("C" or "F") in degC: :func:`display_temp`'s inverse."""
+    return (temp - 32.0) * 5.0 / 9.0 if units == "F" else temp
+
+
+def celsius_delta_of(delta, units: str = "C"):
+    """A temperature difference in the display unit in K: :func:`display_temp_delta`'s inverse."""
+    return delta * 5.0 / 9.0 if units == "F" else delta
+
+
 #: Share of the roast after the turning point during which the drum metal may run colder than
 #: the beans before a fit is called physically implausible [-] (on a machine whose inlet air is
 #: colder than the beans, see :func:`implausible_states`).

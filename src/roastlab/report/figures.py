@@ -119,6 +119,22 @@ def ror_limits(ax, time_s, *curves) -> None:
         ax.set_ylim(min(0.0, bottom) - 2.0, max(top, 5.0) * 1.15 + 1.0)
 
 
+def temperature_axis(ax, label: str, units: str = "C", delta: bool = False) -> None:
+    """Label ``ax``, whose curves are in degC, as ``label`` with ``{u}`` its unit; in "F" a Fahrenheit
+    scale of its own (round degF ticks, :func:`~roastlab.metrics.profile.display_temp`) takes the
+    place of the Celsius one, so every curve stays drawn from the same degC numbers. ``delta``: the
+    axis holds differences or rates (degC/min), which convert without the 32 degF offset."""
+    if units != "F":
+        ax.set_ylabel(label.format(u="°C"))
+        return
+    from ..metrics.profile import celsius_delta_of, celsius_of, display_temp, display_temp_delta
+
+    there, back = (display_temp_delta, celsius_delta_of) if delta else (display_temp, celsius_of)
+    scale = ax.secondary_yaxis("left", functions=(lambda v: there(v, "F"), lambda v: back(v, "F")))
+    ax.tick_params(axis="y", left=False, labelleft=False)
+    scale.set_ylabel(label.format(u="°F"))
+
+
 def _shade_band(ax, band, color: str, what: str) -> None:
     """A :class:`~roastlab.evaluate.bands.Band` shaded on ``ax`` (minutes), labelled "90 % ``what``"."""
     ax.fill_between(band.time_s / 60.0, band.lower_C, band.upper_C, color=color, alpha=0.15, lw=0,
@@ -327,24 +343,28 @@ def _readings_of(sim):
     return types.SimpleNamespace(Tb2_C=sim.Tb2_measured_C, events=(getattr(sim, "meta", None) or {}).get("events", {}))
 
 
-def second_bean_reading(b) -> tuple[str, bool] | None:
+def second_bean_reading(b, units: str = "C") -> tuple[str, bool] | None:
     """How a batch's second bean reading is named on a figure or the page: ``(label, few)``, ``few``
     where it is a few readings (drawn as markers that stand out), or None where it has none. A curve
     of readings (the Bullet's IR) is "beans measured (second reading)"; the first-crack mark read as
-    the beans (a map's ``[Tb2] first_crack``) says so."""
+    the beans (a map's ``[Tb2] first_crack``) says so, its temperature in ``units`` ("C" or "F")."""
+    from ..metrics.profile import display_temp
+
     marked = np.isfinite(b.Tb2_C) if b.Tb2_C is not None else np.zeros(0, dtype=bool)
     if not marked.any():
         return None
     if np.count_nonzero(marked) > 3:
         return "beans measured (second reading)", False
     at_crack = np.all(b.Tb2_C[marked] == FIRST_CRACK_BEAN_C) and "FCs" in b.events
-    return (f"beans at first crack ({FIRST_CRACK_BEAN_C:g} °C, the FCs mark)" if at_crack else "beans measured"), True
+    crack = f"{display_temp(FIRST_CRACK_BEAN_C, units):g} °{units}"
+    return (f"beans at first crack ({crack}, the FCs mark)" if at_crack else "beans measured"), True
 
 
-def plot_whatif(w, path=None, outputs=None):
+def plot_whatif(w, path=None, outputs=None, units: str = "C"):
     """Artisan-style: measured BT, the model's probe BT and bean temperature as run and with the
     changes, the log's event marks; below, BT's rate of rise (clipped to the roast after the
-    turning point); bottom, the settings as run and changed. Times in m:ss.
+    turning point); bottom, the settings as run and changed. Times in m:ss, temperatures in
+    ``units`` ("C" or "F", :func:`temperature_axis`).
 
     ``w`` is a :class:`roastlab.workflows.whatif.WhatIf`.
     """
@@ -355,7 +375,7 @@ def plot_whatif(w, path=None, outputs=None):
     ax, ax_r, ax2 = fig.subplots(3, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1.3, 1.1]})
     if b.Ta_C is not None:
         ax.plot(t_min, b.Ta_C, ".", ms=3, color="0.3", label="BT measured (probe)")
-    if (reading := second_bean_reading(b)) is not None:
+    if (reading := second_bean_reading(b, units)) is not None:
         label, few = reading
         marked = np.isfinite(b.Tb2_C)
         if few:  # the first-crack mark read as the beans: a marker that stands out
@@ -371,7 +391,7 @@ def plot_whatif(w, path=None, outputs=None):
         _shade_band(ax, w.band, "tab:orange", "band, changed")
     ax.plot(t_min, w.as_run.Tb_C, color="tab:blue", lw=1.0, ls="--", label="beans model (Tb), as run")
     ax.plot(t_min, w.changed.Tb_C, color="tab:orange", lw=1.0, ls="--", label="beans model (Tb), changed")
-    ax.set_ylabel("temperature [°C]")
+    temperature_axis(ax, "temperature [{u}]", units)
     ax.legend(loc="lower right", fontsize=7)
     ax.grid(alpha=0.3)
     ax.set_xlim(t_min[0], t_min[-1])
@@ -384,7 +404,7 @@ def plot_whatif(w, path=None, outputs=None):
         if bt is not None:
             ax_r.plot(t_min, rate_of_rise_C_per_min(t, bt), color=color, lw=1.0, label=f"BT RoR {label}")
     ror_limits(ax_r, t, b.Ta_C, w.as_run.Ta_C, w.changed.Ta_C)
-    ax_r.set_ylabel(f"RoR [°C/min]\n({ROR_SPAN_S:g} s)")
+    temperature_axis(ax_r, f"RoR [{{u}}/min]\n({ROR_SPAN_S:g} s)", units, delta=True)
     ax_r.legend(loc="upper right", fontsize=7, ncol=3)
     ax_r.grid(alpha=0.3)
     logged = [(n, c) for n, c in (("heater", "tab:red"), ("fan", "tab:green")) if getattr(b, n) is not None]
@@ -406,7 +426,7 @@ def plot_whatif(w, path=None, outputs=None):
     if not logged:
         handles += ax2.plot(t_min, w.as_run.Tgi_C, color="tab:red", label="inlet gas Tgi as run")
         handles += ax2.plot(t_min, w.changed.Tgi_C, color="tab:red", ls="--", label="inlet gas Tgi changed")
-        ax2.set_ylabel("Tgi [°C]")
+        temperature_axis(ax2, "Tgi [{u}]", units)
     time_axis(ax2)
     ax2.legend(handles=handles, loc="upper right", fontsize=7, ncol=2, framealpha=0.9)
     ax2.grid(alpha=0.3)

@@ -361,10 +361,11 @@ class WhatIf(Result):
         df["model_error"] = df["as_run"] - df["measured"]
         return df
 
-    def _figure(self, path, outputs):
+    def _figure(self, path, outputs, units: str | None = None):
+        """``units``: "C" or "F" for the temperatures (default: the log's own, :attr:`Batch.temp_unit`)."""
         from ..report.figures import plot_whatif
 
-        return plot_whatif(self, path, outputs=outputs)
+        return plot_whatif(self, path, outputs=outputs, units=units or self.batch.temp_unit)
 
     def _draw(self, ax) -> None:
         t = self.as_run.time_s

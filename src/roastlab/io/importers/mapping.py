@@ -776,6 +776,7 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
     initial: dict = {}
     events: dict = {}
     unit = ""
+    temp_unit = "F" if str(cmap.Ta.get("unit", "C")).upper() == "F" else "C"  # a CSV's: its map's
     started_epoch_s = None  # when the recording started (Artisan roastepoch, RoasTime dateTime)
     bean_channel = None if cmap.first_crack_as_beans else cmap.Tb2  # the mark is read after the log, below
     settings = {k: spec for k, spec in (("heater", cmap.heater), ("fan", cmap.fan), ("Tb2", bean_channel)) if spec}
@@ -825,6 +826,7 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
             et_spec = settings.get("ET")
         Mb = log.weight_in_kg
         unit = log.unit
+        temp_unit = log.mode  # Artisan's profile mode (RoasTime: degC)
         started_epoch_s = log.started_epoch_s
         drop_known = log.drop_index is not None
         events = dict(log.events)
@@ -1036,6 +1038,7 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
         events=events,
         unit=unit,
         started_epoch_s=started_epoch_s,
+        temp_unit=temp_unit,
     )
     batch.initial.update(initial)
     if cmap.first_crack_as_beans:
