@@ -2,7 +2,8 @@
 
 Starts ``roastlab app``'s server on a temporary data folder (the SYNTHETIC paper batch and model,
 and where ../shared/data/real exists, a Bullet log with a model fitted on the 490 g logs), drives
-Debian's chromium with Playwright, saves docs/app-*.png and prints:
+Debian's chromium with Playwright, saves docs/app-*.png (app-tablet.png the first screen at a tablet's
+820 px) and prints:
 
 * page ready: from starting the server to the curves drawn (numba's disk cache warm);
 * what-if: from an input change to the new curve drawn in the browser, median of 20 changes,
@@ -122,6 +123,13 @@ def main() -> int:
         page.wait_for_function("document.body.dataset.opened !== undefined")
         ready_s = time.perf_counter() - t_start
         page.screenshot(path=str(DOCS / "app-open.png"), full_page=True)
+        page.set_viewport_size({"width": 820, "height": 1180})  # a tablet beside the roaster: its first screen
+        page.wait_for_function("document.getElementById('plot').clientWidth < 820")
+        time.sleep(0.5)  # the figure's redraw at the new width
+        page.screenshot(path=str(DOCS / "app-tablet.png"))
+        page.set_viewport_size({"width": 1400, "height": 1050})
+        page.wait_for_function("document.getElementById('plot').clientWidth > 820")
+        time.sleep(0.5)
 
         # what-if latency: input change -> curve drawn, 20 changes
         kg = float(page.input_value("#batch_kg") or 1.0)
@@ -208,7 +216,7 @@ def main() -> int:
     print(f"what-if on the 15-minute synthetic roast ({long_len[0]} samples, {long_len[1] / 60:.1f} min), median of "
           f"20: {statistics.median(long_lat):.1f} ms (server {statistics.median(long_server):.2f} ms)")  # fmt: skip
     print(
-        "wrote docs/app-open.png, docs/app-whatif.png, docs/app-drag.png, docs/app-transfer.png, docs/app-fit.png, docs/app-skywalker.png"
+        "wrote docs/app-open.png, docs/app-tablet.png, docs/app-whatif.png, docs/app-drag.png, docs/app-transfer.png, docs/app-fit.png, docs/app-skywalker.png"
     )
     shutil.rmtree(d, ignore_errors=True)
     return 0
