@@ -21,14 +21,15 @@ async function api(path, body) {
 
 function say(text) { $("message").textContent = text || ""; }
 const F = () => $("units").value === "F";
-const temp = (v) => (v === null || v === undefined ? null : F() ? v * 9 / 5 + 32 : v);
-const dtemp = (v) => (v === null || v === undefined ? null : F() ? v * 9 / 5 : v);
-const unit = () => (F() ? "°F" : "°C");
-// The what-if's temperature fields show the page's unit; the server is asked in degC. A level (the drum
-// or the beans at CHARGE) converts with Fahrenheit's offset, a difference (the inlet gas offset) without.
-const TEMP_FIELDS = { Tm0_C: "level", Tm0_C_range: "level", Tb0_C: "level", tgi: "delta" };
+// A degC value in the page's unit and back: a level (a temperature) converts with Fahrenheit's offset,
+// a difference or a rate (RoR, an offset) without.
 const shown = (c, kind, f = F()) => (!f ? c : kind === "level" ? c * 9 / 5 + 32 : c * 9 / 5);
 const celsius = (v, kind, f = F()) => (!f ? v : kind === "level" ? (v - 32) * 5 / 9 : v * 5 / 9);
+const temp = (v) => (v === null || v === undefined ? null : shown(v, "level"));
+const dtemp = (v) => (v === null || v === undefined ? null : shown(v, "delta"));
+const unit = () => (F() ? "°F" : "°C");
+// The what-if's temperature fields show the page's unit; the server is asked in degC.
+const TEMP_FIELDS = { Tm0_C: "level", Tm0_C_range: "level", Tb0_C: "level", tgi: "delta" };
 const round1 = (v) => Math.round(v * 10) / 10;
 function fieldC(id) {  // a temperature field's value in degC, or "" when empty
   const v = $(id).value.trim();

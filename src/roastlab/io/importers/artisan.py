@@ -67,7 +67,10 @@ WEIGHT_UNITS = {"g": 1e-3, "kg": 1.0, "lb": 0.45359237, "oz": 0.028349523125}
 
 
 def f_to_c(values):
-    return (np.asarray(values, dtype=float) - 32.0) * 5.0 / 9.0
+    """Temperatures [degF] as a float array [degC] (:func:`roastlab.metrics.profile.celsius_of`)."""
+    from ...metrics.profile import celsius_of
+
+    return celsius_of(np.asarray(values, dtype=float), "F")
 
 
 #: Artisan's default special-event types, in its order (a log's ``specialeventstype`` indexes them).

@@ -463,8 +463,11 @@ def _missing(path, key):
 
 
 def to_celsius(values: np.ndarray, unit: str) -> np.ndarray:
+    """A column in ``unit`` ("C", "F" or "K") in degC."""
     if unit == "F":
-        return (values - 32.0) * 5.0 / 9.0
+        from ...metrics.profile import celsius_of
+
+        return celsius_of(values, "F")
     if unit == "K":
         return values - 273.15
     return values
