@@ -427,6 +427,30 @@ def test_whatif_speaks_the_unit_the_log_was_recorded_in(cli, sky_model, tmp_path
     assert (tmp_path / "f.png").stat().st_size > 20_000
 
 
+def test_transfer_speaks_the_unit_the_log_was_recorded_in(cli, sky_model, tmp_path):
+    """transfer from a roast logged in degF: its summary's errors, tolerance and band in degF (9/5 of the
+    degC ones, the same program), --units C back in degC; the program file is the same either way."""
+    from conftest import rewritten_alog
+
+    model_path, log = sky_model
+    f_log = rewritten_alog(log, tmp_path / "in_F.alog", _in_fahrenheit)
+    runs = {}
+    for units in (None, "C"):
+        out = tmp_path / f"program-{units}.csv"
+        argv = ["transfer", "--model", model_path, "--reference", f_log, "--batch-kg", "0.22", "--out", out]
+        code, text, err = cli(*argv, *(["--units", units] if units else []))
+        assert code == 0, err
+        runs[units] = text, out.read_text()
+    (f_text, f_prog), (c_text, c_prog) = runs[None], runs["C"]
+    assert "RMSE °F" in f_text and "°C" not in f_text and "RMSE °C" in c_text and f_prog == c_prog
+
+    def rmse(text):
+        return float(next(ln for ln in text.splitlines() if ln.startswith("runnable")).split()[-2])
+
+    assert rmse(f_text) == pytest.approx(rmse(c_text) * 9 / 5, abs=2e-3)
+    assert "(max |e| <= 3.6 °F)" in f_text or "(max |e| > 3.6 °F)" in f_text
+
+
 def _whatif_written(cli, sky_model, heater: str, option: str, path):
     """``roastlab whatif LOG --heater HEATER OPTION PATH`` on the Skywalker model (exit 0), and the same
     what-if as a library call, to compare the written file with."""

@@ -382,6 +382,9 @@ def test_the_page_runs_a_transfer_and_its_downloads_load(page, tmp_path):
     page.click("#run-transfer")
     page.wait_for_function("document.body.dataset.transfer === 'done'", timeout=60_000)
     assert "RMSE" in page.inner_text("#transfer-summary")
+    # the figure takes its box's width (drawn once its box is shown, not sized in a hidden one)
+    drawn = page.evaluate("document.querySelector('#transfer-plot .main-svg').getBoundingClientRect().width")
+    assert drawn > 0.95 * page.evaluate("document.getElementById('transfer-plot').clientWidth") > 900
     links = page.locator("#downloads a")
     assert links.count() == 2
     saved = []

@@ -451,7 +451,7 @@ async function runTransfer() {
   $("transfer_progress").removeAttribute("value");  // indeterminate: the solve reports no steps
   $("transfer-summary").textContent = "running the transfer ...";
   try {
-    const r = await api("/api/transfer", { batch_kg: $("tr_batch_kg").value, plant_to: $("tr_plant").value.trim(), tm0_free: $("tr_tm0_free").checked, limit_low: $("tr_low").value, limit_high: $("tr_high").value, target: $("tr_target").value });
+    const r = await api("/api/transfer", { batch_kg: $("tr_batch_kg").value, plant_to: $("tr_plant").value.trim(), tm0_free: $("tr_tm0_free").checked, limit_low: $("tr_low").value, limit_high: $("tr_high").value, target: $("tr_target").value, units: $("units").value });
     $("transfer-summary").textContent = r.summary;
     $("downloads").innerHTML = r.downloads.map((u) => `<a href="${u}" download>${u.split("/").pop()}</a>`).join("");
     const x = minutes(r.time_s);
@@ -460,6 +460,7 @@ async function runTransfer() {
       { x, y: r.band.lower.map(temp), fill: "tonexty", fillcolor: "rgba(31,119,180,0.15)", line: { width: 0 },
         name: `${Math.round(r.band.level * 100)} % band of the predicted BT` },
     ] : [];
+    $("transfer-plot").classList.add("drawn");  // shown before drawing: Plotly sizes the figure to its box
     Plotly.react("transfer-plot", [
       ...band,
       { x, y: r.target.map(temp), name: "target BT", line: { color: "#333", width: 2 } },

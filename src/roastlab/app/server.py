@@ -467,6 +467,7 @@ def create_app(data_dir: str | Path):
             batch_kg=None if kg in (None, "") else check_value("batch_kg", kg, "to batch"),
             tm0_free=tm0_free,
             band_level=None if why_no_band(session.model) else BAND_LEVEL,
+            units="F" if body.get("units") == "F" else "C",  # the page's unit, for the summary's words
         )
         stem = f"{reference.name}-{r.batch_kg:g}kg"  # the followed curve's name (a --target's)
         files = {f"{stem}-program.csv": r.program_csv_text(), f"{stem}-background.alog": r.alog_text()}

@@ -84,6 +84,7 @@ def cmd_transfer(args) -> int:
         tolerance_C=args.tolerance,
         initial=initial,
         band_level=args.band,
+        units=args.units,
     )
     say(result.metrics["notes"])
     print(result.summary())
@@ -238,6 +239,12 @@ def add_parsers(sub) -> None:
     )
     add_band_option(p, "the predicted BT's prediction band", "its median width and BT at DROP in the output, "
                     "shaded in --plot, in --json: where a roast run with the program is expected")  # fmt: skip
+    p.add_argument(
+        "--units",
+        choices=("C", "F"),
+        help="temperatures in the summary and the figure in C or F (default: the reference log's own, as Artisan "
+        "recorded it; the limits, --tolerance and the files stay in degC)",
+    )
     p.add_argument("--json", metavar="METRICS.json", help="write the metrics, baselines and limits as JSON")
     p.add_argument(
         "--plot", metavar="FIG.png", help="target vs predicted BT, the program with its limits, the baselines"

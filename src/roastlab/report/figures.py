@@ -435,10 +435,18 @@ def plot_whatif(w, path=None, outputs=None, units: str = "C"):
 
 def plot_transfer(r, path=None, outputs=None):
     """Target vs predicted BT on plant B with the baselines; below, the program with its limits
-    shaded and the baselines' inputs; bottom, the tracking error.
+    shaded and the baselines' inputs; bottom, the tracking error. Temperatures in ``r.units``
+    (:func:`temperature_axis`; a Tgi program's axis stays in degC, as its limits are).
 
     ``r`` is a :class:`roastlab.workflows.transfer.TransferResult`.
     """
+    from ..metrics.profile import display_temp_delta
+
+    units = r.units
+
+    def d(v, digits: int = 1):  # an error in the figure's unit, with it
+        return f"{display_temp_delta(v, units):.{digits}f} °{units}"
+
     t_min = r.time_s / 60.0
     lim = r.limits
     fig = new_figure(figsize=(9, 8.5), layout="constrained")
@@ -451,7 +459,7 @@ def plot_transfer(r, path=None, outputs=None):
         color="tab:blue",
         lw=1.6,
         label=f"predicted on {r.plant_to}, {'runnable' if 'runnable' in m else 'optimised'} program "
-        f"(RMSE {m['rmse_C']:.2f} °C)",
+        f"(RMSE {d(m['rmse_C'], 2)})",
     )
     if r.band is not None:  # where a roast run with the program is expected (transfer --band)
         ax.fill_between(t_min, r.band.lower_C, r.band.upper_C, color="tab:blue", alpha=0.12, lw=0,
@@ -462,11 +470,11 @@ def plot_transfer(r, path=None, outputs=None):
         color, ls = styles[name]
         rm = m[keys[name]]["rmse_C"]
         if rm is not None:
-            ax.plot(t_min, ta, color=color, ls=ls, lw=1.3, label=f"{name} (RMSE {rm:.1f} °C)")
-    ax.set_ylabel("bean temperature BT [°C]")
+            ax.plot(t_min, ta, color=color, ls=ls, lw=1.3, label=f"{name} (RMSE {d(rm)})")
+    temperature_axis(ax, "bean temperature BT [{u}]", units)
     ax.set_title(
         f"{r.plant_from} -> {r.plant_to}, {r.batch_kg:g} kg: "
-        + ("feasible" if m["feasible"] else f"NOT feasible (max |e| {m['max_abs_C']:.1f} °C)"),
+        + ("feasible" if m["feasible"] else f"NOT feasible (max |e| {d(m['max_abs_C'])})"),
         fontsize=10,
     )
     ax.legend(loc="lower right", fontsize=8)
@@ -497,7 +505,7 @@ def plot_transfer(r, path=None, outputs=None):
 
     ax3.axhspan(-m["tolerance_C"], m["tolerance_C"], color="tab:blue", alpha=0.1, lw=0, label="tolerance")
     ax3.plot(t_min, r.program.Ta_pred_C - r.target_C, color="tab:blue", lw=1.2, label="predicted - target")
-    ax3.set_ylabel("error [°C]")
+    temperature_axis(ax3, "error [{u}]", units, delta=True)
     time_axis(ax3)
     ax3.legend(loc="upper right", fontsize=7)
     ax3.grid(alpha=0.3)

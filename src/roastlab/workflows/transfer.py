@@ -81,6 +81,9 @@ class TransferResult(Result):
     et_source: str = "Tgi"
     #: the machine's fan (for the background's Air events), when the map declares one
     fan_actuator: object = None
+    #: "C" or "F": the unit the summary and the figure give temperatures in (the reference log's own
+    #: unless asked otherwise); the arrays and the metrics stay in degC
+    units: str = "C"
     #: the predicted probe BT's prediction band (:class:`roastlab.evaluate.bands.Band`) when asked for
     band: object | None = None
     #: why the band may hold fewer samples than its level (:func:`roastlab.evaluate.bands.band_note`)
@@ -88,17 +91,24 @@ class TransferResult(Result):
 
     # ------------------------------------------------------------------ text outputs
     def summary(self) -> str:
-        m = self.metrics
+        from ..metrics.profile import display_temp, display_temp_delta
+
+        m, units = self.metrics, self.units
+        u = f"°{units}"
+
+        def d(v):  # an error or a tolerance in the summary's unit
+            return display_temp_delta(v, units)
+
         head = (
             f"transfer of {self.reference}: {self.plant_from} -> {self.plant_to} ({self.batch_kg:g} kg), "
             f"{len(self.time_s)} knots every {self.time_s[1] - self.time_s[0]:g} s"
         )
-        rows = [head, "", f"{'program':<24} {'RMSE °C':>9} {'max |e| °C':>11}"]
+        rows = [head, "", f"{'program':<24} {'RMSE ' + u:>9} {'max |e| ' + u:>11}"]
         label = "runnable (machine steps)" if "runnable" in m else "optimised"
-        rows.append(f"{label:<24} {m['rmse_C']:>9.3f} {m['max_abs_C']:>11.3f}")
+        rows.append(f"{label:<24} {d(m['rmse_C']):>9.3f} {d(m['max_abs_C']):>11.3f}")
         if "continuous" in m and m["continuous"]["rmse_C"] is not None:
             c = m["continuous"]
-            rows.append(f"{'continuous (optimiser)':<24} {c['rmse_C']:>9.3f} {c['max_abs_C']:>11.3f}")
+            rows.append(f"{'continuous (optimiser)':<24} {d(c['rmse_C']):>9.3f} {d(c['max_abs_C']):>11.3f}")
         for key, label in (
             ("baseline_same_inputs", "A's inputs unchanged"),
             ("baseline_retimed", "A's inputs retimed"),
@@ -107,17 +117,17 @@ class TransferResult(Result):
             if b["rmse_C"] is None:
                 rows.append(f"{label:<24} {'(could not be simulated)':>21}")
             else:
-                rows.append(f"{label:<24} {b['rmse_C']:>9.3f} {b['max_abs_C']:>11.3f}")
+                rows.append(f"{label:<24} {d(b['rmse_C']):>9.3f} {d(b['max_abs_C']):>11.3f}")
         rows.append("")
         verdict = "feasible" if m["feasible"] else "NOT feasible"
         rows.append(
-            f"{verdict} (max |e| {'<=' if m['feasible'] else '>'} {m['tolerance_C']:g} °C); "
+            f"{verdict} (max |e| {'<=' if m['feasible'] else '>'} {d(m['tolerance_C']):g} {u}); "
             f"solved in {m['solve_s']:.2f} s ({m['simulations']} simulations)"
         )
         rows += [f"  {s}" for s in m["explanation"]]
         after, tp_s = m.get("max_abs_from_turning_point_C"), m.get("turning_point_s")
         if not m["feasible"] and after is not None and tp_s:  # a turning point at CHARGE says nothing new
-            line = f"  from the target's turning point ({mmss(tp_s)}) on: max |e| {after:.1f} °C"
+            line = f"  from the target's turning point ({mmss(tp_s)}) on: max |e| {d(after):.1f} {u}"
             if after <= m["tolerance_C"]:
                 line += (
                     ", within the tolerance: the misses are the charge's dip, which the drum and the probe at "
@@ -127,11 +137,11 @@ class TransferResult(Result):
                     line += " (--tm0 free lets the optimiser choose the drum at CHARGE)"
             rows.append(line)
         if m.get("Tm0_chosen"):
-            rows.append(f"drum at CHARGE (chosen by the optimiser): {m['Tm0_C']:.0f} °C")
+            rows.append(f"drum at CHARGE (chosen by the optimiser): {display_temp(m['Tm0_C'], units):.0f} {u}")
         if self.band is not None:
             from ..evaluate.bands import band_words
 
-            rows.append(band_words(self.band, "the predicted BT"))
+            rows.append(band_words(self.band, "the predicted BT", units))
             rows.append(
                 "  (a roast run with the program is expected inside it; the tolerance above is the model against "
                 "the target, not the roast against the model)"
@@ -424,6 +434,7 @@ def transfer(
     tolerance_C: float = 2.0,
     initial: dict | None = None,
     band_level: float | None = None,
+    units: str | None = None,
 ) -> TransferResult:
     """Compute the program that reproduces ``reference``'s probe curve on ``plant_to``.
 
@@ -444,6 +455,8 @@ def transfer(
     initial : charge state changes on B (``Tb0_C``, ``Tm0_C``, ``X0``)
     band_level : e.g. 0.9: also the predicted probe BT's prediction band, the program's batch
         (:meth:`TransferResult.program_batch`) through :func:`roastlab.evaluate.bands.prediction_bands`
+    units : "C" or "F", the unit of the summary's and the figure's temperatures (default: the reference
+        log's own, :attr:`Batch.temp_unit`); every array and metric stays in degC
     """
     from ..io.plants import load_plant
 
@@ -566,7 +579,8 @@ def transfer(
     # to the beans, the drum's heat at CHARGE) more than the program's: said apart, judged as a whole
     tp_s = turning_point(t, target)[0]
     from_tp = _errors(program.Ta_pred_C[t >= tp_s], target[t >= tp_s]) if tp_s is not None else None
-    explanation = _explain(t, program.Ta_pred_C - target, spans, tolerance_C, pb.name, mass_b, feasible)
+    units = units or reference.temp_unit
+    explanation = _explain(t, program.Ta_pred_C - target, spans, tolerance_C, pb.name, mass_b, feasible, units)
     baselines_best = min((b["rmse_C"] for b in (base_same, base_ret) if b["rmse_C"] is not None), default=None)
     metrics = {
         "reference": src,
@@ -634,6 +648,7 @@ def transfer(
         events=dict(reference.events),
         et_source=et_source(cmap),
         fan_actuator=cmap.actuator("fan") if cmap is not None and cmap.fan else None,
+        units=units,
     )
     if band_level is not None:
         from ..evaluate.bands import band_note, band_summary, prediction_bands
@@ -663,10 +678,13 @@ def _spans_in_words(spans, listed: int = 3) -> str:
     return "; ".join(words)
 
 
-def _explain(t, e, spans, tol, plant, mass, feasible) -> list[str]:
+def _explain(t, e, spans, tol, plant, mass, feasible, units: str = "C") -> list[str]:
     """Where the program misses the target by more than ``tol`` and the limits that hold it back
     in the direction of the miss (below the target: a ceiling or a rising rate; above it: a
-    floor or a falling rate), so an explanation never contradicts the error it explains."""
+    floor or a falling rate), so an explanation never contradicts the error it explains; the
+    misses in ``units`` ("C" or "F")."""
+    from ..metrics.profile import display_temp_delta
+
     out = []
     bad = np.abs(e) > tol
     if feasible:
@@ -685,5 +703,6 @@ def _explain(t, e, spans, tol, plant, mass, feasible) -> list[str]:
             why += f": the {mass:g} kg batch on {plant} {verb}"
         else:
             why = "no limit holds the program back here: the model cannot follow the target's shape"
-        out.append(f"{mmss(t[i])}-{mmss(t[j])}: predicted BT up to {abs(e[worst]):.1f} °C {side} the target; {why}")
+        miss = display_temp_delta(abs(e[worst]), units)
+        out.append(f"{mmss(t[i])}-{mmss(t[j])}: predicted BT up to {miss:.1f} °{units} {side} the target; {why}")
     return out
