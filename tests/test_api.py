@@ -398,14 +398,16 @@ def _in_fahrenheit(doc: dict) -> None:
 
 
 def test_whatif_speaks_the_unit_the_log_was_recorded_in(cli, sky_model, tmp_path):
-    """The same roast logged in degF: whatif's table and figure are in degF without being told (the
-    figure's temperatures on a degF scale), --units C gives them in degC, and the numbers are the same
-    roast's either way."""
+    """The same roast logged in degF: whatif's table, figure and Artisan background are in degF without
+    being told (the figure's temperatures on a degF scale), --units C gives the table in degC, and the
+    numbers are the same roast's either way."""
     from conftest import rewritten_alog
 
     model_path, log = sky_model
     f_log = rewritten_alog(log, tmp_path / "in_F.alog", _in_fahrenheit)
-    code, out_f, err = cli("whatif", f_log, "--model", model_path, "--heater", "+5@3:00", "--plot", tmp_path / "f.png")
+    bg = tmp_path / "next.alog"
+    argv = ["whatif", f_log, "--model", model_path, "--heater", "+5@3:00", "--plot", tmp_path / "f.png", "--alog", bg]
+    code, out_f, err = cli(*argv)
     assert code == 0, err
     code, out_c, err = cli("whatif", f_log, "--model", model_path, "--heater", "+5@3:00", "--units", "C")
     assert code == 0, err
@@ -425,6 +427,13 @@ def test_whatif_speaks_the_unit_the_log_was_recorded_in(cli, sky_model, tmp_path
     labels = [a.get_ylabel() for ax in fig.axes for a in (ax, *ax.child_axes)]  # the degF scales: child axes
     assert "temperature [°F]" in labels and any(s.startswith("RoR [°F/min]") for s in labels)
     assert (tmp_path / "f.png").stat().st_size > 20_000
+    # the Artisan background in the roaster's own mode (degF), the same changed curve read back in degC
+    import ast
+
+    from roastlab.io.importers.artisan import read_alog
+
+    assert ast.literal_eval(bg.read_text())["mode"] == "F"
+    assert np.max(np.abs(read_alog(bg).channels["BT"] - w.changed.Ta_C)) <= 0.005
 
 
 def test_transfer_speaks_the_unit_the_log_was_recorded_in(cli, sky_model, tmp_path):

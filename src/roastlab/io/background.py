@@ -79,6 +79,7 @@ def background_alog_text(
     notes: str,
     roaster: str,
     batch_kg: float,
+    mode: str = "C",
 ) -> str:
     """The ``.alog`` text of a predicted roast from CHARGE (``time_s[0]``) to DROP (its last sample).
 
@@ -86,8 +87,12 @@ def background_alog_text(
     (:data:`~roastlab.io.importers.artisan.EVENT_NAMES`: DRY, FCs, ...) -> time [s] on ``time_s``,
     each written at its nearest sample (CHARGE is the first sample, DROP the last); ``events``: from
     :func:`setting_events`; ``title``, ``notes`` (Artisan's roasting notes), ``roaster`` (its
-    machine name) and ``batch_kg`` (the green weight) describe the prediction.
+    machine name) and ``batch_kg`` (the green weight) describe the prediction. ``mode``: "C" or "F",
+    Artisan's profile mode, the unit BT and ET are written in (the roaster's own, so the background
+    needs no conversion in an Artisan set to it).
     """
+    from ..metrics.profile import display_temp
+
     t = np.asarray(time_s, dtype=float)
     n = len(t)
     timeindex = [0] * 8
@@ -103,7 +108,7 @@ def background_alog_text(
         "revision": "",
         "build": "",
         "artisan_os": "roastlab",
-        "mode": "C",
+        "mode": mode,
         "title": title,
         "roastertype": roaster,
         "operator": "",
@@ -115,8 +120,8 @@ def background_alog_text(
         "roastepoch": int(now.timestamp()),
         "samplinginterval": float(t[1] - t[0]),
         "timex": [round(float(v), 3) for v in t],
-        "temp1": [round(float(v), 2) for v in et_C],
-        "temp2": [round(float(v), 2) for v in bt_C],
+        "temp1": [round(float(display_temp(v, mode)), 2) for v in et_C],
+        "temp2": [round(float(display_temp(v, mode)), 2) for v in bt_C],
         "timeindex": timeindex,
         "specialevents": [int(e[0]) for e in events],
         "specialeventstype": [DEFAULT_ETYPES.index(e[1]) for e in events],

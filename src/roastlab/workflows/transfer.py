@@ -276,6 +276,7 @@ class TransferResult(Result):
             ),
             roaster=self.plant_to,
             batch_kg=self.batch_kg,
+            mode=self.units,  # the roaster's unit (the reference log's, unless asked otherwise)
         )
 
     def to_frame(self):

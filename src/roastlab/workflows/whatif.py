@@ -327,6 +327,7 @@ class WhatIf(Result):
             ),
             roaster=self.roaster,
             batch_kg=self.batch_kg or 0.0,
+            mode=self.batch.temp_unit,  # the roaster's own unit, as Artisan recorded the log
         )
 
     def alarms_text(self) -> str:
