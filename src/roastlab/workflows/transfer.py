@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, ParameterError
 from ..fit.program import (
     ProgramLimits,
     ProgramResult,
@@ -581,6 +581,8 @@ def transfer(
     tp_s = turning_point(t, target)[0]
     from_tp = _errors(program.Ta_pred_C[t >= tp_s], target[t >= tp_s]) if tp_s is not None else None
     units = units or reference.temp_unit
+    if units not in ("C", "F"):
+        raise ParameterError(f"units must be 'C' or 'F', got {units!r}")
     explanation = _explain(t, program.Ta_pred_C - target, spans, tolerance_C, pb.name, mass_b, feasible, units)
     baselines_best = min((b["rmse_C"] for b in (base_same, base_ret) if b["rmse_C"] is not None), default=None)
     metrics = {
