@@ -451,6 +451,13 @@ def test_transfer_speaks_the_unit_the_log_was_recorded_in(cli, sky_model, tmp_pa
         assert code == 0, err
         runs[units] = text, out.read_text()
     (f_text, f_prog), (c_text, c_prog) = runs[None], runs["C"]
+    # the Artisan background in the mode the reference was recorded in, whatever --units shows
+    import ast
+
+    bg = tmp_path / "bg.alog"
+    argv = ["transfer", "--model", model_path, "--reference", f_log, "--batch-kg", "0.22", "--out", tmp_path / "p.csv"]
+    assert cli(*argv, "--units", "C", "--alog", bg)[0] == 0
+    assert ast.literal_eval(bg.read_text())["mode"] == "F"
     assert "RMSE °F" in f_text and "°C" not in f_text and "RMSE °C" in c_text and f_prog == c_prog
 
     def rmse(text):

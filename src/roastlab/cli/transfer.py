@@ -242,8 +242,8 @@ def add_parsers(sub) -> None:
     p.add_argument(
         "--units",
         choices=("C", "F"),
-        help="temperatures in the summary, the figure and the --alog background in C or F (default: the reference "
-        "log's own, as Artisan recorded it; the limits, --tolerance, OUT and --json stay in degC)",
+        help="temperatures in the summary and the figure in C or F (default: the reference log's own, as Artisan "
+        "recorded it, which --alog is written in; the limits, --tolerance, OUT and --json stay in degC)",
     )
     p.add_argument("--json", metavar="METRICS.json", help="write the metrics, baselines and limits as JSON")
     p.add_argument(

@@ -84,6 +84,8 @@ class TransferResult(Result):
     #: "C" or "F": the unit the summary and the figure give temperatures in (the reference log's own
     #: unless asked otherwise); the arrays and the metrics stay in degC
     units: str = "C"
+    #: "C" or "F": the unit the reference log was recorded in, its Artisan background's mode
+    log_unit: str = "C"
     #: the predicted probe BT's prediction band (:class:`roastlab.evaluate.bands.Band`) when asked for
     band: object | None = None
     #: why the band may hold fewer samples than its level (:func:`roastlab.evaluate.bands.band_note`)
@@ -276,7 +278,7 @@ class TransferResult(Result):
             ),
             roaster=self.plant_to,
             batch_kg=self.batch_kg,
-            mode=self.units,  # the roaster's unit (the reference log's, unless asked otherwise)
+            mode=self.log_unit,  # the roaster's own unit, as Artisan recorded the reference
         )
 
     def to_frame(self):
@@ -652,6 +654,7 @@ def transfer(
         et_source=et_source(cmap),
         fan_actuator=cmap.actuator("fan") if cmap is not None and cmap.fan else None,
         units=units,
+        log_unit=reference.temp_unit,
     )
     if band_level is not None:
         from ..evaluate.bands import band_note, band_summary, prediction_bands
