@@ -467,6 +467,33 @@ def test_transfer_speaks_the_unit_the_log_was_recorded_in(cli, sky_model, tmp_pa
     assert "(max |e| <= 3.6 °F)" in f_text or "(max |e| > 3.6 °F)" in f_text
 
 
+@pytest.mark.parametrize(
+    ("text", "delta", "want"),
+    [("204", False, 204.0), ("400F", False, 204.444), ("400 °F", False, 204.444), ("204c", False, 204.0),
+     ("72f", False, 22.222), ("36F", True, 20.0), ("+18F", True, 10.0), ("-10", True, -10.0)],
+)  # fmt: skip
+def test_a_temperature_option_takes_degf_written_as_such(text, delta, want):
+    """--tm0/--tb0/--tgi: degC as a bare number, degF with an F after it (a roaster who reads degF); an
+    offset converts without the 32 degF."""
+    from roastlab.cli.common import temperature_arg
+
+    assert temperature_arg("--tm0", delta)(text) == pytest.approx(want, abs=1e-3)
+
+
+def test_whatif_takes_the_drum_in_degf(cli, sky_model, tmp_path):
+    """whatif --tm0 400F is the drum at 204.4 degC: the same answer as --tm0 204.444."""
+    model_path, log = sky_model
+    runs = [
+        cli("whatif", log, "--model", model_path, "--tm0", tm0, "--json", tmp_path / f"{k}.json")
+        for k, tm0 in enumerate(["400F", "204.444444"])
+    ]
+    assert all(code == 0 for code, _, _ in runs), runs
+    a, b = (json.loads((tmp_path / f"{k}.json").read_text())["rows"] for k in range(2))
+    assert [r["changed"] for r in a] == pytest.approx([r["changed"] for r in b], rel=1e-6)
+    code, _, err = cli("whatif", log, "--model", model_path, "--tm0", "400X")
+    assert code == 2 and "--tm0 must be a number, got '400X'" in err
+
+
 def _whatif_written(cli, sky_model, heater: str, option: str, path):
     """``roastlab whatif LOG --heater HEATER OPTION PATH`` on the Skywalker model (exit 0), and the same
     what-if as a library call, to compare the written file with."""

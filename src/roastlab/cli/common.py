@@ -65,6 +65,29 @@ def float_arg(name: str):
     return parse
 
 
+#: The suffixes a temperature on the command line may carry, and the unit each names.
+TEMPERATURE_SUFFIXES = (("°F", "F"), ("°C", "C"), ("F", "F"), ("C", "C"))
+
+
+def temperature_arg(name: str, delta: bool = False):
+    """A temperature option [degC]: a number, or one with its unit after it (``400F``, ``204C``, ``400 °F``)
+    for a roaster who reads degF, converted here (:func:`roastlab.metrics.profile.celsius_of`).
+    ``delta``: a difference or an offset (``+36F`` is 20 degC), converted without the 32 degF."""
+
+    def parse(text: str) -> float:
+        from ..metrics.profile import celsius_delta_of, celsius_of
+
+        bare, unit = text.strip(), "C"
+        for suffix, named in TEMPERATURE_SUFFIXES:
+            if bare.upper().endswith(suffix.upper()):
+                bare, unit = bare[: -len(suffix)].strip(), named
+                break
+        v = float_arg(name)(bare if bare else text)
+        return float(celsius_delta_of(v, unit) if delta else celsius_of(v, unit))
+
+    return parse
+
+
 def seed_arg(text: str) -> int:
     try:
         v = int(text)
@@ -313,13 +336,14 @@ def add_initial_options(p: argparse.ArgumentParser) -> None:
 
     p.add_argument(
         "--tb0",
-        type=float_arg("--tb0"),
-        help=f"initial bean temperature [degC] (default: the model's, else {default('Tb0_C'):g})",
+        type=temperature_arg("--tb0"),
+        help=f"initial bean temperature [degC; 72F for degF] (default: the model's, else {default('Tb0_C'):g})",
     )
     p.add_argument(
         "--tm0",
-        type=float_arg("--tm0"),
-        help=f"initial drum metal temperature, the preheat [degC] (default: the model's or the log's, else {default('Tm0_C'):g})",
+        type=temperature_arg("--tm0"),
+        help="initial drum metal temperature, the preheat [degC; 400F for degF] (default: the model's or the log's, "
+        f"else {default('Tm0_C'):g})",
     )
     p.add_argument(
         "--x0",

@@ -13,6 +13,7 @@ from .common import (
     range_arg,
     read_inputs,
     say,
+    temperature_arg,
     warn_if_failed,
     write_artisan_files,
     write_json_and_plot,
@@ -53,9 +54,11 @@ def cmd_transfer(args) -> int:
             tm0_free = range_arg(args.tm0_range, "--tm0-range")
         else:
             try:
-                initial["Tm0_C"] = check_value("Tm0_C", float(args.tm0), "--tm0")
-            except ValueError:
-                raise InputError(f"expected a temperature [degC] or 'free', got {args.tm0!r}", "--tm0") from None
+                initial["Tm0_C"] = check_value("Tm0_C", temperature_arg("--tm0")(args.tm0), "--tm0")
+            except argparse.ArgumentTypeError:
+                raise InputError(
+                    f"expected a temperature [degC; 400F for degF] or 'free', got {args.tm0!r}", "--tm0"
+                ) from None
     decide = args.decide or default_limits(model, args.plant_from, args.plant_to).decide
     if decide == "heater":
         if reference.heater is None:
@@ -160,13 +163,14 @@ def add_parsers(sub) -> None:
     )
     p.add_argument(
         "--tb0",
-        type=float_arg("--tb0"),
-        help=f"bean temperature at CHARGE on B [degC] (default: the model's, else {default('Tb0_C'):g})",
+        type=temperature_arg("--tb0"),
+        help=f"bean temperature at CHARGE on B [degC; 72F for degF] (default: the model's, else {default('Tb0_C'):g})",
     )
     p.add_argument(
         "--tm0",
         metavar="C|free",
-        help="drum temperature at CHARGE on B [degC], or 'free' to let the optimiser choose it (the preheat)",
+        help="drum temperature at CHARGE on B [degC; 400F for degF], or 'free' to let the optimiser choose it (the "
+        "preheat)",
     )
     p.add_argument(
         "--tm0-range",

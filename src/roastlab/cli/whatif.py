@@ -13,6 +13,7 @@ from .common import (
     initial_changes,
     read_inputs,
     say,
+    temperature_arg,
     warn_if_failed,
     write_artisan_files,
     write_json_and_plot,
@@ -101,7 +102,11 @@ def add_parsers(sub) -> None:
         help="set heater or fan to V from time T (m:ss or s) on, e.g. heater=6@2:00; with a sign it is relative: "
         "heater=+1@4:00 (repeatable)",
     )
-    p.add_argument("--tgi", type=float_arg("--tgi"), help="add this to the inlet gas temperature [degC]")
+    p.add_argument(
+        "--tgi",
+        type=temperature_arg("--tgi", delta=True),
+        help="add this to the inlet gas temperature [degC; 36F for degF]",
+    )
     p.add_argument("--batch-kg", type=float_arg("--batch-kg"), help="green batch mass [kg] (default: the log's)")
     add_initial_options(p)
     add_band_option(p, "the changed probe BT's prediction band", "its median width and BT at DROP in the table, "
@@ -110,7 +115,7 @@ def add_parsers(sub) -> None:
         "--units",
         choices=("C", "F"),
         help="temperatures in the table and the figure in C or F (default: the log's own, as Artisan recorded it; "
-        "--tm0, --tb0 and --tgi stay in degC)",
+        "--tm0, --tb0 and --tgi are degC unless written with an F: 400F)",
     )
     p.add_argument("--json", metavar="WHATIF.json", help="write the table as JSON (temperatures in degC, times in s)")
     p.add_argument("--plot", metavar="FIG.png", help="overlay measured BT and both predictions (.png/.svg/.pdf)")
