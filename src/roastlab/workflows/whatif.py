@@ -429,7 +429,13 @@ def whatif(
             new = np.clip(new, act.low, act.high)  # a shift past the knob's end stays at the end
             labels[labels.index(str(c))] += f" (held within {act.label(act.low)}-{act.label(act.high)})"
         changed_batch = dataclasses.replace(changed_batch, **{c.setting: new})
-    names = {"Tgi_offset_C": "Tgi {:+g} °C", "batch_kg": "batch {:g} kg", "Tm0_C": "drum at charge {:g} °C"}
+    # four digits: a drum given as 400F is "drum at charge 204.4 °C", not 204.444
+    names = {
+        "Tgi_offset_C": "Tgi {:+.4g} °C",
+        "batch_kg": "batch {:g} kg",
+        "Tm0_C": "drum at charge {:.4g} °C",
+        "Tb0_C": "beans at charge {:.4g} °C",
+    }
     labels += [names.get(k, k + " = {:g}").format(float(v)) for k, v in changes.items()]
     as_run = model.predict(batch)
     changed = model.predict(changed_batch, **changes)
