@@ -297,6 +297,19 @@ def _traces(page) -> dict:
     return page.evaluate("Object.fromEntries(document.getElementById('plot').data.map(t => [t.name, t.y]))")
 
 
+def _longest_heater_step(page) -> dict:
+    """The heater's longest program step: its shape's name and level, the middle of it on screen
+    (x, y, in the window's pixels), and where three levels lower is (y_to)."""
+    return page.evaluate(
+        """() => { const gd = document.getElementById('plot'), sh = gd._fullLayout.shapes;
+        let k = -1, best = -1;
+        sh.forEach((s, i) => { if (s.name && s.name.startsWith('heater:') && s.x1 - s.x0 > best) { best = s.x1 - s.x0; k = i; } });
+        const s = sh[k], xa = gd._fullLayout.xaxis, ya = gd._fullLayout.yaxis3, r = gd.getBoundingClientRect();
+        return { name: s.name, level: s.y0, x: r.left + xa._offset + xa.l2p((s.x0 + s.x1) / 2),
+                 y: r.top + ya._offset + ya.l2p(s.y0), y_to: r.top + ya._offset + ya.l2p(s.y0 - 3) }; }"""
+    )
+
+
 @pytest.mark.slow
 def test_the_page_draws_a_real_log_and_follows_a_what_if(page, data_dir, tmp_path):
     if not (data_dir / "bullet-model.json").exists():
@@ -346,14 +359,7 @@ def test_a_program_step_dragged_with_the_mouse_changes_the_prediction(page, data
         pytest.skip("../shared/data/real is absent")
     _open(page, "logs/bullet-500g.json", "bullet-model.json")
     before = page.inner_text("tr[data-key='beans-DROP_C'] td.changed")
-    spot = page.evaluate(
-        """() => { const gd = document.getElementById('plot'), sh = gd._fullLayout.shapes;
-        let k = -1, best = -1;
-        sh.forEach((s, i) => { if (s.name && s.name.startsWith('heater:') && s.x1 - s.x0 > best) { best = s.x1 - s.x0; k = i; } });
-        const s = sh[k], xa = gd._fullLayout.xaxis, ya = gd._fullLayout.yaxis3, r = gd.getBoundingClientRect();
-        return { name: s.name, level: s.y0, x: r.left + xa._offset + xa.l2p((s.x0 + s.x1) / 2),
-                 y: r.top + ya._offset + ya.l2p(s.y0), y_to: r.top + ya._offset + ya.l2p(s.y0 - 3) }; }"""
-    )
+    spot = _longest_heater_step(page)
     updates = page.evaluate("Number(document.body.dataset.updates || 0)")
     page.mouse.click(spot["x"], spot["y"])  # activate the step, then drag it three levels down
     page.mouse.move(spot["x"], spot["y"])
@@ -371,6 +377,54 @@ def test_a_program_step_dragged_with_the_mouse_changes_the_prediction(page, data
     after = page.inner_text("tr[data-key='beans-DROP_C'] td.changed")
     assert float(after) < float(before)  # less heat: cooler beans at DROP
     page.screenshot(path=str(tmp_path / "drag.png"), full_page=True)
+
+
+@pytest.mark.slow
+def test_a_program_step_dragged_with_a_finger_changes_the_prediction(browser, server):
+    """On a tablet a finger lands a few pixels off a 5-px step: it still takes the step, moves it three
+    levels down (snapped to the machine's steps) with the prediction following, and the page does not
+    scroll under it. A touch away from every step leaves the program alone."""
+    if not (REAL_DATA / "bullet").is_dir():
+        pytest.skip("../shared/data/real is absent")
+    context = browser.new_context(viewport={"width": 820, "height": 1180}, has_touch=True, is_mobile=True)
+    try:
+        page = context.new_page()
+        page.goto(server + "/")
+        _open(page, "logs/bullet-500g.json", "bullet-model.json")
+        spot = _longest_heater_step(page)
+        cdp = context.new_cdp_session(page)
+
+        def swipe(x, y0, y1):
+            cdp.send("Input.dispatchTouchEvent", {"type": "touchStart", "touchPoints": [{"x": x, "y": y0}]})
+            for i in range(1, 11):
+                cdp.send(
+                    "Input.dispatchTouchEvent",
+                    {"type": "touchMove", "touchPoints": [{"x": x, "y": y0 + (y1 - y0) * i / 10}]},
+                )
+            cdp.send("Input.dispatchTouchEvent", {"type": "touchEnd", "touchPoints": []})
+
+        program = page.evaluate("JSON.stringify(state.program)")
+        top = page.evaluate(
+            "(() => { const gd = document.getElementById('plot'); return gd.getBoundingClientRect().top + gd._fullLayout.yaxis._offset + 30; })()"
+        )
+        swipe(spot["x"], top, top + 40)  # on the temperature panel, far from any step
+        page.wait_for_timeout(300)
+        assert page.evaluate("JSON.stringify(state.program)") == program
+        page.evaluate("window.scrollTo(0, 0)")
+        updates = page.evaluate("Number(document.body.dataset.updates || 0)")
+        miss = 9.0  # px below the step's line, where a fingertip lands
+        swipe(spot["x"], spot["y"] + miss, spot["y_to"] + miss)
+        page.wait_for_function(f"Number(document.body.dataset.updates || 0) > {updates}")
+        page.wait_for_function("!state.busy && !state.pending")
+        k = int(spot["name"].split(":")[1])
+        step = page.evaluate(f"state.program.heater[{k}]")
+        assert step["value"] == spot["level"] - 3  # snapped to a P level, three lower
+        assert page.evaluate("window.scrollY") == 0  # the finger moved the step, not the page
+        heater = np.array(_traces(page)["heater [steps]"], dtype=float)
+        t = np.array(page.evaluate("state.open.curves.time_s"), dtype=float)
+        assert np.all(heater[(t >= step["from_s"]) & (t < step["until_s"])] == step["value"])
+    finally:
+        context.close()
 
 
 @pytest.mark.slow

@@ -5,7 +5,7 @@ const sid = sessionStorage.getItem("roastlab-session") || crypto.randomUUID();
 sessionStorage.setItem("roastlab-session", sid);
 const $ = (id) => document.getElementById(id);
 const state = { open: null, changed: null, changedBand: null, table: null, busy: false, pending: false, lastDrawMs: null, tInput: null,
-                program: {} };  // setting -> [{from_s, until_s, value, logged}]: the steps the roaster can drag
+                program: {}, touchStep: null };  // program: setting -> [{from_s, until_s, value, logged}], the steps the roaster can drag
 
 async function api(path, body) {
   const opts = { method: body === undefined ? "GET" : "POST", headers: { "X-Session": sid } };
@@ -128,6 +128,46 @@ function onRelayout(ev) {  // a program step was dragged: its new level (and sta
     changed = true;
   }
   if (changed) { state.tInput = performance.now(); whatif(); }
+}
+
+// A finger on a tablet: Plotly drags an editable shape only from the 5-7 px line itself, which a
+// fingertip misses (4 px off already did). A touch within FINGER_PX of a step takes it instead: the
+// step moves up and down as far as the finger does (its level, snapped to the machine's steps), the
+// prediction follows it, and the page does not scroll meanwhile. A touch anywhere else scrolls and
+// pans as before. Moving a step along time stays the mouse's (or the heater and fan fields').
+const FINGER_PX = 24;
+function stepNear(touch) {
+  const gd = $("plot"), fl = gd._fullLayout;
+  if (!state.open || !fl || !fl.xaxis) return null;
+  const r = gd.getBoundingClientRect(), xa = fl.xaxis, px = touch.clientX - r.left - xa._offset;
+  let best = null;
+  for (const [name, steps] of Object.entries(state.program)) {
+    const axis = "yaxis" + settingAxis(name).slice(1), ya = fl[axis];
+    if (!ya) continue;
+    const py = touch.clientY - r.top - ya._offset;
+    steps.forEach((st, k) => {
+      const inside = px >= xa.l2p(st.from_s / 60) - 4 && px <= xa.l2p(st.until_s / 60) + 4;
+      const d = Math.abs(py - ya.l2p(st.value));
+      if (inside && d <= FINGER_PX && (!best || d < best.d)) best = { name, k, axis, d, y0: touch.clientY, from: st.value };
+    });
+  }
+  return best;
+}
+function onStepTouch(ev) {
+  if (ev.type === "touchstart") state.touchStep = ev.touches.length === 1 ? stepNear(ev.touches[0]) : null;
+  const hit = state.touchStep;
+  if (!hit) return;  // not on a step: the page's and Plotly's own handling
+  ev.preventDefault();  // no scroll, no pan, no emulated click
+  ev.stopPropagation();
+  if (ev.type === "touchend" || ev.type === "touchcancel") { state.touchStep = null; return; }
+  if (ev.type !== "touchmove") return;
+  const ya = $("plot")._fullLayout[hit.axis], st = state.program[hit.name][hit.k];
+  const v = snap(hit.name, hit.from + ya.p2l(ev.touches[0].clientY) - ya.p2l(hit.y0));  // by as much as the finger moved
+  if (v !== st.value) {
+    st.value = v;
+    if (state.tInput === null) state.tInput = performance.now();
+    whatif();
+  }
 }
 
 function programBody() {  // the dragged steps as "set" changes (applied in order, as the what-if does)
@@ -508,6 +548,9 @@ window.addEventListener("DOMContentLoaded", async () => {
   $("run-transfer").addEventListener("click", runTransfer);
   $("whatif-background").addEventListener("click", whatifBackground);
   $("run-fit").addEventListener("click", runFit);
+  for (const kind of ["touchstart", "touchmove", "touchend", "touchcancel"]) {  // before Plotly's own handlers
+    $("plot").addEventListener(kind, onStepTouch, { capture: true, passive: false });
+  }
   link("Tm0_C", "Tm0_C_range");
   link("batch_kg", "batch_kg_range");
   const changed = () => { if (state.tInput === null) state.tInput = performance.now(); whatif(); };
