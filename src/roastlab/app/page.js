@@ -39,6 +39,10 @@ function setFieldC(id, c) { $(id).value = c === null || c === undefined || c ===
 function unitLabels() { for (const e of document.querySelectorAll(".tunit")) e.textContent = unit(); }
 const narrow = () => $("plot").clientWidth < 900;  // the figure's legend wraps into more rows
 const phone = () => $("plot").clientWidth < 600;
+// A touch screen's finger (a tablet, a phone): a swipe over a figure scrolls the page, as everywhere
+// else on it, rather than zooming the curves (Plotly's default drag, which there trapped the page:
+// the curves fill most of the screen). The modebar's zoom and pan buttons still turn dragging on.
+const fingerDrag = () => (window.matchMedia("(pointer: coarse)").matches ? false : "zoom");
 function mmss(s) {
   if (s === null || s === undefined || !isFinite(s)) return "-";
   const n = Math.round(Math.abs(s));
@@ -244,6 +248,7 @@ function draw() {
     ...(twoScales() ? { yaxis4: { title: { text: `fan [${unitName("fan")}]`, font: { color: STEP_COLORS.fan } },
                                   overlaying: "y3", side: "right", showgrid: false, tickmode: "auto", nticks: 5 } } : {}),
     shapes: [...ph.shapes, ...ev.shapes, ...programShapes()], annotations: [...ph.notes, ...ev.notes], uirevision: "keep",
+    dragmode: fingerDrag(),
   }, { displaylogo: false, responsive: true }).then(() => {
     if (!state.hooked) { $("plot").on("plotly_relayout", onRelayout); state.hooked = true; }
     state.lastDrawMs = performance.now() - t0;
@@ -507,7 +512,7 @@ async function runTransfer() {
       { x, y: r.predicted.map(temp), name: "predicted BT with the program", line: { color: "#1f77b4" } },
       { x, y: r.program, name: `program: ${r.decide} [${shownUnit(r.unit)}]`, yaxis: "y2", line: { shape: "hv", color: "#d62728" } },
     ], {
-      margin: { t: 20, r: 60, l: 60, b: 40 }, legend: { orientation: "h", y: narrow() ? -0.3 : -0.2 },
+      margin: { t: 20, r: 60, l: 60, b: 40 }, legend: { orientation: "h", y: narrow() ? -0.3 : -0.2 }, dragmode: fingerDrag(),
       xaxis: { title: { text: "time after CHARGE [m:ss]" }, ...mmssTicks(x) }, yaxis: { title: { text: `BT [${unit()}]` } },
       yaxis2: { title: { text: `${r.decide} [${shownUnit(r.unit)}]` }, overlaying: "y", side: "right", showgrid: false,
                 range: [r.low - (r.step || (r.high - r.low) / 20), r.high + (r.step || (r.high - r.low) / 20)],
