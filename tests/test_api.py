@@ -436,6 +436,29 @@ def test_whatif_speaks_the_unit_the_log_was_recorded_in(cli, sky_model, tmp_path
     assert np.max(np.abs(read_alog(bg).channels["BT"] - w.changed.Ta_C)) <= 0.005
 
 
+def test_a_validation_figure_speaks_degf_on_every_scale(sky_model, tmp_path):
+    """plot_fit in degF (fit-roaster's held-out figure for a roaster logging in degF): BT, its rate of
+    rise on the right and the residual each on a degF scale, each panel's MAE in degF (9/5 of the degC
+    one), the curves the same degC numbers."""
+    from conftest import rewritten_alog
+    from roastlab.report.figures import plot_fit
+
+    model_path, log = sky_model
+    model = roastlab.load_model(model_path)
+    batch = roastlab.load_log(rewritten_alog(log, tmp_path / "in_F.alog", _in_fahrenheit), model.column_map)
+    result = model.validate([batch])
+    fig = plot_fit(result, units="F")
+    labels = [a.get_ylabel() for ax in fig.axes for a in (ax, *ax.child_axes)]
+    assert "BT [°F]" in labels and "RoR [°F/min]" in labels and "residual\nBT meas − pred [°F]" in labels
+    assert not any("°C" in text for text in labels)
+    title = next(ax.get_title() for ax in fig.axes if ax.get_title())
+    assert f"MAE {9 / 5 * result.rows[0]['MAE']:.2f} °F" in title
+    ror = next(a for ax in fig.axes for a in ax.child_axes if a.get_ylabel() == "RoR [°F/min]")
+    assert ror.get_yaxis().get_ticks_position() == "right"  # beside the RoR's curves, not over BT's scale
+    celsius = plot_fit(result)
+    assert "BT [°C]" in [ax.get_ylabel() for ax in celsius.axes] and not any(ax.child_axes for ax in celsius.axes)
+
+
 def test_transfer_speaks_the_unit_the_log_was_recorded_in(cli, sky_model, tmp_path):
     """transfer from a roast logged in degF: its summary's errors, tolerance and band in degF (9/5 of the
     degC ones, the same program), --units C back in degC; the program file is the same either way."""

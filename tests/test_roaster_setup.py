@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import roastlab
 from conftest import REAL_DATA, REPO, printed_percent
 from roastlab.errors import InputError
 from roastlab.workflows import roaster, survey
@@ -1447,7 +1448,8 @@ def test_a_roaster_logging_in_fahrenheit_gets_the_fit_it_gets_in_celsius(cli, tm
     """The same six Skywalker roasts as Artisan writes them in Fahrenheit mode: init writes the
     same map, plant and fit spec, and fit-roaster (the inlet air taken from the room each log
     records) the same held-out figures: the importer reads every temperature, the room among
-    them, in the profile's unit (the copies round to 1e-4 degF)."""
+    them, in the profile's unit (the copies round to 1e-4 degF). The roaster who logs in degF
+    reads the errors in degF, on the terminal and in the report; the model file is the same."""
     folder = REAL_DATA / "skywalker"
     if not folder.is_dir():
         pytest.skip("../shared/data/real is absent")
@@ -1464,13 +1466,18 @@ def test_a_roaster_logging_in_fahrenheit_gets_the_fit_it_gets_in_celsius(cli, tm
         code, out, err = cli("fit-roaster", tmp_path / f"cfg{unit}", *paths)
         assert code == 0, err
         held[unit] = printed_percent(out, "held out: FIT ")
-        mae[unit] = float(out.split("held out: FIT")[1].split("MAE ")[1].split(" °C")[0])
+        mae[unit] = float(out.split("held out: FIT")[1].split("MAE ")[1].split(f" °{unit}")[0])
+        report = (tmp_path / f"cfg{unit}" / "report.md").read_text()
+        assert (f"| model MAE °{unit} |" in report) and (("Temperatures in °F" in report) == (unit == "F"))
     for name in ("plant.toml", "fit.toml"):
         assert (tmp_path / "cfgC" / name).read_text() == (tmp_path / "cfgF" / name).read_text(), name
     assert 'name = "skywalker"' in (tmp_path / "cfgC" / "plant.toml").read_text()
     # the map names the files it was written from, the same names in both folders
     assert (tmp_path / "cfgC" / "map.toml").read_text() == (tmp_path / "cfgF" / "map.toml").read_text()
-    assert abs(held["C"] - held["F"]) < 0.2 and abs(mae["C"] - mae["F"]) < 0.05, (held, mae)
+    assert abs(held["C"] - held["F"]) < 0.2 and abs(9 / 5 * mae["C"] - mae["F"]) < 0.09, (held, mae)
+    # the model the same, in degC, whatever the report shows
+    theta = {u: roastlab.load_model(tmp_path / f"cfg{u}" / "model.json").theta for u in "CF"}
+    assert theta["F"].hbm == pytest.approx(theta["C"].hbm, rel=1e-3)
 
 
 def test_a_fit_on_one_batch_size_holds_the_probe_depth_the_spec_frees():

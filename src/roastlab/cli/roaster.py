@@ -54,6 +54,7 @@ def cmd_init(args) -> int:
 
 
 def cmd_fit_roaster(args) -> int:
+    from ..metrics.profile import display_temp_delta, temp_symbol
     from ..workflows.roaster import band_sentence, every_log_sentence, fit_roaster, grouped_notes
     from ..workflows.sizes import across_sizes_sentence
 
@@ -66,22 +67,28 @@ def cmd_fit_roaster(args) -> int:
         by_size=args.by_size,
         fit_size_kg=args.fit_size_kg,
         unit=args.unit,
+        units=args.units,
     )
-    f, h, b = r["fit"], r["held_out"], r["baseline_held_out"]
+    f, h, b, units = r["fit"], r["held_out"], r["baseline_held_out"], r["units"]
+    u = temp_symbol(units)
+
+    def dT(v: float) -> float:  # an error or a width in the report's unit
+        return display_temp_delta(v, units)
+
     for line in grouped_notes(r["notes"]):
         print(f"note: {line}", file=sys.stderr)
     for why in r["left_out"].values():
         print(f"left out: {why}")
     if r["refit"]:
         print(f"refitted: {r['refit']}")
-    print(f"fit set:  FIT {f['FIT']:.1f} %, MAE {f['MAE']:.2f} °C")
+    print(f"fit set:  FIT {f['FIT']:.1f} %, MAE {dT(f['MAE']):.2f} {u}")
     print(
-        f"held out: FIT {h['FIT']:.1f} %, MAE {h['MAE']:.2f} °C (first-order baseline: {b['FIT']:.1f} %, {b['MAE']:.2f} °C)"
+        f"held out: FIT {h['FIT']:.1f} %, MAE {dT(h['MAE']):.2f} {u} (first-order baseline: {b['FIT']:.1f} %, {dT(b['MAE']):.2f} {u})"
     )
     if r["below_baseline"]:
         print(f"verdict:  {r['below_baseline']}")
     if r["band"] is not None:
-        print(f"band:     {band_sentence(r['band'])}")
+        print(f"band:     {band_sentence(r['band'], units)}")
         if r["band"]["note"]:
             print(f"note: {r['band']['note']}")
     if r["held_out_by_unit"]:
@@ -94,7 +101,9 @@ def cmd_fit_roaster(args) -> int:
         )
     e = r["every_log"]
     if e:
-        print(f"each log held out once: {every_log_sentence(e['FIT'], e['band_inside'], e['band_median_width_C'])}")
+        print(
+            f"each log held out once: {every_log_sentence(e['FIT'], e['band_inside'], e['band_median_width_C'], units)}"
+        )
     a = r["across_sizes"]
     if a:
         print(f"across sizes: {across_sizes_sentence(a)}")
@@ -207,5 +216,11 @@ def add_parsers(sub) -> None:
         help="fit only the logs recorded by this roaster unit (its serial number, as 'init' lists them; RoasTime "
         "logs carry it): one drum's model, the other units' logs left out and said. Units of one make differ by more "
         "than a batch size does; without --unit, held-out logs of several units are also reported by unit",
+    )
+    p.add_argument(
+        "--units",
+        choices=("C", "F"),
+        help="the report's and the figures' temperatures in C or F (default: the unit the logs were recorded in; "
+        "a folder of both reads in C); model.json stays in degC",
     )
     p.set_defaults(func=cmd_fit_roaster)

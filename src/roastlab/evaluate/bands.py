@@ -292,9 +292,9 @@ def band_summary(band: Band, note: str | None = None) -> dict:
 def band_words(band: Band, what: str, units: str = "C") -> str:
     """A band in one line: its level, what it is the band of (``what``: "the changed probe BT"), its
     median width and BT at DROP between its bounds, in ``units`` ("C" or "F")."""
-    from ..metrics.profile import display_temp, display_temp_delta
+    from ..metrics.profile import display_temp, display_temp_delta, temp_symbol
 
-    u = "°F" if units == "F" else "°C"
+    u = temp_symbol(units)
     return (
         f"{band.level * 100:g} % prediction band of {what} (parameter covariance and roast-to-roast spread): "
         f"median width {display_temp_delta(band.median_width_C, units):.1f} {u}; BT at DROP "

@@ -128,6 +128,13 @@ class Batch:
         return self
 
 
+def logs_temp_unit(batches) -> str:
+    """The unit a set of logs was recorded in (:attr:`Batch.temp_unit`): "F" where every one of them
+    was recorded in degF, else "C" (a folder of logs in both units reads in degC)."""
+    units = {b.temp_unit for b in batches}
+    return "F" if units == {"F"} else "C"
+
+
 def recording_second(started_epoch_s) -> int | None:
     """The second a recording started, the key by which two logs are one roast (None: unknown)."""
     return round(started_epoch_s) if started_epoch_s else None

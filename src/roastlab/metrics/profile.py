@@ -264,6 +264,11 @@ def display_temp(temp_C: float, units: str = "C") -> float:
     return temp_C * 9.0 / 5.0 + 32.0 if units == "F" else temp_C
 
 
+def temp_symbol(units: str = "C") -> str:
+    """The display unit ("C" or "F") as written after a number: "°C" or "°F"."""
+    return "°F" if units == "F" else "°C"
+
+
 def display_temp_delta(delta_C: float, units: str = "C") -> float:
     """A temperature difference [K] in the display unit ("C" or "F")."""
     return delta_C * 9.0 / 5.0 if units == "F" else delta_C

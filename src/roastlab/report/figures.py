@@ -119,20 +119,25 @@ def ror_limits(ax, time_s, *curves) -> None:
         ax.set_ylim(min(0.0, bottom) - 2.0, max(top, 5.0) * 1.15 + 1.0)
 
 
-def temperature_axis(ax, label: str, units: str = "C", delta: bool = False) -> None:
+def temperature_axis(ax, label: str, units: str = "C", delta: bool = False, side: str = "left"):
     """Label ``ax``, whose curves are in degC, as ``label`` with ``{u}`` its unit; in "F" a Fahrenheit
     scale of its own (round degF ticks, :func:`~roastlab.metrics.profile.display_temp`) takes the
     place of the Celsius one, so every curve stays drawn from the same degC numbers. ``delta``: the
-    axis holds differences or rates (degC/min), which convert without the 32 degF offset."""
+    axis holds differences or rates (degC/min), which convert without the 32 degF offset. ``side``:
+    where the scale stands ("right" for a twin axis's, as a rate of rise's). Returns the axis that
+    carries the scale (``ax`` itself in degC), for its ticks' style."""
+    from ..metrics.profile import temp_symbol
+
     if units != "F":
-        ax.set_ylabel(label.format(u="°C"))
-        return
+        ax.set_ylabel(label.format(u=temp_symbol(units)))
+        return ax
     from ..metrics.profile import celsius_delta_of, celsius_of, display_temp, display_temp_delta
 
     there, back = (display_temp_delta, celsius_delta_of) if delta else (display_temp, celsius_of)
-    scale = ax.secondary_yaxis("left", functions=(lambda v: there(v, "F"), lambda v: back(v, "F")))
-    ax.tick_params(axis="y", left=False, labelleft=False)
-    scale.set_ylabel(label.format(u="°F"))
+    scale = ax.secondary_yaxis(side, functions=(lambda v: there(v, "F"), lambda v: back(v, "F")))
+    ax.tick_params(axis="y", **{side: False, f"label{side}": False})
+    scale.set_ylabel(label.format(u=temp_symbol(units)))
+    return scale
 
 
 def _shade_band(ax, band, color: str, what: str) -> None:
@@ -205,9 +210,10 @@ def plot_simulation(result, path=None, title=None, outputs=None, events=None):
     return finish_figure(fig, path, title, outputs)
 
 
-def plot_fit(result, path=None, title=None, max_panels: int = 8, outputs=None, bands=None):
+def plot_fit(result, path=None, title=None, max_panels: int = 8, outputs=None, bands=None, units: str = "C"):
     """Measured vs predicted BT per batch of a ValidationResult, each with its residual below;
-    ``bands`` (:func:`roastlab.evaluate.bands.prediction_bands`, one per batch) shaded."""
+    ``bands`` (:func:`roastlab.evaluate.bands.prediction_bands`, one per batch) shaded; the
+    temperatures' scales and each panel's MAE in ``units`` ("C" or "F"; the curves are degC)."""
     k = min(len(result.names), max_panels)
     cols = 2 if k > 1 else 1
     rows = (k + cols - 1) // cols
@@ -218,7 +224,7 @@ def plot_fit(result, path=None, title=None, max_panels: int = 8, outputs=None, b
         r, c = divmod(i, cols)
         ax = fig.add_subplot(grid[2 * r, c])
         res = fig.add_subplot(grid[2 * r + 1, c], sharex=ax)
-        _profile_panel(ax, result, i, legend=False)
+        _profile_panel(ax, result, i, legend=False, units=units)
         if bands is not None:
             _shade_band(ax, bands[i], "tab:green", "prediction band")
         t = result.time_s[i] / 60.0
@@ -231,7 +237,7 @@ def plot_fit(result, path=None, title=None, max_panels: int = 8, outputs=None, b
         )
         sim = result.results[i] if i < len(result.results) else None
         # named and drawn as the page and the what-if figure do: a curve, or the first-crack mark as a marker
-        reading = None if sim is None else second_bean_reading(_readings_of(sim))
+        reading = None if sim is None else second_bean_reading(_readings_of(sim), units)
         if reading is not None:  # the second bean reading and the model's Tb
             label, few = reading
             second = sim.Tb2_measured_C
@@ -240,13 +246,13 @@ def plot_fit(result, path=None, title=None, max_panels: int = 8, outputs=None, b
             ax.plot(t, second, color="tab:brown", label=label, **style)
             res.plot(t, second - sim.Tb_C, color="tab:brown", label="residual beans meas − model Tb (below)",
                      **({"ls": "none", "marker": "D", "ms": 5, "mfc": "none"} if few else {"ls": ":", "lw": 1}))  # fmt: skip
-        for h, text in zip(*_ror_overlay(ax, result.time_s[i], result.measured[i], result.predicted[i])):
+        for h, text in zip(*_ror_overlay(ax, result.time_s[i], result.measured[i], result.predicted[i], units)):
             entries.setdefault(text, h)  # every panel draws the same curves; a second bean reading on some
         if reading is not None:  # its residual beside BT's, which the axis names
             for h, text in zip(*res.get_legend_handles_labels()):
                 entries.setdefault(text, h)
         res.axhline(0.0, color="k", lw=0.6)
-        res.set_ylabel("residual\nBT meas − pred [°C]", fontsize=8)
+        temperature_axis(res, "residual\nBT meas − pred [{u}]", units, delta=True).yaxis.label.set_fontsize(8)
         time_axis(res)
         res.grid(alpha=0.3)
     if entries:
@@ -256,18 +262,19 @@ def plot_fit(result, path=None, title=None, max_panels: int = 8, outputs=None, b
     return finish_figure(fig, path, title, outputs)
 
 
-def _ror_overlay(ax, time_s, measured, predicted) -> tuple[list, list]:
+def _ror_overlay(ax, time_s, measured, predicted, units: str = "C") -> tuple[list, list]:
     """Measured and predicted rate of rise [degC/min] on a right-hand axis of a BT panel, as
-    Artisan draws it (the one RoR definition; the axis clipped past the charge drop). Returns the
-    handles and labels of both axes, for one legend."""
+    Artisan draws it (the one RoR definition; the axis clipped past the charge drop), its scale in
+    ``units``. Returns the handles and labels of both axes, for one legend."""
     ror = ax.twinx()
     t = np.asarray(time_s, dtype=float)
     ror.plot(t / 60.0, rate_of_rise_C_per_min(t, predicted), color="tab:blue", lw=1.0, alpha=0.8,
              label="RoR predicted")  # fmt: skip
     ror.plot(t / 60.0, rate_of_rise_C_per_min(t, measured), ":", color="tab:blue", lw=1.2, label="RoR measured")
     ror_limits(ror, t, measured, predicted)
-    ror.set_ylabel("RoR [°C/min]", color="tab:blue", fontsize=8)
-    ror.tick_params(axis="y", labelcolor="tab:blue", labelsize=8)
+    scale = temperature_axis(ror, "RoR [{u}/min]", units, delta=True, side="right")
+    scale.yaxis.label.set(color="tab:blue", fontsize=8)
+    scale.tick_params(axis="y", labelcolor="tab:blue", labelsize=8)
     # the BT axis drawn above the RoR axis, its curves over the RoR's
     handles, labels = ax.get_legend_handles_labels()
     more, more_labels = ror.get_legend_handles_labels()
@@ -276,13 +283,16 @@ def _ror_overlay(ax, time_s, measured, predicted) -> tuple[list, list]:
     return handles + more, labels + more_labels
 
 
-def _profile_panel(ax, result, i, label=None, legend: bool = True):
+def _profile_panel(ax, result, i, label=None, legend: bool = True, units: str = "C"):
+    from ..metrics.profile import display_temp_delta, temp_symbol
+
     t = result.time_s[i] / 60.0
     row = result.rows[i]
     ax.plot(t, result.predicted[i], color="tab:green", lw=2, label="BT predicted (model Ta)")
     ax.plot(t, result.measured[i], "--", color="tab:pink", lw=2, label="BT measured (Ta)")
-    ax.set_title(f"{label or result.names[i]}: FIT {row['FIT']:.1f} %, MAE {row['MAE']:.2f} °C", fontsize=10)
-    ax.set_ylabel("BT [°C]")
+    mae = f"{display_temp_delta(row['MAE'], units):.2f} {temp_symbol(units)}"
+    ax.set_title(f"{label or result.names[i]}: FIT {row['FIT']:.1f} %, MAE {mae}", fontsize=10)
+    temperature_axis(ax, "BT [{u}]", units)
     ax.grid(alpha=0.3)
     if legend:
         ax.legend(fontsize=8)

@@ -11,7 +11,9 @@ import re
 from collections import Counter
 from pathlib import Path
 
-from ..errors import InputError
+from ..errors import InputError, ParameterError
+from ..io.batch import logs_temp_unit
+from ..metrics.profile import display_temp_delta, temp_symbol
 from .survey import (
     INLET_NAMES,
     UNNAMED_UNIT,
@@ -145,14 +147,15 @@ def below_baseline(model_fit_pct: float, baseline_fit_pct: float, column_map) ->
     return text
 
 
-def band_sentence(band: dict) -> str:
-    """:func:`roastlab.evaluate.bands.held_out_band` in words: the share inside against the level and the width (its note apart)."""
+def band_sentence(band: dict, units: str = "C") -> str:
+    """:func:`roastlab.evaluate.bands.held_out_band` in words: the share inside against the level and the width (its note
+    apart), the width in ``units`` ("C" or "F")."""
     level = f"{100 * band['level']:.0f} %"
     return (
         f"{100 * band['inside_all']:.0f} % of the held-out logs' probe samples lie inside the {level} prediction "
         f"band ({'parameters and spread between roasts' if band.get('spread', True) else 'parameters only'}; "
         f"a calibrated band holds about {level}), median width "
-        f"{band['median_width_C']:.1f} °C"
+        f"{display_temp_delta(band['median_width_C'], units):.1f} {temp_symbol(units)}"
     )
 
 
@@ -166,6 +169,7 @@ def fit_roaster(
     by_size: bool = False,
     fit_size_kg: float | None = None,
     unit: str | None = None,
+    units: str | None = None,
 ) -> dict:
     """Fit, validate and report a roaster set up by :func:`init_roaster`.
 
@@ -194,6 +198,10 @@ def fit_roaster(
 
     ``unit``: fit only the logs of that roaster unit (its serial number; :func:`logs_of_unit`), the
     others left out and said in one line.
+
+    ``units``: "C" or "F", the report's temperatures and figures (default: the unit the logs were
+    recorded in, :func:`roastlab.io.batch.logs_temp_unit`); the model file, the fit's own sentences
+    and the returned figures (``*_C``, MAE) stay in degC.
     """
     from ..evaluate.bands import held_out_band
     from ..evaluate.metrics import average_metrics
@@ -241,6 +249,14 @@ def fit_roaster(
         order, by = sorted(range(len(paths)), key=lambda k: paths[k].name), "name"
     paths = [paths[k] for k in order]
     batches = [load_log(p, cmap) for p in paths]
+    units = units or logs_temp_unit(batches)
+    if units not in ("C", "F"):
+        raise ParameterError(f"units must be 'C' or 'F', got {units!r}")
+    u = temp_symbol(units)
+
+    def dT(v: float) -> float:  # an error or a width in the report's unit
+        return display_temp_delta(v, units)
+
     sizes = size_split(batches, fit_size_kg) if (by_size or fit_size_kg is not None) else None
     fit_b, val_b = batches[0::2], batches[1::2]
     spec, depth_held = depth_held_on_one_size(load_fit_spec(d / "fit.toml"), fit_b)
@@ -268,6 +284,15 @@ def fit_roaster(
         f"{len(batches)} logs sorted by {by}, split alternately: {len(fit_b)} fit, {len(val_b)} held out "
         f"(the fit never saw them). Fit in {result.identification.wall_s:.1f} s.",
         "",
+        *(
+            [
+                "Temperatures in °F, the unit the logs were recorded in; the model file and the fit's own sentences "
+                "below in °C.",
+                "",
+            ]
+            if units == "F"
+            else []
+        ),  # fmt: skip
         *(line for why in left_out.values() for line in (f"Left out: {why}.", "")),
         *([f"Refitted: {refit}.", ""] if refit else []),
         *([f"The fit {depth_held}.", ""] if depth_held else []),
@@ -281,10 +306,10 @@ def fit_roaster(
             if any(b.notes for b in batches)
             else []
         ),  # fmt: skip
-        "| set | logs | model FIT % | model MAE °C | baseline FIT % | baseline MAE °C |",
+        f"| set | logs | model FIT % | model MAE {u} | baseline FIT % | baseline MAE {u} |",
         "|---|---|---|---|---|---|",
-        f"| fit | {len(fit_b)} | {v_fit.average['FIT']:.1f} | {v_fit.average['MAE']:.2f} | {bf['FIT']:.1f} | {bf['MAE']:.2f} |",
-        f"| held out | {len(val_b)} | {v_val.average['FIT']:.1f} | {v_val.average['MAE']:.2f} | {bv['FIT']:.1f} | {bv['MAE']:.2f} |",
+        f"| fit | {len(fit_b)} | {v_fit.average['FIT']:.1f} | {dT(v_fit.average['MAE']):.2f} | {bf['FIT']:.1f} | {dT(bf['MAE']):.2f} |",
+        f"| held out | {len(val_b)} | {v_val.average['FIT']:.1f} | {dT(v_val.average['MAE']):.2f} | {bv['FIT']:.1f} | {dT(bv['MAE']):.2f} |",
         "",
         f"Baseline: the first-order lag fed the same inputs ({describe(base)}).",
         "",
@@ -307,19 +332,19 @@ def fit_roaster(
         "",
     ]
     if band is None:
-        lines += ["| held-out log | FIT % | MAE °C |", "|---|---|---|"]
-        lines += [f"| {n} | {r['FIT']:.1f} | {r['MAE']:.2f} |" for n, r in zip(v_val.names, v_val.rows)]
+        lines += [f"| held-out log | FIT % | MAE {u} |", "|---|---|---|"]
+        lines += [f"| {n} | {r['FIT']:.1f} | {dT(r['MAE']):.2f} |" for n, r in zip(v_val.names, v_val.rows)]
     else:
         level = f"{100 * band['level']:.0f} %"
         lines += [
-            f"| held-out log | FIT % | MAE °C | inside the {level} band | its median width °C |",
+            f"| held-out log | FIT % | MAE {u} | inside the {level} band | its median width {u} |",
             "|---|---|---|---|---|",
         ]
         lines += [
-            f"| {n} | {r['FIT']:.1f} | {r['MAE']:.2f} | {100 * b['inside']:.0f} % | {b['median_width_C']:.1f} |"
+            f"| {n} | {r['FIT']:.1f} | {dT(r['MAE']):.2f} | {100 * b['inside']:.0f} % | {dT(b['median_width_C']):.1f} |"
             for n, r, b in zip(v_val.names, v_val.rows, band["batches"])
         ]
-        lines += ["", f"{band_sentence(band)}." + (f" Note: {band['note']}." if band["note"] else "")]
+        lines += ["", f"{band_sentence(band, units)}." + (f" Note: {band['note']}." if band["note"] else "")]
         if band["by_size"]:
             lines += ["", "| batch size | held-out logs | inside the band |", "|---|---|---|"]
             lines += [f"| {g['size']} | {g['logs']} | {100 * g['inside']:.0f} % |" for g in band["by_size"]]
@@ -329,11 +354,11 @@ def fit_roaster(
             "",
             "Held out by roaster unit (the serial number the logs record; one fit treats the units as one drum):",
             "",
-            "| unit | held-out logs | FIT % | MAE °C | inside the band |",
+            f"| unit | held-out logs | FIT % | MAE {u} | inside the band |",
             "|---|---|---|---|---|",
         ]
         lines += [
-            f"| {g['unit']} | {g['logs']} | {g['FIT']:.1f} | {g['MAE']:.2f} | "
+            f"| {g['unit']} | {g['logs']} | {g['FIT']:.1f} | {dT(g['MAE']):.2f} | "
             + ("-" if g["inside"] is None else f"{100 * g['inside']:.0f} %")
             + " |"
             for g in by_unit
@@ -342,7 +367,7 @@ def fit_roaster(
         stage(0, 0, f"each log held out once: {len(batches)} fits")
     every = held_out_one_by_one(batches, d, cmap, seed, progress, spec) if every_log else None
     if every is not None:
-        lines += every_log_lines(every, len(batches))
+        lines += every_log_lines(every, len(batches), units)
     across = None
     if sizes is not None:
         size_b = [batches[k] for k in sizes.fit]
@@ -351,7 +376,7 @@ def fit_roaster(
         size_fit, _, size_refit = fit_checked(size_b, d, size_spec, cmap, seed, progress)
         across = across_sizes(size_fit.model, batches, sizes)
         across["failed"], across["refit"] = size_fit.failed, size_refit
-        lines += across_sizes_lines(across, SIZES_FIGURE)
+        lines += across_sizes_lines(across, SIZES_FIGURE, units)
         if size_depth:
             lines += ["", f"The fit on {sizes.fit_size} alone {size_depth}."]
         if size_refit:
@@ -362,7 +387,7 @@ def fit_roaster(
     from ..report.markdown import html_document
 
     stage(0, 0, "writing the report and its figures")
-    figures = {d / HELD_OUT_FIGURE: plot_fit(v_val, bands=bands)}
+    figures = {d / HELD_OUT_FIGURE: plot_fit(v_val, bands=bands, units=units)}
     if across is not None:
         figures[d / SIZES_FIGURE] = across_sizes_figure(across)
     pngs = {path: figure_bytes(fig, path) for path, fig in figures.items()}
@@ -385,6 +410,7 @@ def fit_roaster(
         "refit": refit,
         "notes": {p.name: list(b.notes) for p, b in zip(paths, batches) if b.notes},
         "band": band,
+        "units": units,
         "held_out_by_unit": by_unit,
         "every_log": every
         and {
@@ -475,8 +501,9 @@ def held_out_one_by_one(batches, config_dir: Path, column_map, seed: int, progre
     ).scores[0]
 
 
-def every_log_lines(score, n_logs: int) -> list[str]:
-    """The report's section on every log held out once (:func:`held_out_one_by_one`)."""
+def every_log_lines(score, n_logs: int, units: str = "C") -> list[str]:
+    """The report's section on every log held out once (:func:`held_out_one_by_one`), its band's width
+    in ``units``."""
     from ..evaluate.bands import BAND_LEVEL
 
     level = f"{100 * BAND_LEVEL:.0f} %"
@@ -497,18 +524,19 @@ def every_log_lines(score, n_logs: int) -> list[str]:
         lines.append(f"| {name} | {fit_pct:.1f} |{band}")
     lines += [
         "",
-        f"Every log held out once: {every_log_sentence(score.cv_FIT, score.cv_band_inside, score.cv_band_width_C)}"
+        f"Every log held out once: {every_log_sentence(score.cv_FIT, score.cv_band_inside, score.cv_band_width_C, units)}"
         + (f"; an honest band holds about {level}." if has_band else "."),
     ]
     return lines
 
 
-def every_log_sentence(fit_pct: float, band_inside: float, band_width_C: float) -> str:
-    """Every log held out once, in one clause: the report's and the terminal's (:func:`held_out_one_by_one`)."""
+def every_log_sentence(fit_pct: float, band_inside: float, band_width_C: float, units: str = "C") -> str:
+    """Every log held out once, in one clause: the report's and the terminal's (:func:`held_out_one_by_one`), the
+    band's width in ``units``."""
     text = f"FIT {fit_pct:.1f} % on average"
     if math.isfinite(band_inside):
         text += (
             f", {100 * band_inside:.0f} % of the samples inside the band of the fit without their log "
-            f"(median width {band_width_C:.1f} °C)"
+            f"(median width {display_temp_delta(band_width_C, units):.1f} {temp_symbol(units)})"
         )
     return text

@@ -188,8 +188,10 @@ def across_sizes_sentence(res: dict) -> str:
     return text
 
 
-def across_sizes_lines(res: dict, figure_name: str) -> list[str]:
-    """The report's section (Markdown lines)."""
+def across_sizes_lines(res: dict, figure_name: str, units: str = "C") -> list[str]:
+    """The report's section (Markdown lines), its MAE in ``units`` ("C" or "F")."""
+    from ..metrics.profile import display_temp_delta, temp_symbol
+
     level = f"{100 * res['band_level']:.0f} %"
     has_band = math.isfinite(res["reference"]["inside"])
     has_beans = any(math.isfinite(r["FIT_beans"]) for r in res["rows"])
@@ -200,7 +202,8 @@ def across_sizes_lines(res: dict, figure_name: str) -> list[str]:
 
     def cells(s: dict) -> str:
         band = f" {100 * s['inside']:.0f} % |" if has_band else ""
-        return f" {s['logs']} | {s['FIT']:.1f} | {s['MAE']:.2f} | {s['MPE']:+.2f} |{band}{beans(s['FIT_beans'])}"
+        mae = display_temp_delta(s["MAE"], units)
+        return f" {s['logs']} | {s['FIT']:.1f} | {mae:.2f} | {s['MPE']:+.2f} |{band}{beans(s['FIT_beans'])}"
 
     ref = res["reference"]
     lines = [
@@ -221,7 +224,7 @@ def across_sizes_lines(res: dict, figure_name: str) -> list[str]:
             else ""
         ),
         "",
-        f"| batch size | logs | FIT % | MAE °C | signed error % |{f' inside the {level} band |' if has_band else ''}"
+        f"| batch size | logs | FIT % | MAE {temp_symbol(units)} | signed error % |{f' inside the {level} band |' if has_band else ''}"
         f"{' beans vs the second reading, FIT % |' if has_beans else ''} gap to the held-out fit size, FIT points |",
         f"|---|---|---|---|---|{'---|' if has_band else ''}{'---|' if has_beans else ''}---|",
         f"| {res['fit_size']}, held out |{cells(ref)} |",

@@ -93,10 +93,10 @@ class TransferResult(Result):
 
     # ------------------------------------------------------------------ text outputs
     def summary(self) -> str:
-        from ..metrics.profile import display_temp, display_temp_delta
+        from ..metrics.profile import display_temp, display_temp_delta, temp_symbol
 
         m, units = self.metrics, self.units
-        u = f"°{units}"
+        u = temp_symbol(units)
 
         def d(v):  # an error or a tolerance in the summary's unit
             return display_temp_delta(v, units)
@@ -689,7 +689,7 @@ def _explain(t, e, spans, tol, plant, mass, feasible, units: str = "C") -> list[
     in the direction of the miss (below the target: a ceiling or a rising rate; above it: a
     floor or a falling rate), so an explanation never contradicts the error it explains; the
     misses in ``units`` ("C" or "F")."""
-    from ..metrics.profile import display_temp_delta
+    from ..metrics.profile import display_temp_delta, temp_symbol
 
     out = []
     bad = np.abs(e) > tol
@@ -710,5 +710,7 @@ def _explain(t, e, spans, tol, plant, mass, feasible, units: str = "C") -> list[
         else:
             why = "no limit holds the program back here: the model cannot follow the target's shape"
         miss = display_temp_delta(abs(e[worst]), units)
-        out.append(f"{mmss(t[i])}-{mmss(t[j])}: predicted BT up to {miss:.1f} °{units} {side} the target; {why}")
+        out.append(
+            f"{mmss(t[i])}-{mmss(t[j])}: predicted BT up to {miss:.1f} {temp_symbol(units)} {side} the target; {why}"
+        )
     return out

@@ -29,6 +29,7 @@ from ..metrics.profile import (  # noqa: F401  (re-exported)
     milestone_levels,
     milestones,
     mmss,
+    temp_symbol,
 )
 from ..model.actuators import SETTING_GAINS, inert_settings
 from ..report.result import Result, draw_curves
@@ -210,7 +211,7 @@ class WhatIf(Result):
 
     def table(self, units: str = "C") -> str:
         """The milestone table as text; ``units`` "C" or "F" for temperatures."""
-        u = "°F" if units == "F" else "°C"
+        u = temp_symbol(units)
         lines = [f"what if ({'; '.join(self.changes) or 'no change'}) on {self.batch.name}"]
         lines.append("judged on the beans (the model's bean temperature); the probe BT, what the roaster sees, below")
         head = f"{'':40s}{'measured':>10s}{'as run':>10s}{'changed':>10s}{'change':>10s}{'model err':>11s}"
