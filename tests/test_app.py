@@ -655,13 +655,17 @@ def test_a_model_is_fitted_on_the_page_in_the_background(client, data_dir):
     opened = client.post("/api/open", json={"log": logs[0], "model": st["model"]}, headers=H).json()
     assert opened["report_html"] == html
     assert st["verdict"] is None and "Not usable" not in st["report"]  # it beats the first-order baseline
-    # the page's "also hold each log out once": fit-roaster --every-log behind it
-    assert client.post("/api/fit", json={"logs": logs, "name": "sky", "every_log": True}, headers=H).json()["started"]
+    assert "| model MAE °C |" in st["report"]  # °C logs, no unit asked: the logs' own
+    # the page's "also hold each log out once": fit-roaster --every-log behind it, the report in the
+    # page's unit (°F chosen on the page)
+    body = {"logs": logs, "name": "sky", "every_log": True, "units": "F"}
+    assert client.post("/api/fit", json=body, headers=H).json()["started"]
     deadline = time.monotonic() + 300
     while (st := client.get("/api/fit-status", headers=H).json()).get("running") and time.monotonic() < deadline:
         time.sleep(0.2)
     assert "error" not in st, st
     assert "## Every log held out once" in st["report"] and -100 < st["every_log"]["FIT"] <= 100
+    assert "| model MAE °F |" in st["report"] and "Temperatures in °F" in st["report"]
     # the page's "also predict other batch sizes": fit-roaster --by-size behind it; four logs of one size
     # (150-152 g) cannot, and the page says why
     one_size = ["roast_25-09-27_1236_R14", "roast_25-10-04_1155", "roast_25-10-04_1229", "roast_25-10-25_1544"]

@@ -450,6 +450,7 @@ async function runFit() {
   try {
     await api("/api/fit", {
       logs, name: $("fit_name").value, every_log: $("fit_every_log").checked, by_size: $("fit_by_size").checked,
+      units: $("units").value,  // the report in the page's unit
     });
     const poll = async () => {
       const st = await api("/api/fit-status");
@@ -459,7 +460,7 @@ async function runFit() {
       if (st.running) { setTimeout(poll, 300); return; }
       if (st.error) { say(st.error); return; }
       showReport(st.report_html);
-      $("fit_text").textContent = `held out: FIT ${st.held_out.FIT.toFixed(1)} %, MAE ${st.held_out.MAE.toFixed(2)} °C` +
+      $("fit_text").textContent = `held out: FIT ${st.held_out.FIT.toFixed(1)} %, MAE ${dtemp(st.held_out.MAE).toFixed(2)} ${unit()}` +
         (st.every_log ? `; each log held out once: FIT ${st.every_log.FIT.toFixed(1)} %` : "") +
         (st.across_sizes ? `; across sizes: ${st.across_sizes}` : "");
       if (st.verdict) say(`not usable: ${st.verdict}`);

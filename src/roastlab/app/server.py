@@ -519,6 +519,7 @@ def create_app(data_dir: str | Path):
                     progress=progress,
                     every_log=bool(body.get("every_log")),
                     by_size=bool(body.get("by_size")),
+                    units=body.get("units") if body.get("units") in ("C", "F") else None,  # the page's, else the logs
                 )
                 session.fit.update(
                     running=False,
