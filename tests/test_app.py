@@ -187,6 +187,46 @@ def test_the_page_transfers_another_logs_curve_with_the_programs_band(client, da
     assert out.status_code == 400 and "data folder" in out.json()["error"]
 
 
+def test_a_port_in_use_is_one_line_and_port_0_serves_on_a_free_one(cli, tmp_path):
+    """roastlab app on a port another program holds: one line saying so and how to choose, exit 2,
+    and no URL printed for a page that is not there. --port 0 takes a free port, prints it and
+    serves the page there (127.0.0.1 only)."""
+    import subprocess
+    import sys
+
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        code, out, err = cli("app", "--data-dir", tmp_path, "--port", port, "--no-browser")
+    assert code == 2 and f"port {port} on 127.0.0.1 is in use" in err and "--port 0" in err
+    assert len(err.strip().splitlines()) == 1 and "http://" not in err
+    code, _, err = cli("app", "--data-dir", tmp_path, "--host", "no-such-host.invalid", "--no-browser")
+    assert code == 2 and "not an address of this machine" in err and len(err.strip().splitlines()) == 1
+    cmd = [sys.executable, "-m", "roastlab", "app", "--data-dir", str(tmp_path), "--port", "0", "--no-browser"]
+    proc = subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True)
+    try:
+        line = proc.stderr.readline()
+        url = line.split()[2]
+        assert url.startswith("http://127.0.0.1:") and not url.endswith(":0/"), line
+        import urllib.request
+
+        deadline = time.monotonic() + 20
+        while True:
+            try:
+                with urllib.request.urlopen(url, timeout=5) as page:
+                    assert page.status == 200 and b"roastlab" in page.read()
+                break
+            except OSError:
+                if time.monotonic() > deadline:
+                    raise
+                time.sleep(0.1)
+    finally:
+        proc.terminate()
+        proc.wait(timeout=10)
+        proc.stderr.close()
+
+
 def test_tabs_do_not_share_state(client):
     client.post("/api/open", json={"log": "batch1.csv", "model": "paper-model.json"}, headers=H)
     other = client.post("/api/whatif", json={"tgi": 10}, headers={"X-Session": "test-session-b"}).json()
