@@ -423,7 +423,7 @@ def test_a_program_step_dragged_with_the_mouse_changes_the_prediction(page, data
 def test_a_program_step_dragged_with_a_finger_changes_the_prediction(browser, server):
     """On a tablet a finger lands a few pixels off a 5-px step: it still takes the step, moves it three
     levels down (snapped to the machine's steps) with the prediction following, and the page does not
-    scroll under it. A swipe away from every step leaves the program alone and scrolls the page (Plotly's
+    scroll under it; sideways, it moves the step along time. A swipe away from every step leaves the program alone and scrolls the page (Plotly's
     default drag zoomed the curves instead, so the page could not be scrolled from them)."""
     if not (REAL_DATA / "bullet").is_dir():
         pytest.skip("../shared/data/real is absent")
@@ -435,13 +435,12 @@ def test_a_program_step_dragged_with_a_finger_changes_the_prediction(browser, se
         spot = _longest_heater_step(page)
         cdp = context.new_cdp_session(page)
 
-        def swipe(x, y0, y1):
+        def swipe(x, y0, y1, x1=None):
+            x1 = x if x1 is None else x1
             cdp.send("Input.dispatchTouchEvent", {"type": "touchStart", "touchPoints": [{"x": x, "y": y0}]})
             for i in range(1, 11):
-                cdp.send(
-                    "Input.dispatchTouchEvent",
-                    {"type": "touchMove", "touchPoints": [{"x": x, "y": y0 + (y1 - y0) * i / 10}]},
-                )
+                point = {"x": x + (x1 - x) * i / 10, "y": y0 + (y1 - y0) * i / 10}
+                cdp.send("Input.dispatchTouchEvent", {"type": "touchMove", "touchPoints": [point]})
             cdp.send("Input.dispatchTouchEvent", {"type": "touchEnd", "touchPoints": []})
 
         program = page.evaluate("JSON.stringify(state.program)")
@@ -469,6 +468,22 @@ def test_a_program_step_dragged_with_a_finger_changes_the_prediction(browser, se
         heater = np.array(_traces(page)["heater [steps]"], dtype=float)
         t = np.array(page.evaluate("state.open.curves.time_s"), dtype=float)
         assert np.all(heater[(t >= step["from_s"]) & (t < step["until_s"])] == step["value"])
+        # sideways (a little off the line again): the step starts later by as much as the finger moved, on
+        # the 5-s grid, as long as it was and at its level
+        updates = page.evaluate("Number(document.body.dataset.updates || 0)")
+        minutes = page.evaluate(
+            "(() => { const xa = document.getElementById('plot')._fullLayout.xaxis; return xa.p2l(60) - xa.p2l(0); })()"
+        )
+        swipe(spot["x"], spot["y_to"] - miss, spot["y_to"] - miss + 3, spot["x"] + 60)
+        page.wait_for_function(f"Number(document.body.dataset.updates || 0) > {updates}")
+        page.wait_for_function("!state.busy && !state.pending")
+        moved = page.evaluate(f"state.program.heater[{k}]")
+        assert moved["from_s"] == round((step["from_s"] / 60 + minutes) * 60 / 5) * 5 > step["from_s"]
+        assert (
+            moved["until_s"] - moved["from_s"] == step["until_s"] - step["from_s"] and moved["value"] == step["value"]
+        )
+        heater = np.array(_traces(page)["heater [steps]"], dtype=float)
+        assert np.all(heater[(t >= moved["from_s"]) & (t < moved["until_s"])] == step["value"])
     finally:
         context.close()
 

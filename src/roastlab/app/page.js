@@ -109,6 +109,13 @@ function snap(name, v) {
   return a.step ? a.low + Math.round((v - a.low) / a.step) * a.step : Math.round(v * 10) / 10;
 }
 
+// A step moved along time starts at ``minutes`` (on a 5-s grid, not before CHARGE) and keeps its length.
+function startAt(st, minutes) {
+  const len = st.until_s - st.from_s;
+  st.from_s = Math.max(0, Math.round(minutes * 60 / 5) * 5);
+  st.until_s = st.from_s + len;
+}
+
 function onRelayout(ev) {  // a program step was dragged: its new level (and start, if moved along time)
   const moved = {};
   for (const [key, v] of Object.entries(ev || {})) {
@@ -124,22 +131,19 @@ function onRelayout(ev) {  // a program step was dragged: its new level (and sta
     const st = state.program[name][Number(k)];
     const y = m.y0 !== undefined && m.y1 !== undefined ? (m.y0 + m.y1) / 2 : (m.y0 ?? m.y1);
     if (y !== undefined) st.value = snap(name, y);
-    if (m.x0 !== undefined && m.x1 !== undefined) {  // moved along time: the step starts and ends elsewhere
-      const len = st.until_s - st.from_s;
-      st.from_s = Math.max(0, Math.round(m.x0 * 60 / 5) * 5);
-      st.until_s = st.from_s + len;
-    }
+    if (m.x0 !== undefined && m.x1 !== undefined) startAt(st, m.x0);  // moved along time
     changed = true;
   }
   if (changed) { state.tInput = performance.now(); whatif(); }
 }
 
 // A finger on a tablet: Plotly drags an editable shape only from the 5-7 px line itself, which a
-// fingertip misses (4 px off already did). A touch within FINGER_PX of a step takes it instead: the
-// step moves up and down as far as the finger does (its level, snapped to the machine's steps), the
-// prediction follows it, and the page does not scroll meanwhile. A touch anywhere else scrolls and
-// pans as before. Moving a step along time stays the mouse's (or the heater and fan fields').
-const FINGER_PX = 24;
+// fingertip misses (4 px off already did). A touch within FINGER_PX of a step takes it instead, and
+// the page does not scroll meanwhile; a touch anywhere else scrolls and pans as before. The finger's
+// first LOCK_PX of travel says which way it moves the step, as the mouse does either: up and down
+// its level (snapped to the machine's steps), sideways its start (and end) along time. The prediction
+// follows as it moves.
+const FINGER_PX = 24, LOCK_PX = 8;
 function stepNear(touch) {
   const gd = $("plot"), fl = gd._fullLayout;
   if (!state.open || !fl || !fl.xaxis) return null;
@@ -152,7 +156,9 @@ function stepNear(touch) {
     steps.forEach((st, k) => {
       const inside = px >= xa.l2p(st.from_s / 60) - 4 && px <= xa.l2p(st.until_s / 60) + 4;
       const d = Math.abs(py - ya.l2p(st.value));
-      if (inside && d <= FINGER_PX && (!best || d < best.d)) best = { name, k, axis, d, y0: touch.clientY, from: st.value };
+      if (inside && d <= FINGER_PX && (!best || d < best.d)) {
+        best = { name, k, axis, d, x0: touch.clientX, y0: touch.clientY, level: st.value, start: st.from_s / 60, way: null };
+      }
     });
   }
   return best;
@@ -165,10 +171,19 @@ function onStepTouch(ev) {
   ev.stopPropagation();
   if (ev.type === "touchend" || ev.type === "touchcancel") { state.touchStep = null; return; }
   if (ev.type !== "touchmove") return;
-  const ya = $("plot")._fullLayout[hit.axis], st = state.program[hit.name][hit.k];
-  const v = snap(hit.name, hit.from + ya.p2l(ev.touches[0].clientY) - ya.p2l(hit.y0));  // by as much as the finger moved
-  if (v !== st.value) {
-    st.value = v;
+  const fl = $("plot")._fullLayout, st = state.program[hit.name][hit.k], touch = ev.touches[0];
+  const dx = touch.clientX - hit.x0, dy = touch.clientY - hit.y0;
+  if (!hit.way) {
+    if (Math.hypot(dx, dy) < LOCK_PX) return;
+    hit.way = Math.abs(dx) > Math.abs(dy) ? "time" : "level";
+  }
+  const was = [st.value, st.from_s];
+  if (hit.way === "level") {  // by as much as the finger moved, on the step's own scale
+    st.value = snap(hit.name, hit.level + fl[hit.axis].p2l(touch.clientY) - fl[hit.axis].p2l(hit.y0));
+  } else {
+    startAt(st, hit.start + fl.xaxis.p2l(touch.clientX) - fl.xaxis.p2l(hit.x0));
+  }
+  if (st.value !== was[0] || st.from_s !== was[1]) {
     if (state.tInput === null) state.tInput = performance.now();
     whatif();
   }
