@@ -41,9 +41,11 @@ def _bound_socket(host: str, port: int):
     import socket
 
     try:
-        family, kind, proto, _, address = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)[0]
+        found = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)
     except (socket.gaierror, UnicodeError) as exc:
         raise InputError(f"--host {host}: not an address of this machine ({exc})", "command line") from None
+    # a name with both (localhost): its IPv4 address, as uvicorn takes it
+    family, kind, proto, _, address = next((a for a in found if a[0] == socket.AF_INET), found[0])
     sock = socket.socket(family, kind, proto)
     sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)  # as uvicorn: a restart need not wait out TIME_WAIT
     try:
