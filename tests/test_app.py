@@ -547,7 +547,8 @@ def test_the_page_saves_the_what_if_as_an_artisan_background(page, tmp_path):
 def test_the_page_fits_a_tablet_beside_the_roaster(browser, server):
     """At a tablet's width (820 px, portrait) the page fits the screen, and at a phone's (390 px): nothing runs off its right edge,
     the curves take the screen's width under the what-if's controls, the legend lies below the time axis's title,
-    and on a wider screen (a window made wider) the figure follows the new width."""
+    and on a wider screen (a window made wider) the figure follows the new width; made narrower, its time
+    axis's ticks and the phases' names are chosen again, none running into another."""
     context = browser.new_context(viewport={"width": 820, "height": 1180})
     page = context.new_page()
     try:
@@ -581,9 +582,34 @@ def test_the_page_fits_a_tablet_beside_the_roaster(browser, server):
             "Math.abs(document.querySelector('#plot .main-svg').getBoundingClientRect().width"
             f" - document.getElementById('plot').clientWidth) < 2 && document.getElementById('plot').clientWidth > {width + 100}"
         )
-        # a phone: still nothing off the right edge (a fieldset's and a grid column's own minimum widths)
+        ticks = "JSON.stringify(document.getElementById('plot')._fullLayout.xaxis.tickvals)"
+        assert json.loads(page.evaluate(ticks))[:3] == [0, 1, 2]  # a tick a minute where there is room
+        # a phone: still nothing off the right edge (a fieldset's and a grid column's own minimum widths);
+        # the page chooses its time axis's ticks again for the narrower figure (they ran into each other
+        # and Plotly turned them on end), and the phases' names shrink to what their bands hold
         page.set_viewport_size({"width": 390, "height": 844})
         page.wait_for_function("document.documentElement.scrollWidth <= 390")
+        page.wait_for_function(f"JSON.parse({ticks})[1] > 1")
+
+        def apart(selector):  # the boxes of the texts ``selector`` finds, none over another
+            boxes = page.evaluate(
+                f"Array.from(document.querySelectorAll('{selector}')).map((e) => {{ const r = e.getBoundingClientRect(); return [r.left, r.right, r.top, r.bottom]; }})"
+            )
+            boxes = [b for b in boxes if b[1] > b[0]]
+            over = [
+                (a, b)
+                for i, a in enumerate(boxes)
+                for b in boxes[i + 1 :]
+                if a[0] < b[1] and b[0] < a[1] and a[2] < b[3] and b[2] < a[3]
+            ]
+            return len(boxes) > 1 and not over
+
+        assert apart("#plot .xtick text")
+        if (REAL_DATA / "bullet").is_dir():  # a real log's phases: drying, Maillard, development
+            _open(page, "logs/bullet-500g.json", "bullet-model.json")
+            page.wait_for_function(f"JSON.parse({ticks})[1] > 1")
+            page.wait_for_timeout(400)  # past the resize's redraw (150 ms after the last resize)
+            assert apart("#plot .xtick text") and apart("#plot .annotation-text-g text")
     finally:
         context.close()
 

@@ -49,21 +49,29 @@ function mmss(s) {
   return `${s < 0 ? "-" : ""}${Math.floor(n / 60)}:${String(n % 60).padStart(2, "0")}`;
 }
 const minutes = (ts) => ts.map((t) => t / 60);
-function mmssTicks(x) {  // the roaster's time axis: a tick a minute, written m:ss
+// Pixels a minute of a figure's time axis takes: its box less the margins the figures keep (60 px a side).
+const pxPerMinute = (id, x) => Math.max(1, $(id).clientWidth - 120) / Math.max(1e-9, Math.max(...x) - Math.min(0, ...x));
+function mmssTicks(x, pxMin) {  // the roaster's time axis written m:ss: a tick a minute, or every 2 or 5 on a phone
   const last = Math.ceil(Math.max(...x));
-  const vals = Array.from({ length: last + 1 }, (_, i) => i);
+  const every = [1, 2, 5, 10].find((k) => k * pxMin >= 40) || 10;  // "10:00" takes about 35 px
+  const vals = Array.from({ length: Math.floor(last / every) + 1 }, (_, i) => i * every);
   return { tickvals: vals, ticktext: vals.map((m) => `${m}:00`) };
 }
 
 const PHASE_COLORS = { drying: "rgba(255, 214, 102, 0.18)", Maillard: "rgba(214, 140, 69, 0.16)", development: "rgba(140, 80, 40, 0.16)" };
 
-function phaseShapes(phases) {  // Artisan's phase bands: drying, Maillard, development (from the log's marks)
+// Artisan's phase bands: drying, Maillard, development (from the log's marks), each named with its
+// length where its band is wide enough for the words (about 6 px a letter at 10 px), else its length
+// alone, else nothing: on a phone the names ran into each other.
+function phaseShapes(phases, pxMin) {
   const shapes = [], notes = [];
   for (const p of phases || []) {
     shapes.push({ type: "rect", xref: "x", yref: "paper", x0: p.from_s / 60, x1: p.to_s / 60, y0: 0.42, y1: 1,
                   fillcolor: PHASE_COLORS[p.name] || "rgba(0,0,0,0.05)", line: { width: 0 }, layer: "below" });
-    notes.push({ xref: "x", yref: "paper", x: (p.from_s + p.to_s) / 120, y: 0.43, text: `${p.name} ${mmss(p.to_s - p.from_s)}`,
-                 showarrow: false, font: { size: 10, color: "#7a5a3a" } });
+    const width = (p.to_s - p.from_s) / 60 * pxMin, length = mmss(p.to_s - p.from_s);
+    const text = [`${p.name} ${length}`, length].find((words) => 6 * words.length + 6 <= width);
+    if (text) notes.push({ xref: "x", yref: "paper", x: (p.from_s + p.to_s) / 120, y: 0.43, text,
+                           showarrow: false, font: { size: 10, color: "#7a5a3a" } });
   }
   return { shapes, notes };
 }
@@ -199,15 +207,18 @@ function programBody() {  // the dragged steps as "set" changes (applied in orde
   return out;
 }
 
+// The log's marks (CHARGE, DRY, FCs, DROP) as dotted lines, named in time order in three staggered
+// rows a line of 10-px text apart: in pixels, as a share of the figure's height they ran into each
+// other on a phone, where the legend takes half of it.
 function eventShapes(events) {
   const shapes = [], notes = [];
-  let i = 0;
-  for (const [name, t] of Object.entries(events || {})) {
+  const marks = Object.entries(events || {}).sort((a, b) => a[1] - b[1]);
+  marks.forEach(([name, t], i) => {
     shapes.push({ type: "line", xref: "x", yref: "paper", x0: t / 60, x1: t / 60, y0: 0.42, y1: 1,
                   line: { color: "#999", width: 1, dash: "dot" } });
-    notes.push({ xref: "x", yref: "paper", x: t / 60, y: 1 - 0.04 * (i++ % 3), text: `${name} ${mmss(t)}`,
+    notes.push({ xref: "x", yref: "paper", x: t / 60, y: 1, yanchor: "top", yshift: -13 * (i % 3), text: `${name} ${mmss(t)}`,
                  showarrow: false, xanchor: "left", font: { size: 10, color: "#555" } });
-  }
+  });
   return { shapes, notes };
 }
 
@@ -246,14 +257,15 @@ function draw() {
   traces.push({ x, y: ch.RoR_model.map(dtemp), name: "RoR model, changed", yaxis: "y2", line: { color: "#ff7f0e", width: 1 } });
   if (ch.heater) traces.push({ x, y: ch.heater, name: `heater [${unitName("heater")}]`, yaxis: "y3", line: { shape: "hv", color: "#d62728" } });
   if (ch.fan) traces.push({ x, y: ch.fan, name: `fan [${unitName("fan")}]`, yaxis: settingAxis("fan"), line: { shape: "hv", color: "#2ca02c" } });
-  const ev = eventShapes(o.events), ph = phaseShapes(o.phases);
+  const pxMin = pxPerMinute("plot", x);
+  const ev = eventShapes(o.events), ph = phaseShapes(o.phases, pxMin);
   const rorAfter = (ch.RoR_model || []).filter((v, i) => v !== null && c.time_s[i] > 90).map(dtemp);
   const rorTop = rorAfter.length ? Math.max(...rorAfter) * 1.2 + 2 : 30;
   const t0 = performance.now();
   Plotly.react("plot", traces, {
     // a narrow screen (a tablet beside the roaster) wraps the legend into more rows: below the time axis's title
     margin: { t: 30, r: 60, l: 60, b: 40 }, legend: { orientation: "h", y: narrow() ? -0.2 : -0.12, font: { size: 10 } },
-    xaxis: { title: { text: "time after CHARGE [m:ss]" }, domain: [0, 1], anchor: "y3", ...mmssTicks(x) },
+    xaxis: { title: { text: "time after CHARGE [m:ss]" }, domain: [0, 1], anchor: "y3", ...mmssTicks(x, pxMin) },
     yaxis: { title: { text: `temperature [${unit()}]` }, domain: [0.42, 1] },
     yaxis2: { title: { text: `RoR [${unit()}/min]` }, overlaying: "y", side: "right", range: [dtemp(-2), rorTop], showgrid: false,
               tickmode: "auto", nticks: 6, tickformat: ".0f" },
@@ -506,6 +518,32 @@ async function upload(ev) {
   }
 }
 
+function drawTransfer() {
+  const r = state.transfer;
+  if (!r) return;
+  const x = minutes(r.time_s), T = (a) => a.map((v) => shown(v, "level", r.F));
+  const band = r.band ? [  // where a roast run with the program is expected (transfer --band)
+    { x, y: T(r.band.upper), line: { width: 0 }, showlegend: false, hoverinfo: "skip" },
+    { x, y: T(r.band.lower), fill: "tonexty", fillcolor: "rgba(31,119,180,0.15)", line: { width: 0 },
+      name: `${Math.round(r.band.level * 100)} % band of the predicted BT` },
+  ] : [];
+  $("transfer-plot").classList.add("drawn");  // shown before drawing: Plotly sizes the figure to its box
+  Plotly.react("transfer-plot", [
+    ...band,
+    { x, y: T(r.target), name: "target BT", line: { color: "#333", width: 2 } },
+    { x, y: T(r.predicted), name: "predicted BT with the program", line: { color: "#1f77b4" } },
+    { x, y: r.program, name: `program: ${r.decide} [${shownUnit(r.unit)}]`, yaxis: "y2", line: { shape: "hv", color: "#d62728" } },
+  ], {
+    margin: { t: 20, r: 60, l: 60, b: 40 }, legend: { orientation: "h", y: narrow() ? -0.3 : -0.2 }, dragmode: fingerDrag(),
+    xaxis: { title: { text: "time after CHARGE [m:ss]" }, ...mmssTicks(x, pxPerMinute("transfer-plot", x)) },
+    yaxis: { title: { text: `BT [${r.F ? "°F" : "°C"}]` } },
+    yaxis2: { title: { text: `${r.decide} [${shownUnit(r.unit)}]` }, overlaying: "y", side: "right", showgrid: false,
+              range: [r.low - (r.step || (r.high - r.low) / 20), r.high + (r.step || (r.high - r.low) / 20)],
+              // on the machine's steps, a tick every step or every few (at most about ten ticks)
+              ...(r.step ? { dtick: r.step * Math.max(1, Math.ceil((r.high - r.low) / r.step / 10)), tickformat: "d" } : {}) },
+  }, { displaylogo: false, responsive: true });
+}
+
 async function runTransfer() {
   say("");
   $("transfer_progress").hidden = false;
@@ -515,26 +553,8 @@ async function runTransfer() {
     const r = await api("/api/transfer", { batch_kg: $("tr_batch_kg").value, plant_to: $("tr_plant").value.trim(), tm0_free: $("tr_tm0_free").checked, limit_low: $("tr_low").value, limit_high: $("tr_high").value, target: $("tr_target").value, units: $("units").value });
     $("transfer-summary").textContent = r.summary;
     $("downloads").innerHTML = r.downloads.map((u) => `<a href="${u}" download>${u.split("/").pop()}</a>`).join("");
-    const x = minutes(r.time_s);
-    const band = r.band ? [  // where a roast run with the program is expected (transfer --band)
-      { x, y: r.band.upper.map(temp), line: { width: 0 }, showlegend: false, hoverinfo: "skip" },
-      { x, y: r.band.lower.map(temp), fill: "tonexty", fillcolor: "rgba(31,119,180,0.15)", line: { width: 0 },
-        name: `${Math.round(r.band.level * 100)} % band of the predicted BT` },
-    ] : [];
-    $("transfer-plot").classList.add("drawn");  // shown before drawing: Plotly sizes the figure to its box
-    Plotly.react("transfer-plot", [
-      ...band,
-      { x, y: r.target.map(temp), name: "target BT", line: { color: "#333", width: 2 } },
-      { x, y: r.predicted.map(temp), name: "predicted BT with the program", line: { color: "#1f77b4" } },
-      { x, y: r.program, name: `program: ${r.decide} [${shownUnit(r.unit)}]`, yaxis: "y2", line: { shape: "hv", color: "#d62728" } },
-    ], {
-      margin: { t: 20, r: 60, l: 60, b: 40 }, legend: { orientation: "h", y: narrow() ? -0.3 : -0.2 }, dragmode: fingerDrag(),
-      xaxis: { title: { text: "time after CHARGE [m:ss]" }, ...mmssTicks(x) }, yaxis: { title: { text: `BT [${unit()}]` } },
-      yaxis2: { title: { text: `${r.decide} [${shownUnit(r.unit)}]` }, overlaying: "y", side: "right", showgrid: false,
-                range: [r.low - (r.step || (r.high - r.low) / 20), r.high + (r.step || (r.high - r.low) / 20)],
-                // on the machine's steps, a tick every step or every few (at most about ten ticks)
-                ...(r.step ? { dtick: r.step * Math.max(1, Math.ceil((r.high - r.low) / r.step / 10)), tickformat: "d" } : {}) },
-    }, { displaylogo: false, responsive: true });
+    state.transfer = { ...r, F: F() };  // drawn again when the window changes, in the unit its summary speaks
+    drawTransfer();
     say("");
     document.body.dataset.transfer = "done";
   } catch (e) {
@@ -550,6 +570,14 @@ function link(numberId, rangeId) {
   $(rangeId).addEventListener("input", () => { $(numberId).value = $(rangeId).value; go(); });
   $(numberId).addEventListener("input", () => { $(rangeId).value = $(numberId).value; go(); });
 }
+
+// A window resized or a tablet turned: Plotly's responsive figures take the new width; what the page
+// chose for the old one (the time axis's ticks, the phases' names, the legend's place) is chosen again.
+let resizeTimer = null;
+window.addEventListener("resize", () => {
+  clearTimeout(resizeTimer);
+  resizeTimer = setTimeout(() => { draw(); drawTransfer(); }, 150);
+});
 
 window.addEventListener("DOMContentLoaded", async () => {
   $("open").addEventListener("click", openLog);
