@@ -609,6 +609,8 @@ def test_the_page_fits_a_tablet_beside_the_roaster(browser, server):
             _open(page, "logs/bullet-500g.json", "bullet-model.json")
             page.wait_for_function(f"JSON.parse({ticks})[1] > 1")
             page.wait_for_timeout(400)  # past the resize's redraw (150 ms after the last resize)
+            # the legend's dozen rows under the curves leave them most of a tablet's height (233 px at 560)
+            assert page.evaluate("document.getElementById('plot')._fullLayout._size.h") > 380
             assert apart("#plot .xtick text") and apart("#plot .annotation-text-g text")
     finally:
         context.close()
