@@ -5,7 +5,7 @@ const sid = sessionStorage.getItem("roastlab-session") || crypto.randomUUID();
 sessionStorage.setItem("roastlab-session", sid);
 const $ = (id) => document.getElementById(id);
 const state = { open: null, changed: null, changedBand: null, table: null, busy: false, pending: false, lastDrawMs: null, tInput: null,
-                program: {}, touchStep: null };  // program: setting -> [{from_s, until_s, value, logged}], the steps the roaster can drag
+                program: {}, touchStep: null, transfer: null };  // program: setting -> [{from_s, until_s, value, logged}], the steps the roaster can drag
 
 async function api(path, body) {
   const opts = { method: body === undefined ? "GET" : "POST", headers: { "X-Session": sid } };
@@ -27,7 +27,7 @@ const shown = (c, kind, f = F()) => (!f ? c : kind === "level" ? c * 9 / 5 + 32 
 const celsius = (v, kind, f = F()) => (!f ? v : kind === "level" ? (v - 32) * 5 / 9 : v * 5 / 9);
 const temp = (v) => (v === null || v === undefined ? null : shown(v, "level"));
 const dtemp = (v) => (v === null || v === undefined ? null : shown(v, "delta"));
-const unit = () => (F() ? "°F" : "°C");
+const unit = (f = F()) => (f ? "°F" : "°C");
 // The what-if's temperature fields show the page's unit; the server is asked in degC.
 const TEMP_FIELDS = { Tm0_C: "level", Tm0_C_range: "level", Tb0_C: "level", tgi: "delta" };
 const round1 = (v) => Math.round(v * 10) / 10;
@@ -49,8 +49,10 @@ function mmss(s) {
   return `${s < 0 ? "-" : ""}${Math.floor(n / 60)}:${String(n % 60).padStart(2, "0")}`;
 }
 const minutes = (ts) => ts.map((t) => t / 60);
-// Pixels a minute of a figure's time axis takes: its box less the margins the figures keep (60 px a side).
-const pxPerMinute = (id, x) => Math.max(1, $(id).clientWidth - 120) / Math.max(1e-9, Math.max(...x) - Math.min(0, ...x));
+// The figures' left and right margins (their axes' titles and ticks), and the pixels a minute of a
+// figure's time axis takes: its box less those margins.
+const SIDE_PX = 60;
+const pxPerMinute = (id, x) => Math.max(1, $(id).clientWidth - 2 * SIDE_PX) / Math.max(1e-9, Math.max(...x) - Math.min(0, ...x));
 function mmssTicks(x, pxMin) {  // the roaster's time axis written m:ss: a tick a minute, or every 2 or 5 on a phone
   const last = Math.ceil(Math.max(...x));
   const every = [1, 2, 5, 10].find((k) => k * pxMin >= 40) || 10;  // "10:00" takes about 35 px
@@ -264,7 +266,7 @@ function draw() {
   const t0 = performance.now();
   Plotly.react("plot", traces, {
     // a narrow screen (a tablet beside the roaster) wraps the legend into more rows: below the time axis's title
-    margin: { t: 30, r: 60, l: 60, b: 40 }, legend: { orientation: "h", y: narrow() ? -0.2 : -0.12, font: { size: 10 } },
+    margin: { t: 30, r: SIDE_PX, l: SIDE_PX, b: 40 }, legend: { orientation: "h", y: narrow() ? -0.2 : -0.12, font: { size: 10 } },
     xaxis: { title: { text: "time after CHARGE [m:ss]" }, domain: [0, 1], anchor: "y3", ...mmssTicks(x, pxMin) },
     yaxis: { title: { text: `temperature [${unit()}]` }, domain: [0.42, 1] },
     yaxis2: { title: { text: `RoR [${unit()}/min]` }, overlaying: "y", side: "right", range: [dtemp(-2), rorTop], showgrid: false,
@@ -534,9 +536,9 @@ function drawTransfer() {
     { x, y: T(r.predicted), name: "predicted BT with the program", line: { color: "#1f77b4" } },
     { x, y: r.program, name: `program: ${r.decide} [${shownUnit(r.unit)}]`, yaxis: "y2", line: { shape: "hv", color: "#d62728" } },
   ], {
-    margin: { t: 20, r: 60, l: 60, b: 40 }, legend: { orientation: "h", y: narrow() ? -0.3 : -0.2 }, dragmode: fingerDrag(),
+    margin: { t: 20, r: SIDE_PX, l: SIDE_PX, b: 40 }, legend: { orientation: "h", y: narrow() ? -0.3 : -0.2 }, dragmode: fingerDrag(),
     xaxis: { title: { text: "time after CHARGE [m:ss]" }, ...mmssTicks(x, pxPerMinute("transfer-plot", x)) },
-    yaxis: { title: { text: `BT [${r.F ? "°F" : "°C"}]` } },
+    yaxis: { title: { text: `BT [${unit(r.F)}]` } },
     yaxis2: { title: { text: `${r.decide} [${shownUnit(r.unit)}]` }, overlaying: "y", side: "right", showgrid: false,
               range: [r.low - (r.step || (r.high - r.low) / 20), r.high + (r.step || (r.high - r.low) / 20)],
               // on the machine's steps, a tick every step or every few (at most about ten ticks)
