@@ -249,7 +249,8 @@ def fit_roaster(
         order, by = sorted(range(len(paths)), key=lambda k: paths[k].name), "name"
     paths = [paths[k] for k in order]
     batches = [load_log(p, cmap) for p in paths]
-    units = units or logs_temp_unit(batches)
+    recorded = logs_temp_unit(batches)
+    units = units or recorded
     if units not in ("C", "F"):
         raise ParameterError(f"units must be 'C' or 'F', got {units!r}")
     u = temp_symbol(units)
@@ -286,8 +287,8 @@ def fit_roaster(
         "",
         *(
             [
-                "Temperatures in °F, the unit the logs were recorded in; the model file and the fit's own sentences "
-                "below in °C.",
+                f"Temperatures in °F, {'the unit the logs were recorded in' if recorded == 'F' else 'as asked'}; the "
+                "model file and the fit's own sentences below in °C.",
                 "",
             ]
             if units == "F"
