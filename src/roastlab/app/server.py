@@ -493,11 +493,13 @@ def create_app(data_dir: str | Path):
         }
 
     def fit_start(session: Session, body: dict) -> dict:
+        from ..metrics.profile import DISPLAY_UNITS
         from ..workflows.roaster import fit_roaster
         from ..workflows.sizes import across_sizes_sentence
         from ..workflows.survey import init_roaster, roaster_name
 
         logs = body.get("logs") or []
+        units = body.get("units") if body.get("units") in DISPLAY_UNITS else None  # the page's, else the logs'
         if not isinstance(logs, list) or len(logs) < 2:
             raise InputError("choose at least two logs of one roaster to fit (one to fit, one to hold out)", "fit")
         paths = [inside(data, rel) for rel in logs]
@@ -519,7 +521,7 @@ def create_app(data_dir: str | Path):
                     progress=progress,
                     every_log=bool(body.get("every_log")),
                     by_size=bool(body.get("by_size")),
-                    units=body.get("units") if body.get("units") in ("C", "F") else None,  # the page's, else the logs
+                    units=units,
                 )
                 session.fit.update(
                     running=False,

@@ -264,6 +264,19 @@ def display_temp(temp_C: float, units: str = "C") -> float:
     return temp_C * 9.0 / 5.0 + 32.0 if units == "F" else temp_C
 
 
+#: The units temperatures are shown in (a table, a figure, a report); every value inside stays degC.
+DISPLAY_UNITS = ("C", "F")
+
+
+def display_units(units: str) -> str:
+    """``units`` if it is one of :data:`DISPLAY_UNITS`, else ParameterError."""
+    if units not in DISPLAY_UNITS:
+        from ..errors import ParameterError
+
+        raise ParameterError(f"units must be 'C' or 'F', got {units!r}")
+    return units
+
+
 def temp_symbol(units: str = "C") -> str:
     """The display unit ("C" or "F") as written after a number: "°C" or "°F"."""
     return "°F" if units == "F" else "°C"

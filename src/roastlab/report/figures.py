@@ -126,12 +126,11 @@ def temperature_axis(ax, label: str, units: str = "C", delta: bool = False, side
     axis holds differences or rates (degC/min), which convert without the 32 degF offset. ``side``:
     where the scale stands ("right" for a twin axis's, as a rate of rise's). Returns the axis that
     carries the scale (``ax`` itself in degC), for its ticks' style."""
-    from ..metrics.profile import temp_symbol
+    from ..metrics.profile import celsius_delta_of, celsius_of, display_temp, display_temp_delta, temp_symbol
 
     if units != "F":
         ax.set_ylabel(label.format(u=temp_symbol(units)))
         return ax
-    from ..metrics.profile import celsius_delta_of, celsius_of, display_temp, display_temp_delta
 
     there, back = (display_temp_delta, celsius_delta_of) if delta else (display_temp, celsius_of)
     scale = ax.secondary_yaxis(side, functions=(lambda v: there(v, "F"), lambda v: back(v, "F")))

@@ -11,9 +11,9 @@ import re
 from collections import Counter
 from pathlib import Path
 
-from ..errors import InputError, ParameterError
+from ..errors import InputError
 from ..io.batch import logs_temp_unit
-from ..metrics.profile import display_temp_delta, temp_symbol
+from ..metrics.profile import display_temp_delta, display_units, temp_symbol
 from .survey import (
     INLET_NAMES,
     UNNAMED_UNIT,
@@ -250,9 +250,7 @@ def fit_roaster(
     paths = [paths[k] for k in order]
     batches = [load_log(p, cmap) for p in paths]
     recorded = logs_temp_unit(batches)
-    units = units or recorded
-    if units not in ("C", "F"):
-        raise ParameterError(f"units must be 'C' or 'F', got {units!r}")
+    units = display_units(units or recorded)
     u = temp_symbol(units)
 
     def dT(v: float) -> float:  # an error or a width in the report's unit

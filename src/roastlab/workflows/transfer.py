@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-from ..errors import InputError, ParameterError
+from ..errors import InputError
 from ..fit.program import (
     ProgramLimits,
     ProgramResult,
@@ -33,6 +33,7 @@ from ..metrics.profile import (
     FIRST_CRACK_C,
     crossing_or_projected_s,
     crossing_time_s,
+    display_units,
     mmss,
     turning_point,
 )
@@ -582,9 +583,7 @@ def transfer(
     # to the beans, the drum's heat at CHARGE) more than the program's: said apart, judged as a whole
     tp_s = turning_point(t, target)[0]
     from_tp = _errors(program.Ta_pred_C[t >= tp_s], target[t >= tp_s]) if tp_s is not None else None
-    units = units or reference.temp_unit
-    if units not in ("C", "F"):
-        raise ParameterError(f"units must be 'C' or 'F', got {units!r}")
+    units = display_units(units or reference.temp_unit)
     explanation = _explain(t, program.Ta_pred_C - target, spans, tolerance_C, pb.name, mass_b, feasible, units)
     baselines_best = min((b["rmse_C"] for b in (base_same, base_ret) if b["rmse_C"] is not None), default=None)
     metrics = {
