@@ -1449,7 +1449,8 @@ def test_a_roaster_logging_in_fahrenheit_gets_the_fit_it_gets_in_celsius(cli, tm
     same map, plant and fit spec, and fit-roaster (the inlet air taken from the room each log
     records) the same held-out figures: the importer reads every temperature, the room among
     them, in the profile's unit (the copies round to 1e-4 degF). The roaster who logs in degF
-    reads the errors in degF, on the terminal and in the report; the model file is the same."""
+    reads the errors in degF, on the terminal and in the report, and validate's table, band and notes
+    likewise (``--units C`` asks for degC); the model file is the same."""
     folder = REAL_DATA / "skywalker"
     if not folder.is_dir():
         pytest.skip("../shared/data/real is absent")
@@ -1478,6 +1479,36 @@ def test_a_roaster_logging_in_fahrenheit_gets_the_fit_it_gets_in_celsius(cli, tm
     # the model the same, in degC, whatever the report shows
     theta = {u: roastlab.load_model(tmp_path / f"cfg{u}" / "model.json").theta for u in "CF"}
     assert theta["F"].hbm == pytest.approx(theta["C"].hbm, rel=1e-3)
+    # validate speaks the logs' unit too: its table, the held-out line, the band's widths, the import's notes;
+    # --units C reads the degF logs' own fit in degC (the two fits' bands are not compared: a three-log fit's
+    # spread between roasts comes from refits on two logs, which need not agree)
+    printed = []
+    for cfg, paths, asked in (("C", logs, ()), ("F", logs_F, ()), ("F", logs_F, ("--units", "C"))):
+        cfg = tmp_path / f"cfg{cfg}"
+        code, out, err = cli(
+            "validate", "--model", cfg / "model.json", "--map", cfg / "map.toml", *paths, "--band", *asked
+        )
+        assert code == 0, err
+        unit = "F" if "°F" in out else "C"
+        mae = float(out.split("held out only")[1].split("MAE ")[1].split(f" °{unit}")[0])
+        band = float(out.split("median width\n")[1].split("\n")[0].split()[-2])
+        average = next(line for line in out.splitlines() if line.startswith("average"))  # the probe's
+        printed.append(
+            (unit, mae, band, [float(v) for v in average.split()[1:]], err)
+        )  # n SSR norm MAE MPE MAPE FIT rho
+    (
+        (_, mae_C, _, avg_C, err_C),
+        (unit_F, mae_F, band_F, avg_F, err_F),
+        (unit_asked, mae_asked, band_asked, avg_asked, _),
+    ) = printed
+    assert (unit_F, unit_asked) == ("F", "C") and mae_F == pytest.approx(9 / 5 * mae_C, abs=0.09)
+    assert avg_F[3] == pytest.approx(9 / 5 * avg_C[3], rel=0.02) and avg_F[1] == pytest.approx(
+        81 / 25 * avg_C[1], rel=0.04
+    )
+    assert avg_F[4:] == pytest.approx(avg_C[4:], abs=0.15)  # MPE, MAPE in % of the degC reading, FIT, rho: no unit
+    assert mae_asked == pytest.approx(5 / 9 * mae_F, abs=0.01) and band_asked == pytest.approx(5 / 9 * band_F, abs=0.06)
+    assert avg_asked[3] == pytest.approx(5 / 9 * avg_F[3], abs=2e-3) and avg_asked[4:] == avg_F[4:]
+    assert "°F" not in err_C and ("°C" in err_C) == ("°F" in err_F)  # a note with a temperature, in the log's unit
 
 
 def test_a_fit_on_one_batch_size_holds_the_probe_depth_the_spec_frees():

@@ -283,6 +283,14 @@ def add_band_option(p: argparse.ArgumentParser, what: str, where: str) -> None:
     )
 
 
+def add_units_option(p: argparse.ArgumentParser, help: str) -> None:
+    """``--units {C,F}`` (:data:`roastlab.metrics.profile.DISPLAY_UNITS`): the unit temperatures are
+    shown in; ``help`` says where, and what the default is."""
+    from ..metrics.profile import DISPLAY_UNITS
+
+    p.add_argument("--units", choices=DISPLAY_UNITS, help=help)
+
+
 def add_model_options(p: argparse.ArgumentParser, with_model: bool = True) -> None:
     if with_model:
         p.add_argument("--model", "--theta", dest="model", metavar="MODEL.json", help=MODEL_HELP)

@@ -10,6 +10,7 @@ from .common import (
     add_batch_options,
     add_model_options,
     add_starts_option,
+    add_units_option,
     check_targets,
     failed_fit_status,
     fit_inputs,
@@ -107,7 +108,9 @@ def _identify_per_batch(args, batches, plant_spec, fix, bounds, outputs) -> int:
 
 
 def cmd_validate(args) -> int:
+    from ..io.batch import logs_temp_unit
     from ..io.files import Outputs
+    from ..metrics.profile import display_temp_delta, temp_symbol
     from ..report.figures import plot_fit
 
     outputs = Outputs(fit_inputs(args))
@@ -130,9 +133,11 @@ def cmd_validate(args) -> int:
     fitted = model.fitted_roasts(batches)
     say(result.notes + list(fitted.values()))
     th = model.theta
+    units = args.units or logs_temp_unit(batches)  # the logs' own unit unless asked otherwise
     print(
         result.table(
-            f"validation on plant {result.plant}, theta = hgm {th.hgm:.4f}, hbm {th.hbm:.4f}, Pbm {th.Pbm:.4f}"
+            f"validation on plant {result.plant}, theta = hgm {th.hgm:.4f}, hbm {th.hbm:.4f}, Pbm {th.Pbm:.4f}",
+            units,
         )
     )
     doc = result.to_json_dict()
@@ -145,17 +150,22 @@ def cmd_validate(args) -> int:
             doc["average_held_out"] = avg = average_metrics(held)
             print(
                 f"held out only ({len(held)} of {len(result.names)} logs; the others are named above): "
-                f"FIT {avg['FIT']:.1f} %, MAE {avg['MAE']:.2f} °C"
+                f"FIT {avg['FIT']:.1f} %, MAE {display_temp_delta(avg['MAE'], units):.2f} {temp_symbol(units)}"
             )
     bands = None
     if args.band is not None:
-        doc["band"], bands = _band_table(model, batches, args.band)
+        doc["band"], bands = _band_table(model, batches, args.band, units)
     with outputs as out:
         if args.json:
             out.write_text(args.json, json_text(doc))
         if args.plot:
             plot_fit(
-                result, args.plot, title=f"measured vs predicted BT, plant {result.plant}", outputs=out, bands=bands
+                result,
+                args.plot,
+                title=f"measured vs predicted BT, plant {result.plant}",
+                outputs=out,
+                bands=bands,
+                units=units,
             )
         if args.predictions:
             written = set()
@@ -199,10 +209,11 @@ def cmd_compare_models(args) -> int:
     return 0
 
 
-def _band_table(model, batches, level) -> tuple[dict, list]:
-    """Print and return how often each batch's measured probe lies inside the model's band, and
-    the bands (drawn by --plot)."""
+def _band_table(model, batches, level, units: str = "C") -> tuple[dict, list]:
+    """Print and return how often each batch's measured probe lies inside the model's band (its width in
+    ``units``, "C" or "F"; the returned document's in degC), and the bands (drawn by --plot)."""
     from ..evaluate.bands import band_report, stored_spread
+    from ..metrics.profile import display_temp_delta, temp_symbol
 
     if not stored_spread(model):
         print("note: the model file has no roast-to-roast spread (fitted on one log, or by an older roastlab): "
@@ -212,7 +223,9 @@ def _band_table(model, batches, level) -> tuple[dict, list]:
     print(f"{'batch':<36} {'kg':>6} {'inside':>7} {'median width':>13}")
     for r in report["batches"]:
         kg = "" if not r["Mb_kg"] else f"{r['Mb_kg']:.3g}"
-        print(f"{r['name'][:36]:<36} {kg:>6} {r['inside']:>7.0%} {r['median_width_C']:>10.1f} °C")
+        print(
+            f"{r['name'][:36]:<36} {kg:>6} {r['inside']:>7.0%} {display_temp_delta(r['median_width_C'], units):>10.1f} {temp_symbol(units)}"
+        )
     for g in report["by_size"]:
         label = f"size {g['size']} ({g['logs']} log{'s' * (g['logs'] > 1)})"
         print(f"{label:<36} {'':>6} {g['inside']:>7.0%}")
@@ -236,6 +249,7 @@ def _safe_stem(name: str, taken: set) -> str:
 
 def _validate_baseline(args, outputs) -> int:
     from ..fit.baseline import baseline_document, describe, load_baseline, validation_of_first_order
+    from ..io.batch import logs_temp_unit
     from ..report.figures import plot_fit
 
     if not args.model:
@@ -245,12 +259,13 @@ def _validate_baseline(args, outputs) -> int:
     params = load_baseline(args.model)
     batches, plant_spec = load_batches(args)
     result = validation_of_first_order(batches, params, str(plant_spec))
-    print(result.table(f"first-order baseline ({describe(params)})"))
+    units = args.units or logs_temp_unit(batches)
+    print(result.table(f"first-order baseline ({describe(params)})", units))
     with outputs as out:
         if args.json:
             out.write_text(args.json, json_text(baseline_document(params, result)))
         if args.plot:
-            plot_fit(result, args.plot, title="measured vs first-order baseline", outputs=out)
+            plot_fit(result, args.plot, title="measured vs first-order baseline", outputs=out, units=units)
     return 0
 
 
@@ -398,5 +413,11 @@ def add_parsers(sub) -> None:
     )
     add_band_option(p, "score the model's prediction band", "the share of each batch's measured probe samples "
                     "inside it and its median width, then the share per batch size when the logs have several")  # fmt: skip
+    add_units_option(
+        p,
+        "temperatures in the table, the band's widths and the figure in C or F (default: the logs' own, as "
+        "Artisan recorded them; a set of both reads in C); MPE and MAPE stay percent of the reading in degC, as "
+        "the paper's Table 2 defines them, and --json, --predictions and --tgi-offset stay in degC",
+    )
     add_model_options(p)
     p.set_defaults(func=cmd_validate)

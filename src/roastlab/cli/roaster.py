@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .common import failed_fit_status, float_arg, progress
+from .common import add_units_option, failed_fit_status, float_arg, progress
 
 
 def cmd_init(args) -> int:
@@ -217,10 +217,9 @@ def add_parsers(sub) -> None:
         "logs carry it): one drum's model, the other units' logs left out and said. Units of one make differ by more "
         "than a batch size does; without --unit, held-out logs of several units are also reported by unit",
     )
-    p.add_argument(
-        "--units",
-        choices=("C", "F"),
-        help="the report's and the figures' temperatures in C or F (default: the unit the logs were recorded in; "
+    add_units_option(
+        p,
+        "the report's and the figures' temperatures in C or F (default: the unit the logs were recorded in; "
         "a folder of both reads in C); model.json stays in degC",
     )
     p.set_defaults(func=cmd_fit_roaster)

@@ -8,6 +8,7 @@ from ..errors import InputError
 from .common import (
     MODEL_HELP,
     add_band_option,
+    add_units_option,
     check_targets,
     float_arg,
     range_arg,
@@ -243,10 +244,9 @@ def add_parsers(sub) -> None:
     )
     add_band_option(p, "the predicted BT's prediction band", "its median width and BT at DROP in the output, "
                     "shaded in --plot, in --json: where a roast run with the program is expected")  # fmt: skip
-    p.add_argument(
-        "--units",
-        choices=("C", "F"),
-        help="temperatures in the summary and the figure in C or F (default: the reference log's own, as Artisan "
+    add_units_option(
+        p,
+        "temperatures in the summary and the figure in C or F (default: the reference log's own, as Artisan "
         "recorded it, which --alog is written in; the limits, --tolerance, OUT and --json stay in degC)",
     )
     p.add_argument("--json", metavar="METRICS.json", help="write the metrics, baselines and limits as JSON")

@@ -8,6 +8,7 @@ from .common import (
     MODEL_HELP,
     add_band_option,
     add_initial_options,
+    add_units_option,
     check_targets,
     float_arg,
     initial_changes,
@@ -111,10 +112,9 @@ def add_parsers(sub) -> None:
     add_initial_options(p)
     add_band_option(p, "the changed probe BT's prediction band", "its median width and BT at DROP in the table, "
                     "shaded in --plot, in --json")  # fmt: skip
-    p.add_argument(
-        "--units",
-        choices=("C", "F"),
-        help="temperatures in the table and the figure in C or F (default: the log's own, as Artisan recorded it; "
+    add_units_option(
+        p,
+        "temperatures in the table and the figure in C or F (default: the log's own, as Artisan recorded it; "
         "--tm0, --tb0 and --tgi are degC unless written with an F: 400F)",
     )
     p.add_argument("--json", metavar="WHATIF.json", help="write the table as JSON (temperatures in degC, times in s)")

@@ -50,6 +50,23 @@ def size_labels(masses_kg, step_kg: float | None = None) -> tuple[list[str], flo
 
 
 METRIC_NAMES = ("n", "SSR", "norm", "MAE", "MPE", "MAPE", "FIT", "rho")
+#: The power of a temperature difference each index carries (SSR in K², norm and MAE in K); the
+#: others have none: FIT and rho are ratios, and MPE and MAPE are percent of the reading in degC, as
+#: Table 2 defines them (a percent of a reading depends on the scale's zero, so not restated in degF).
+METRIC_TEMP_POWER = {"SSR": 2, "norm": 1, "MAE": 1}
+
+
+def metrics_in_units(row: dict, units: str = "C") -> dict:
+    """A row of :func:`batch_metrics` with its temperature differences in the display unit ("C" or "F";
+    :data:`METRIC_TEMP_POWER`).
+
+    >>> metrics_in_units({"n": 3, "SSR": 200.0, "norm": 14.1, "MAE": 5.0, "FIT": 90.0}, "F")["MAE"]
+    9.0
+    """
+    from ..metrics.profile import display_temp_delta
+
+    return {k: display_temp_delta(1.0, units) ** METRIC_TEMP_POWER[k] * v if k in METRIC_TEMP_POWER else v
+            for k, v in row.items()}  # fmt: skip
 
 
 def fit_percent(measured, predicted) -> float:

@@ -14,7 +14,7 @@ from ..metrics.profile import beans_at_first_crack
 from ..model.constants import FIRST_CRACK_BEAN_C
 from ..model.parameters import MODEL_OF_OUTPUT
 from ..report.result import Result, draw_curves
-from .metrics import METRIC_NAMES, absolute_error_moments, average_metrics, batch_metrics
+from .metrics import METRIC_NAMES, absolute_error_moments, average_metrics, batch_metrics, metrics_in_units
 
 #: Predicted states written beside measured and predicted Ta (Ta itself is Ta_pred_C).
 PREDICTED_STATES = ("Tb_C", "Tm_C", "X_kg_kg", "He_kJ_kg")
@@ -120,32 +120,39 @@ class ValidationResult(Result):
                 }
         return out
 
-    def table(self, title: str | None = None) -> str:
-        """A readable text table of the metrics (columns sized to their contents)."""
+    def table(self, title: str | None = None, units: str = "C") -> str:
+        """A readable text table of the metrics (columns sized to their contents), its temperature
+        differences in ``units`` ("C" or "F"; :func:`~roastlab.evaluate.metrics.metrics_in_units`)."""
+        from ..metrics.profile import display_temp, display_temp_delta, temp_symbol
+
+        u, scale = temp_symbol(units), display_temp_delta(1.0, units)
+
+        def line(name, row):
+            row = metrics_in_units(row, units)
+            return f"{name:<{w}}" + "".join(_fmt(key, row[key]) for key in METRIC_NAMES)
+
         w = max([len("average")] + [len(n) for n in self.names]) + 2
         head = f"{'batch':<{w}}" + "".join(f"{k:>11}" for k in METRIC_NAMES)
-        lines = ([title] if title else []) + [head, "-" * len(head)]
-        for name, row in zip(self.names, self.rows):
-            lines.append(f"{name:<{w}}" + "".join(_fmt(k, row[k]) for k in METRIC_NAMES))
-        lines.append("-" * len(head))
-        lines.append(f"{'average':<{w}}" + "".join(_fmt(k, self.average[k]) for k in METRIC_NAMES))
+        lines = ([title] if title else []) + ([f"SSR in {u}², norm and MAE in {u}; MPE and MAPE in % of the reading in °C "
+                                               "(Table 2); FIT in %"] if units == "F" else [])  # fmt: skip
+        lines += [head, "-" * len(head)]
+        lines += [line(name, row) for name, row in zip(self.names, self.rows)]
+        lines += ["-" * len(head), line("average", self.average)]
         em = self.error_moments
         lines.append(
-            f"|e| over {em['samples']} samples: mean {em['mean_abs_error']:.3f} °C, variance {em['var_abs_error']:.3f} °C²"
+            f"|e| over {em['samples']} samples: mean {scale * em['mean_abs_error']:.3f} {u}, "
+            f"variance {scale**2 * em['var_abs_error']:.3f} {u}²"
         )
         for name, o in self.outputs.items():
-            avg = self.output_average(name)
             lines += ["", f"second output {name}: {o['compared']}", head, "-" * len(head)]
-            lines += [
-                f"{n:<{w}}" + "".join(_fmt(k, row[k]) for k in METRIC_NAMES) for n, row in zip(o["names"], o["rows"])
-            ]
-            lines += ["-" * len(head), f"{'average':<{w}}" + "".join(_fmt(k, avg[k]) for k in METRIC_NAMES)]
+            lines += [line(n, row) for n, row in zip(o["names"], o["rows"])]
+            lines += ["-" * len(head), line("average", self.output_average(name))]
         if self.first_crack_beans_C:
-            v = np.array(list(self.first_crack_beans_C.values()))
+            v = display_temp(np.array(list(self.first_crack_beans_C.values())), units)
             lines += [
                 "",
-                f"model beans at the logs' first-crack marks: median {np.median(v):.0f} °C ({v.min():.0f}-{v.max():.0f} °C, "
-                f"{v.size} log{'s' * (v.size > 1)}); coffee cracks at about {FIRST_CRACK_BEAN_C:.0f} °C",
+                f"model beans at the logs' first-crack marks: median {np.median(v):.0f} {u} ({v.min():.0f}-{v.max():.0f} {u}, "
+                f"{v.size} log{'s' * (v.size > 1)}); coffee cracks at about {display_temp(FIRST_CRACK_BEAN_C, units):.0f} {u}",
             ]
         return "\n".join(lines)
 

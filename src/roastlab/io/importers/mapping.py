@@ -75,7 +75,14 @@ from pathlib import Path
 import numpy as np
 
 from ...errors import InputError, ParameterError
-from ...metrics.profile import ET_CHECK_FROM_S, et_minus_bt_C, first_crack_s
+from ...metrics.profile import (
+    ET_CHECK_FROM_S,
+    display_temp,
+    display_temp_delta,
+    et_minus_bt_C,
+    first_crack_s,
+    temp_symbol,
+)
 from ...model.actuators import UNIT_DEFAULTS, Actuator
 from ...model.constants import FIRST_CRACK_BEAN_C
 from ...model.limits import check_value
@@ -613,11 +620,11 @@ def _resample(time_s: np.ndarray, columns: dict[str, np.ndarray], step: float, p
     return grid, {k: np.interp(grid, time_s, v) for k, v in columns.items()}
 
 
-def _drop_et_not_drum_air(time_s, Ta, drop_s, settings: dict, series: dict, notes: list) -> set:
+def _drop_et_not_drum_air(time_s, Ta, drop_s, settings: dict, series: dict, notes: list, units: str = "C") -> set:
     """Where the map asks (``[ET] above_BT``) and ET reads below BT through the roast, ET is not the
     drum's air on this log (:func:`roastlab.metrics.profile.et_minus_bt_C`): it is removed from
-    ``settings`` and ``series`` with a note; returns the channels so rejected (no initial state
-    is read from them)."""
+    ``settings`` and ``series`` with a note (its gap in ``units``, the log's "C" or "F"); returns the
+    channels so rejected (no initial state is read from them)."""
     spec = settings.get("ET")
     if spec is None or not spec.get("above_BT"):
         return set()
@@ -625,7 +632,7 @@ def _drop_et_not_drum_air(time_s, Ta, drop_s, settings: dict, series: dict, note
     if gap is None or gap >= 0:
         return set()
     notes.append(
-        f"ET reads {-gap:.0f} degC below BT through the roast (median from {ET_CHECK_FROM_S:g} s): "
+        f"ET reads {display_temp_delta(-gap, units):.0f} {temp_symbol(units)} below BT through the roast (median from {ET_CHECK_FROM_S:g} s): "
         f"{ET_NOT_DRUM_AIR}, so it is neither fitted nor scored"
     )
     del settings["ET"], series["ET"]
@@ -825,7 +832,9 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
         if et_spec is not None:
             settings["ET"] = et_spec
             series["ET"] = channel(et_spec, "ET") + (et_spec.get("offset_C") or 0.0)
-            rejected = _drop_et_not_drum_air(time_s, Ta, log.events.get("DROP"), settings, series, default_notes)
+            rejected = _drop_et_not_drum_air(
+                time_s, Ta, log.events.get("DROP"), settings, series, default_notes, log.mode
+            )
             et_spec = settings.get("ET")
         Mb = log.weight_in_kg
         unit = log.unit
@@ -899,7 +908,7 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
                 to_celsius(v, spec.get("unit", "C")) + (spec.get("offset_C") or 0.0) if k in ("Tb2", "ET") else v
             )
         drop_known = True
-        rejected = _drop_et_not_drum_air(time_s, Ta, None, settings, series, default_notes)
+        rejected = _drop_et_not_drum_air(time_s, Ta, None, settings, series, default_notes, temp_unit)
         # the first row is the charge: an initial state from the log is one of the map's temperature
         # columns read there (in its unit), the first of a list that has a reading
         temps = {cmap.Ta["column"]: Ta}
@@ -996,24 +1005,27 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
     if (incomplete := int((~ok).sum()) - stumbled) > 0:  # a missing time is a missing value
         notes.append(f"dropped {incomplete} incomplete sample(s) (missing values)")
     spikes, j = probe_faults(time_s, Ta)
+    u = temp_symbol(temp_unit)  # the notes speak the log's own unit
+
+    def jump(k):
+        return f"bean temperature jumps {display_temp(Ta[k], temp_unit):.0f} -> {display_temp(Ta[k + 1], temp_unit):.0f} {u} at t = {time_s[k + 1]:.0f} s"
+
     if spikes.any():
         at = time_s[spikes]
         notes.append(
             f"dropped {spikes.sum()} sample(s) of bean-probe spikes at t = {at[0]:.0f}"
             + (f"-{at[-1]:.0f}" if at[-1] > at[0] else "")
-            + f" s (a step over {MAX_JUMP_C:g} degC that came back within {SPIKE_MAX_S:g} s)"
+            + f" s (a step over {display_temp_delta(MAX_JUMP_C, temp_unit):g} {u} that came back within {SPIKE_MAX_S:g} s)"
         )
         time_s, Ta, Tgi, Gg, series = select(~spikes)
     if j is not None:
         # a probe fault: keep what came before it rather than fit a physically impossible step
         if j + 1 < max(2, 0.5 * len(Ta)):
             raise InputError(
-                f"bean temperature jumps {Ta[j]:.0f} -> {Ta[j + 1]:.0f} degC at t = {time_s[j + 1]:.0f} s, early in the log: sensor fault?",
+                f"{jump(j)}, early in the log: sensor fault?",
                 path,
             )
-        notes.append(
-            f"bean temperature jumps {Ta[j]:.0f} -> {Ta[j + 1]:.0f} degC at t = {time_s[j + 1]:.0f} s (probe fault): log cut there"
-        )
+        notes.append(f"{jump(j)} (probe fault): log cut there")
         time_s, Ta, Tgi, Gg, series = select(slice(None, j + 1))
     if drop_known and (why := hot_drop(Ta[-1])):
         raise InputError(why, path)
