@@ -120,20 +120,24 @@ def test_init_reads_an_et_that_falls_to_the_green_beans_as_a_second_bean_reading
     assert et_source(load_map(tmp_path / "cfg2" / "map.toml")) == "Tm"  # the drum, as for the Skywalker
 
 
-def test_an_et_below_bt_through_every_roast_is_not_used_and_a_swap_is_suggested(cli, tmp_path):
+@pytest.mark.parametrize("mode", ["C", "F"])
+def test_an_et_below_bt_through_every_roast_is_not_used_and_a_swap_is_suggested(cli, tmp_path, mode):
     """SYNTHETIC logs whose ET reads 15 degC below BT through every roast (ET and BT swapped in the
     device setup, or a probe outside the drum): not the drum's air on any log, which runs above the
     beans it heats. init does not weigh it against the model's air (before, only logs far below the
     others' median were dropped, so a machine whose every log read so kept it), and says a swap is
-    likely; the heater then heats the drum alone, as without ET."""
+    likely; the heater then heats the drum alone, as without ET. Logs recorded in degF hear it in degF."""
     bt = [130.0 - 0.2 * i if i < 30 else 124.0 + 0.5 * (i - 30) for i in range(120)]
     logs = [tmp_path / f"r{k}.alog" for k in range(3)]
+    f = (lambda c: 9 / 5 * c + 32) if mode == "F" else (lambda c: c)
     for k, p in enumerate(logs):
-        p.write_text(fake_alog(bt=bt, et=[b - 15.0 + k for b in bt], extra={**_BURNER_AIR, "roastepoch": 1e9 + k}))
+        p.write_text(fake_alog(mode, bt=[f(b) for b in bt], et=[f(b - 15.0 + k) for b in bt],
+                               extra={**_BURNER_AIR, "roastepoch": 1e9 + k}))  # fmt: skip
     code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
     assert code == 0, err
     assert "ET: below BT on every log, not used" in out
-    assert "ET reads below BT through the roast on every log (by 13 to 15 degC)" in out and "swap them back" in out
+    by = "by 13 to 15 °C" if mode == "C" else "by 23 to 27 °F"
+    assert f"ET reads below BT through the roast on every log ({by})" in out and "swap them back" in out
     spec = (tmp_path / "cfg" / "fit.toml").read_text()
     assert "\nET = " not in spec and "Tgi_gain_C" not in spec.split("[free]")[1].split("[")[0], spec
 
@@ -480,7 +484,7 @@ def test_a_folder_of_logs_is_read_and_a_recording_that_is_no_roast_is_named_and_
     assert "left out: aborted.alog cannot be read as a roast (no bean temperature (BT) in this log" in out
     assert "left out: empty.alog cannot be read as a roast (key timex: needs at least 2 samples" in out
     assert (
-        "left out: dead_probe.alog cannot be read as a roast (BT never reads above the room (22 degC; highest 0" in out
+        "left out: dead_probe.alog cannot be read as a roast (BT never reads above the room (22 °C; highest 0" in out
     )
     assert (
         "left out: stopped.alog cannot be read as a roast (the log ends 0:28 after CHARGE, shorter than any roast "
@@ -1270,25 +1274,25 @@ def test_a_plain_csvs_columns_are_found_by_name(header, want):
 
 def test_notes_said_alike_on_many_logs_are_one_line_with_the_range():
     notes = {
-        "a.alog": ["dropped 4 incomplete sample(s) (missing values)", "ET reads 32 degC below BT (median from 60 s)"],
+        "a.alog": ["dropped 4 incomplete sample(s) (missing values)", "ET reads 32 °C below BT (median from 60 s)"],
         "b.alog": ["dropped 1 incomplete sample(s) (missing values)"],
-        "c.alog": ["dropped 6 incomplete sample(s) (missing values)", "bean temperature jumps 176 -> 349 degC"],
+        "c.alog": ["dropped 6 incomplete sample(s) (missing values)", "bean temperature jumps 176 -> 349 °C"],
         "d.alog": ["dropped 1 incomplete sample(s) (missing values)"],
-        "e.alog": ["dropped 2 incomplete sample(s) (missing values)", "ET reads -3.5 degC below BT (median from 60 s)"],
+        "e.alog": ["dropped 2 incomplete sample(s) (missing values)", "ET reads -3.5 °C below BT (median from 60 s)"],
     }
     lines = roaster.grouped_notes(notes)
     assert lines[0] == "5 logs: dropped 1-6 incomplete sample(s) (missing values)"  # more than NAMED_UP_TO: counted
-    assert "a.alog: ET reads 32 degC below BT (median from 60 s)" in lines  # said on two logs: each as said
-    assert "c.alog: bean temperature jumps 176 -> 349 degC" in lines and len(lines) == 4
+    assert "a.alog: ET reads 32 °C below BT (median from 60 s)" in lines  # said on two logs: each as said
+    assert "c.alog: bean temperature jumps 176 -> 349 °C" in lines and len(lines) == 4
     clock = {
         f"{k}.alog": [f"no DROP marked: taken at {t} after CHARGE"] for k, t in enumerate(("10:01", "9:58", "11:48"))
     }
     assert roaster.grouped_notes(clock) == [
         "3 logs (0.alog, 1.alog, 2.alog): no DROP marked: taken at 9:58-11:48 after CHARGE"
     ]
-    notes["f.alog"] = ["ET reads 40 degC below BT (median from 60 s)"]
+    notes["f.alog"] = ["ET reads 40 °C below BT (median from 60 s)"]
     assert (
-        "3 logs (a.alog, e.alog, f.alog): ET reads -3.5 to 40 degC below BT (median from 60 s)"
+        "3 logs (a.alog, e.alog, f.alog): ET reads -3.5 to 40 °C below BT (median from 60 s)"
         in roaster.grouped_notes(notes)
     )
 

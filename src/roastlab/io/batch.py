@@ -129,8 +129,9 @@ class Batch:
 
 
 def logs_temp_unit(batches) -> str:
-    """The unit a set of logs was recorded in (:attr:`Batch.temp_unit`): "F" where every one of them
-    was recorded in degF, else "C" (a folder of logs in both units reads in degC)."""
+    """The unit a set of logs was recorded in (each one's ``temp_unit``: a :class:`Batch`, or
+    :class:`roastlab.workflows.survey.LogInfo`): "F" where every one of them was recorded in degF, else
+    "C" (a folder of logs in both units reads in degC)."""
     units = {b.temp_unit for b in batches}
     return "F" if units == {"F"} else "C"
 

@@ -52,7 +52,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..evaluate.metrics import size_labels
-from ..io.batch import first_of_each_roast
+from ..io.batch import first_of_each_roast, logs_temp_unit
 from ..io.importers.artisan import DRUM_AT_CHARGE as ARTISAN_DRUM_AT_CHARGE
 from ..io.importers.artisan import (
     ET_BEFORE_CHARGE,
@@ -76,12 +76,15 @@ from ..io.importers.roastime import DRUM_AT_CHARGE, read_roastime
 from ..metrics.profile import (
     LOG_THE_HEATER,
     SHORTEST_ROAST_S,
+    display_temp,
+    display_temp_delta,
     et_below_bt_on_every_log,
     et_minus_bt_C,
     et_not_drum_air,
     et_reads_beans,
     first_crack_s,
     mmss,
+    temp_symbol,
 )
 from ..model.actuators import CONTROL_UNITS, PRESSURE_FAN_EXP, PRESSURE_HEATER_EXP, PRESSURE_UNITS, UNIT_DEFAULTS
 from ..model.bed import CROSS_VALIDATED, PROBE_DEPTH_OVER_DIAMETER
@@ -244,6 +247,7 @@ class LogInfo:
     seen: dict = field(default_factory=dict)  # the heater's and the fan's distinct logged values (their unit: survey)
     inlet: str | None = None  # a temperature channel named as the inlet air (INLET_NAMES)
     marks_first_crack: bool = False  # the log marks first crack (FCs) within its samples
+    temp_unit: str = "C"  # the unit the log was recorded in ("C" or "F": Artisan's mode, a CSV's column names)
 
 
 @dataclass
@@ -469,10 +473,11 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
     bt = bt[: fault + 1] if fault is not None else bt
     if log.drop_index is not None and (why := hot_drop(float(bt[-1]))):
         raise InputError(why, path)  # the import refuses it too; say it before the files are written
-    if not live_reading(bt):  # a probe that read nothing (0 degC throughout)
+    if not live_reading(bt):  # a probe that read nothing (0 degC throughout), said in the log's unit
+        u = temp_symbol(log.mode)
         raise InputError(
-            f"BT never reads above the room ({default('T_room_C'):g} degC; highest {bt.max():.0f} degC): no roast "
-            "recorded, an unconnected probe?",
+            f"BT never reads above the room ({display_temp(default('T_room_C'), log.mode):g} {u}; highest "
+            f"{display_temp(bt.max(), log.mode):.0f} {u}): no roast recorded, an unconnected probe?",
             path,
         )
     if (length := float(log.time_s[-1] - log.time_s[0])) < SHORTEST_ROAST_S:
@@ -538,6 +543,7 @@ def inspect_log(path, batch_kg: float | None = None) -> LogInfo:
         info.et_before_charge = ET_BEFORE_CHARGE in log.fields
     info.inlet = inlet
     info.marks_first_crack = first_crack_s(log.time_s, log.events) is not None
+    info.temp_unit = log.mode
     for what, channel in (("heater", heater), ("fan", fan)):
         if channel:
             values = log.channels[channel]
@@ -789,12 +795,14 @@ def survey(paths, batch_kg: float | None = None, units: dict | None = None) -> S
             "set up those logs apart"
         )
     # weighed against the model's air, an ET that is the drum's air on no log would pull the fit off
+    unit = logs_temp_unit(infos)  # the notes' temperatures in the unit the logs were recorded in
     differences = [i.et_minus_bt_C if i.has_et else None for i in infos]
     et_below_bt = not et_is_bean and et_below_bt_on_every_log(differences)
     if et_below_bt:
         notes.append(
-            f"ET reads below BT through the roast on every log (by {-max(differences):.0f} to "
-            f"{-min(differences):.0f} degC): not the drum's air, which runs above the beans it heats, so the "
+            f"ET reads below BT through the roast on every log (by {display_temp_delta(-max(differences), unit):.0f} "
+            f"to {display_temp_delta(-min(differences), unit):.0f} {temp_symbol(unit)}): not the drum's air, which "
+            "runs above the beans it heats, so the "
             "map does not use it; if ET and BT are swapped in the device setup, swap them back and run init again"
         )
     odd = (
@@ -813,7 +821,7 @@ def survey(paths, batch_kg: float | None = None, units: dict | None = None) -> S
     if first_crack:
         notes.append(
             f"no bean reading but the probe; {marked} of {len(infos)} log(s) mark first crack, where the beans are at "
-            f"about {FIRST_CRACK_BEAN_C:.0f} degC: the map reads each mark as the beans' temperature then ([Tb2] "
+            f"about {display_temp(FIRST_CRACK_BEAN_C, unit):.0f} {temp_symbol(unit)}: the map reads each mark as the beans' temperature then ([Tb2] "
             "first_crack), so the fit cannot put the beans where coffee does not crack"
         )
     has_et = all(i.has_et for i in infos) and not et_is_bean and not et_below_bt
