@@ -357,7 +357,7 @@ def second_bean_reading(b, units: str = "C") -> tuple[str, bool] | None:
     where it is a few readings (drawn as markers that stand out), or None where it has none. A curve
     of readings (the Bullet's IR) is "beans measured (second reading)"; the first-crack mark read as
     the beans (a map's ``[Tb2] first_crack``) says so, its temperature in ``units`` ("C" or "F")."""
-    from ..metrics.profile import display_temp
+    from ..metrics.profile import display_temp, temp_symbol
 
     marked = np.isfinite(b.Tb2_C) if b.Tb2_C is not None else np.zeros(0, dtype=bool)
     if not marked.any():
@@ -365,7 +365,7 @@ def second_bean_reading(b, units: str = "C") -> tuple[str, bool] | None:
     if np.count_nonzero(marked) > 3:
         return "beans measured (second reading)", False
     at_crack = np.all(b.Tb2_C[marked] == FIRST_CRACK_BEAN_C) and "FCs" in b.events
-    crack = f"{display_temp(FIRST_CRACK_BEAN_C, units):g} °{units}"
+    crack = f"{display_temp(FIRST_CRACK_BEAN_C, units):g} {temp_symbol(units)}"
     return (f"beans at first crack ({crack}, the FCs mark)" if at_crack else "beans measured"), True
 
 
@@ -449,12 +449,12 @@ def plot_transfer(r, path=None, outputs=None):
 
     ``r`` is a :class:`roastlab.workflows.transfer.TransferResult`.
     """
-    from ..metrics.profile import display_temp_delta
+    from ..metrics.profile import display_temp_delta, temp_symbol
 
     units = r.units
 
     def d(v, digits: int = 1):  # an error in the figure's unit, with it
-        return f"{display_temp_delta(v, units):.{digits}f} °{units}"
+        return f"{display_temp_delta(v, units):.{digits}f} {temp_symbol(units)}"
 
     t_min = r.time_s / 60.0
     lim = r.limits
