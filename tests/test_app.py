@@ -642,7 +642,8 @@ def _fahrenheit_log(folder: Path) -> tuple[str, str]:
 def test_a_log_in_fahrenheit_opens_in_fahrenheit_and_its_fields_speak_it(page, data_dir):
     """An Artisan log recorded in degF opens with the page in degF: the curves, the table and the what-if's
     temperature fields (the drum at CHARGE shown in degF, asked of the server in degC); switched to degC
-    the fields keep what they hold, and a log in degC opened after keeps the unit the roaster chose."""
+    the fields keep what they hold and the notes under the table follow, and a log in degC opened after keeps
+    the unit the roaster chose."""
     log, model = _fahrenheit_log(data_dir / "fahrenheit")
     page.reload()  # the page lists the folder's files as it loads
     _open(page, log, model)
@@ -656,9 +657,12 @@ def test_a_log_in_fahrenheit_opens_in_fahrenheit_and_its_fields_speak_it(page, d
     page.dispatch_event("#Tm0_C", "input")
     page.wait_for_function(f"Number(document.body.dataset.updates || 0) > {n}")
     assert page.evaluate("changes().Tm0_C") == pytest.approx(opened["Tm0_C"] + 10.0, abs=0.05)
+    # the notes under the table speak its unit (a change within the model's error on this log, in degF)
+    assert "°F against" in page.inner_text("#warnings") and "°C" not in page.inner_text("#warnings")
     page.select_option("#units", "C")
     assert float(page.input_value("#Tm0_C")) == pytest.approx(opened["Tm0_C"] + 10.0, abs=0.05)
     assert "[°C]" in page.inner_text("label:has(#Tm0_C)")
+    assert "°C against" in page.inner_text("#warnings") and "°F" not in page.inner_text("#warnings")
     _open(page, "batch1.csv", "paper-model.json")
     assert page.input_value("#units") == "C"
 

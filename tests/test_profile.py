@@ -184,7 +184,8 @@ def test_a_whatif_change_from_after_the_log_ends_is_refused():
 
 def test_whatif_changes_within_the_models_own_error_are_one_note():
     """SYNTHETIC straight-line BT against the paper's model (far from it): a 1 degC warmer inlet moves
-    every milestone less than the model misses them on this log, and the note names them all in one line."""
+    every milestone less than the model misses them on this log, and the note names them all in one line,
+    in the unit of the table it stands under."""
     from roastlab import FittedModel
     from roastlab.io.batch import Batch
     from roastlab.workflows.whatif import whatif
@@ -200,3 +201,12 @@ def test_whatif_changes_within_the_models_own_error_are_one_note():
         notes[0].split("): ", 1)[1].count(" against ") == len(small)
         and f"{small[0]['reading']} {small[0]['what']} " in notes[0]
     )
+    # in degF, as the table it stands under: a temperature's change and error 9/5 as large, a time's the same
+    temp = next(r for r in small if r["kind"] == "temp")
+    note_F = next(n for n in w.warnings("F") if n.startswith("within the model's own error"))
+    said = note_F.split(f"{temp['reading']} {temp['what']} ")[1].split(";")[0]
+    assert (
+        said
+        == f"{9 / 5 * (temp['changed'] - temp['as_run']):+.1f} °F against {9 / 5 * (temp['as_run'] - temp['measured']):+.1f} °F"
+    )
+    assert "°C" not in note_F and note_F.count(" s against ") == notes[0].count(" s against ")

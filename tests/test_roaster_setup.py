@@ -483,9 +483,7 @@ def test_a_folder_of_logs_is_read_and_a_recording_that_is_no_roast_is_named_and_
     assert out.startswith("3 log(s)"), out
     assert "left out: aborted.alog cannot be read as a roast (no bean temperature (BT) in this log" in out
     assert "left out: empty.alog cannot be read as a roast (key timex: needs at least 2 samples" in out
-    assert (
-        "left out: dead_probe.alog cannot be read as a roast (BT never reads above the room (22 °C; highest 0" in out
-    )
+    assert "left out: dead_probe.alog cannot be read as a roast (BT never reads above the room (22 °C; highest 0" in out
     assert (
         "left out: stopped.alog cannot be read as a roast (the log ends 0:28 after CHARGE, shorter than any roast "
         "(1:00): an aborted recording, or CHARGE marked where the beans did not go in?)" in out

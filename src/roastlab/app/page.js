@@ -322,7 +322,8 @@ function drawTable() {
     (b && b.lower ? `; ${Math.round(b.level * 100)} % band median width ${dtemp(b.median_width_C).toFixed(1)} ${unit()}` : b && b.why ? `; ${b.why}` : "") +
     (state.changed && state.changedBand ? `; changed: ${dtemp(state.changedBand.median_width_C).toFixed(1)} ${unit()}` : "");
   const bandNotes = [b && b.note, state.changed && state.changedBand && state.changedBand.note];
-  $("warnings").textContent = [...(t.warnings || []), ...new Set(bandNotes.filter(Boolean))].map((w) => "note: " + w).join("\n");
+  const notes = (t.warnings_by_unit || {})[$("units").value] || t.warnings || [];  // in the table's unit
+  $("warnings").textContent = [...notes, ...new Set(bandNotes.filter(Boolean))].map((w) => "note: " + w).join("\n");
 }
 
 function changes() {

@@ -41,7 +41,7 @@ import numpy as np
 from ..errors import InputError, RoastlabError
 from ..io.files import Outputs
 from ..io.importers.mapping import is_log_by_content
-from ..metrics.profile import rate_of_rise_C_per_min
+from ..metrics.profile import DISPLAY_UNITS, rate_of_rise_C_per_min
 
 #: Largest upload [bytes]: a 30-minute log sampled every second is ~2 MB.
 MAX_UPLOAD_BYTES = 16 * 1024 * 1024
@@ -183,6 +183,13 @@ def band(model, batch) -> dict:
     if why is not None:
         return {"why": why}
     return band_dict(prediction_bands(model, [batch], BAND_LEVEL)[0], band_note(model, [batch]))
+
+
+def whatif_table(w) -> dict:
+    """A :class:`~roastlab.workflows.whatif.WhatIf`'s table as ``roastlab whatif --json`` writes it (numbers
+    in degC), and its notes, sentences, in each unit the page shows (``warnings_by_unit``): the page
+    turns the numbers into its unit itself, and a note reads in the unit of the table beside it."""
+    return {**w.to_json_dict(), "warnings_by_unit": {u: w.warnings(u) for u in DISPLAY_UNITS}}
 
 
 def band_dict(b, note: str | None = None) -> dict:
@@ -385,7 +392,7 @@ def create_app(data_dir: str | Path):
             "phases": phases(ms),
             "band": band(model, batch),
             "metrics": _fit_figures(batch, w.as_run, fitted=batch.name in model.fitted_roasts([batch])),
-            "table": w.to_json_dict(),
+            "table": whatif_table(w),
             "settings": model.column_map.setting_units() if model.column_map else {},
             "actuators": actuators,
             "report_html": _report_beside(model_path),  # the fit report, where fit-roaster wrote the model
@@ -408,7 +415,7 @@ def create_app(data_dir: str | Path):
         )
         return {
             "curves": curves(None, w.changed, session.et),
-            "table": w.to_json_dict(),
+            "table": whatif_table(w),
             "band": band_dict(w.band, w.band_note) if w.band is not None else None,
             "server_ms": round((time.perf_counter() - t0) * 1e3, 2),
         }
@@ -493,7 +500,6 @@ def create_app(data_dir: str | Path):
         }
 
     def fit_start(session: Session, body: dict) -> dict:
-        from ..metrics.profile import DISPLAY_UNITS
         from ..workflows.roaster import fit_roaster
         from ..workflows.sizes import across_sizes_sentence
         from ..workflows.survey import init_roaster, roaster_name

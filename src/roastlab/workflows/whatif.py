@@ -244,14 +244,15 @@ class WhatIf(Result):
                 lines.append(f"note: {self.band_note}")
         if any(r["projected"] for r in self.rows):
             lines.append("* past the logged DROP: where the curve would reach it at the rate of rise of its last 2 min")
-        lines += [f"note: {w}" for w in self.warnings()]
+        lines += [f"note: {w}" for w in self.warnings(units)]
         return "\n".join(lines)
 
-    def warnings(self) -> list[str]:
+    def warnings(self, units: str = "C") -> list[str]:
         """What the table alone would hide: a changed setting the model does not respond to (its
         "+0.0" is the model file's, not the roast's), milestones a curve reaches only past DROP, and
         rows where the change is smaller than the model's own error on this log (the change may be
-        real, but this log cannot confirm the model that close)."""
+        real, but this log cannot confirm the model that close). Temperatures in ``units`` ("C" or "F")."""
+        u = temp_symbol(units)
         out = [
             f"the model does not respond to the {setting} ({' and '.join(gains)} = 0 in this model file, or "
             f"negligibly above: its fit spec held {'them' if len(gains) > 1 else 'it'} at 0, or the fit found "
@@ -264,7 +265,7 @@ class WhatIf(Result):
             for col in r["projected"]:
                 who = "the model as run" if col == "as_run" else "the changed roast"
                 out.append(
-                    f"{r['reading']}: {who} reaches the first-crack temperature ({level:.1f} °C) only after the "
+                    f"{r['reading']}: {who} reaches the first-crack temperature ({display_temp(level, units):.1f} {u}) only after the "
                     f"logged DROP (at {mmss(r[col])}, projected){': it runs cooler than this log late in the roast' if col == 'as_run' else ''}"
                 )
         small = []
@@ -273,8 +274,11 @@ class WhatIf(Result):
             if a is None or c is None or m is None or r["key"].startswith("TP"):
                 continue
             if 1e-6 < abs(c - a) < abs(a - m):  # a change there is, smaller than the model's own error
-                unit = {"time": "s", "temp": "°C", "pct": "points"}[r["kind"]]
-                small.append(f"{r['reading']} {r['what']} {c - a:+.1f} {unit} against {a - m:+.1f} {unit}")
+                unit = {"time": "s", "temp": u, "pct": "points"}[r["kind"]]
+                scale = display_temp_delta(1.0, units) if r["kind"] == "temp" else 1.0
+                small.append(
+                    f"{r['reading']} {r['what']} {scale * (c - a):+.1f} {unit} against {scale * (a - m):+.1f} {unit}"
+                )
         if small:  # one line for them all: a roaster reads which, not the same sentence eight times
             out.append(
                 "within the model's own error on this log, so this log cannot confirm "
@@ -286,14 +290,15 @@ class WhatIf(Result):
         """The comparison table (:meth:`table`)."""
         return self.table()
 
-    def to_json_dict(self) -> dict:
+    def to_json_dict(self, units: str = "C") -> dict:
+        """The table as JSON: every number in degC and s; the warnings, sentences, in ``units``."""
         return {
             "batch": self.batch.name,
             "changes": self.changes,
             "judged_on": "beans",
             "levels_C": self.levels,
             "rows": self.rows,
-            "warnings": self.warnings(),
+            "warnings": self.warnings(units),
             **({"band": bands.band_summary(self.band, self.band_note)} if self.band is not None else {}),
         }
 
