@@ -1472,6 +1472,9 @@ def test_a_roaster_logging_in_fahrenheit_gets_the_fit_it_gets_in_celsius(cli, tm
         mae[unit] = float(out.split("held out: FIT")[1].split("MAE ")[1].split(f" °{unit}")[0])
         report = (tmp_path / f"cfg{unit}" / "report.md").read_text()
         assert (f"| model MAE °{unit} |" in report) and (("Temperatures in °F" in report) == (unit == "F"))
+        # the first fit's misses that set ET's weight, and the baseline's offset, in the same unit
+        baseline = next(line for line in report.splitlines() if line.startswith("Baseline:"))
+        assert f" °{unit} RMS and ET by " in report and re.search(rf"offset [-+]\d+\.\d\d deg{unit},", baseline)
     for name in ("plant.toml", "fit.toml"):
         assert (tmp_path / "cfgC" / name).read_text() == (tmp_path / "cfgF" / name).read_text(), name
     assert 'name = "skywalker"' in (tmp_path / "cfgC" / "plant.toml").read_text()

@@ -260,7 +260,7 @@ def _validate_baseline(args, outputs) -> int:
     batches, plant_spec = load_batches(args)
     result = validation_of_first_order(batches, params, str(plant_spec))
     units = args.units or logs_temp_unit(batches)
-    print(result.table(f"first-order baseline ({describe(params)})", units))
+    print(result.table(f"first-order baseline ({describe(params, units)})", units))
     with outputs as out:
         if args.json:
             out.write_text(args.json, json_text(baseline_document(params, result)))

@@ -86,12 +86,18 @@ def fit_first_order(batches) -> dict:
     }
 
 
-def describe(params: dict) -> str:
-    """One line: the baseline's fitted values."""
+def describe(params: dict, units: str = "C") -> str:
+    """One line: the baseline's fitted values, its offset and gains (temperature differences) in ``units``
+    ("C" or "F")."""
+    from ..metrics.profile import display_temp_delta
+
+    u = "degF" if units == "F" else "degC"  # the ASCII spelling this line has always had
     gains = "".join(
-        f", {k.removesuffix('_gain_C')} gain {params[k]:+.3g} degC/unit" for k in SETTING_GAINS.values() if k in params
+        f", {k.removesuffix('_gain_C')} gain {display_temp_delta(params[k], units):+.3g} {u}/unit"
+        for k in SETTING_GAINS.values()
+        if k in params
     )
-    return f"tau {params['tau_s']:.1f} s, offset {params['offset_C']:+.2f} degC{gains}"
+    return f"tau {params['tau_s']:.1f} s, offset {display_temp_delta(params['offset_C'], units):+.2f} {u}{gains}"
 
 
 def validate_first_order(batches, params: dict):

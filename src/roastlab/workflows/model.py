@@ -467,9 +467,13 @@ class FittedModel:
         lines += [f"warning: {w}" for w in fit.get("warnings", [])]
         return "\n".join(lines)
 
-    def residual_weight_lines(self) -> list[str]:
+    def residual_weight_lines(self, units: str = "C") -> list[str]:
         """One line per output whose weight the fit set from its residuals (a spec's ``"residual"``,
-        :func:`roastlab.fit.identify.residual_weights`), with the first fit's errors it came from."""
+        :func:`roastlab.fit.identify.residual_weights`), with the first fit's errors it came from (in
+        ``units``, "C" or "F")."""
+        from ..metrics.profile import display_temp_delta, temp_symbol
+
+        u = temp_symbol(units)
 
         def table(d, key) -> dict:  # a model file is a user's file: anything but a table reads as none
             v = d.get(key) if isinstance(d, dict) else None
@@ -485,7 +489,8 @@ class FittedModel:
             if all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in (w, *rms.values())):
                 lines.append(
                     f"weight of {name} from the residuals: {w:.3g} (a first fit at weight 1 missed Ta by "
-                    f"{rms['Ta']:.2f} °C RMS and {name} by {rms[name]:.2f} °C RMS: (Ta/{name})^2)"
+                    f"{display_temp_delta(rms['Ta'], units):.2f} {u} RMS and {name} by "
+                    f"{display_temp_delta(rms[name], units):.2f} {u} RMS: (Ta/{name})^2)"
                 )
         return lines
 

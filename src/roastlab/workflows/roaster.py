@@ -273,7 +273,7 @@ def fit_roaster(
     _, b_val = validate_first_order(val_b, base)
     bf, bv = average_metrics(b_fit), average_metrics(b_val)
     verdict = below_baseline(v_val.average["FIT"], bv["FIT"], cmap)
-    weighed = [f"{line[0].upper()}{line[1:]}." for line in model.residual_weight_lines()]
+    weighed = [f"{line[0].upper()}{line[1:]}." for line in model.residual_weight_lines(units)]
     roaster_name = model.plant.name if model.plant else "roaster"
     lines = [
         f"# {roaster_name}: fitted by roastlab fit-roaster",
@@ -286,7 +286,8 @@ def fit_roaster(
         *(
             [
                 f"Temperatures in °F, {'the unit the logs were recorded in' if recorded == 'F' else 'as asked'}; the "
-                "model file and the fit's own sentences below in °C.",
+                "model file, the parameters' table and what the fit says of its states (a failed fit's drum and "
+                "beans) in °C.",
                 "",
             ]
             if units == "F"
@@ -310,7 +311,7 @@ def fit_roaster(
         f"| fit | {len(fit_b)} | {v_fit.average['FIT']:.1f} | {dT(v_fit.average['MAE']):.2f} | {bf['FIT']:.1f} | {dT(bf['MAE']):.2f} |",
         f"| held out | {len(val_b)} | {v_val.average['FIT']:.1f} | {dT(v_val.average['MAE']):.2f} | {bv['FIT']:.1f} | {dT(bv['MAE']):.2f} |",
         "",
-        f"Baseline: the first-order lag fed the same inputs ({describe(base)}).",
+        f"Baseline: the first-order lag fed the same inputs ({describe(base, units)}).",
         "",
         *weighed,
         *([""] if weighed else []),
