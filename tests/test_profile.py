@@ -63,6 +63,13 @@ def test_implausible_states_only_where_the_heat_must_come_through_the_drum():
     hot_metal = SimpleNamespace(time_s=t, Ta_C=ta, Tb_C=beans, Tm_C=beans + 40.0, Tgi_C=np.full(t.size, 22.0))
     assert "colder than the beans" in implausible_states(room)[0]
     assert implausible_states(gas) == [] and implausible_states(hot_metal) == []
+    # the drum and beans it names, in the unit asked (a roaster logging in degF reads degF)
+    after = t >= 60.0  # the probe's turning point
+    said = {u: implausible_states(room, u)[0].split("(metal ")[1].split(")")[0] for u in "CF"}
+    f = lambda c: 9 / 5 * c + 32  # noqa: E731
+    m, b = cold_metal[after], beans[after]
+    assert said["C"] == f"{m.min():.0f}-{m.max():.0f} °C, beans {b.min():.0f}-{b.max():.0f} °C"
+    assert said["F"] == f"{f(m.min()):.0f}-{f(m.max()):.0f} °F, beans {f(b.min()):.0f}-{f(b.max()):.0f} °F"
 
 
 def test_beans_far_from_where_coffee_cracks_at_the_first_crack_mark_are_implausible():
@@ -84,6 +91,10 @@ def test_beans_far_from_where_coffee_cracks_at_the_first_crack_mark_are_implausi
 
     cold = roast(FIRST_CRACK_BEAN_C - FIRST_CRACK_TOLERANCE_C - 15.0, {"FCs": 480.0})
     assert "at the log's first crack (8:00)" in implausible_states(cold)[0]
+    tb = 9 / 5 * (FIRST_CRACK_BEAN_C - FIRST_CRACK_TOLERANCE_C - 15.0) + 32
+    cracks = 9 / 5 * FIRST_CRACK_BEAN_C + 32
+    assert implausible_states(cold, "F")[0].startswith(f"beans at {tb:.0f} °F at the log's first crack (8:00), "
+                                                       f"where coffee cracks at about {cracks:.0f} °F: ")  # fmt: skip
     assert implausible_states(roast(FIRST_CRACK_BEAN_C - 6.0, {"FCs": 480.0})) == []
     assert implausible_states(roast(140.0, {})) == []  # no mark: nothing to say
     assert implausible_states(roast(140.0, {"FCs": 900.0})) == []  # a mark past the log's end

@@ -1475,6 +1475,10 @@ def test_a_roaster_logging_in_fahrenheit_gets_the_fit_it_gets_in_celsius(cli, tm
         # the first fit's misses that set ET's weight, and the baseline's offset, in the same unit
         baseline = next(line for line in report.splitlines() if line.startswith("Baseline:"))
         assert f" °{unit} RMS and ET by " in report and re.search(rf"offset [-+]\d+\.\d\d deg{unit},", baseline)
+        if unit == "F":  # degC only where the report says: the header naming it and the parameters' table
+            celsius = [ln for ln in report.splitlines() if "°C" in ln or "degC" in ln]
+            assert celsius[0].startswith("Temperatures in °F") and all(ln.startswith("| ") for ln in celsius[1:])
+            assert "Refitted: " in report  # these six logs' first fit fails: its sentence's drum and beans in degF
     for name in ("plant.toml", "fit.toml"):
         assert (tmp_path / "cfgC" / name).read_text() == (tmp_path / "cfgF" / name).read_text(), name
     assert 'name = "skywalker"' in (tmp_path / "cfgC" / "plant.toml").read_text()

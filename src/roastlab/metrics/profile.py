@@ -403,8 +403,9 @@ def et_reads_beans(time_s, et_C, bt_C, room_C: float) -> bool | None:
     return bool(float(et[ok_et].min()) - room_C < BEANS_SHARE * (bt_low - room_C))
 
 
-def implausible_states(result) -> list[str]:
-    """What a simulation's states say that the machine cannot do (empty when nothing).
+def implausible_states(result, units: str = "C") -> list[str]:
+    """What a simulation's states say that the machine cannot do (empty when nothing), its temperatures
+    in ``units`` ("C" or "F").
 
     On a machine whose logged inlet air is colder than the beans (room air drawn into an
     electric or induction drum: ``Tgi_C`` below ``Tb_C`` for most of the roast), the heat reaches
@@ -418,7 +419,17 @@ def implausible_states(result) -> list[str]:
     a probe curve alone can be fitted as well with beans 60 degC colder and the probe in hot air.
     ``result`` has ``time_s``, ``Ta_C``, ``Tb_C``, ``Tm_C``, ``Tgi_C`` (and ``meta``).
     """
-    return _metal_below_beans(result) + _beans_at_first_crack(result)
+    return _metal_below_beans(result, units) + _beans_at_first_crack(result, units)
+
+
+def implausible_summary(results, units: str = "C") -> str | None:
+    """:func:`implausible_states` of simulated batches (each with a ``name``) in one sentence: the
+    first batch's, and how many more are alike; None where every batch's states are possible. The
+    sentence a fit that failed is marked with (:attr:`roastlab.workflows.model.FittedModel.failed`)."""
+    odd = [f"{r.name}: {w}" for r in results for w in implausible_states(r, units)]
+    if not odd:
+        return None
+    return odd[0] if len(odd) == 1 else f"{odd[0]} (and {len(odd) - 1} more batch(es) alike)"
 
 
 def first_crack_s(time_s, events: dict) -> float | None:
@@ -442,7 +453,7 @@ def beans_at_first_crack(result) -> tuple[float, float] | None:
 LOG_THE_HEATER = "log the heater's setting (Artisan's event sliders or an extra device)"
 
 
-def _beans_at_first_crack(result) -> list[str]:
+def _beans_at_first_crack(result, units: str = "C") -> list[str]:
     """The beans far from :data:`~roastlab.model.constants.FIRST_CRACK_BEAN_C` at the log's FCs mark
     (:func:`beans_at_first_crack`), by more than :data:`FIRST_CRACK_TOLERANCE_C`, with what to do: read
     the mark as a bean reading where the fit did not (:func:`_mark_fitted`); where it did and still
@@ -454,9 +465,10 @@ def _beans_at_first_crack(result) -> list[str]:
     fc_s, tb = mark
     if abs(tb - FIRST_CRACK_BEAN_C) <= FIRST_CRACK_TOLERANCE_C:
         return []
+    u = temp_symbol(units)
     where = (
-        f"beans at {tb:.0f} °C at the log's first crack ({mmss(fc_s)}), where coffee cracks at about "
-        f"{FIRST_CRACK_BEAN_C:.0f} °C: "
+        f"beans at {display_temp(tb, units):.0f} {u} at the log's first crack ({mmss(fc_s)}), where coffee cracks "
+        f"at about {display_temp(FIRST_CRACK_BEAN_C, units):.0f} {u}: "
     )
     if not _mark_fitted(result, fc_s):
         return [
@@ -486,7 +498,7 @@ def _mark_fitted(result, fc_s: float) -> bool:
     return bool(np.isfinite(np.asarray(tb2, dtype=float)[int(np.argmin(np.abs(t - fc_s)))]))
 
 
-def _metal_below_beans(result) -> list[str]:
+def _metal_below_beans(result, units: str = "C") -> list[str]:
     """The drum metal below the beans for most of the roast where the inlet air cannot heat them."""
     t = np.asarray(result.time_s, dtype=float)
     tp_s, _ = turning_point(t, result.Ta_C)
@@ -498,10 +510,14 @@ def _metal_below_beans(result) -> list[str]:
         return []  # the inlet gas can heat the beans: metal below them is possible
     below = np.asarray(result.Tm_C)[after] < tb
     if below.mean() > METAL_BELOW_BEANS_SHARE:
-        tm, tb = np.asarray(result.Tm_C)[after], np.asarray(result.Tb_C)[after]
+        tm, tb = (
+            display_temp(np.asarray(result.Tm_C)[after], units),
+            display_temp(np.asarray(result.Tb_C)[after], units),
+        )
+        u = temp_symbol(units)
         return [
             f"drum metal colder than the beans for {100 * below.mean():.0f} % of the roast after the turning point "
-            f"(metal {tm.min():.0f}-{tm.max():.0f} °C, beans {tb.min():.0f}-{tb.max():.0f} °C): physically "
+            f"(metal {tm.min():.0f}-{tm.max():.0f} {u}, beans {tb.min():.0f}-{tb.max():.0f} {u}): physically "
             "implausible for a drum roaster, the fit found another path for the heat; let the fit tell the heater's "
             "paths apart: weight the logged ET ([weights] ET = 1 in the fit spec, or --weight ET=1), or, where no ET "
             "is logged, let the heater heat the drum alone (remove Tgi_gain_C from [free])"

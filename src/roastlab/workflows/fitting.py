@@ -30,13 +30,17 @@ from ..io.batch import Batch, first_of_each_roast
 from ..io.fitspec import FitSpec, load_fit_spec
 from ..io.importers.mapping import ET_NOT_DRUM_AIR, ColumnMap
 from ..io.plants import load_plant
-from ..metrics.profile import implausible_states
+from ..metrics.profile import implausible_summary
 from ..model.bed import PAPER_BED, BedLaws
 from ..model.parameters import N_STARTS, REGISTRY, RESIDUAL_WEIGHT, STATE0, THETA_NAMES, THETA_START
 from ..report.result import Result
 from ..sim.population import pack_batches
 from ..sim.simulate import InitialState
 from .model import PAPER_INITIAL, PLACEHOLDER_GG_KG_S, FittedModel, load_log, provenance
+
+#: How a fit whose states the machine cannot have is marked, before the sentence that says which
+#: (:func:`~roastlab.metrics.profile.implausible_summary`; :attr:`FittedModel.failed`).
+FAILED_STATES = "non-physical states: "
 
 
 @dataclasses.dataclass
@@ -63,6 +67,22 @@ class FitResult(Result):
     def failed(self) -> str | None:
         """Why the fit failed (states the machine cannot have, :attr:`FittedModel.failed`), or None."""
         return self.model.failed
+
+    def failed_in(self, units: str = "C") -> str | None:
+        """:attr:`failed` with its temperatures in ``units`` ("C" or "F"), said again from the fit set's
+        states (the model file keeps it in degC)."""
+        if self.failed is None or units == "C":
+            return self.failed
+        summary = implausible_summary(self.validation.results, units)
+        return f"{FAILED_STATES}{summary}" if summary else self.failed
+
+    def warnings_in(self, units: str = "C") -> list[str]:
+        """:attr:`warnings` with the one about the states (:func:`implausible_summary`) in ``units``."""
+        said = None if units == "C" else implausible_summary(self.validation.results)
+        if said is None:
+            return self.warnings
+        there = implausible_summary(self.validation.results, units)
+        return [there if w == said else w for w in self.warnings]
 
     def report(self) -> str:
         """Text report in the spirit of lmfit's ``fit_report``: values, errors, fit figures, warnings."""
@@ -268,12 +288,11 @@ def fit(
         doc["fit"]["warnings"] = ident.warnings
     # a fit whose states a drum roaster cannot have has failed, however small its SSR (metrics.profile);
     # the model file is still written, marked, so it can be looked at
-    odd = [f"{r.name}: {w}" for r in validation.results for w in implausible_states(r)]
-    if odd:
-        summary = odd[0] if len(odd) == 1 else f"{odd[0]} (and {len(odd) - 1} more batch(es) alike)"
+    summary = implausible_summary(validation.results)
+    if summary:
         ident.warnings.append(summary)
         doc["fit"]["warnings"] = ident.warnings
-        doc["fit"]["failed"] = f"non-physical states: {summary}"
+        doc["fit"]["failed"] = f"{FAILED_STATES}{summary}"
     # the roast-to-roast part of the prediction bands (evaluate.bands): each log's probe error by time
     # (each log's error as predicted by the fit redone without it, fit.uncertainty.held_out_residuals; the fit set's own
     # errors when the probe was not fitted)

@@ -264,7 +264,7 @@ def fit_roaster(
 
     first = "; first run: compiling, 2-3 min once" if cold() else ""  # the kernels, then cached
     stage(0, 0, f"fitting {len(fit_b)} logs{first}")
-    result, spec, refit = fit_checked(fit_b, d, spec, cmap, seed, progress)
+    result, spec, refit = fit_checked(fit_b, d, spec, cmap, seed, progress, units)
     model = result.model
     stage(0, 0, "validating, the baseline and the band")
     v_fit, v_val = model.validate(fit_b), model.validate(val_b)
@@ -278,7 +278,7 @@ def fit_roaster(
     lines = [
         f"# {roaster_name}: fitted by roastlab fit-roaster",
         "",
-        *([f"**The fit failed**: {result.failed}.", ""] if result.failed else []),
+        *([f"**The fit failed**: {result.failed_in(units)}.", ""] if result.failed else []),
         *([f"**Not usable**: {verdict}.", ""] if verdict else []),
         f"{len(batches)} logs sorted by {by}, split alternately: {len(fit_b)} fit, {len(val_b)} held out "
         f"(the fit never saw them). Fit in {result.identification.wall_s:.1f} s.",
@@ -286,8 +286,7 @@ def fit_roaster(
         *(
             [
                 f"Temperatures in °F, {'the unit the logs were recorded in' if recorded == 'F' else 'as asked'}; the "
-                "model file, the parameters' table and what the fit says of its states (a failed fit's drum and "
-                "beans) in °C.",
+                "model file and the parameters' table in °C.",
                 "",
             ]
             if units == "F"
@@ -321,7 +320,7 @@ def fit_roaster(
     for name, value, se, unit, how in model.table():
         lines.append(f"| {name} | {value or how} | {se or ('on a bound' if how == 'fitted' else '-')} | {unit} |")
     lines += ["", "What the fit says in plain words:", ""]
-    lines += [f"- {w}" for w in result.warnings] or ["- no warnings"]
+    lines += [f"- {w}" for w in result.warnings_in(units)] or ["- no warnings"]
     band, bands = held_out_band(model, val_b)
     shaded = f", the {100 * band['level']:.0f} % prediction band shaded" if band else ""
     lines += [
@@ -373,16 +372,16 @@ def fit_roaster(
         size_b = [batches[k] for k in sizes.fit]
         size_spec, size_depth = depth_held_on_one_size(spec, size_b)
         stage(0, 0, f"fitting {sizes.fit_size} alone ({len(size_b)} logs) for the other sizes")
-        size_fit, _, size_refit = fit_checked(size_b, d, size_spec, cmap, seed, progress)
+        size_fit, _, size_refit = fit_checked(size_b, d, size_spec, cmap, seed, progress, units)
         across = across_sizes(size_fit.model, batches, sizes)
-        across["failed"], across["refit"] = size_fit.failed, size_refit
+        across["failed"], across["refit"] = size_fit.failed_in(units), size_refit
         lines += across_sizes_lines(across, SIZES_FIGURE, units)
         if size_depth:
             lines += ["", f"The fit on {sizes.fit_size} alone {size_depth}."]
         if size_refit:
             lines += ["", f"Refitted (the fit on {sizes.fit_size} alone): {size_refit}."]
         if size_fit.failed:
-            lines += ["", f"**The fit on {sizes.fit_size} alone failed**: {size_fit.failed}."]
+            lines += ["", f"**The fit on {sizes.fit_size} alone failed**: {size_fit.failed_in(units)}."]
     from ..report.figures import figure_bytes, plot_fit
     from ..report.markdown import html_document
 
@@ -420,8 +419,8 @@ def fit_roaster(
             "by_log": every.cv_by_group,
         },
         "across_sizes": across,
-        "warnings": result.warnings,
-        "failed": result.failed,
+        "warnings": result.warnings_in(units),
+        "failed": result.failed_in(units),
         "model": d / "model.json",
         "report": d / "report.md",
         "report_html": d / "report.html",
@@ -445,10 +444,11 @@ def depth_held_on_one_size(spec, batches):
     return held, f"holds the probe's depth scale at {depth.start:g} m: logs of one batch size cannot determine it"
 
 
-def fit_checked(batches, config_dir: Path, spec, column_map, seed: int, progress=None):
+def fit_checked(batches, config_dir: Path, spec, column_map, seed: int, progress=None, units: str = "C"):
     """Fit ``batches`` with ``spec`` (:func:`roastlab.workflows.fitting.fit`); a fit that fails on
     its states with both of the heater's paths free is refitted with the drum's path alone
-    (:func:`drum_path_alone`). Returns ``(result, spec as used, refit sentence or None)``."""
+    (:func:`drum_path_alone`). Returns ``(result, spec as used, refit sentence or None)``, the sentence's
+    temperatures in ``units`` ("C" or "F")."""
     from .fitting import fit
 
     plant = Path(config_dir) / "plant.toml"
@@ -458,7 +458,7 @@ def fit_checked(batches, config_dir: Path, spec, column_map, seed: int, progress
         again = fit(batches, plant, drum_only, column_map=column_map, progress=progress, seed=seed)
         if not again.failed:
             refit = (
-                f"with the heater free to heat the air and the drum, the fit failed on {result.failed}; "
+                f"with the heater free to heat the air and the drum, the fit failed on {result.failed_in(units)}; "
                 "refitted with the heater heating the drum alone (Tgi_gain_C held at 0), the path of a drum "
                 "roaster; to keep this, remove Tgi_gain_C from [free] in fit.toml"
             )
