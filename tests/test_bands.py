@@ -132,7 +132,8 @@ def test_validate_band_cli(fitted, tmp_path):
 
 
 def test_validate_band_reports_each_batch_size(fitted, tmp_path):
-    """Logs of two sizes: a line and a JSON entry per size, its share the samples-weighted share of its logs."""
+    """Logs of two sizes: a line and a JSON entry per size, its share the samples-weighted share of its logs,
+    and its mean FIT and MAE over the held-out logs (the batch-size question, asked of any model)."""
     import json
 
     from roastlab.io.batch import write_batch_csv
@@ -155,6 +156,14 @@ def test_validate_band_reports_each_batch_size(fitted, tmp_path):
     assert by_size["180 kg"]["logs"] == 2 and by_size["180 kg"]["n"] == sum(r["n"] for r in heavy)
     want = sum(r["n"] * r["inside"] for r in heavy) / sum(r["n"] for r in heavy)
     assert by_size["180 kg"]["inside"] == pytest.approx(want)
+    # and the metrics by size, of the logs held out from the fit (every log where none was fitted on)
+    doc = json.loads((tmp_path / "v.json").read_text())
+    scored = [r for r in doc["batches"] if r["name"] not in doc.get("not_held_out", {})]
+    fit_of = {g["size"]: g for g in doc["by_size"]}
+    heavy_fit = [r["FIT"] for r in scored if r["name"] in ("b1", "b2")]
+    assert fit_of["180 kg"]["logs"] == 2 and fit_of["180 kg"]["FIT"] == pytest.approx(np.mean(heavy_fit))
+    line = next(ln for ln in out.stdout.splitlines() if ln.startswith("size 180 kg (2 logs)") and "FIT" in ln)
+    assert f"FIT {np.mean(heavy_fit):>6.1f} %" in line and line.endswith(" °C")
 
 
 def test_a_band_says_when_a_batch_size_lies_outside_the_fitted_ones():

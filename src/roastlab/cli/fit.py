@@ -108,6 +108,7 @@ def _identify_per_batch(args, batches, plant_spec, fix, bounds, outputs) -> int:
 
 
 def cmd_validate(args) -> int:
+    from ..evaluate.validate import metrics_by_size
     from ..io.batch import logs_temp_unit
     from ..io.files import Outputs
     from ..metrics.profile import display_temp_delta, temp_symbol
@@ -152,6 +153,15 @@ def cmd_validate(args) -> int:
                 f"held out only ({len(held)} of {len(result.names)} logs; the others are named above): "
                 f"FIT {avg['FIT']:.1f} %, MAE {display_temp_delta(avg['MAE'], units):.2f} {temp_symbol(units)}"
             )
+    kg = {b.name: b.Mb_kg for b in batches}  # each scored log's green weight, by its name
+    held_at = [k for k, name in enumerate(result.names) if name not in fitted]
+    if by_size := metrics_by_size(result.rows, [kg.get(name) for name in result.names], held_at):
+        doc["by_size"] = by_size  # degC, as the rest of the document
+        print(f"\nby batch size ({'the held-out logs' if fitted else 'every log'}):")
+        for g in by_size:
+            label = f"size {g['size']} ({g['logs']} log{'s' * (g['logs'] > 1)})"
+            mae = display_temp_delta(g["MAE"], units)
+            print(f"{label:<36} FIT {g['FIT']:>6.1f} %  MAE {mae:>6.2f} {temp_symbol(units)}")
     bands = None
     if args.band is not None:
         doc["band"], bands = _band_table(model, batches, args.band, units)

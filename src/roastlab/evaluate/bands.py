@@ -352,20 +352,10 @@ def inside_by_size(rows: list[dict]) -> list[dict]:
     >>> [(g["size"], g["logs"], round(g["inside"], 2)) for g in inside_by_size(rows)]
     [('0.2 kg', 1, 0.2), ('0.49-0.5 kg', 2, 0.95)]
     """
-    from .metrics import size_labels
+    from .metrics import size_groups
 
-    masses = [r.get("Mb_kg") for r in rows]
-    if not rows or not all(isinstance(m, (int, float)) and m > 0 for m in masses):
-        return []
-    labels, _ = size_labels(masses)
-    if len(set(labels)) < 2:
-        return []
-    out = []
-    for label in sorted(set(labels), key=lambda lab: min(m for m, x in zip(masses, labels) if x == lab)):
-        members = [r for r, x in zip(rows, labels) if x == label]
-        out.append({"size": label, "logs": len(members), "n": sum(r["n"] for r in members),
-                    "inside": share_inside(members)})  # fmt: skip
-    return out
+    return [{"size": label, "logs": len(at), "n": sum(rows[i]["n"] for i in at), "inside": share_inside([rows[i] for i in at])}
+            for label, at in size_groups([r.get("Mb_kg") for r in rows])]  # fmt: skip
 
 
 def band_report(model, batches, level: float = BAND_LEVEL) -> tuple[dict, list[Band]]:

@@ -49,6 +49,24 @@ def size_labels(masses_kg, step_kg: float | None = None) -> tuple[list[str], flo
     return [labels[k] for k in keys], step_kg
 
 
+def size_groups(masses_kg) -> list[tuple[str, list[int]]]:
+    """The positions of ``masses_kg`` [kg] by batch size (:func:`size_labels`), lightest size first:
+    ``[(label, [i, ...]), ...]``; empty unless every mass is a positive weight and they make more than
+    one size.
+
+    >>> size_groups([0.5, 0.2, 0.49])
+    [('0.2 kg', [1]), ('0.49-0.5 kg', [0, 2])]
+    """
+    masses = list(masses_kg)
+    if not masses or not all(isinstance(m, (int, float)) and not isinstance(m, bool) and m > 0 for m in masses):
+        return []
+    labels, _ = size_labels(masses)
+    if len(set(labels)) < 2:
+        return []
+    order = sorted(set(labels), key=lambda lab: min(m for m, x in zip(masses, labels) if x == lab))
+    return [(lab, [i for i, x in enumerate(labels) if x == lab]) for lab in order]
+
+
 METRIC_NAMES = ("n", "SSR", "norm", "MAE", "MPE", "MAPE", "FIT", "rho")
 #: The power of a temperature difference each index carries (SSR in K², norm and MAE in K); the
 #: others have none: FIT and rho are ratios, and MPE and MAPE are percent of the reading in degC, as

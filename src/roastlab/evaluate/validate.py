@@ -157,6 +157,27 @@ class ValidationResult(Result):
         return "\n".join(lines)
 
 
+def metrics_by_size(rows: list[dict], masses_kg, scored=None) -> list[dict]:
+    """The mean metrics (:func:`~roastlab.evaluate.metrics.average_metrics`) of ``rows`` by batch size
+    (:func:`~roastlab.evaluate.metrics.size_groups` of all their green weights ``masses_kg`` [kg], lightest
+    first): ``[{"size", "logs", **metrics}]`` over the rows whose position is in ``scored`` (default all;
+    the held-out ones, say), a size with none of them left out; empty unless the rows make more than one size.
+
+    >>> rows = [{k: v for k in METRIC_NAMES} for v in (80.0, 90.0, 70.0)]
+    >>> [(g["size"], g["logs"], g["FIT"]) for g in metrics_by_size(rows, [0.5, 0.49, 0.2], scored={1, 2})]
+    [('0.2 kg', 1, 70.0), ('0.49-0.5 kg', 1, 90.0)]
+    """
+    from .metrics import size_groups
+
+    keep = set(range(len(rows))) if scored is None else set(scored)
+    out = []
+    for label, at in size_groups(masses_kg):
+        members = [rows[i] for i in at if i in keep]
+        if members:
+            out.append({"size": label, "logs": len(members), **average_metrics(members)})
+    return out
+
+
 def _fmt(key, value) -> str:
     if key == "n":
         return f"{int(value):>11d}"
