@@ -405,7 +405,8 @@ def add_parsers(sub) -> None:
         description="Apply MODEL.json (all of it: theta, fitted flow and constants, initial states; default: the "
         "paper's theta*) to each batch and report n, SSR, ||e||, MAE, MPE, MAPE, FIT, rho per batch and on average. "
         "A batch the model was fitted on (by name, or a copy of one by its recording start) or one roast given "
-        "twice is named, and the held-out batches' own average is printed beside the table's.",
+        "twice is named, and the held-out batches' own average is printed beside the table's; logs of more than "
+        "one batch size get their FIT and MAE by size (the held-out ones). Temperatures in the logs' unit.",
         epilog="example: roastlab validate --model model.json --plant 360kg dataset-V/ --predictions pred/",
     )
     add_batch_options(
