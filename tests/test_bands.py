@@ -166,6 +166,27 @@ def test_validate_band_reports_each_batch_size(fitted, tmp_path):
     assert f"FIT {np.mean(heavy_fit):>6.1f} %" in line and line.endswith(" °C")
 
 
+def test_a_validation_figure_of_several_sizes_shows_each_size_in_turn(fitted):
+    """Logs of two sizes, the heavier listed first: the panels take a log of each size in turn, lightest
+    first, each titled with its batch, and the title says how they were chosen (validate --plot)."""
+    from roastlab.evaluate.validate import each_size_in_turn
+    from roastlab.report.figures import plot_fit
+    from test_compare import synthetic_sizes
+
+    model, batches, _ = fitted
+    heavy = [b for b in synthetic_sizes(seed=10) if b.Mb_kg == 180.0]
+    logs = [*heavy, batches[3]]  # 180, 180, 120 kg
+    result = model.validate(logs)
+    masses = [b.Mb_kg for b in logs]
+    turns = each_size_in_turn(masses)
+    assert turns == [2, 0, 1]
+    labels = {i: f"{name} ({masses[i]:.3g} kg)" for i, name in enumerate(result.names)}
+    fig = plot_fit(result, which=(turns, "each size in turn:"), labels=labels, max_panels=2)
+    titles = [ax.get_title() for ax in fig.axes if ax.get_title()]
+    assert [t.split(":")[0] for t in titles] == [labels[2], labels[0]]
+    assert fig.get_suptitle() == "(each size in turn: 2 of 3 batches)"
+
+
 def test_a_band_says_when_a_batch_size_lies_outside_the_fitted_ones():
     """The spread keeps the fitted green weights' range; a batch outside it gets a note, inside none."""
     from types import SimpleNamespace

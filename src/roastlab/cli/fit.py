@@ -108,7 +108,7 @@ def _identify_per_batch(args, batches, plant_spec, fix, bounds, outputs) -> int:
 
 
 def cmd_validate(args) -> int:
-    from ..evaluate.validate import metrics_by_size
+    from ..evaluate.validate import each_size_in_turn, metrics_by_size
     from ..io.batch import logs_temp_unit
     from ..io.files import Outputs
     from ..metrics.profile import display_temp_delta, temp_symbol
@@ -154,8 +154,9 @@ def cmd_validate(args) -> int:
                 f"FIT {avg['FIT']:.1f} %, MAE {display_temp_delta(avg['MAE'], units):.2f} {temp_symbol(units)}"
             )
     kg = {b.name: b.Mb_kg for b in batches}  # each scored log's green weight, by its name
+    masses = [kg.get(name) for name in result.names]
     held_at = [k for k, name in enumerate(result.names) if name not in fitted]
-    if by_size := metrics_by_size(result.rows, [kg.get(name) for name in result.names], held_at):
+    if by_size := metrics_by_size(result.rows, masses, held_at):
         doc["by_size"] = by_size  # degC, as the rest of the document
         print(f"\nby batch size ({'the held-out logs' if fitted else 'every log'}):")
         for g in by_size:
@@ -169,6 +170,8 @@ def cmd_validate(args) -> int:
         if args.json:
             out.write_text(args.json, json_text(doc))
         if args.plot:
+            # logs of several sizes: a panel of each size in turn (held-out logs), each named with its batch
+            turns = each_size_in_turn(masses, held_at) if by_size else []
             plot_fit(
                 result,
                 args.plot,
@@ -176,6 +179,8 @@ def cmd_validate(args) -> int:
                 outputs=out,
                 bands=bands,
                 units=units,
+                which=(turns, "each size's held-out logs in turn:") if turns else None,
+                labels={i: f"{name} ({masses[i]:.3g} kg)" for i, name in enumerate(result.names)} if turns else None,
             )
         if args.predictions:
             written = set()

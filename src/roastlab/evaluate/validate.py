@@ -178,6 +178,21 @@ def metrics_by_size(rows: list[dict], masses_kg, scored=None) -> list[dict]:
     return out
 
 
+def each_size_in_turn(masses_kg, scored=None) -> list[int]:
+    """Positions of the batches by size in turn: the first scored batch (``scored``, default all) of each
+    batch size (:func:`~roastlab.evaluate.metrics.size_groups`, lightest first), then the second of each,
+    and so on; what a figure of a few panels shows of logs of several sizes. Empty for one size.
+
+    >>> each_size_in_turn([0.5, 0.49, 0.2, 0.5, 0.9], scored={1, 2, 3, 4})
+    [2, 1, 4, 3]
+    """
+    from .metrics import size_groups
+
+    keep = set(range(len(list(masses_kg)))) if scored is None else set(scored)
+    groups = [[i for i in at if i in keep] for _, at in size_groups(masses_kg)]
+    return [g[k] for k in range(max((len(g) for g in groups), default=0)) for g in groups if k < len(g)]
+
+
 def _fmt(key, value) -> str:
     if key == "n":
         return f"{int(value):>11d}"

@@ -209,21 +209,27 @@ def plot_simulation(result, path=None, title=None, outputs=None, events=None):
     return finish_figure(fig, path, title, outputs)
 
 
-def plot_fit(result, path=None, title=None, max_panels: int = 8, outputs=None, bands=None, units: str = "C"):
+def plot_fit(result, path=None, title=None, max_panels: int = 8, outputs=None, bands=None, units: str = "C",
+             which=None, labels=None):  # fmt: skip
     """Measured vs predicted BT per batch of a ValidationResult, each with its residual below;
     ``bands`` (:func:`roastlab.evaluate.bands.prediction_bands`, one per batch) shaded; the
-    temperatures' scales and each panel's MAE in ``units`` ("C" or "F"; the curves are degC)."""
-    k = min(len(result.names), max_panels)
+    temperatures' scales and each panel's MAE in ``units`` ("C" or "F"; the curves are degC).
+    ``which``: ``(positions, why)``, the batches to draw in that order and what chose them (the title
+    says it when they are not all), else the first ``max_panels``; ``labels``: a panel's title by position,
+    in place of the batch's name."""
+    shown, why = which if which is not None else (list(range(len(result.names))), "first")
+    shown = list(shown)[:max_panels]
+    k = len(shown)
     cols = 2 if k > 1 else 1
     rows = (k + cols - 1) // cols
     fig = new_figure(figsize=(6.5 * cols, 4.6 * rows), layout="constrained")
     grid = fig.add_gridspec(rows * 2, cols, height_ratios=[3, 1] * rows)
     entries = {}  # one legend for all panels, below them: in a panel it covered the curves' ends or the RoR's peak
-    for i in range(k):
-        r, c = divmod(i, cols)
+    for at, i in enumerate(shown):
+        r, c = divmod(at, cols)
         ax = fig.add_subplot(grid[2 * r, c])
         res = fig.add_subplot(grid[2 * r + 1, c], sharex=ax)
-        _profile_panel(ax, result, i, legend=False, units=units)
+        _profile_panel(ax, result, i, label=(labels or {}).get(i), legend=False, units=units)
         if bands is not None:
             _shade_band(ax, bands[i], "tab:green", "prediction band")
         t = result.time_s[i] / 60.0
@@ -257,7 +263,7 @@ def plot_fit(result, path=None, title=None, max_panels: int = 8, outputs=None, b
     if entries:
         fig.legend(list(entries.values()), list(entries), loc="outside lower center", ncol=4, fontsize=8)
     if len(result.names) > k:
-        title = f"{title or ''} (first {k} of {len(result.names)} batches)".strip()
+        title = f"{title or ''} ({why} {k} of {len(result.names)} batches)".strip()
     return finish_figure(fig, path, title, outputs)
 
 
