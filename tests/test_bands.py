@@ -169,7 +169,7 @@ def test_validate_band_reports_each_batch_size(fitted, tmp_path):
 def test_a_validation_figure_of_several_sizes_shows_each_size_in_turn(fitted):
     """Logs of two sizes, the heavier listed first: the panels take a log of each size in turn, lightest
     first, each titled with its batch, and the title says how they were chosen (validate --plot)."""
-    from roastlab.evaluate.validate import each_size_in_turn
+    from roastlab.evaluate.validate import each_size_in_turn, panels_by_size
     from roastlab.report.figures import plot_fit
     from test_compare import synthetic_sizes
 
@@ -178,13 +178,18 @@ def test_a_validation_figure_of_several_sizes_shows_each_size_in_turn(fitted):
     logs = [*heavy, batches[3]]  # 180, 180, 120 kg
     result = model.validate(logs)
     masses = [b.Mb_kg for b in logs]
-    turns = each_size_in_turn(masses)
-    assert turns == [2, 0, 1]
-    labels = {i: f"{name} ({masses[i]:.3g} kg)" for i, name in enumerate(result.names)}
-    fig = plot_fit(result, which=(turns, "each size in turn:"), labels=labels, max_panels=2)
+    assert each_size_in_turn(masses) == [2, 0, 1] and each_size_in_turn(masses, scored={0, 1}) == [0, 1]
+    panels = panels_by_size(result.names, masses)
+    fig = plot_fit(result, max_panels=2, **panels)
     titles = [ax.get_title() for ax in fig.axes if ax.get_title()]
-    assert [t.split(":")[0] for t in titles] == [labels[2], labels[0]]
-    assert fig.get_suptitle() == "(each size in turn: 2 of 3 batches)"
+    assert [t.split(":")[0] for t in titles] == [f"{result.names[2]} (120 kg)", f"{result.names[0]} (180 kg)"]
+    assert fig.get_suptitle() == "(each size's logs in turn: 2 of 3 batches)"
+    # validate's: some logs were fitted on, so the held-out ones; one size: the first panels, as before
+    assert panels_by_size(result.names, masses, scored={0, 2})["which"] == (
+        [2, 0],
+        "each size's held-out logs in turn:",
+    )
+    assert panels_by_size(result.names[:2], masses[:2]) == {}
 
 
 def test_a_band_says_when_a_batch_size_lies_outside_the_fitted_ones():

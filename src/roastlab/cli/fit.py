@@ -108,7 +108,7 @@ def _identify_per_batch(args, batches, plant_spec, fix, bounds, outputs) -> int:
 
 
 def cmd_validate(args) -> int:
-    from ..evaluate.validate import each_size_in_turn, metrics_by_size
+    from ..evaluate.validate import metrics_by_size, panels_by_size
     from ..io.batch import logs_temp_unit
     from ..io.files import Outputs
     from ..metrics.profile import display_temp_delta, temp_symbol
@@ -170,8 +170,6 @@ def cmd_validate(args) -> int:
         if args.json:
             out.write_text(args.json, json_text(doc))
         if args.plot:
-            # logs of several sizes: a panel of each size in turn (held-out logs), each named with its batch
-            turns = each_size_in_turn(masses, held_at) if by_size else []
             plot_fit(
                 result,
                 args.plot,
@@ -179,8 +177,7 @@ def cmd_validate(args) -> int:
                 outputs=out,
                 bands=bands,
                 units=units,
-                which=(turns, "each size's held-out logs in turn:") if turns else None,
-                labels={i: f"{name} ({masses[i]:.3g} kg)" for i, name in enumerate(result.names)} if turns else None,
+                **(panels_by_size(result.names, masses, held_at) if by_size else {}),  # a panel of each size in turn
             )
         if args.predictions:
             written = set()

@@ -193,6 +193,18 @@ def each_size_in_turn(masses_kg, scored=None) -> list[int]:
     return [g[k] for k in range(max((len(g) for g in groups), default=0)) for g in groups if k < len(g)]
 
 
+def panels_by_size(names, masses_kg, scored=None) -> dict:
+    """:func:`~roastlab.report.figures.plot_fit`'s ``which`` and ``labels`` for logs of several sizes: the
+    scored logs (``scored``, default all; the held-out ones, say) of each size in turn
+    (:func:`each_size_in_turn`), each panel named with its batch; ``{}`` for logs of one size."""
+    turns = each_size_in_turn(masses_kg, scored)
+    if not turns:
+        return {}
+    some = scored is not None and len(set(scored)) < len(names)
+    why = f"each size's {'held-out ' if some else ''}logs in turn:"
+    return {"which": (turns, why), "labels": {i: f"{names[i]} ({masses_kg[i]:.3g} kg)" for i in turns}}
+
+
 def _fmt(key, value) -> str:
     if key == "n":
         return f"{int(value):>11d}"

@@ -382,11 +382,14 @@ def fit_roaster(
             lines += ["", f"Refitted (the fit on {sizes.fit_size} alone): {size_refit}."]
         if size_fit.failed:
             lines += ["", f"**The fit on {sizes.fit_size} alone failed**: {size_fit.failed_in(units)}."]
+    from ..evaluate.validate import panels_by_size
     from ..report.figures import figure_bytes, plot_fit
     from ..report.markdown import html_document
 
     stage(0, 0, "writing the report and its figures")
-    figures = {d / HELD_OUT_FIGURE: plot_fit(v_val, bands=bands, units=units)}
+    # held-out logs of several sizes (an alternate split of every size): a panel of each size in turn
+    held_kg = [b.Mb_kg for b in val_b]
+    figures = {d / HELD_OUT_FIGURE: plot_fit(v_val, bands=bands, units=units, **panels_by_size(v_val.names, held_kg))}
     if across is not None:
         figures[d / SIZES_FIGURE] = across_sizes_figure(across)
     pngs = {path: figure_bytes(fig, path) for path, fig in figures.items()}
