@@ -111,7 +111,7 @@ def cmd_validate(args) -> int:
     from ..evaluate.validate import metrics_by_size, panels_by_size
     from ..io.batch import logs_temp_unit
     from ..io.files import Outputs
-    from ..metrics.profile import display_temp_delta, temp_symbol
+    from ..metrics.profile import delta_text, display_temp_delta, temp_symbol
     from ..report.figures import plot_fit
 
     outputs = Outputs(fit_inputs(args))
@@ -151,7 +151,7 @@ def cmd_validate(args) -> int:
             doc["average_held_out"] = avg = average_metrics(held)
             print(
                 f"held out only ({len(held)} of {len(result.names)} logs; the others are named above): "
-                f"FIT {avg['FIT']:.1f} %, MAE {display_temp_delta(avg['MAE'], units):.2f} {temp_symbol(units)}"
+                f"FIT {avg['FIT']:.1f} %, MAE {delta_text(avg['MAE'], units, 2)}"
             )
     kg = {b.name: b.Mb_kg for b in batches}  # each scored log's green weight, by its name
     masses = [kg.get(name) for name in result.names]

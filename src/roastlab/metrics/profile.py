@@ -287,6 +287,15 @@ def display_temp_delta(delta_C: float, units: str = "C") -> float:
     return delta_C * 9.0 / 5.0 if units == "F" else delta_C
 
 
+def delta_text(delta_C: float, units: str = "C", digits: int = 1) -> str:
+    """A temperature difference [K] written in the display unit with its symbol: ``"7.20 °F"``.
+
+    >>> delta_text(4.0, "F", 2)
+    '7.20 °F'
+    """
+    return f"{display_temp_delta(delta_C, units):.{digits}f} {temp_symbol(units)}"
+
+
 def celsius_of(temp, units: str = "C"):
     """A temperature in the display unit ("C" or "F") in degC: :func:`display_temp`'s inverse."""
     return (temp - 32.0) * 5.0 / 9.0 if units == "F" else temp

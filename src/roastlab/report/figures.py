@@ -289,13 +289,13 @@ def _ror_overlay(ax, time_s, measured, predicted, units: str = "C") -> tuple[lis
 
 
 def _profile_panel(ax, result, i, label=None, legend: bool = True, units: str = "C"):
-    from ..metrics.profile import display_temp_delta, temp_symbol
+    from ..metrics.profile import delta_text
 
     t = result.time_s[i] / 60.0
     row = result.rows[i]
     ax.plot(t, result.predicted[i], color="tab:green", lw=2, label="BT predicted (model Ta)")
     ax.plot(t, result.measured[i], "--", color="tab:pink", lw=2, label="BT measured (Ta)")
-    mae = f"{display_temp_delta(row['MAE'], units):.2f} {temp_symbol(units)}"
+    mae = delta_text(row["MAE"], units, 2)
     ax.set_title(f"{label or result.names[i]}: FIT {row['FIT']:.1f} %, MAE {mae}", fontsize=10)
     temperature_axis(ax, "BT [{u}]", units)
     ax.grid(alpha=0.3)
@@ -455,12 +455,12 @@ def plot_transfer(r, path=None, outputs=None):
 
     ``r`` is a :class:`roastlab.workflows.transfer.TransferResult`.
     """
-    from ..metrics.profile import display_temp_delta, temp_symbol
+    from ..metrics.profile import delta_text
 
     units = r.units
 
     def d(v, digits: int = 1):  # an error in the figure's unit, with it
-        return f"{display_temp_delta(v, units):.{digits}f} {temp_symbol(units)}"
+        return delta_text(v, units, digits)
 
     t_min = r.time_s / 60.0
     lim = r.limits

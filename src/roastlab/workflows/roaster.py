@@ -13,7 +13,7 @@ from pathlib import Path
 
 from ..errors import InputError
 from ..io.batch import logs_temp_unit
-from ..metrics.profile import display_temp_delta, display_units, temp_symbol
+from ..metrics.profile import delta_text, display_temp_delta, display_units, temp_symbol
 from .survey import (
     INLET_NAMES,
     UNNAMED_UNIT,
@@ -155,7 +155,7 @@ def band_sentence(band: dict, units: str = "C") -> str:
         f"{100 * band['inside_all']:.0f} % of the held-out logs' probe samples lie inside the {level} prediction "
         f"band ({'parameters and spread between roasts' if band.get('spread', True) else 'parameters only'}; "
         f"a calibrated band holds about {level}), median width "
-        f"{display_temp_delta(band['median_width_C'], units):.1f} {temp_symbol(units)}"
+        f"{delta_text(band['median_width_C'], units)}"
     )
 
 
@@ -540,6 +540,6 @@ def every_log_sentence(fit_pct: float, band_inside: float, band_width_C: float, 
     if math.isfinite(band_inside):
         text += (
             f", {100 * band_inside:.0f} % of the samples inside the band of the fit without their log "
-            f"(median width {display_temp_delta(band_width_C, units):.1f} {temp_symbol(units)})"
+            f"(median width {delta_text(band_width_C, units)})"
         )
     return text

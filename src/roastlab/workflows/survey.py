@@ -76,6 +76,7 @@ from ..io.importers.roastime import DRUM_AT_CHARGE, read_roastime
 from ..metrics.profile import (
     LOG_THE_HEATER,
     SHORTEST_ROAST_S,
+    delta_text,
     display_temp,
     display_temp_delta,
     et_below_bt_on_every_log,
@@ -801,7 +802,7 @@ def survey(paths, batch_kg: float | None = None, units: dict | None = None) -> S
     if et_below_bt:
         notes.append(
             f"ET reads below BT through the roast on every log (by {display_temp_delta(-max(differences), unit):.0f} "
-            f"to {display_temp_delta(-min(differences), unit):.0f} {temp_symbol(unit)}): not the drum's air, which "
+            f"to {delta_text(-min(differences), unit, 0)}): not the drum's air, which "
             "runs above the beans it heats, so the "
             "map does not use it; if ET and BT are swapped in the device setup, swap them back and run init again"
         )

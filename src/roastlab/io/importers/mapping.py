@@ -77,6 +77,7 @@ import numpy as np
 from ...errors import InputError, ParameterError
 from ...metrics.profile import (
     ET_CHECK_FROM_S,
+    delta_text,
     display_temp,
     display_temp_delta,
     et_minus_bt_C,
@@ -632,7 +633,7 @@ def _drop_et_not_drum_air(time_s, Ta, drop_s, settings: dict, series: dict, note
     if gap is None or gap >= 0:
         return set()
     notes.append(
-        f"ET reads {display_temp_delta(-gap, units):.0f} {temp_symbol(units)} below BT through the roast (median from {ET_CHECK_FROM_S:g} s): "
+        f"ET reads {delta_text(-gap, units, 0)} below BT through the roast (median from {ET_CHECK_FROM_S:g} s): "
         f"{ET_NOT_DRUM_AIR}, so it is neither fitted nor scored"
     )
     del settings["ET"], series["ET"]
