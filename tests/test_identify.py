@@ -300,30 +300,74 @@ def test_a_polish_that_overflows_gives_up_its_start_not_the_fit(monkeypatch):
     monkeypatch.setattr(ident, "BASIN_FACTOR", 0.0)  # polish every start
     real_polish, calls = ident._polish, []
 
-    def first_fails(obj, z0):
+    def first_fails(obj, z0, *found):
         calls.append(z0)
         if len(calls) == 1:
             raise ValueError("array must not contain infs or NaNs")
-        return real_polish(obj, z0)
+        return real_polish(obj, z0, *found)
 
     monkeypatch.setattr(ident, "_polish", first_fails)
     result = identify(packed, free, fixed, seed=0, n_starts=3)
     assert result.starts[0]["skipped"] == ident.POLISH_OVERFLOW
     assert all("SSR" in s for s in result.starts[1:]) and np.isfinite(result.SSR)
 
-    def always_fails(obj, z0):
+    def always_fails(obj, z0, *found):
         raise ValueError("array must not contain infs or NaNs")
 
     monkeypatch.setattr(ident, "_polish", always_fails)
     with pytest.raises(ParameterError, match="every start of the fit"):
         identify(packed, free, fixed, seed=0, n_starts=3)
 
-    def another_error(obj, z0):
+    def another_error(obj, z0, *found):
         raise ValueError("x0 is infeasible")
 
     monkeypatch.setattr(ident, "_polish", another_error)  # any other error is not hidden as an overflow
     with pytest.raises(ValueError, match="infeasible"):
         identify(packed, free, fixed, seed=0, n_starts=3)
+
+
+def test_a_later_polish_that_reaches_an_optimum_found_stops_there(monkeypatch):
+    """Dataset-I's later polishes all end at the first one's optimum; with the join rule each stops once
+    its iterate is within JOIN_TOL of it (its end then that optimum), so the fit takes fewer evaluations
+    and finds the same values as with every polish run to its own end."""
+    from roastlab.fit import identify as ident
+
+    packed = shipped_packed()
+    free, fixed = build_free_parameters()
+    joined = identify(packed, free, fixed, seed=0, held_out=False)
+    monkeypatch.setattr(ident, "JOIN_TOL", -1.0)  # no polish stops early
+    alone = identify(packed, free, fixed, seed=0, held_out=False)
+    stopped = [s for s in joined.starts if "joined" in s]
+    assert stopped and not any("joined" in s for s in alone.starts)
+    for s in stopped:
+        assert s["end"] == joined.starts[s["joined"]]["end"] and "joined" not in joined.starts[s["joined"]]
+    assert joined.nfev < alone.nfev - 10, (joined.nfev, alone.nfev)
+    assert joined.SSR == pytest.approx(alone.SSR, rel=1e-10)
+    for name, value in alone.values.items():
+        assert joined.values[name] == pytest.approx(value, rel=1e-6, abs=1e-9), name
+    assert joined.stderr.keys() == alone.stderr.keys()
+    for name, se in alone.stderr.items():
+        assert (joined.stderr[name] is None) == (se is None), name
+        if se is not None:
+            assert joined.stderr[name] == pytest.approx(se, rel=1e-5), name
+
+
+def test_a_polish_near_an_optimum_found_that_it_betters_is_not_stopped():
+    """The join rule stops a polish only at a point no lower than the optimum found: a polish passing
+    near an "optimum" whose SSR it already betters runs to its own end."""
+    from roastlab.fit import identify as ident
+
+    packed = shipped_packed()
+    free, fixed = build_free_parameters()
+    obj = ident.Objective(packed, free, fixed)
+    z, ssr, r, J, joined = ident._polish(obj, obj.start)
+    assert joined is None and ssr == pytest.approx(float(r @ r)) and J.shape == (r.size, z.size)
+    np.testing.assert_allclose(J, obj.jacobian(z))  # the Jacobian it returns is the one at its end
+    higher = (z.copy(), 2.0 * ssr, r, J)  # the same point, stored with an SSR the polish betters
+    z2, ssr2, _, _, joined2 = ident._polish(obj, obj.start, [higher])
+    assert joined2 is None and ssr2 == pytest.approx(ssr, rel=1e-12)
+    z3, ssr3, _, _, joined3 = ident._polish(obj, obj.start, [(z.copy(), ssr, r, J)])
+    assert joined3 == 0 and ssr3 == ssr and np.array_equal(z3, z)
 
 
 def test_screening_tolerance_ranks_trial_points_as_the_full_accuracy_does():

@@ -22,6 +22,7 @@ AIC and BIC, and which parameters a bound holds) follows the one rule of
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 
@@ -71,7 +72,9 @@ class IdentificationResult:
     values : identified value of every free parameter (per-batch ones as lists);
     fixed : values held fixed; SSR : summed squared residual [degC^2] (eq. 19);
     stderr, correlation : from the Jacobian at the optimum; warnings : human-readable;
-    n_residuals, nfev, wall_s, method, seed, starts : diagnostics;
+    n_residuals, nfev, wall_s, method, seed : diagnostics; starts : each start chosen, in order, with
+    its polish's end and SSR, or why it was skipped, and ``joined``: the index of the start whose
+    optimum its polish reached on the way and stopped at (:data:`JOIN_TOL`);
     outputs : per fitted output {"weight", "n", "SSR" (unweighted, degC^2)};
     held_out_Ta : (nb, nmax) model - measured probe [degC] of each batch as predicted had it been
     left out of the fit (refitted without it, :func:`roastlab.fit.uncertainty.held_out_residuals`), NaN where no
@@ -479,27 +482,62 @@ class _Basins:
 POLISH_OVERFLOW = "its polish met values where the model's sensitivities overflow"
 
 
-def _polish(obj: Objective, z0: np.ndarray):
+#: A later polish whose accepted iterate comes within this share of every bound's width of an optimum
+#: already found, no lower than it, stops there: it is converging on that optimum (its iterates close
+#: in on one by orders of magnitude per step at that distance), so its last steps would only find it
+#: again. Its end is then that optimum, with the residuals and Jacobian stored with it.
+JOIN_TOL = 1e-4
+
+
+class _Joined(Exception):
+    """Raised inside a polish that reached the optimum ``found[index]`` (:data:`JOIN_TOL`)."""
+
+    def __init__(self, index: int):
+        super().__init__(index)
+        self.index = index
+
+
+def _polish(obj: Objective, z0: np.ndarray, found=()):
+    """A least-squares polish from ``z0``: (end, SSR, residuals, Jacobian at the end, joined), where
+    ``joined`` is the index into ``found`` (optima already polished, each (end, SSR, residuals,
+    Jacobian)) of the optimum the polish reached on its way (:data:`JOIN_TOL`), or None."""
     scale = obj.upper - obj.lower
+    cost = {}  # SSR of each point SciPy evaluated, by its bytes: a Jacobian is asked for at an accepted point
+
+    def residuals(z):
+        r = obj.residuals(z)
+        cost[z.tobytes()] = float(r @ r)
+        return r
+
+    def jacobian(z):
+        ssr = cost.get(z.tobytes(), math.inf)
+        for i, (end, ssr_found, _, _) in enumerate(found):
+            if ssr >= ssr_found and np.max(np.abs(z - end) / scale) <= JOIN_TOL:
+                raise _Joined(i)
+        return obj.jacobian(z)
+
     # far out along a parameter spanning decades (A) SciPy's products overflow; the start is then
     # given up (identify catches the ValueError) or the step rejected, so no warning is printed. Its
     # trust-region solver divides by a zero derivative of the step's secular equation on a flat
     # direction (phi / phi_prime, scipy.optimize._lsq.common.solve_lsq_trust_region) and recovers
     # alike (a parameter held by the data to none of its range: exotherm freed on the Skywalker)
-    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-        res = least_squares(
-            obj.residuals,
-            z0,
-            jac=obj.jacobian,
-            bounds=(obj.lower, obj.upper),
-            method="trf",
-            x_scale=scale,
-            ftol=1e-12,
-            xtol=1e-10,
-            gtol=1e-10,
-            max_nfev=200,
-        )
-    return res.x, float(res.fun @ res.fun)
+    try:
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            res = least_squares(
+                residuals,
+                z0,
+                jac=jacobian,
+                bounds=(obj.lower, obj.upper),
+                method="trf",
+                x_scale=scale,
+                ftol=1e-12,
+                xtol=1e-10,
+                gtol=1e-10,
+                max_nfev=200,
+            )
+    except _Joined as joined:
+        return (*found[joined.index], joined.index)
+    return res.x, float(res.fun @ res.fun), res.fun, res.jac, None
 
 
 def identify(
@@ -589,21 +627,28 @@ def _identify(packed, free, fixed, method, seed, n_trial, n_starts, progress, we
         candidates = [de.x]
     best = None
     basins = _Basins(obj.lower, width)
+    found, found_by = [], []  # the optima polished to their end, (end, SSR, residuals, Jacobian), and their starts
     for k, z0 in enumerate(candidates):
         if basins.holds(z0):
             starts_log.append({"start": [float(v) for v in z0], "skipped": "inside the basin of an optimum found"})
         else:
             try:
-                z, ssr_k = _polish(obj, np.asarray(z0, dtype=float))
+                z, ssr_k, r_k, J_k, joined = _polish(obj, np.asarray(z0, dtype=float), found)
             except ValueError as exc:  # SciPy refuses a non-finite matrix: the sensitivities overflowed
                 if "infs or NaNs" not in str(exc):
                     raise
                 starts_log.append({"start": [float(v) for v in z0], "skipped": POLISH_OVERFLOW})
                 continue
-            starts_log.append({"start": [float(v) for v in z0], "end": [float(v) for v in z], "SSR": ssr_k})
+            entry = {"start": [float(v) for v in z0], "end": [float(v) for v in z], "SSR": ssr_k}
+            if joined is None:
+                found.append((z, ssr_k, r_k, J_k))
+                found_by.append(len(starts_log))
+            else:  # reached the optimum this start's polish found, on its way, and stopped there
+                entry["joined"] = found_by[joined]
+            starts_log.append(entry)
             basins.add(z0, z)
             if best is None or ssr_k < best[1]:
-                best = (z, ssr_k)
+                best = (z, ssr_k, r_k, J_k)
         if progress is not None and best is not None:
             progress(k + 1, len(candidates), f"SSR {best[1]:.6g}, {obj.nfev} simulations")
     if best is None:
@@ -611,7 +656,7 @@ def _identify(packed, free, fixed, method, seed, n_trial, n_starts, progress, we
             f"every start of the fit ({len(candidates)}) ran into values where the model overflows: "
             "narrow the bounds of the parameters that span several decades (e.g. A)"
         )
-    z, ssr = best
+    z, ssr, r, J = best
     failed = obj.failed_batches(z)
     if failed:
         raise ParameterError(
@@ -619,7 +664,6 @@ def _identify(packed, free, fixed, method, seed, n_trial, n_starts, progress, we
             "the bounds admit only values for which the model diverges"
         )
     labels = [free[j].name if b < 0 else f"{free[j].name}[{packed.names[b]}]" for j, b in obj.layout]
-    r, J = obj.residuals(z), obj.jacobian(z)
     unc = uncertainty.from_jacobian(J, z, obj.lower, obj.upper, ssr, labels)
     values: dict = {}
     for k, (j, b) in enumerate(obj.layout):
