@@ -179,9 +179,9 @@ def test_identification_that_cannot_simulate_is_an_error(monkeypatch, fail_when)
     real = ident.predict_outputs
     calls = {"n": 0}
 
-    def diverging(packed_, names, values, with_tb=True, with_tgo=False, tol_scale=1.0):
+    def diverging(packed_, names, values, with_tb=True, with_tgo=False, tol_scale=1.0, **options):
         calls["n"] += 1
-        out = real(packed_, names, values, with_tb, with_tgo, tol_scale)
+        out = real(packed_, names, values, with_tb, with_tgo, tol_scale, **options)
         if fail_when == "always" or calls["n"] > 1:
             out[0][:] = np.nan
         return out

@@ -201,6 +201,55 @@ def test_held_out_residuals_given_the_model_are_refits_without_each_group():
     assert np.array_equal(kept, linear)
 
 
+def test_a_refit_simulates_the_batches_it_fits_and_ends_where_scipy_ends_it():
+    """Each held-out refit on dataset-I simulates only the batches it fits (``by_group``) and stops
+    at the point where SciPy's ftol test ends it, without the Jacobian SciPy would then compute: the
+    held-out residuals are those of SciPy's own refit, run to its end on every batch, to the bit, with
+    one sensitivity run fewer per refit that ended on that test."""
+    import importlib
+
+    from scipy.optimize import least_squares
+
+    from roastlab.io.batch import read_dataset
+    from roastlab.workflows.reproduce import default_dataset_root
+
+    ident = importlib.import_module("roastlab.fit.identify")
+    ds = read_dataset(default_dataset_root() / "dataset-I")
+    free, fixed = build_free_parameters()
+    obj = ident.Objective(pack_batches(ds.batches, ds.plant, THETA_START), free, fixed)
+    z, ssr, r, J, _ = ident._polish(obj, obj.start)
+    det = uncertainty.from_jacobian(J, z, obj.lower, obj.upper, ssr, list(obj.names)).determined
+    groups, nb = obj.batch_of_residual, obj.packed.n_batches
+    asked = []
+
+    def jacobian(zz, groups=None):
+        asked.append(groups)
+        return obj.jacobian(zz, groups)
+
+    held = uncertainty.held_out_residuals(
+        J, r, groups, det, z, obj.lower, obj.upper, obj.residuals_many, jacobian, by_group=True
+    )
+    assert asked and all(len(g) == nb - 1 for g in asked)  # never the batch left out
+    scipy_jacobians = 0
+
+    def full(x):
+        zz = z.copy()
+        zz[det] = x
+        return zz
+
+    for g in range(nb):
+        keep = groups != g
+        end = least_squares(
+            lambda x, keep=keep: obj.residuals(full(x))[keep], z[det],
+            jac=lambda x, keep=keep: obj.jacobian(full(x))[keep][:, det],
+            bounds=(obj.lower[det], obj.upper[det]), method="trf", x_scale="jac", ftol=uncertainty.REFIT_TOL,
+            xtol=uncertainty.REFIT_TOL, gtol=uncertainty.REFIT_TOL, max_nfev=uncertainty.REFIT_MAX_NFEV,
+        )  # fmt: skip
+        assert np.array_equal(held[~keep], obj.residuals(full(end.x))[~keep]), g
+        scipy_jacobians += end.njev - 1 - (end.status == 2)  # its first is the fit's; its last goes unused
+    assert len(asked) == scipy_jacobians, (len(asked), scipy_jacobians)
+
+
 def test_held_out_residuals_equal_refits_without_each_group_for_a_linear_model():
     """The linearised leave-one-group-out rule is exact when the model is linear in its parameters:
     checked against refitting (numpy lstsq) without each group, on seeded synthetic data."""

@@ -253,9 +253,12 @@ class Objective:
     def n_residuals(self) -> int:
         return int(self.measured.size)
 
-    def _predicted(self, Z: np.ndarray, tol_scale: float = 1.0) -> np.ndarray:
-        """(m, n_residuals) model outputs at the measured samples, in the residuals' order."""
-        out = predict_outputs(self.packed, self.names, self.values_array(Z), self.with_tb, self.with_tgo, tol_scale)
+    def _predicted(self, Z: np.ndarray, tol_scale: float = 1.0, batches=None) -> np.ndarray:
+        """(m, n_residuals) model outputs at the measured samples, in the residuals' order (``batches``:
+        the batches to simulate, None: all; the others' outputs are NaN)."""
+        out = predict_outputs(
+            self.packed, self.names, self.values_array(Z), self.with_tb, self.with_tgo, tol_scale, batches=batches
+        )
         model = dict(zip(("Ta", "Tb", "Tgo"), out))
         return np.concatenate(
             [model[MODEL_OF_OUTPUT[k]][:, self.masks[k]] for k in OUTPUTS if self.masks[k].any()], axis=1
@@ -288,14 +291,20 @@ class Objective:
             V[:, :, j] = self.fixed[name]
         return V
 
-    def residuals_many(self, Z: np.ndarray, tol_scale: float = 1.0) -> np.ndarray:
+    def residuals_many(self, Z: np.ndarray, tol_scale: float = 1.0, groups=None) -> np.ndarray:
         """(m, n_residuals) weighted residuals (model - measured) for m parameter vectors (a
         sample whose simulation failed counts as a 1e3 degC error); ``tol_scale`` > 1 loosens the
-        integrator's tolerances (:data:`SCREENING_TOL_SCALE`)."""
+        integrator's tolerances (:data:`SCREENING_TOL_SCALE`); ``groups``: the batches (indices, the
+        labels of :attr:`batch_of_residual`) whose residuals are wanted, None: all (the others are NaN)."""
         Z = np.atleast_2d(Z)
         self.nfev += Z.shape[0]
-        r = self._predicted(Z, tol_scale) - self.measured[None, :]
-        r[~np.isfinite(r)] = FAILED_RESIDUAL_C
+        r = self._predicted(Z, tol_scale, groups) - self.measured[None, :]
+        failed = ~np.isfinite(r)
+        if groups is not None:
+            wanted = np.zeros(self.packed.n_batches, dtype=bool)
+            wanted[groups] = True
+            failed &= wanted[self.batch_of_residual][None, :]
+        r[failed] = FAILED_RESIDUAL_C
         return r * self.sqrt_w[None, :]
 
     def residuals(self, z: np.ndarray) -> np.ndarray:
@@ -311,8 +320,17 @@ class Objective:
             return None
         r = (
             uncertainty.held_out_residuals(
-                J, r, self.batch_of_residual, determined, z, self.lower, self.upper, self.residuals_many, self.jacobian
-            )
+                J,
+                r,
+                self.batch_of_residual,
+                determined,
+                z,
+                self.lower,
+                self.upper,
+                self.residuals_many,
+                self.jacobian,
+                by_group=True,
+            )  # fmt: skip
             / self.sqrt_w
         )
         out = np.full(self.packed.TA.shape, np.nan)
@@ -329,13 +347,14 @@ class Objective:
         r = self.residuals_many(Z, tol_scale)
         return np.einsum("ij,ij->i", r, r)
 
-    def jacobian(self, z: np.ndarray) -> np.ndarray:
+    def jacobian(self, z: np.ndarray, groups=None) -> np.ndarray:
         """d residuals / d z, exact: the forward sensitivities of every batch in one population
         call (:func:`roastlab.sim.population.output_sensitivities`). A sample whose simulation
-        failed gets a zero row (its residual is the constant :data:`FAILED_RESIDUAL_C`)."""
+        failed gets a zero row (its residual is the constant :data:`FAILED_RESIDUAL_C`), as do the
+        samples of the batches not in ``groups`` (as in :meth:`residuals_many`)."""
         self.nfev += 1
         V = self.values_array(z[None, :])[0]
-        res = output_sensitivities(self.packed, self.names, V, self.layout, with_tgo=self.with_tgo)
+        res = output_sensitivities(self.packed, self.names, V, self.layout, with_tgo=self.with_tgo, batches=groups)
         parts = [res[MODEL_OF_OUTPUT[k]][1][self.masks[k]] for k in OUTPUTS if self.masks[k].any()]
         J = np.concatenate(parts, axis=0) * self.sqrt_w[:, None]
         return np.where(np.isfinite(J), J, 0.0)

@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 
@@ -304,7 +305,7 @@ REFIT_TOL = 1e-6
 
 
 def held_out_residuals(
-    J, r, groups, determined, z=None, lower=None, upper=None, residuals_many=None, jacobian=None
+    J, r, groups, determined, z=None, lower=None, upper=None, residuals_many=None, jacobian=None, by_group=False
 ) -> np.ndarray:
     """Each residual as it would be had its group (a batch) been left out of the fit: the
     leave-one-group-out (cross-validated) residuals, refitted without each group when the model is
@@ -333,7 +334,9 @@ def held_out_residuals(
     :data:`REFIT_MAX_NFEV` evaluations), and the group's residuals are the model's at that refit:
     the leave-one-out the formula stands in for. A local refit, not a new global search: it finds
     the optimum nearest the full fit's, as a fit that lost one roast would. Where SciPy refuses the
-    refit (values whose products overflow), the group keeps the linearised step.
+    refit (values whose products overflow), the group keeps the linearised step. With ``by_group``
+    the two callables take ``groups=`` (the labels whose rows are wanted; the other rows may hold
+    anything), so a refit simulates the groups it fits and, at its end, the one it left out.
 
     >>> J = np.array([[1.0], [1.0], [1.0], [1.0]])  # a mean fitted to two groups of two
     >>> r = np.array([2.0, 2.0, -2.0, -2.0])
@@ -369,15 +372,33 @@ def held_out_residuals(
     upper = np.full(z.shape, np.inf) if upper is None else np.asarray(upper, dtype=float)
     for g in labels:
         try:
-            out[rows[g]] = _refit_without(~rows[g], z, det, lower, upper, residuals_many, jacobian, J)[rows[g]]
+            if by_group:
+                others = labels[labels != g]
+                fitted = (partial(residuals_many, groups=others), partial(jacobian, groups=others))
+                left_out = partial(residuals_many, groups=np.array([g]))
+            else:
+                fitted, left_out = (residuals_many, jacobian), residuals_many
+            out[rows[g]] = _refit_without(~rows[g], z, det, lower, upper, *fitted, J, left_out)[rows[g]]
         except ValueError:  # SciPy refuses values where the products overflow: the step stands in
             pass
     return out
 
 
-def _refit_without(held_in, z, det, lower, upper, residuals_many, jacobian, J0) -> np.ndarray:
+class _Converged(Exception):
+    """Raised by a refit's Jacobian at the point where SciPy's ``ftol`` test has just ended the refit."""
+
+
+def _refit_without(held_in, z, det, lower, upper, residuals_many, jacobian, J0, left_out=None) -> np.ndarray:
     """The residuals (n,) of the fit redone on the ``held_in`` residuals alone, from ``z`` (where the
-    Jacobian is ``J0``), over the ``det`` parameters within the bounds (:func:`held_out_residuals`)."""
+    Jacobian is ``J0``), over the ``det`` parameters within the bounds (:func:`held_out_residuals`);
+    the left-out rows from ``left_out`` (default ``residuals_many``) at the refit's end.
+
+    SciPy asks for the Jacobian at every point it accepts, the last one too, after its ``ftol`` test
+    (the cost fell by less than :data:`REFIT_TOL` of itself) has ended the refit there. That last
+    Jacobian is not used, so the refit applies the same test when a Jacobian is asked for and stops
+    at that point instead: where SciPy's test ended the refit, the same end with one sensitivity run
+    fewer (SciPy also asks that the step's reduction was more than a quarter of the predicted one; a
+    refit that meets the test without it stops here, one step before SciPy would have)."""
     from scipy.optimize import least_squares
 
     def full(x):
@@ -395,29 +416,40 @@ def _refit_without(held_in, z, det, lower, upper, residuals_many, jacobian, J0) 
 
     lo, hi = lower[det], upper[det]
     x0 = np.clip(z[det], lo, hi)
+    accepted = []  # the cost 0.5 |r|^2 at each point SciPy accepted
 
     def jac(x):
+        r = fun(x)
+        cost = 0.5 * float(r @ r)
+        if accepted and accepted[-1] - cost < REFIT_TOL * accepted[-1]:
+            raise _Converged(x.copy())
+        accepted.append(cost)
         J = J0 if np.array_equal(x, x0) else jacobian(full(x))
         return np.asarray(J, dtype=float)[held_in][:, det]
 
     # far out along a parameter spanning decades (the reaction's A) SciPy's products overflow, as in
     # the fit's own polish (roastlab.fit.identify._polish): the step is rejected, or SciPy raises
     # ValueError and held_out_residuals keeps the linearised step for that group
-    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-        sol = least_squares(
-            fun,
-            x0,
-            jac=jac,
-            bounds=(lo, hi),
-            method="trf",
-            x_scale="jac",
-            ftol=REFIT_TOL,
-            xtol=REFIT_TOL,
-            gtol=REFIT_TOL,
-            max_nfev=REFIT_MAX_NFEV,
-        )
-    fun(sol.x)
-    return seen[sol.x.tobytes()]
+    try:
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            end = least_squares(
+                fun,
+                x0,
+                jac=jac,
+                bounds=(lo, hi),
+                method="trf",
+                x_scale="jac",
+                ftol=REFIT_TOL,
+                xtol=REFIT_TOL,
+                gtol=REFIT_TOL,
+                max_nfev=REFIT_MAX_NFEV,
+            ).x
+    except _Converged as stop:
+        end = stop.args[0]
+    out = seen[end.tobytes()].copy() if end.tobytes() in seen else residuals_many(full(end)[None, :])[0]
+    if left_out is not None and left_out is not residuals_many:
+        out[~held_in] = left_out(full(end)[None, :])[0][~held_in]
+    return out
 
 
 def from_jacobian(J, z, lower, upper, ssr: float, names) -> Uncertainty:

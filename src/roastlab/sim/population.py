@@ -195,6 +195,25 @@ def predict_ta(
     return predict_outputs(packed, names, values, with_tb=False, use_lanes=use_lanes)[0]
 
 
+def _only(batches, batch_of, *arrays):
+    """The runs of ``batches`` (indices; None: every run): (which of the runs, and the arrays' rows of them)."""
+    if batches is None:
+        return None, (batch_of, *arrays)
+    wanted = np.zeros(max(int(batch_of.max()), int(np.max(batches))) + 1, dtype=bool)
+    wanted[batches] = True
+    keep = np.flatnonzero(wanted[batch_of])
+    return keep, (batch_of[keep], *(a[keep] for a in arrays))
+
+
+def _scattered(keep, out: np.ndarray, runs: int) -> np.ndarray:
+    """``out`` of the runs ``keep`` (None: all ``runs``) placed among ``runs`` rows, NaN elsewhere."""
+    if keep is None:
+        return out
+    full = np.full((runs, *out.shape[1:]), np.nan)
+    full[keep] = out
+    return full
+
+
 def predict_outputs(
     packed: PackedBatches,
     names: list[str],
@@ -203,34 +222,43 @@ def predict_outputs(
     with_tgo=False,
     tol_scale=1.0,
     use_lanes: bool | None = None,
+    batches=None,
 ):
     """Simulated probe reading Ta, (``with_tb``) bean temperature Tb and (``with_tgo``) outlet gas
     Tgo for every (value set, batch): arrays of shape (m, nb, nmax), NaN-padded; Tb and Tgo are
     None when not asked for. Returns (ta, tb) or, with ``with_tgo``, (ta, tb, tgo). ``tol_scale``
     loosens the integrator's tolerances (:func:`roastlab.sim.kernels.integrate_into`; 1: full accuracy).
-    ``use_lanes``: which integrator (:func:`_lanes_key`; None: by the number of runs)."""
+    ``use_lanes``: which integrator (:func:`_lanes_key`; None: by the number of runs). ``batches``:
+    the indices of the batches to simulate (None: all); the others' rows are NaN."""
     m, nb = values.shape[0], packed.n_batches
-    batch_of, X0, PP = run_arrays(packed, names, values)
+    keep, (batch_of, X0, PP) = _only(batches, *run_arrays(packed, names, values))
+    runs = batch_of.shape[0]
     key = _lanes_key(PP, use_lanes)
     if key is not None:  # many runs: several at once per core
         cols = np.array([S_TA, *((S_TB,) if with_tb else ()), *((I_TGO,) if with_tgo else ())], dtype=np.int64)
-        out = np.full((m * nb, packed.T.shape[1], cols.size), np.nan)
+        out = np.full((runs, packed.T.shape[1], cols.size), np.nan)
         lanes.simulate_runs(*packed.inputs, batch_of, X0, PP, packed.zoh, packed.h_max_s, cols, out, tol_scale, key)
+        out = _scattered(keep, out, m * nb)
         ta = out[:, :, 0]
         tb = out[:, :, 1] if with_tb else None
         tgo = out[:, :, -1] if with_tgo else None
     else:
-        ta = np.full((m * nb, packed.T.shape[1]), np.nan)
+        ta = np.full((runs, packed.T.shape[1]), np.nan)
         tb = np.full_like(ta, np.nan) if with_tb else np.empty((0, 0))
         tgo = np.full_like(ta, np.nan) if with_tgo else np.empty((0, 0))
         ta_population_kernel(
             *packed.inputs, batch_of, X0, PP, packed.zoh, packed.h_max_s, ta, tb, tgo, float(tol_scale)
         )
+        ta = _scattered(keep, ta, m * nb)
+        tb = _scattered(keep, tb, m * nb) if with_tb else tb
+        tgo = _scattered(keep, tgo, m * nb) if with_tgo else tgo
     out = (ta.reshape(m, nb, -1), (tb.reshape(m, nb, -1) if with_tb else None))
     return (*out, tgo.reshape(m, nb, -1)) if with_tgo else out
 
 
-def output_sensitivities(packed: PackedBatches, names: list[str], values: np.ndarray, directions, with_tgo=False):
+def output_sensitivities(
+    packed: PackedBatches, names: list[str], values: np.ndarray, directions, with_tgo=False, batches=None
+):
     """The fitted outputs and their exact derivatives with respect to ``directions``, for one
     value set over every batch (forward sensitivities,
     :func:`roastlab.sim.sensitivity.sens_population_kernel`).
@@ -239,6 +267,7 @@ def output_sensitivities(packed: PackedBatches, names: list[str], values: np.nda
     :func:`predict_outputs`). ``directions``: one (j, b) per column, the derivative with respect to
     ``names[j]`` in batch ``b`` only, or in every batch when b < 0. Returns {"Ta": (value (nb,
     nmax), derivative (nb, nmax, m)), "Tb": ..., and with ``with_tgo`` "Tgo": ...}, NaN-padded.
+    ``batches``: the indices of the batches to simulate (None: all); the others' rows are NaN.
     """
     from .sensitivity import outlet_sens_kernel, sens_population_kernel
 
@@ -274,23 +303,27 @@ def output_sensitivities(packed: PackedBatches, names: list[str], values: np.nda
             PQ[bb, e], PC[bb, e], PV[bb, e] = q, c, v
     # every state's sensitivity when Tgo is asked for (it depends on Tb, Tm, X and H)
     rows = np.arange(NS, dtype=np.int64) if with_tgo else np.array([S_TA, S_TB], dtype=np.int64)
-    out_x = np.full((nb, nmax, NS), np.nan)
-    out_s = np.full((nb, nmax, rows.size, m), np.nan)
+    keep, (batch_of, X0, PP, S0, PQ, PC, PV) = _only(batches, batch_of, X0, PP, S0, PQ, PC, PV)
+    runs = batch_of.shape[0]
+    out_x = np.full((runs, nmax, NS), np.nan)
+    out_s = np.full((runs, nmax, rows.size, m), np.nan)
     sens_population_kernel(
         *packed.inputs, batch_of, X0, PP, packed.zoh, packed.h_max_s, S0, PQ, PC, PV, rows, out_x, out_s
     )
-    row = {int(r): k for k, r in enumerate(rows)}
-    res = {
-        "Ta": (out_x[:, :, S_TA], out_s[:, :, row[S_TA], :]),
-        "Tb": (out_x[:, :, S_TB], out_s[:, :, row[S_TB], :]),
-    }
+    res = {}
     if with_tgo:
-        g = np.full((nb, nmax), np.nan)
-        dg = np.full((nb, nmax, m), np.nan)
+        g = np.full((runs, nmax), np.nan)
+        dg = np.full((runs, nmax, m), np.nan)
         outlet_sens_kernel(packed.GG, packed.TGI, packed.FF, packed.N, batch_of, out_x, out_s, PP, PQ, PC, PV,
                            packed.zoh, g, dg)  # fmt: skip
-        res["Tgo"] = (g, dg)
-    return res
+        res["Tgo"] = (_scattered(keep, g, nb), _scattered(keep, dg, nb))
+    out_x, out_s = _scattered(keep, out_x, nb), _scattered(keep, out_s, nb)
+    row = {int(r): k for k, r in enumerate(rows)}
+    return {
+        "Ta": (out_x[:, :, S_TA], out_s[:, :, row[S_TA], :]),
+        "Tb": (out_x[:, :, S_TB], out_s[:, :, row[S_TB], :]),
+        **res,
+    }
 
 
 def _population_task(packed, names, values, use_lanes):
