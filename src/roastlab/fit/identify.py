@@ -318,21 +318,11 @@ class Objective:
         fitted, None when the probe has no weight."""
         if not self.masks["Ta"].any():
             return None
-        r = (
-            uncertainty.held_out_residuals(
-                J,
-                r,
-                self.batch_of_residual,
-                determined,
-                z,
-                self.lower,
-                self.upper,
-                self.residuals_many,
-                self.jacobian,
-                by_group=True,
-            )  # fmt: skip
-            / self.sqrt_w
+        model = (self.residuals_many, self.jacobian)  # each refit simulates the batches it fits (by_group)
+        held = uncertainty.held_out_residuals(
+            J, r, self.batch_of_residual, determined, z, self.lower, self.upper, *model, by_group=True
         )
+        r = held / self.sqrt_w
         out = np.full(self.packed.TA.shape, np.nan)
         out[self.masks["Ta"]] = r[self.output_of_residual == OUTPUTS.index("Ta")]
         return out

@@ -377,7 +377,7 @@ def held_out_residuals(
                 fitted = (partial(residuals_many, groups=others), partial(jacobian, groups=others))
                 left_out = partial(residuals_many, groups=np.array([g]))
             else:
-                fitted, left_out = (residuals_many, jacobian), residuals_many
+                fitted, left_out = (residuals_many, jacobian), None
             out[rows[g]] = _refit_without(~rows[g], z, det, lower, upper, *fitted, J, left_out)[rows[g]]
         except ValueError:  # SciPy refuses values where the products overflow: the step stands in
             pass
@@ -391,7 +391,8 @@ class _Converged(Exception):
 def _refit_without(held_in, z, det, lower, upper, residuals_many, jacobian, J0, left_out=None) -> np.ndarray:
     """The residuals (n,) of the fit redone on the ``held_in`` residuals alone, from ``z`` (where the
     Jacobian is ``J0``), over the ``det`` parameters within the bounds (:func:`held_out_residuals`);
-    the left-out rows from ``left_out`` (default ``residuals_many``) at the refit's end.
+    the left-out rows from ``left_out`` at the refit's end, where ``residuals_many`` leaves them out
+    (None: ``residuals_many`` gives every row).
 
     SciPy asks for the Jacobian at every point it accepts, the last one too, after its ``ftol`` test
     (the cost fell by less than :data:`REFIT_TOL` of itself) has ended the refit there. That last
@@ -446,8 +447,9 @@ def _refit_without(held_in, z, det, lower, upper, residuals_many, jacobian, J0, 
             ).x
     except _Converged as stop:
         end = stop.args[0]
-    out = seen[end.tobytes()].copy() if end.tobytes() in seen else residuals_many(full(end)[None, :])[0]
-    if left_out is not None and left_out is not residuals_many:
+    fun(end)
+    out = seen[end.tobytes()].copy()
+    if left_out is not None:
         out[~held_in] = left_out(full(end)[None, :])[0][~held_in]
     return out
 
