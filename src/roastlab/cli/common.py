@@ -262,7 +262,7 @@ def add_starts_option(p: argparse.ArgumentParser, per: str = "") -> None:
         type=count_arg("--starts", 1, 100),
         default=N_STARTS,
         help=f"starts chosen for a local polish{per} (default {N_STARTS}); a start inside the basin of an optimum "
-        "already found is skipped",
+        "already found is skipped, and a polish that reaches one stops there",
     )
 
 
