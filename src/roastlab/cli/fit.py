@@ -160,7 +160,7 @@ def cmd_validate(args) -> int:
         doc["by_size"] = by_size  # degC, as the rest of the document
         print(f"\nby batch size ({'the held-out logs' if fitted else 'every log'}):")
         for g in by_size:
-            label = f"size {g['size']} ({g['logs']} log{'s' * (g['logs'] > 1)})"
+            label = _size_label(g)
             mae = display_temp_delta(g["MAE"], units)
             print(f"{label:<36} FIT {g['FIT']:>6.1f} %  MAE {mae:>6.2f} {temp_symbol(units)}")
     bands = None
@@ -221,6 +221,11 @@ def cmd_compare_models(args) -> int:
     return 0
 
 
+def _size_label(group: dict) -> str:
+    """A batch-size group's row label in validate's tables: "size 0.2 kg (1 log)"."""
+    return f"size {group['size']} ({group['logs']} log{'s' * (group['logs'] > 1)})"
+
+
 def _band_table(model, batches, level, units: str = "C") -> tuple[dict, list]:
     """Print and return how often each batch's measured probe lies inside the model's band (its width in
     ``units``, "C" or "F"; the returned document's in degC), and the bands (drawn by --plot)."""
@@ -239,8 +244,7 @@ def _band_table(model, batches, level, units: str = "C") -> tuple[dict, list]:
             f"{r['name'][:36]:<36} {kg:>6} {r['inside']:>7.0%} {display_temp_delta(r['median_width_C'], units):>10.1f} {temp_symbol(units)}"
         )
     for g in report["by_size"]:
-        label = f"size {g['size']} ({g['logs']} log{'s' * (g['logs'] > 1)})"
-        print(f"{label:<36} {'':>6} {g['inside']:>7.0%}")
+        print(f"{_size_label(g):<36} {'':>6} {g['inside']:>7.0%}")
     print(f"{'all samples':<36} {'':>6} {report['inside_all']:>7.0%}   (a calibrated band holds about {level:.0%})")
     if report["note"]:
         print(f"note: {report['note']}")
