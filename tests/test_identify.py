@@ -459,8 +459,17 @@ def test_the_solver_runs_on_one_blas_thread_and_gives_back_the_threads_after(mon
         seen.append(blas_threads())
         return least_squares(*args, **kwargs)
 
+    from roastlab.fit import uncertainty
+
+    newton = uncertainty._newton_refit
+
+    def newton_spy(*args, **kwargs):
+        seen.append(blas_threads())
+        return newton(*args, **kwargs)
+
     monkeypatch.setattr(identify_module, "least_squares", spy)
     monkeypatch.setattr("scipy.optimize.least_squares", spy)  # the held-out refits import it there
+    monkeypatch.setattr(uncertainty, "_newton_refit", newton_spy)  # or refit by Gauss-Newton's steps
     ds = read_dataset(default_dataset_root() / "dataset-I")
     free, fixed = build_free_parameters()
     identify(pack_batches(ds.batches, ds.plant, THETA_START), free, fixed, seed=0)
