@@ -432,7 +432,8 @@ def _refit_without(held_in, z, det, lower, upper, residuals_many, jacobian, J0, 
     x0 = np.clip(z[det], lo, hi)
     if r0 is not None and np.array_equal(x0, z[det]):
         seen[x0.tobytes()] = np.asarray(r0, dtype=float)
-        end = _newton_refit(fun, lambda x: jacobian(full(x)), x0, J0, held_in, det, lo, hi)
+        with np.errstate(over="ignore", invalid="ignore"):  # a step into overflow fails its check
+            end = _newton_refit(fun, lambda x: jacobian(full(x)), x0, J0, held_in, det, lo, hi)
         if end is not None:
             return _refit_end(end, full, fun, seen, held_in, left_out)
     accepted = []  # the cost 0.5 |r|^2 at each point SciPy accepted
