@@ -400,6 +400,47 @@ def test_residual_weights_are_the_probes_residual_variance_over_the_outputs():
         residual_weights(outputs, ["Tb2"])
 
 
+def test_the_second_fit_of_a_weight_from_the_residuals_searches_as_the_first(tmp_path, monkeypatch):
+    """SYNTHETIC, seeded (the probe and ET of three batches at hbm 0.02, ET with an error the model has
+    no term for): the second fit, at the weight the first fit's residuals set, starts its search at the
+    first fit's optimum and polishes as many starts as the first. A polish from that optimum alone
+    stopped short of the optimum on the Skywalker's flat ridge (docs/real-roaster.md, "Skywalker: the
+    second fit searches"), so its SSR here is at most that polish's."""
+    import roastlab
+    import roastlab.workflows.fitting as fitting
+    from roastlab.sim.kernels import I_TGO
+    from roastlab.sim.population import simulate_population
+
+    truth = (THETA_START.hgm, 0.02, THETA_START.Pbm)
+    batches = noise_free_batches(11, "120kg", truth, count=3)
+    tgo = simulate_population(pack_batches(batches, "120kg", truth, InitialState(Ta0_C=30.0)))[0, :, :, I_TGO]
+    rng = np.random.default_rng(5)
+    for i, b in enumerate(batches):
+        b.Ta_C = b.Ta_C + rng.normal(0.0, 0.5, b.n)
+        b.ET_C = tgo[i, : b.n] + 12.0 * np.sin(b.time_s / 300.0) + rng.normal(0.0, 0.5, b.n)
+    spec = tmp_path / "fit.toml"
+    spec.write_text(
+        "[free]\nhgm = [0.005, 0.2, 0.05]\nhbm = [0.001, 0.2, 0.05]\n[fixed]\n"
+        f'Pbm = {truth[2]}\n[weights]\nET = "residual"\n'
+    )
+    calls = []
+
+    def recorded(packed, free, fixed, **kwargs):
+        out = identify(packed, free, fixed, **kwargs)
+        calls.append((kwargs, {f.name: f.start for f in free}, out, packed, free, fixed))
+        return out
+
+    monkeypatch.setattr(fitting, "identify", recorded)
+    fit = roastlab.fit(batches, "120kg", spec, initial={"Ta0_C": 30.0}, starts=3)
+    (first_kw, _, first, *_), (second_kw, started, second, packed, free, fixed) = calls
+    assert first_kw["n_starts"] == second_kw["n_starts"] == 3
+    assert started == first.values  # its first start is the first fit's optimum
+    assert second.starts[0]["start"] == pytest.approx([first.values[f.name] for f in free], rel=1e-12)
+    alone = identify(packed, free, fixed, seed=0, n_starts=1, weights=second_kw["weights"], held_out=False)
+    assert second.SSR <= alone.SSR * (1 + 1e-12)
+    assert fit.model.doc["fit"]["SSR"] == second.SSR
+
+
 def test_an_output_weighed_by_its_residuals_pulls_the_beans_less_than_at_weight_one(tmp_path):
     """SYNTHETIC, seeded: the probe is the model's at hbm 0.02 with 0.5 degC of noise; ET is the model's
     outlet gas at the same hbm plus an error the model has no term for (a slow 12 degC swing) and 0.5 degC
@@ -475,3 +516,21 @@ def test_the_solver_runs_on_one_blas_thread_and_gives_back_the_threads_after(mon
     identify(pack_batches(ds.batches, ds.plant, THETA_START), free, fixed, seed=0)
     assert len(seen) > len(ds.batches) and all(s == {1} for s in seen), seen  # polishes and refits alike
     assert blas_threads() == before
+
+
+def test_one_start_is_polished_without_simulating_trial_points(monkeypatch):
+    """With ``n_starts=1`` the start alone is polished: the trial points, which could only rank starts
+    that are not polished, are not simulated, and the optimum is that start's polish (dataset-I)."""
+    import importlib
+
+    ident = importlib.import_module("roastlab.fit.identify")
+    ds = read_dataset(default_dataset_root() / "dataset-I")
+    free, fixed = build_free_parameters()
+    packed = pack_batches(ds.batches, ds.plant, THETA_START)
+    obj = ident.Objective(packed, free, fixed)
+    z, ssr, *_ = ident._polish(obj, obj.start)
+    screened = []
+    monkeypatch.setattr(ident.Objective, "ssr_many", lambda self, *a, **k: screened.append(1))
+    one = identify(packed, free, fixed, seed=0, n_starts=1, held_out=False)
+    assert not screened and len(one.starts) == 1
+    assert [one.values[f.name] for f in free] == pytest.approx(z, rel=1e-9) and one.SSR == pytest.approx(ssr, rel=1e-12)

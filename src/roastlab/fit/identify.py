@@ -570,7 +570,8 @@ def identify(
     method : ``"global"`` (scattered trial points + least-squares polish) or ``"de"``
     seed : makes the search deterministic
     n_trial, n_starts : trial points scored and starts chosen for a polish (``"global"``; a start
-        inside the basin of an optimum already found is skipped, :data:`BASIN_FACTOR`)
+        inside the basin of an optimum already found is skipped, :data:`BASIN_FACTOR`); with one
+        start, the start alone is polished and no trial point is simulated
     progress : callable ``progress(done, total, text)`` called after each polish, or None
     weights : {output: weight} over :data:`OUTPUTS` (default Ta 1, Tb2 0: the probe alone)
     held_out : compute ``held_out_Ta``, each batch's probe error had it been left out (one local
@@ -602,7 +603,9 @@ def _identify(packed, free, fixed, method, seed, n_trial, n_starts, progress, we
     rng = np.random.default_rng(seed)
     width = obj.upper - obj.lower
     starts_log = []
-    if method == "global":
+    if method == "global" and n_starts <= 1:  # the start alone: no trial point to rank
+        candidates = [trial_points(trial_unit(obj.start[None, :], obj.lower, obj.upper), obj.lower, obj.upper)[0]]
+    elif method == "global":
         sampler = qmc.Sobol(nz, scramble=True, seed=rng)
         unit = np.vstack([trial_unit(obj.start[None, :], obj.lower, obj.upper), on_bounds(sampler.random(n_trial))])
         trial = trial_points(unit, obj.lower, obj.upper)
