@@ -400,14 +400,10 @@ def test_residual_weights_are_the_probes_residual_variance_over_the_outputs():
         residual_weights(outputs, ["Tb2"])
 
 
-def test_the_second_fit_of_a_weight_from_the_residuals_searches_as_the_first(tmp_path, monkeypatch):
-    """SYNTHETIC, seeded (the probe and ET of three batches at hbm 0.02, ET with an error the model has
-    no term for): the second fit, at the weight the first fit's residuals set, starts its search at the
-    first fit's optimum and polishes as many starts as the first. A polish from that optimum alone
-    stopped short of the optimum on the Skywalker's flat ridge (docs/real-roaster.md, "Skywalker: the
-    second fit searches"), so its SSR here is at most that polish's."""
-    import roastlab
-    import roastlab.workflows.fitting as fitting
+def probe_and_et_batches():
+    """SYNTHETIC, seeded: (truth, three batches) whose probe is the model's at hbm 0.02 with 0.5 degC of
+    noise, and whose ET is the model's outlet gas at the same values plus an error the model has no
+    term for (a slow 12 degC swing) and 0.5 degC of noise."""
     from roastlab.sim.kernels import I_TGO
     from roastlab.sim.population import simulate_population
 
@@ -418,6 +414,19 @@ def test_the_second_fit_of_a_weight_from_the_residuals_searches_as_the_first(tmp
     for i, b in enumerate(batches):
         b.Ta_C = b.Ta_C + rng.normal(0.0, 0.5, b.n)
         b.ET_C = tgo[i, : b.n] + 12.0 * np.sin(b.time_s / 300.0) + rng.normal(0.0, 0.5, b.n)
+    return truth, batches
+
+
+def test_the_second_fit_of_a_weight_from_the_residuals_searches_as_the_first(tmp_path, monkeypatch):
+    """SYNTHETIC, seeded (the probe and ET of three batches at hbm 0.02, ET with an error the model has
+    no term for): the second fit, at the weight the first fit's residuals set, starts its search at the
+    first fit's optimum and polishes as many starts as the first. A polish from that optimum alone
+    stopped short of the optimum on the Skywalker's flat ridge (docs/real-roaster.md, "Skywalker: the
+    second fit searches"), so its SSR here is at most that polish's."""
+    import roastlab
+    import roastlab.workflows.fitting as fitting
+
+    truth, batches = probe_and_et_batches()
     spec = tmp_path / "fit.toml"
     spec.write_text(
         "[free]\nhgm = [0.005, 0.2, 0.05]\nhbm = [0.001, 0.2, 0.05]\n[fixed]\n"
@@ -448,16 +457,8 @@ def test_an_output_weighed_by_its_residuals_pulls_the_beans_less_than_at_weight_
     spec) the weight is the first fit's residual variance ratio, recorded in the model file, and hbm
     lands nearer the truth."""
     import roastlab
-    from roastlab.sim.kernels import I_TGO
-    from roastlab.sim.population import simulate_population
 
-    truth = (THETA_START.hgm, 0.02, THETA_START.Pbm)
-    batches = noise_free_batches(11, "120kg", truth, count=3)
-    tgo = simulate_population(pack_batches(batches, "120kg", truth, InitialState(Ta0_C=30.0)))[0, :, :, I_TGO]
-    rng = np.random.default_rng(5)
-    for i, b in enumerate(batches):
-        b.Ta_C = b.Ta_C + rng.normal(0.0, 0.5, b.n)
-        b.ET_C = tgo[i, : b.n] + 12.0 * np.sin(b.time_s / 300.0) + rng.normal(0.0, 0.5, b.n)
+    truth, batches = probe_and_et_batches()
     spec = tmp_path / "fit.toml"
     for w in ("1.0", '"residual"'):
         spec.write_text(
