@@ -339,7 +339,8 @@ def add_parsers(sub) -> None:
         "map's [Tb2], or its first_crack: the log's FCs mark as the beans' temperature; compared with the model's "
         "Tb; default 0) or ET (the logged ET, compared with the model's "
         "outlet gas; default 0), e.g. --weight Tb2=0.25; W = residual sets it from a first fit's residuals "
-        "(--weight ET=residual) (repeatable; overrides the spec's [weights])",
+        "(--weight ET=residual), and a second fit searches again from the first's optimum "
+        "(repeatable; overrides the spec's [weights])",
     )
     add_model_options(p, with_model=False)
     p.set_defaults(func=cmd_identify)
