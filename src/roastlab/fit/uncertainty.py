@@ -388,7 +388,7 @@ def held_out_residuals(
                 left_out = partial(residuals_many, groups=np.array([g]))
             else:
                 fitted, left_out = (residuals_many, jacobian), None
-            out[rows[g]] = _refit_without(~rows[g], z, det, lower, upper, *fitted, J, left_out, r)[rows[g]]
+            out[rows[g]] = _refit_without(~rows[g], z, det, lower, upper, *fitted, J, r, left_out)
         except ValueError:  # SciPy refuses values where the products overflow: the step stands in
             pass
     return out
@@ -398,14 +398,16 @@ class _Converged(Exception):
     """Raised by a refit's Jacobian at the point where SciPy's ``ftol`` test has just ended the refit."""
 
 
-def _refit_without(held_in, z, det, lower, upper, residuals_many, jacobian, J0, left_out=None, r0=None) -> np.ndarray:
-    """The residuals (n,) of the fit redone on the ``held_in`` residuals alone, from ``z`` (where the
-    Jacobian is ``J0`` and, if given, the residuals ``r0``), over the ``det`` parameters within the
-    bounds (:func:`held_out_residuals`); the left-out rows from ``left_out`` at the refit's end,
+def _refit_without(held_in, z, det, lower, upper, residuals_many, jacobian, J0, r0, left_out=None) -> np.ndarray:
+    """The left-out residuals (the rows not ``held_in``) at the end of the fit redone on the
+    ``held_in`` residuals alone, from ``z`` (where the Jacobian is ``J0`` and the residuals ``r0``),
+    over the ``det`` parameters within the bounds (:func:`held_out_residuals`); from ``left_out``
     where ``residuals_many`` leaves them out (None: ``residuals_many`` gives every row).
 
-    Gauss-Newton's steps first (:func:`_newton_refit`); where they are not borne out, SciPy's
-    trust region from ``z``, as follows.
+    Gauss-Newton's steps first (:func:`_newton_refit`, a solver of its own rather than the
+    program optimiser's damped one in :mod:`roastlab.fit.program`: a refit wants a step that
+    fails, to hand it to SciPy, not one damped until it passes); where they are not borne out,
+    SciPy's trust region from ``z``, as follows.
 
     SciPy asks for the Jacobian at every point it accepts, the last one too, after its ``ftol`` test
     (the cost fell by less than :data:`REFIT_TOL` of itself) has ended the refit there. That last
@@ -430,12 +432,12 @@ def _refit_without(held_in, z, det, lower, upper, residuals_many, jacobian, J0, 
 
     lo, hi = lower[det], upper[det]
     x0 = np.clip(z[det], lo, hi)
-    if r0 is not None and np.array_equal(x0, z[det]):
+    if np.array_equal(x0, z[det]):
         seen[x0.tobytes()] = np.asarray(r0, dtype=float)
         with np.errstate(over="ignore", invalid="ignore"):  # a step into overflow fails its check
             end = _newton_refit(fun, lambda x: jacobian(full(x)), x0, J0, held_in, det, lo, hi)
         if end is not None:
-            return _refit_end(end, full, fun, seen, held_in, left_out)
+            return _left_out_at(end, full, fun, seen, held_in, left_out)
     accepted = []  # the cost 0.5 |r|^2 at each point SciPy accepted
 
     def jac(x):
@@ -466,17 +468,16 @@ def _refit_without(held_in, z, det, lower, upper, residuals_many, jacobian, J0, 
             ).x
     except _Converged as stop:
         end = stop.args[0]
-    return _refit_end(end, full, fun, seen, held_in, left_out)
+    return _left_out_at(end, full, fun, seen, held_in, left_out)
 
 
-def _refit_end(end, full, fun, seen, held_in, left_out) -> np.ndarray:
-    """Every residual at a refit's ``end``: the rows it fitted as simulated (``seen``), the left-out
-    rows from ``left_out`` (or from the same simulation when ``left_out`` is None)."""
-    fun(end)
-    out = seen[end.tobytes()].copy()
+def _left_out_at(end, full, fun, seen, held_in, left_out) -> np.ndarray:
+    """The left-out rows at a refit's ``end``: from ``left_out`` (the rows it fitted are not
+    simulated again), or, when ``left_out`` is None, from the simulation of every row (``seen``)."""
     if left_out is not None:
-        out[~held_in] = left_out(full(end)[None, :])[0][~held_in]
-    return out
+        return left_out(full(end)[None, :])[0][~held_in]
+    fun(end)
+    return seen[end.tobytes()][~held_in]
 
 
 def _newton_refit(fun, jacobian, x0, J0, held_in, det, lo, hi) -> np.ndarray | None:
