@@ -603,11 +603,12 @@ def _identify(packed, free, fixed, method, seed, n_trial, n_starts, progress, we
     rng = np.random.default_rng(seed)
     width = obj.upper - obj.lower
     starts_log = []
+    start_unit = trial_unit(obj.start[None, :], obj.lower, obj.upper)
     if method == "global" and n_starts <= 1:  # the start alone: no trial point to rank
-        candidates = [trial_points(trial_unit(obj.start[None, :], obj.lower, obj.upper), obj.lower, obj.upper)[0]]
+        candidates = [trial_points(start_unit, obj.lower, obj.upper)[0]]
     elif method == "global":
         sampler = qmc.Sobol(nz, scramble=True, seed=rng)
-        unit = np.vstack([trial_unit(obj.start[None, :], obj.lower, obj.upper), on_bounds(sampler.random(n_trial))])
+        unit = np.vstack([start_unit, on_bounds(sampler.random(n_trial))])
         trial = trial_points(unit, obj.lower, obj.upper)
         ssr = obj.ssr_many(trial, SCREENING_TOL_SCALE)
         order = np.argsort(ssr[1:]) + 1
