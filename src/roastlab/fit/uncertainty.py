@@ -372,10 +372,14 @@ def held_out_residuals(
     labels = np.unique(groups)
     rows = {g: groups == g for g in labels}
     A = Jd.T @ Jd
-    for g in labels:
+
+    def linearised(g):  # the group's residuals after the one Gauss-Newton step of the formula above
         Ji = Jd[rows[g]]
-        out[rows[g]] = r[rows[g]] + Ji @ (scaled_pinv(A - Ji.T @ Ji) @ (Ji.T @ r[rows[g]]))
+        return r[rows[g]] + Ji @ (scaled_pinv(A - Ji.T @ Ji) @ (Ji.T @ r[rows[g]]))
+
     if residuals_many is None:
+        for g in labels:
+            out[rows[g]] = linearised(g)
         return out
     z = np.asarray(z, dtype=float)
     lower = np.full(z.shape, -np.inf) if lower is None else np.asarray(lower, dtype=float)
@@ -390,7 +394,7 @@ def held_out_residuals(
                 fitted, left_out = (residuals_many, jacobian), None
             out[rows[g]] = _refit_without(~rows[g], z, det, lower, upper, *fitted, J, r, left_out)
         except ValueError:  # SciPy refuses values where the products overflow: the step stands in
-            pass
+            out[rows[g]] = linearised(g)  # (the refit's own first step is this step: not computed twice)
     return out
 
 
