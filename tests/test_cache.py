@@ -89,3 +89,24 @@ def test_numba_threads_sleep_between_calls_unless_the_environment_says_otherwise
     policy, loaded = out.stdout.split()
     assert policy == expected
     assert loaded == "False", "OpenMP was loaded before roastlab.sim could set its wait policy"
+
+
+def test_a_literal_entry_is_kept_per_value_and_per_argument_types():
+    """``literal_entry`` compiles once per constant and per the arguments' types, and hands back the
+    kept entry when called again with the same (the sensitivities ask for it at every Jacobian)."""
+    import numba
+    import numpy as np
+
+    @numba.njit
+    def scaled(x, k):
+        numba.literally(k)
+        return x * k
+
+    a = np.ones(3)
+    two = cache.literal_entry(scaled, (a, 2), 1)
+    assert cache.literal_entry(scaled, (np.zeros(3), 2), 1) is two and two(a, 2)[0] == 2.0
+    three = cache.literal_entry(scaled, (a, 3), 1)
+    assert three is not two and three(a, 3)[0] == 3.0
+    single = cache.literal_entry(scaled, (a.astype(np.float32), 2), 1)
+    assert single is not two and single(a.astype(np.float32), 2).dtype == np.float32
+    assert len(scaled.overloads) == 3

@@ -56,10 +56,22 @@ def test_lanes_once_per_set_of_laws_and_first():
     assert bullet.bed == BedLaws(probe="tumbling", probe_gas="mean")
     todo = precompile.jobs([precompile.LawSet(), bullet, precompile.LawSet(), bullet])
     names = [job.__name__ for job, _ in todo]
-    assert names == ["job_lanes", "job_lanes", "job_population", "job_sensitivities", "job_stepper"]
+    assert names == [
+        "job_lanes",
+        "job_lanes",
+        "job_population",
+        "job_sensitivities",
+        "job_sensitivities",
+        "job_stepper",
+    ]
     assert [args for _, args in todo[:2]] == [
         ("paper", "schwartzberg"),
         ("probe=tumbling,probe_gas=mean", "schwartzberg"),
+    ]
+    # the sensitivities once per bed and moisture law (their codes are compiled in), the program's once
+    assert [args for _, args in todo[3:5]] == [
+        ("paper", "schwartzberg", True),
+        ("probe=tumbling,probe_gas=mean", "schwartzberg", False),
     ]
     assert [job.__name__ for job, _ in precompile.jobs()][0] == "job_lanes"
     assert precompile.process_count(5, None) >= 1
@@ -115,7 +127,12 @@ def test_each_family_of_jobs_keeps_its_processes():
         assert sorted(map(repr, sum(groups, []))) == sorted(map(repr, todo))
     lanes, rest = precompile.chains(todo, 2)
     assert [job.__name__ for job, _ in lanes] == ["job_lanes", "job_lanes"]
-    assert [job.__name__ for job, _ in rest] == ["job_population", "job_sensitivities", "job_stepper"]
+    assert [job.__name__ for job, _ in rest] == [
+        "job_population",
+        "job_sensitivities",
+        "job_sensitivities",
+        "job_stepper",
+    ]
     assert precompile.chains(todo, 1) == [todo]
 
 

@@ -170,6 +170,74 @@ def test_generated_source_is_the_cached_one():
     assert path.read_text() == generate_source()
 
 
+@pytest.mark.parametrize("key", range(len(COMBOS)), ids=lambda k: ",".join(f"{v:g}" for v in COMBOS[k].values()))
+def test_a_combinations_codes_written_in_give_its_jacobian_to_the_bit(key):
+    """The generated functions with one combination's codes written in (what the sensitivity kernel
+    compiles per combination, so the compiler decides the codes' tests) read no code from ``p`` and
+    give the numbers of the function that reads them, bit for bit, every parameter column asked for."""
+    from roastlab.sim.jacobian import COMBINATIONS, _source_text, code_key, with_codes
+
+    codes = COMBOS[key]
+    assert tuple(codes.values()) == COMBINATIONS[key]
+    text = _source_text()
+    special = with_codes(text, key)
+    for name in CODE_VALUES:
+        read = f"p_{name} = p[{P[name]}]"
+        assert read in text and read not in special, name
+    function = load(key=key)
+    rng = np.random.default_rng(100 + key)
+    p = _params(codes, rng)
+    for _ in range(3):
+        x, u = _point(rng)
+        want = np.ones(N_PARAMS, dtype=bool)
+        got = np.zeros(NS), np.zeros((NS, NS)), np.zeros((NS, N_INPUTS)), np.zeros((NS, N_PARAMS))
+        function(*x, *u, p, want, *got)
+        for a, b in zip(got, _generated(x, u, p)):
+            assert np.array_equal(a, b)
+    assert code_key(np.vstack([p, p])) == key
+
+
+def test_runs_share_a_code_key_only_when_every_code_is_one_of_its_values():
+    from roastlab.sim.jacobian import COMBINATIONS, code_key
+
+    p = _params(COMBOS[0], np.random.default_rng(3))
+    assert code_key(p[None, :]) == 0 and COMBINATIONS[0] == tuple(COMBOS[0].values())
+    q = _params(COMBOS[5], np.random.default_rng(3))
+    assert code_key(np.vstack([p, q])) == -1  # runs whose laws differ
+    q = p.copy()
+    q[P["x_exp"]] = 1.5  # no law's exponent
+    assert code_key(q[None, :]) == -1
+    assert code_key(np.zeros((0, N_PARAMS))) == -1
+
+
+def test_the_sensitivity_kernel_for_the_runs_codes_agrees_with_the_one_reading_them():
+    """A fit's sensitivities run the kernel compiled for its runs' codes; runs whose codes differ (two
+    bed laws in one call) take the kernel that reads them from each run's parameters, and each run's
+    numbers are the same to the bit either way."""
+    import dataclasses
+
+    from roastlab.io.batch import read_dataset
+    from roastlab.model.parameters import THETA_START
+    from roastlab.sim.jacobian import code_key
+    from roastlab.sim.population import output_sensitivities, pack_batches
+    from roastlab.workflows.reproduce import default_dataset_root
+
+    ds = read_dataset(default_dataset_root() / "dataset-I")
+    batches = ds.batches[:2]
+    paper = pack_batches(batches, ds.plant, THETA_START)
+    tumbling = pack_batches(batches, ds.plant, THETA_START, bed="probe=tumbling,probe_gas=mean")
+    mixed = dataclasses.replace(paper, PB=np.vstack([paper.PB[0], tumbling.PB[1]]))
+    names, values, directions = ["hbm", "Pbm"], np.array([[0.03, 0.5], [0.03, 0.5]]), [(0, -1), (1, -1)]
+    one = output_sensitivities(paper, names, values, directions)
+    other = output_sensitivities(tumbling, names, values, directions)
+    both = output_sensitivities(mixed, names, values, directions)
+    for out in ("Ta", "Tb"):
+        for k in range(2):  # the value, its derivatives
+            assert np.array_equal(both[out][k][0], one[out][k][0], equal_nan=True)
+            assert np.array_equal(both[out][k][1], other[out][k][1], equal_nan=True)
+    assert code_key(mixed.PB) == -1 and -1 < code_key(paper.PB) != code_key(tumbling.PB) > -1
+
+
 def test_the_printed_powers_shortcut_only_where_pow_is_exact():
     """A power with an exponent that is not a whole number is printed behind pow's exact cases
     (x**0 = 1, x**1 = x, 1**y = 1): at bases and exponents that hit them, at their neighbours and

@@ -39,15 +39,16 @@ def add_parsers(sub) -> None:
         "A first run of any command otherwise "
         f"compiles what it needs on one core ({FIRST_COMPILE}). The lanes integrator, which "
         "simulates many runs at once, is compiled once per set of laws (the bed and moisture laws, and the held "
-        "values it compiles in: the drive exponents, the beans' swelling): the paper's always, and those of each "
-        "fit spec or model file given. With a warm cache it takes seconds.",
+        "values it compiles in: the drive exponents, the beans' swelling), and a fit's exact sensitivities once per "
+        "bed and moisture law: the paper's always, and those of each fit spec or model file given. With a warm cache "
+        "it takes seconds.",
     )
     p.add_argument(
         "laws",
         nargs="*",
         metavar="SPEC_OR_MODEL",
         help="fit specs (fit.toml) or model files (MODEL.json) whose laws (bed, moisture, held exponents and "
-        "swelling) to compile the lanes for, besides the paper's",
+        "swelling) to compile the lanes and the sensitivities for, besides the paper's",
     )
     p.add_argument(
         "--processes",

@@ -26,6 +26,7 @@ import os
 from pathlib import Path
 
 import numba
+import numpy as np
 from numba.core import caching, config
 
 #: Subpackages whose files the compiled code is built from: the kernels (sim, fit) and the
@@ -140,3 +141,43 @@ def compiled(*args, **options):
     if args and callable(args[0]):
         return decorate(args[0])
     return decorate
+
+
+try:  # numba's dispatcher keys its compiled versions on this (C, about 0.15 us a value)
+    from numba._dispatcher import compute_fingerprint as _fingerprint
+except ImportError:  # pragma: no cover - numba without it
+
+    def _fingerprint(a):
+        """What numba's type of ``a`` depends on: an array's dtype, dimensions, layout, writability and
+        alignment, another value's Python type."""
+        if isinstance(a, np.ndarray):
+            flags = a.flags
+            return (a.dtype.str, a.ndim, flags.c_contiguous, flags.f_contiguous, flags.writeable, flags.aligned)
+        return type(a)
+
+
+_ENTRIES: dict = {}
+
+
+def literal_entry(dispatcher, args: tuple, literal: int):
+    """The compiled entry point of ``dispatcher`` for ``args``, whose entry ``literal`` (a whole
+    number) is a compile-time constant of the code: loaded from the disk cache or compiled once for
+    that value, and called as ``entry(*args)``. Asked for directly, rather than by calling the
+    dispatcher, which would first compile for a value that is merely a number and only then, told by
+    ``numba.literally``, for the constant: a failing attempt that costs as long as compiling. The
+    entry is kept per value and per the arguments' :func:`_fingerprint` (typing the arguments anew
+    took 130 us a call, a quarter of a sensitivity run of dataset-I; the fingerprints 3 us)."""
+    from numba.core import types
+
+    try:
+        fingerprint = (id(dispatcher), int(args[literal]), *(_fingerprint(a) for a in args))
+    except (TypeError, ValueError):  # a value numba's fingerprint does not cover: typed anew
+        fingerprint = None
+    entry = _ENTRIES.get(fingerprint)
+    if entry is None:
+        sig = tuple(types.literal(int(a)) if i == literal else numba.typeof(a) for i, a in enumerate(args))
+        found = dispatcher.overloads.get(sig)
+        entry = dispatcher.compile(sig) if found is None else found.entry_point
+        if fingerprint is not None:
+            _ENTRIES[fingerprint] = entry
+    return entry

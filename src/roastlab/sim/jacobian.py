@@ -10,7 +10,10 @@ written by hand: an edit to ``rhs.py`` changes the generated code with it.
 The right-hand side branches in Python on the discrete model options (the bed laws'
 ``contact_law``, ``probe_law``, ``probe_gas_law`` and the moisture law's exponent ``x_exp``), so
 the code is generated once per combination of their values (:data:`CODE_VALUES`) and the
-generated function picks the block of the combination in ``p`` at run time.
+generated function picks the block of the combination in ``p`` at run time. :func:`load` also
+gives it with one combination's codes written in as constants (``key``, :func:`code_key`), so that
+the compiler decides those branches once instead of at every call: the sensitivity integrator is
+compiled per combination a fit uses (:func:`roastlab.sim.sensitivity.population_sensitivities`).
 
 The generated source is cached beside the compiled kernels (:func:`roastlab.sim.cache.cache_dir`,
 keyed on the hash of the sources it derives from), so SymPy runs once per source version
@@ -27,6 +30,7 @@ a kink (``fmax``, ``where``), the derivative is that of the branch taken.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import importlib.util
 import itertools
@@ -46,8 +50,38 @@ CODE_VALUES: dict[str, tuple[float, ...]] = {
     **{f"{k}_law": tuple(float(i) for i in range(len(v))) for k, v in _bed.LAWS.items()},
     "x_exp": tuple(float(v) for v in MOISTURE_LAWS.values()),
 }
+#: Every combination of the codes' values, in :data:`CODE_VALUES`' order: a combination's index is
+#: its ``key`` (:func:`code_key`, :func:`load`).
+COMBINATIONS: tuple[tuple[float, ...], ...] = tuple(itertools.product(*CODE_VALUES.values()))
 #: Parameter-vector entries the Jacobian differentiates with respect to (every one but the codes).
 CONTINUOUS = tuple(name for name in PARAM_NAMES if name not in CODE_VALUES)
+
+
+_CODE_SLOTS = [P[name] for name in CODE_VALUES]
+_KEYS = {combo: key for key, combo in enumerate(COMBINATIONS)}
+
+
+def code_key(PP) -> int:
+    """The index in :data:`COMBINATIONS` of the codes every row of ``PP`` (runs x N_PARAMS) holds, or
+    -1 when the rows differ or a code is none of its values (:func:`load` then gives the function that
+    reads the codes at run time)."""
+    codes = PP[:, _CODE_SLOTS]
+    if codes.shape[0] == 0 or not (codes == codes[0]).all():
+        return -1
+    return _KEYS.get(tuple(codes[0].tolist()), -1)
+
+
+def with_codes(text: str, key: int) -> str:
+    """The generated source ``text`` with the codes of combination ``key`` written in where the
+    functions read them from ``p`` (the blocks of the other combinations are left for the compiler to
+    drop: every test of a code is then a test of a constant)."""
+    import re
+
+    for name, value in zip(CODE_VALUES, COMBINATIONS[key]):
+        text = re.sub(rf"^(\s+)p_{name} = p\[{P[name]}\]$", rf"\g<1>p_{name} = {value!r}", text, flags=re.M)
+    return text
+
+
 FUNCTION_NAME = "rhs_jacobian"
 OUTLET_FUNCTION_NAME = "outlet_jacobian"
 
@@ -253,26 +287,30 @@ def _write_atomically(path: Path, text: str) -> None:
         raise
 
 
-def source_path() -> Path | None:
-    """Where this source version's generated module is cached (None when no cache folder)."""
+def source_path(key: int = -1) -> Path | None:
+    """Where this source version's generated module is cached (None when no cache folder); ``key``
+    (:func:`code_key`): the module with that combination's codes written in."""
     from .cache import cache_dir
 
     folder = cache_dir()
-    return None if folder is None else folder / f"rhs_jacobian_{_sources_hash()}.py"
+    suffix = "" if key < 0 else f"_k{key}"
+    return None if folder is None else folder / f"rhs_jacobian_{_sources_hash()}{suffix}.py"
 
 
-def load(function: str = FUNCTION_NAME):
+def load(function: str = FUNCTION_NAME, key: int = -1):
     """A generated function (``rhs_jacobian`` or ``outlet_jacobian``) as plain Python (generated
-    and cached on first use; one module per process holds both)."""
+    and cached on first use; one module per process holds both). ``key`` >= 0: the function with
+    the codes of :data:`COMBINATIONS`' entry ``key`` written in (:func:`with_codes`), which gives
+    the same numbers as the one that reads them from ``p`` for parameter vectors holding those codes."""
     # a module in sys.modules under a name of its own: numba's disk cache of the kernels that
     # compile this function in finds its globals by that name in a later process
-    name = f"roastlab_rhs_jacobian_{_sources_hash()}"
+    name = f"roastlab_rhs_jacobian_{_sources_hash()}" + ("" if key < 0 else f"_k{key}")
     if name in sys.modules:
         return getattr(sys.modules[name], function)
-    path = source_path()
+    path = source_path(key)
     text = None
     if path is None or not path.is_file():
-        text = generate_source()
+        text = generate_source() if key < 0 else with_codes(_source_text(), key)
         if path is not None:
             try:
                 _write_atomically(path, text)
@@ -288,3 +326,12 @@ def load(function: str = FUNCTION_NAME):
         sys.modules[name] = module
         exec(compile(text, f"<{name}>", "exec"), module.__dict__)  # our own generated code, never user input
     return getattr(module, function)
+
+
+@functools.cache
+def _source_text() -> str:
+    """The generated source of the functions that read the codes at run time (from the cache folder,
+    else generated)."""
+    load(FUNCTION_NAME)
+    path = source_path()
+    return path.read_text() if path is not None and path.is_file() else generate_source()

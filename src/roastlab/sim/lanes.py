@@ -29,7 +29,7 @@ from numba.extending import intrinsic, register_jitable
 from ..model.layout import I_CONTACT, I_FEXP, I_HEXP, I_HLEXP, I_PROBEGAS, I_PROBELAW, I_SWELL, I_XEXP, N_PARAMS
 from ..model.rhs import outlet_gas_C, rebind
 from . import vecmath
-from .cache import compiled
+from .cache import compiled, literal_entry
 from .kernels import (
     _A21,
     _A31,
@@ -456,21 +456,15 @@ def usable(PP: np.ndarray) -> int | None:
 def simulate_runs(T, GG, TGI, QQ, FF, N, batch_of, X0, PP, zoh, h_max, cols, out, tol_scale, key) -> None:
     """Run :func:`lanes_population_kernel` for the laws ``key`` (:func:`usable`) on numba's threads.
 
-    The key is a compile-time constant of the kernel; calling the kernel's compiled version for it
-    directly (loaded from the disk cache, or compiled once) skips numba's first, failing attempt to
-    compile it for a key that is merely a number, which costs as long as compiling.
+    The key is a compile-time constant of the kernel (:func:`roastlab.sim.cache.literal_entry`).
     """
     import numba
 
-    args = (T, GG, TGI, QQ, FF, N, batch_of, X0, PP, bool(zoh), float(h_max), cols, out, float(tol_scale))
-    sig = (*(numba.typeof(a) for a in args), types.literal(int(key)), types.int64)
-    entry = lanes_population_kernel.overloads.get(sig)
-    if entry is None:
-        with warnings.catch_warnings():
-            # numba's own pedantic check of its SSA pass flags the phis of vecmath's inlined
-            # conditional expressions ("not in scope"); the compiled code is correct (tested)
-            warnings.simplefilter("ignore", NumbaIRAssumptionWarning)
-            entry = lanes_population_kernel.compile(sig)
-    else:
-        entry = entry.entry_point
-    entry(*args, int(key), numba.get_num_threads())
+    args = (T, GG, TGI, QQ, FF, N, batch_of, X0, PP, bool(zoh), float(h_max), cols, out, float(tol_scale), int(key),
+            numba.get_num_threads())  # fmt: skip
+    with warnings.catch_warnings():
+        # numba's own pedantic check of its SSA pass flags the phis of vecmath's inlined
+        # conditional expressions ("not in scope"); the compiled code is correct (tested)
+        warnings.simplefilter("ignore", NumbaIRAssumptionWarning)
+        entry = literal_entry(lanes_population_kernel, args, 14)
+    entry(*args)

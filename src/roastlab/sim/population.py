@@ -261,7 +261,7 @@ def output_sensitivities(
 ):
     """The fitted outputs and their exact derivatives with respect to ``directions``, for one
     value set over every batch (forward sensitivities,
-    :func:`roastlab.sim.sensitivity.sens_population_kernel`).
+    :func:`roastlab.sim.sensitivity.population_sensitivities`).
 
     ``values`` (nb, len(names)): each named parameter's value per batch (as one set of
     :func:`predict_outputs`). ``directions``: one (j, b) per column, the derivative with respect to
@@ -269,7 +269,7 @@ def output_sensitivities(
     nmax), derivative (nb, nmax, m)), "Tb": ..., and with ``with_tgo`` "Tgo": ...}, NaN-padded.
     ``batches``: the indices of the batches to simulate (None: all); the others' rows are NaN.
     """
-    from .sensitivity import outlet_sens_kernel, sens_population_kernel
+    from .sensitivity import outlet_sens_kernel, population_sensitivities
 
     nb, nmax, m = packed.n_batches, packed.T.shape[1], len(directions)
     batch_of, X0, PP = run_arrays(packed, names, values[None, :, :])
@@ -307,7 +307,7 @@ def output_sensitivities(
     runs = batch_of.shape[0]
     out_x = np.full((runs, nmax, NS), np.nan)
     out_s = np.full((runs, nmax, rows.size, m), np.nan)
-    sens_population_kernel(
+    population_sensitivities(
         *packed.inputs, batch_of, X0, PP, packed.zoh, packed.h_max_s, S0, PQ, PC, PV, rows, out_x, out_s
     )
     res = {}

@@ -32,12 +32,13 @@ import functools
 
 import numpy as np
 from numba import prange
-from numba.extending import register_jitable
+from numba.core import types
+from numba.extending import overload, register_jitable
 
 from ..model.layout import N_INPUTS, N_PARAMS, S_H, S_TA, S_TM, S_X, U_GG, U_HEATER, U_TGI
 from . import kernels as _k
-from .cache import compiled
-from .jacobian import OUTLET_FUNCTION_NAME
+from .cache import compiled, literal_entry
+from .jacobian import OUTLET_FUNCTION_NAME, code_key
 from .jacobian import load as _load_jacobian
 from .kernels import (
     H0_S,
@@ -53,8 +54,31 @@ from .kernels import (
     rms_error,
 )
 
-_rhs_jacobian = register_jitable(_load_jacobian())
 _outlet_jacobian = register_jitable(_load_jacobian(OUTLET_FUNCTION_NAME))
+
+
+@functools.cache
+def _rhs_jacobian_for(key: int):
+    """The generated Jacobian of the right-hand side with the model codes of combination ``key``
+    compiled in (:func:`roastlab.sim.jacobian.load`; -1: read from ``p`` at run time)."""
+    return register_jitable(_load_jacobian(key=key))
+
+
+def _rhs_jacobian(key, x0, x1, x2, x3, x4, x5, u0, u1, u2, u3, p, want, f, Jx, Ju, Jp):
+    """The generated Jacobian (:mod:`roastlab.sim.jacobian`) for compiled code: ``key`` a
+    compile-time constant gives the function with that combination's codes written in, any other
+    whole number the one that reads them from ``p``."""
+    raise NotImplementedError("compiled code only")
+
+
+@overload(_rhs_jacobian, prefer_literal=True)
+def _rhs_jacobian_overload(key, x0, x1, x2, x3, x4, x5, u0, u1, u2, u3, p, want, f, Jx, Ju, Jp):
+    function = _rhs_jacobian_for(key.literal_value if isinstance(key, types.IntegerLiteral) else -1)
+
+    def impl(key, x0, x1, x2, x3, x4, x5, u0, u1, u2, u3, p, want, f, Jx, Ju, Jp):
+        function(x0, x1, x2, x3, x4, x5, u0, u1, u2, u3, p, want, f, Jx, Ju, Jp)
+
+    return impl
 
 
 @compiled
@@ -94,13 +118,14 @@ def ta_input_jacobian(t, Gg, Tgi, Q, F, which, states, ta_base, p, zoh, h_max, d
 
 
 @compiled
-def _stage(y, g, T, q, f, p, w, k, zoh, du_ptr, du_j, du_c, du_v, Y, pq, pc, pv, want, nc, fx, Jx, Ju, Jp, K):
+def _stage(y, g, T, q, f, p, w, k, zoh, du_ptr, du_j, du_c, du_v, Y, pq, pc, pv, want, nc, fx, Jx, Ju, Jp, K, key):
     """One stage at state ``y`` and inputs (g, T, q, f): fx = f(y, u) and, over the first ``nc``
     columns, K = J_x Y + J_u du/dz + J_p dp/dz. du/dz is sample k's sparse rows (held, or
     blended with sample k + 1's by ``w`` under a linear hold); dp/dz the triplets (pq, pc, pv),
-    whose parameters ``want`` flags (only their columns of J_p are computed).
+    whose parameters ``want`` flags (only their columns of J_p are computed); ``key`` the model
+    codes' combination (:func:`_rhs_jacobian`).
     Loops run over the contiguous column index, so the compiler can vectorise them."""
-    _rhs_jacobian(y[0], y[1], y[2], y[3], y[4], y[5], g, T, q, f, p, want, fx, Jx, Ju, Jp)
+    _rhs_jacobian(key, y[0], y[1], y[2], y[3], y[4], y[5], g, T, q, f, p, want, fx, Jx, Ju, Jp)
     for i in range(NS):
         for c in range(nc):
             K[i, c] = 0.0
@@ -146,7 +171,30 @@ _DP_E = np.array([_k._E1, 0.0, _k._E3, _k._E4, _k._E5, _k._E6, _k._E7])
 
 @compiled
 def integrate_sens_into(
-    t, Gg, Tgi, Q, F, n, x0, p, zoh, h_max, S0, ncol, du_ptr, du_j, du_c, du_v, pq, pc, pv, rows, out, outS, h0=H0_S
+    t,
+    Gg,
+    Tgi,
+    Q,
+    F,
+    n,
+    x0,
+    p,
+    zoh,
+    h_max,
+    S0,
+    ncol,
+    du_ptr,
+    du_j,
+    du_c,
+    du_v,
+    pq,
+    pc,
+    pv,
+    rows,
+    out,
+    outS,
+    h0=H0_S,
+    key=-1,
 ):
     """:func:`roastlab.sim.kernels.integrate_into` (same steps, same states) with the forward
     sensitivity S = dx/dz of m directions z.
@@ -157,7 +205,9 @@ def integrate_sens_into(
     (u = [Gg, Tgi, heater, fan]; held between samples like the inputs), or an empty ``du_ptr``
     when no input depends on z. dp/dz as triplets: d p[pq[e]] / d z[pc[e]] = pv[e].
     Writes the states to ``out[:n, :NS]`` and S[rows[r], :] to ``outS[:n, r, :]``; returns the
-    next step size. The states' error control alone chooses the steps.
+    next step size. The states' error control alone chooses the steps. ``key``: the model codes'
+    combination ``p`` holds, as a compile-time constant (:func:`roastlab.sim.jacobian.code_key`), or
+    -1 (the codes read from ``p``).
     """
     m = S0.shape[1]
     A, C, E = _DP_A, _DP_C, _DP_E
@@ -196,7 +246,7 @@ def integrate_sens_into(
         if zoh or k == 0:
             _stage(
                 x, g0, T0, q0, f0, p, 0.0, k, zoh, du_ptr, du_j, du_c, du_v, S, pq, pc, pv, want, nc, fx, Jx, Ju, Jp,
-                KS[0],
+                KS[0], key,
             )  # fmt: skip
             for i in range(NS):
                 kx[0, i] = fx[i]
@@ -227,7 +277,7 @@ def integrate_sens_into(
                                 Y[i, c] += coef * KS[j, i, c]
                 _stage(
                     y, g0 + dg * a, T0 + dT * a, q0 + dq * a, f0 + df * a, p, a / dt, k, zoh,
-                    du_ptr, du_j, du_c, du_v, Y, pq, pc, pv, want, nc, fx, Jx, Ju, Jp, KS[st],
+                    du_ptr, du_j, du_c, du_v, Y, pq, pc, pv, want, nc, fx, Jx, Ju, Jp, KS[st], key,
                 )  # fmt: skip
                 for i in range(NS):
                     kx[st, i] = fx[i]
@@ -277,19 +327,36 @@ def _fill(out, outS, start, n, value):
 
 
 @compiled(parallel=True)
-def sens_population_kernel(T, GG, TGI, QQ, FF, N, batch_of, X0, PP, zoh, h_max, S0, PQ, PC, PV, rows, out_x, out_s):
+def sens_population_kernel(
+    T, GG, TGI, QQ, FF, N, batch_of, X0, PP, zoh, h_max, S0, PQ, PC, PV, rows, out_x, out_s, key
+):
     """Forward sensitivities of ``len(batch_of)`` runs in parallel (as
     :func:`roastlab.sim.kernels.ta_population_kernel`): run i starts from X0[i] with S0[i]
     (NS, m), parameters PP[i] and dp/dz triplets PQ[i], PC[i], PV[i] (pad with PV = 0); no input
-    depends on z. Writes the states to out_x[i] and S[rows] to out_s[i]."""
+    depends on z. Writes the states to out_x[i] and S[rows] to out_s[i]. ``key``: the model
+    codes' combination every PP[i] holds (:func:`population_sensitivities` passes it as a constant)."""
     no_int = np.zeros(0, dtype=np.int64)
     no_float = np.zeros(0)
     for i in prange(batch_of.shape[0]):
         b = batch_of[i]
         integrate_sens_into(
             T[b], GG[b], TGI[b], QQ[b], FF[b], N[b], X0[i], PP[i], zoh, h_max, S0[i], no_int,
-            no_int, no_int, no_int, no_float, PQ[i], PC[i], PV[i], rows, out_x[i], out_s[i], H0_S,
+            no_int, no_int, no_int, no_float, PQ[i], PC[i], PV[i], rows, out_x[i], out_s[i], H0_S, key,
         )  # fmt: skip
+
+
+def population_sensitivities(T, GG, TGI, QQ, FF, N, batch_of, X0, PP, zoh, h_max, S0, PQ, PC, PV, rows, out_x, out_s):
+    """:func:`sens_population_kernel` compiled for the model codes the runs share
+    (:func:`roastlab.sim.jacobian.code_key`, a compile-time constant: the Jacobian's tests of them
+    are decided once, not at every stage; one evaluation of dataset-I's takes about a third less,
+    docs/performance.md), or reading them from ``PP`` where the runs differ."""
+    key = code_key(PP)
+    args = (T, GG, TGI, QQ, FF, N, batch_of, X0, PP, bool(zoh), float(h_max), S0, PQ, PC, PV, rows, out_x, out_s, key)
+    if key < 0:
+        sens_population_kernel(*args)
+        return
+    _rhs_jacobian_for(key)  # its module, whose name a kernel loaded from the disk cache refers to
+    literal_entry(sens_population_kernel, args, len(args) - 1)(*args)
 
 
 @compiled(parallel=True)

@@ -12,8 +12,9 @@ load them from the cache.
 
 A *job* is one group of kernels that share compiled callees (compiled in one process, so a callee is
 not compiled twice): the lanes integrator once per set of laws (:func:`roastlab.sim.lanes.law_key`),
-the scalar population kernels with the per-batch fitter, the exact sensitivities with the program's,
-and the single-run stepper. With a warm cache every job only loads, in about a second.
+the scalar population kernels with the per-batch fitter, the exact sensitivities once per bed and
+moisture law (:func:`roastlab.sim.jacobian.code_key`; the program's with the paper's), and the
+single-run stepper. With a warm cache every job only loads, in about a second.
 """
 
 from __future__ import annotations
@@ -126,19 +127,23 @@ def job_population() -> str:
     return "population kernels and the per-batch fitter"
 
 
-def job_sensitivities() -> str:
-    """The exact sensitivities of a fit (every output, the outlet gas's too) and of a program."""
+def job_sensitivities(bed: str = BedLaws().name, moisture: str = "schwartzberg", program: bool = True) -> str:
+    """The exact sensitivities of a fit (every output, the outlet gas's too) for one bed and moisture
+    law (compiled per combination of the model's codes, :func:`roastlab.sim.jacobian.code_key`) and,
+    with ``program``, those of a program."""
     from ..sim.population import output_sensitivities
     from ..sim.sensitivity import program_sensitivity
 
-    packed = _packed()
+    laws = LawSet(BedLaws.parse(bed), moisture)
+    packed = _packed(laws)
     output_sensitivities(packed, ["hbm"], np.full((1, 1), 0.0254), [(0, -1)], with_tgo=True)
-    b = _batch()
-    n = b.n
-    x0 = packed.x0[0].copy()
-    p = packed.PB[0].copy()
-    program_sensitivity(b.time_s, b.Gg_kg_s, b.Tgi_C, np.zeros(n), np.zeros(n), x0, p, False, 0)
-    return "sensitivities"
+    if program:
+        b = _batch()
+        n = b.n
+        x0 = packed.x0[0].copy()
+        p = packed.PB[0].copy()
+        program_sensitivity(b.time_s, b.Gg_kg_s, b.Tgi_C, np.zeros(n), np.zeros(n), x0, p, False, 0)
+    return f"sensitivities ({laws.bed.name}, {laws.moisture} moisture{', a program' if program else ''})"
 
 
 def job_stepper() -> str:
@@ -163,10 +168,14 @@ def jobs(law_sets=(LawSet(),)) -> list[tuple]:
     for laws in law_sets:
         if laws not in seen and compiles_in([v for _, v in laws.held]):
             seen.append(laws)
+    codes: list[tuple[str, str]] = []  # the sensitivities' kernel is one per bed and moisture law
+    for laws in (LawSet(), *law_sets):
+        if (laws.bed.name, laws.moisture) not in codes:
+            codes.append((laws.bed.name, laws.moisture))
     return [
         *((job_lanes, (laws.bed.name, laws.moisture, *((laws.held,) if laws.held else ()))) for laws in seen),
         (job_population, ()),
-        (job_sensitivities, ()),
+        *((job_sensitivities, (bed, moisture, k == 0)) for k, (bed, moisture) in enumerate(codes)),
         (job_stepper, ()),
     ]
 
