@@ -348,7 +348,7 @@ def sens_population_kernel(
 def population_sensitivities(T, GG, TGI, QQ, FF, N, batch_of, X0, PP, zoh, h_max, S0, PQ, PC, PV, rows, out_x, out_s):
     """:func:`sens_population_kernel` compiled for the model codes the runs share
     (:func:`roastlab.sim.jacobian.code_key`, a compile-time constant: the Jacobian's tests of them
-    are decided once, not at every stage; one evaluation of dataset-I's takes about a third less,
+    are decided once, not at every stage: a sensitivity run of dataset-I takes a fifth less,
     docs/performance.md), or reading them from ``PP`` where the runs differ."""
     key = code_key(PP)
     args = (T, GG, TGI, QQ, FF, N, batch_of, X0, PP, bool(zoh), float(h_max), S0, PQ, PC, PV, rows, out_x, out_s, key)
