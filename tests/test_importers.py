@@ -680,6 +680,32 @@ def test_init_flags_an_et_that_reads_below_bt_unlike_the_machines_other_logs():
     assert et_not_drum_air([-30.0, None, 20.0]) == [False] * 3  # two known logs say nothing about a spread
 
 
+def test_an_et_sensor_moved_on_a_third_of_the_logs_is_still_flagged_and_one_sensors_spread_seldom():
+    """A third of the logs with the sensor elsewhere widen the spread of all the logs until none
+    lies far below it; the split into two groups still finds them (the Skywalker's first ten logs
+    by name, three moved). SYNTHETIC draws, seeded: logs of one sensor position (a normal spread
+    about 0) are flagged little more often than by the median rule alone, and machines whose
+    sensor moved on 3 of 10 or 5 of 12 logs (30-40 degC below BT, the others 0-30 above) are found
+    far more often (profile.TWO_SENSORS_SHARE states the larger draw)."""
+    from roastlab.metrics.profile import _far_below_C, et_not_drum_air
+
+    sky10 = [-32.2, -38.1, -31.3, 8.9, 1.7, 24.8, 21.9, 28.1, 12.7, 16.8]
+    assert not any(np.asarray(sky10) < _far_below_C(sky10))  # the median rule alone misses them
+    assert et_not_drum_air(sky10) == [True] * 3 + [False] * 7
+    rng = np.random.default_rng(0)
+    draws = 300
+    for n in (6, 10):
+        one = [rng.normal(0.0, 5.0, n) for _ in range(draws)]
+        by_median = np.mean([np.any(d < _far_below_C(d)) for d in one])
+        by_split = np.mean([any(et_not_drum_air(d)) for d in one])
+        assert by_median <= by_split <= by_median + 0.08, (n, by_median, by_split)
+    for n, moved in ((10, 3), (12, 5)):
+        two = [np.r_[rng.uniform(-40, -30, moved), rng.uniform(0, 30, n - moved)] for _ in range(draws)]
+        by_median = np.mean([np.all(d[:moved] < _far_below_C(d)) for d in two])
+        by_split = np.mean([all(et_not_drum_air(d)[:moved]) for d in two])
+        assert by_median < 0.4 and by_split > 0.9, (n, moved, by_median, by_split)
+
+
 def test_an_et_that_falls_to_the_green_beans_at_charge_reads_the_beans():
     """SYNTHETIC readings: an infrared bean sensor logged as ET reads the green beans as they land
     (25 degC) while the probe cools only to its turning point (100 degC); a drum-air ET dips to about
