@@ -128,7 +128,7 @@ def power(x, a):
 def cube_root(v):
     """v^(1/3) for v in [0.2, 16] (the beans' size, :func:`roastlab.model.rhs.swell_factor`, whose v lies
     in [1, 4]: a bean_swell of at most 3, the reactions' heat at most its total), within 1 unit in the
-    last place (tests/test_lanes.py, against NumPy's ``cbrt``), in a few divisions.
+    last place (tests/test_lanes.py, against the correctly rounded cube root), in a few divisions.
 
     Padé's [1/1] approximant of (1 + t)^(1/3) at t = v - 1, (1 + 2v) / (2 + v), 5.5 % off at v = 4, then
     three steps of Halley's iteration for y^3 = v, written as a correction y + y (v - y^3) / (2y^3 + v)
