@@ -329,6 +329,7 @@ def _open(page, log, model):
     page.wait_for_function("document.getElementById('log').options.length > 0")
     page.select_option("#log", log)
     page.select_option("#model", model)
+    page.evaluate("delete document.body.dataset.opened")  # the page's own first Open may have set it
     page.click("#open")
     page.wait_for_function("document.body.dataset.opened !== undefined && document.getElementById('plot').data")
 
@@ -636,6 +637,39 @@ def _fahrenheit_log(folder: Path) -> tuple[str, str]:
     model["map"] = {"format": "alog", "Ta": {"column": "BT"}, "Tgi": {"column": "ET"}, "Gg": {"constant_kg_s": 3.5}}
     (folder / "paper-F.json").write_text(json.dumps(model))
     return f"{folder.name}/roast-F.alog", f"{folder.name}/paper-F.json"
+
+
+@pytest.mark.slow
+def test_the_last_open_wins_when_an_earlier_answer_arrives_late(page, data_dir):
+    """The page opens a log by itself as it loads; a roaster who picks another log meanwhile must see
+    that one. Here the answer to an Open of the SYNTHETIC paper batch is held back until a log in degF
+    has been opened and shown: arriving late, it changes nothing (before, it replaced the log the
+    roaster chose last)."""
+    log, model = _fahrenheit_log(data_dir / "fahrenheit")
+    held = []
+
+    def hold_the_first_paper_batch(route):
+        if not held and "paper-model.json" in (route.request.post_data or ""):
+            held.append(route)
+        else:
+            route.continue_()
+
+    page.route("**/api/open", hold_the_first_paper_batch)
+    page.reload()
+    page.wait_for_function("document.getElementById('log').options.length > 0")
+    page.select_option("#log", "batch1.csv")
+    page.select_option("#model", "paper-model.json")
+    page.click("#open")
+    page.select_option("#log", log)
+    page.select_option("#model", model)
+    page.evaluate("delete document.body.dataset.opened")
+    page.click("#open")
+    page.wait_for_function("document.body.dataset.opened === 'roast-F'")
+    assert held and page.input_value("#units") == "F"
+    held[0].continue_()  # the earlier Open's answer arrives now
+    page.wait_for_timeout(1500)
+    assert page.evaluate("[document.body.dataset.opened, state.open.log]") == ["roast-F", "roast-F"]
+    assert page.input_value("#units") == "F"
 
 
 @pytest.mark.slow

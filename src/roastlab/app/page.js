@@ -5,7 +5,8 @@ const sid = sessionStorage.getItem("roastlab-session") || crypto.randomUUID();
 sessionStorage.setItem("roastlab-session", sid);
 const $ = (id) => document.getElementById(id);
 const state = { open: null, changed: null, changedBand: null, table: null, busy: false, pending: false, lastDrawMs: null, tInput: null,
-                program: {}, touchStep: null, transfer: null };  // program: setting -> [{from_s, until_s, value, logged}], the steps the roaster can drag
+                program: {}, touchStep: null, transfer: null, opening: 0 };  // program: setting -> [{from_s, until_s, value, logged}], the steps the roaster can drag
+// opening: the number of the latest Open; an earlier one's answer that arrives after it is dropped
 
 async function api(path, body) {
   const opts = { method: body === undefined ? "GET" : "POST", headers: { "X-Session": sid } };
@@ -424,8 +425,10 @@ async function openLog() {
   if (!$("model").value) { say(NO_MODEL); return; }
   say("opening ...");
   $("whatif_downloads").innerHTML = "";
+  const ticket = ++state.opening;  // the last Open wins (the page's own first Open may still be on its way)
   try {
     const r = await api("/api/open", { log: $("log").value, model: $("model").value });
+    if (ticket !== state.opening) return;
     state.open = r;
     state.changed = null;
     state.program = {};
@@ -456,7 +459,7 @@ async function openLog() {
     say("");
     document.body.dataset.opened = r.log;
   } catch (e) {
-    say(e.message);
+    if (ticket === state.opening) say(e.message);
   }
 }
 
