@@ -142,6 +142,20 @@ def test_compile_names_a_missing_file(tmp_path, capsys):
     assert len(err) == 1 and "nosuch.toml" in err[0], err
 
 
+def test_compile_bed_adds_its_laws_and_a_bad_one_is_one_line(monkeypatch, capsys):
+    """--bed adds a set of laws (the paper's moisture law) to the paper's and the specs'; a law the bed
+    does not know is argparse's one line and exit 2, before anything compiles."""
+    asked = []
+    monkeypatch.setattr(precompile, "compile_kernels", lambda law_sets, n, progress=None: asked.append(law_sets))
+    assert main(["compile", "--bed", "contact=wall", "--bed", "probe=tumbling", "--processes", "1"]) == 0
+    assert asked == [
+        [precompile.LawSet(), precompile.LawSet(BedLaws(contact="wall")), precompile.LawSet(BedLaws(probe="tumbling"))]
+    ]
+    with pytest.raises(SystemExit) as exc:
+        main(["compile", "--bed", "contact=nosuch"])
+    assert exc.value.code == 2 and "contact" in capsys.readouterr().err and len(asked) == 1
+
+
 @pytest.mark.slow
 def test_a_fit_after_compile_calls_nothing_compile_left_out():
     """After the jobs, a fit, a validation, a population of lanes and a single run add no compiled

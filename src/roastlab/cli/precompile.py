@@ -5,7 +5,7 @@ from __future__ import annotations
 import sys
 import time
 
-from .common import FIRST_COMPILE, count_arg
+from .common import FIRST_COMPILE, bed_arg, count_arg
 
 
 def cmd_compile(args) -> int:
@@ -13,7 +13,7 @@ def cmd_compile(args) -> int:
     from ..sim.cache import cache_dir
     from ..workflows.precompile import LawSet, compile_kernels, jobs, law_set_of, process_count
 
-    law_sets = [LawSet(), *(law_set_of(path) for path in args.laws)]
+    law_sets = [LawSet(), *(law_set_of(path) for path in args.laws), *(LawSet(bed) for bed in args.bed)]
     total = len(jobs(law_sets))
     n = process_count(total, args.processes)
     print(
@@ -49,6 +49,15 @@ def add_parsers(sub) -> None:
         metavar="SPEC_OR_MODEL",
         help="fit specs (fit.toml) or model files (MODEL.json) whose laws (bed, moisture, held exponents and "
         "swelling) to compile the lanes and the sensitivities for, besides the paper's",
+    )
+    p.add_argument(
+        "--bed",
+        type=bed_arg,
+        action="append",
+        default=[],
+        metavar="LAWS",
+        help="bed laws to compile the lanes and the sensitivities for as well, with the paper's moisture law "
+        "(e.g. 'contact=wall'; the form of fit --bed); may be repeated",
     )
     p.add_argument(
         "--processes",
