@@ -644,6 +644,34 @@ def test_et_below_bt_through_the_roast_is_dropped_when_the_map_asks(tmp_path):
     assert et_minus_bt_C(t[:5], et[:5], np.full(5, 120.0)) is None
 
 
+def test_an_et_below_bt_that_drives_the_model_refuses_the_log_naming_it(tmp_path):
+    """With no heater logged the map takes ET as the inlet air. Where ET reads below BT through the
+    roast (a sensor elsewhere) dropping it as a reading would leave it driving the model, the beans
+    heated by a sensor that was not in the drum: the log is refused, naming it and why (fit-roaster
+    leaves it out); a log whose ET runs above BT is read. A CSV map the same. Synthetic logs."""
+    from roastlab.errors import InputError
+
+    n = 120
+    bt = [130.0 - 0.2 * i if i < 30 else 124.0 + 0.5 * (i - 30) for i in range(n)]
+    low, high = tmp_path / "low.alog", tmp_path / "high.alog"
+    low.write_text(fake_alog(bt=bt, et=[b - 30.0 for b in bt], n=n))
+    high.write_text(fake_alog(bt=bt, et=[b + 15.0 for b in bt], n=n))
+    et_inlet = (
+        '[Ta]\ncolumn = "BT"\n[Tgi]\ncolumn = "ET"\n[Gg]\nidentify = true\n[ET]\ncolumn = "ET"\nabove_BT = true\n'
+    )
+    cmap = load_map(write_map(tmp_path, et_inlet))
+    with pytest.raises(InputError, match="below BT.*drives the model with it as the inlet air") as exc:
+        import_log(low, cmap)
+    assert str(exc.value).startswith(str(low))
+    b = import_log(high, cmap)
+    assert b.ET_C is not None and b.Tgi_C[10] == pytest.approx(bt[15] + 15.0)  # CHARGE at index 5
+    csv = tmp_path / "low.csv"
+    csv.write_text("time_s,BT,ET\n" + "".join(f"{5 * i},{v},{v - 30.0}\n" for i, v in enumerate(bt[5:])))
+    csv_map = load_map(write_map(tmp_path, 'batch_kg = 0.2\n[time]\ncolumn = "time_s"\n' + et_inlet))
+    with pytest.raises(InputError, match="inlet air"):
+        import_log(csv, csv_map)
+
+
 def test_the_drum_at_charge_of_an_artisan_log_is_bt_else_et(tmp_path):
     """roastlab.io.importers.artisan.DRUM_AT_CHARGE, as init writes it: BT at CHARGE, and ET where a
     log has no BT reading then (Artisan's -1) instead of refusing the log. Synthetic logs (fake_alog)."""

@@ -461,6 +461,27 @@ def test_a_log_with_no_green_weight_is_named_and_left_out(cli, tmp_path):
     assert code == 0 and "left out" not in out, err
 
 
+def test_a_log_whose_et_drives_the_model_from_outside_the_drum_is_left_out(cli, tmp_path):
+    """SYNTHETIC logs with no heater logged, so ET drives the model as the inlet air; on one of four
+    ET reads 30 degC below BT through the roast (a sensor elsewhere). init says fit-roaster will
+    leave it out and fit-roaster does, naming it and why: it was fitted with that ET heating its
+    beans."""
+    n = 120
+    bt = [130.0 - 0.2 * i if i < 30 else 124.0 + 0.5 * (i - 30) for i in range(n)]
+    logs = [tmp_path / f"r{k}.alog" for k in range(4)]
+    for k, p in enumerate(logs):
+        p.write_text(fake_alog(bt=bt, et=[b + (-30.0 if k == 2 else 20.0 + k) for b in bt], n=n))
+    code, out, err = cli("init", *logs, "--out", tmp_path / "cfg")
+    assert code == 0, err
+    assert "ET reads below BT through the roast on 1 log(s) (r2.alog)" in out
+    assert "with no heater logged ET is the inlet air that drives the model, so fit-roaster leaves them out" in out
+    code, out, err = cli("fit-roaster", tmp_path / "cfg", *logs)
+    assert code in (0, 1), err  # the fit may fail on its states (no heater): the files say so either way
+    assert out.count("left out: ") == 1, out
+    assert "left out: r2.alog cannot be fitted with the map (ET reads 30 °C below BT" in out
+    assert "drives the model with it as the inlet air" in out
+
+
 def test_a_folder_of_logs_is_read_and_a_recording_that_is_no_roast_is_named_and_left_out(cli, tmp_path):
     """SYNTHETIC: a roaster's folder as Artisan users keep it: three roasts beside an empty
     recording (no samples), an aborted one (no BT reading), one whose probe read 0 degC throughout,

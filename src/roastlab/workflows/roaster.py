@@ -248,7 +248,19 @@ def fit_roaster(
     else:
         order, by = sorted(range(len(paths)), key=lambda k: paths[k].name), "name"
     paths = [paths[k] for k in order]
-    batches = [load_log(p, cmap) for p in paths]
+    batches, unloadable = [], {}
+    for p in paths:  # a log the map cannot drive the model with (its ET elsewhere and ET the inlet): left out
+        try:
+            batches.append(load_log(p, cmap))
+        except InputError as exc:
+            unloadable[p.name] = f"{p.name} cannot be fitted with the map ({exc.problem})"
+    if unloadable:
+        left_out.update(unloadable)
+        paths = [p for p in paths if p.name not in unloadable]
+        if len(paths) < 2:
+            raise InputError(
+                f"fewer than two logs can be fitted with the map ({'; '.join(unloadable.values())})", "fit-roaster"
+            )
     recorded = logs_temp_unit(batches)
     units = display_units(units or recorded)
     u = temp_symbol(units)

@@ -815,6 +815,11 @@ def survey(paths, batch_kg: float | None = None, units: dict | None = None) -> S
         notes.append(
             f"ET reads below BT through the roast on {len(odd)} log(s) ({', '.join(odd[:3])}{' ...' if len(odd) > 3 else ''}), "
             "unlike the others: not the drum's air there, so the map drops ET on such logs ([ET] above_BT)"
+            + (
+                "; with no heater logged ET is the inlet air that drives the model, so fit-roaster leaves them out"
+                if not heater and inlet is None
+                else ""
+            )
         )
     second_bean = first.second_bean or (((first.columns or {}).get("ET") or "ET") if et_is_bean else None)
     marked = sum(i.marks_first_crack for i in infos)

@@ -621,21 +621,32 @@ def _resample(time_s: np.ndarray, columns: dict[str, np.ndarray], step: float, p
     return grid, {k: np.interp(grid, time_s, v) for k, v in columns.items()}
 
 
-def _drop_et_not_drum_air(time_s, Ta, drop_s, settings: dict, series: dict, notes: list, units: str = "C") -> set:
+def _drop_et_not_drum_air(
+    time_s, Ta, drop_s, settings: dict, series: dict, notes: list, units: str = "C", inlet=None, path=None
+) -> set:
     """Where the map asks (``[ET] above_BT``) and ET reads below BT through the roast, ET is not the
     drum's air on this log (:func:`roastlab.metrics.profile.et_minus_bt_C`): it is removed from
     ``settings`` and ``series`` with a note (its gap in ``units``, the log's "C" or "F"); returns the
-    channels so rejected (no initial state is read from them)."""
+    channels so rejected (no initial state is read from them).
+
+    ``inlet``: the channel the model's inlet air was read from on this log (a map with no heater takes
+    ET as the inlet), else None. Where that is the rejected ET, nothing the log records drives the
+    model as the roaster's heat did: an :class:`InputError` naming ``path`` (a fit leaves such a log
+    out), not a prediction driven by a sensor that was elsewhere."""
     spec = settings.get("ET")
     if spec is None or not spec.get("above_BT"):
         return set()
     gap = et_minus_bt_C(time_s, series["ET"], Ta, drop_s)
     if gap is None or gap >= 0:
         return set()
-    notes.append(
-        f"ET reads {delta_text(-gap, units, 0)} below BT through the roast (median from {ET_CHECK_FROM_S:g} s): "
-        f"{ET_NOT_DRUM_AIR}, so it is neither fitted nor scored"
-    )
+    reads = f"ET reads {delta_text(-gap, units, 0)} below BT through the roast (median from {ET_CHECK_FROM_S:g} s)"
+    if inlet is not None and inlet in names_of(spec["column"]):
+        raise InputError(
+            f"{reads}: {ET_NOT_DRUM_AIR}, and the map drives the model with it as the inlet air ([Tgi] column "
+            f"{inlet!r}, no heater logged): nothing else in the log can drive the model",
+            path,
+        )
+    notes.append(f"{reads}: {ET_NOT_DRUM_AIR}, so it is neither fitted nor scored")
     del settings["ET"], series["ET"]
     return {spec["column"]}
 
@@ -813,10 +824,14 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
 
         Ta = channel(cmap.Ta, "Ta") + (cmap.Ta.get("offset_C") or 0.0)
         Tgi = _constant_or(cmap.Tgi, len(time_s), lambda: channel(cmap.Tgi, "Tgi") + (cmap.Tgi.get("offset_C") or 0.0))
+        inlet = None  # the channel the inlet air was read from, if one was
+        if "constant_C" not in cmap.Tgi and "column" in cmap.Tgi:
+            inlet = next(n for n in names_of(cmap.Tgi["column"]) if n in available)  # channel() found one
         if cmap.Tgi.get("room"):
             room_C, note = room_temperature_C(log.room, cmap.Tgi["room_unit"])
             if room_C is not None:
                 Tgi = np.full(len(time_s), room_C)
+                inlet = None
             if note:
                 default_notes.append(note)
         extra = {}
@@ -834,7 +849,7 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
             settings["ET"] = et_spec
             series["ET"] = channel(et_spec, "ET") + (et_spec.get("offset_C") or 0.0)
             rejected = _drop_et_not_drum_air(
-                time_s, Ta, log.events.get("DROP"), settings, series, default_notes, log.mode
+                time_s, Ta, log.events.get("DROP"), settings, series, default_notes, log.mode, inlet, path
             )
             et_spec = settings.get("ET")
         Mb = log.weight_in_kg
@@ -909,7 +924,8 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
                 to_celsius(v, spec.get("unit", "C")) + (spec.get("offset_C") or 0.0) if k in ("Tb2", "ET") else v
             )
         drop_known = True
-        rejected = _drop_et_not_drum_air(time_s, Ta, None, settings, series, default_notes, temp_unit)
+        inlet = cmap.Tgi["column"] if "constant_C" not in cmap.Tgi and "column" in cmap.Tgi else None
+        rejected = _drop_et_not_drum_air(time_s, Ta, None, settings, series, default_notes, temp_unit, inlet, path)
         # the first row is the charge: an initial state from the log is one of the map's temperature
         # columns read there (in its unit), the first of a list that has a reading
         temps = {cmap.Ta["column"]: Ta}
