@@ -482,12 +482,8 @@ def test_the_solver_runs_on_one_blas_thread_and_gives_back_the_threads_after(mon
     """The fit's SVDs run on one BLAS thread (roastlab.fit.threads.one_blas_thread): OpenBLAS's
     threads, left spinning after each, held the cores the model's next simulation ran on (a fit 4x
     slower on 2 cores). Every polish and held-out refit sees one thread; the limit ends with the fit."""
-    import importlib
-
     from scipy.optimize import least_squares
     from threadpoolctl import threadpool_info
-
-    identify_module = importlib.import_module("roastlab.fit.identify")  # roastlab.fit is also a function
 
     def blas_threads():
         return {m["num_threads"] for m in threadpool_info() if m["user_api"] == "blas"}
@@ -509,8 +505,7 @@ def test_the_solver_runs_on_one_blas_thread_and_gives_back_the_threads_after(mon
         seen.append(blas_threads())
         return newton(*args, **kwargs)
 
-    monkeypatch.setattr(identify_module, "least_squares", spy)
-    monkeypatch.setattr("scipy.optimize.least_squares", spy)  # the held-out refits import it there
+    monkeypatch.setattr("scipy.optimize.least_squares", spy)  # the polishes and the held-out refits import it there
     monkeypatch.setattr(uncertainty, "_newton_refit", newton_spy)  # or refit by Gauss-Newton's steps
     ds = read_dataset(default_dataset_root() / "dataset-I")
     free, fixed = build_free_parameters()

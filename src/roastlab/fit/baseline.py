@@ -14,7 +14,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from ..evaluate.metrics import batch_metrics
 from ..sim.cache import compiled
@@ -55,6 +54,10 @@ def _drive(b, gains: dict) -> np.ndarray:
 
 def fit_first_order(batches) -> dict:
     """Fit tau, offset (and a gain per logged setting) jointly on batches with Tgi and Ta."""
+    from scipy.optimize import (
+        least_squares,
+    )  # imported here: SciPy's optimize and stats take about a second, which every command paid
+
     settings = [k for s, k in SETTING_GAINS.items() if any(getattr(b, s, None) is not None for b in batches)]
 
     def predictions(z):

@@ -34,7 +34,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from numba import parallel_chunksize, prange
-from scipy.stats import qmc
 
 from ..errors import InputError
 from ..evaluate.metrics import fit_percent
@@ -395,6 +394,10 @@ def _fit_population(
 @functools.cache
 def _sobol_points(seed: int, n: int, k: int) -> np.ndarray:
     """Scrambled Sobol points in [0, 1)^k, cached: building the generator costs ~1 ms a call."""
+    from scipy.stats import (
+        qmc,
+    )  # imported here: SciPy's optimize and stats take about a second, which every command paid
+
     pts = qmc.Sobol(k, scramble=True, seed=np.random.default_rng(seed)).random(n)
     pts.setflags(write=False)
     return pts

@@ -27,8 +27,6 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import differential_evolution, least_squares
-from scipy.stats import qmc
 
 from ..errors import ParameterError
 from ..model.limits import check_value
@@ -510,6 +508,10 @@ def _polish(obj: Objective, z0: np.ndarray, found=()):
     """A least-squares polish from ``z0``: (end, SSR, residuals, Jacobian at the end, joined), where
     ``joined`` is the index into ``found`` (optima already polished, each (end, SSR, residuals,
     Jacobian)) of the optimum the polish reached on its way (:data:`JOIN_TOL`), or None."""
+    from scipy.optimize import (
+        least_squares,
+    )  # imported here: SciPy's optimize and stats take about a second, which every command paid
+
     scale = obj.upper - obj.lower
     cost = {}  # SSR of each point SciPy evaluated, by its bytes: a Jacobian is asked for at an accepted point
 
@@ -585,6 +587,11 @@ def identify(
 
 def _identify(packed, free, fixed, method, seed, n_trial, n_starts, progress, weights, held_out):
     """:func:`identify`'s work."""
+    from scipy.optimize import differential_evolution
+    from scipy.stats import (
+        qmc,
+    )  # imported here: SciPy's optimize and stats take about a second, which every command paid
+
     if method not in ("global", "de"):
         raise ParameterError(f"unknown method {method!r} (allowed: global, de)")
     fixed = dict(fixed or {})

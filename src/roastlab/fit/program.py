@@ -33,7 +33,6 @@ import types
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from ..errors import InputError
 from ..metrics.profile import ror_operator
@@ -237,6 +236,10 @@ def optimise_program(
         box-bounded damped Gauss-Newton, :func:`_projected_gauss_newton`: lighter per
         iteration, for a warm-started receding horizon)
     """
+    from scipy.optimize import (
+        least_squares,
+    )  # imported here: SciPy's optimize and stats take about a second, which every command paid
+
     t0_clock = time.perf_counter()
     if sensitivities not in ("exact", "fd"):
         raise InputError(f"sensitivities must be 'exact' or 'fd', got {sensitivities!r}", "program")
