@@ -168,10 +168,11 @@ class SimulationResult(Result):
             out["Qloss_kW"] = q[:, 5]
         return out
 
-    def to_frame(self, heat_flows: bool = False):
-        """A pandas DataFrame with time, states, Tgo (and the heat flows if ``heat_flows``)."""
-        import pandas as pd
-
+    def columns(self, heat_flows: bool = False) -> dict[str, np.ndarray]:
+        """The trace's columns by name, in the CLI contract's order: time, states, Tgo, the band where
+        one was drawn, the actuators' settings and what the gas saw where the model has them (and the
+        heat flows if ``heat_flows``). :meth:`to_frame`, :meth:`to_csv_text` and
+        :meth:`to_json_dict` all write these."""
         data = {"time_s": self.time_s}
         for name in PAPER_STATE_NAMES:
             data[name] = self.states[:, S[name]]
@@ -184,16 +185,34 @@ class SimulationResult(Result):
             data.update({"heater": q, "fan": f, HEATER_STATE: self.states[:, S_H], "Gg_seen_kg_s": g, "Tgi_seen_C": T})
         if heat_flows:
             data.update(self.heat_flows())
-        return pd.DataFrame(data)
+        return data
+
+    def to_frame(self, heat_flows: bool = False):
+        """A pandas DataFrame of :meth:`columns`."""
+        import pandas as pd
+
+        return pd.DataFrame(self.columns(heat_flows))
 
     def to_csv_text(self, heat_flows: bool = False) -> str:
-        """The CSV of the CLI contract as text (6 decimals); ``heat_flows`` adds Qgb, Qgm, Qbm, Qr."""
-        return self.to_frame(heat_flows=heat_flows).to_csv(index=False, float_format="%.6f", lineterminator="\n")
+        """The CSV of the CLI contract as text (6 decimals, a missing value empty: what pandas'
+        ``to_csv(float_format="%.6f")`` of :meth:`to_frame` writes, without importing pandas, half a
+        second of a command's start); ``heat_flows`` adds Qgb, Qgm, Qbm, Qr."""
+        data = {k: np.asarray(v) for k, v in self.columns(heat_flows).items()}
+        whole = [v.dtype.kind in "iub" for v in data.values()]  # pandas writes these as they are
+        rows = zip(*(v.tolist() for v in data.values()))
+        lines = [
+            ",".join(data),
+            *(",".join(str(v) if w else "" if v != v else f"{v:.6f}" for v, w in zip(row, whole)) for row in rows),
+        ]
+        return "\n".join(lines) + "\n"
 
     def to_json_dict(self, heat_flows: bool = False) -> dict:
         """``{"name", "columns": {column: values}}`` (6 decimals); ``heat_flows`` adds the heat flows."""
-        frame = self.to_frame(heat_flows=heat_flows)
-        return {"name": self.name, "columns": {c: frame[c].round(6).tolist() for c in frame.columns}}
+        data = self.columns(heat_flows)
+        return {
+            "name": self.name,
+            "columns": {c: np.round(np.asarray(v), 6).tolist() for c, v in data.items()},
+        }
 
     def to_json_text(self, heat_flows: bool = False) -> str:
         """A JSON object of column arrays as text; ``heat_flows`` adds the heat flows."""
