@@ -29,10 +29,11 @@ $(STAMP): pyproject.toml
 # (contact=wall), which the band and comparison tests fit on synthetic batches: left to the suite, both
 # workers compiled it at once (222 worker-seconds in tests/test_bands.py's fixture on 2026-11-30's VM;
 # ahead it adds about 60 s to this step). The lanes tests' other laws still compile in the suite.
+# --durations=20: the slowest tests in every run's log, where CI's 20 minutes go.
 TEST_WORKERS ?= auto
 test: $(STAMP)
 	$(VENV)/bin/roastlab compile examples/bullet/fit.toml examples/skywalker/fit.toml --bed contact=wall
-	$(PY) -m pytest -n $(TEST_WORKERS)
+	$(PY) -m pytest -n $(TEST_WORKERS) --durations=20
 
 # The inner loop: every test but those marked slow (make test, which CI runs, has them all).
 test-fast: $(STAMP)

@@ -188,7 +188,7 @@ class SimulationResult(Result):
         return data
 
     def to_frame(self, heat_flows: bool = False):
-        """A pandas DataFrame of :meth:`columns`."""
+        """A pandas DataFrame of :meth:`columns` (``heat_flows`` adds the heat flows)."""
         import pandas as pd
 
         return pd.DataFrame(self.columns(heat_flows))
