@@ -54,9 +54,8 @@ def _drive(b, gains: dict) -> np.ndarray:
 
 def fit_first_order(batches) -> dict:
     """Fit tau, offset (and a gain per logged setting) jointly on batches with Tgi and Ta."""
-    from scipy.optimize import (
-        least_squares,
-    )  # imported here: SciPy's optimize and stats take about a second, which every command paid
+    # imported where called: SciPy's optimize and stats cost every command ~1 s (tests/test_layout.py)
+    from scipy.optimize import least_squares
 
     settings = [k for s, k in SETTING_GAINS.items() if any(getattr(b, s, None) is not None for b in batches)]
 

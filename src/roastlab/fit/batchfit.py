@@ -394,9 +394,8 @@ def _fit_population(
 @functools.cache
 def _sobol_points(seed: int, n: int, k: int) -> np.ndarray:
     """Scrambled Sobol points in [0, 1)^k, cached: building the generator costs ~1 ms a call."""
-    from scipy.stats import (
-        qmc,
-    )  # imported here: SciPy's optimize and stats take about a second, which every command paid
+    # imported where called: SciPy's optimize and stats cost every command ~1 s (tests/test_layout.py)
+    from scipy.stats import qmc
 
     pts = qmc.Sobol(k, scramble=True, seed=np.random.default_rng(seed)).random(n)
     pts.setflags(write=False)

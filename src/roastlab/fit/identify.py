@@ -508,9 +508,8 @@ def _polish(obj: Objective, z0: np.ndarray, found=()):
     """A least-squares polish from ``z0``: (end, SSR, residuals, Jacobian at the end, joined), where
     ``joined`` is the index into ``found`` (optima already polished, each (end, SSR, residuals,
     Jacobian)) of the optimum the polish reached on its way (:data:`JOIN_TOL`), or None."""
-    from scipy.optimize import (
-        least_squares,
-    )  # imported here: SciPy's optimize and stats take about a second, which every command paid
+    # imported where called: SciPy's optimize and stats cost every command ~1 s (tests/test_layout.py)
+    from scipy.optimize import least_squares
 
     scale = obj.upper - obj.lower
     cost = {}  # SSR of each point SciPy evaluated, by its bytes: a Jacobian is asked for at an accepted point
@@ -587,10 +586,9 @@ def identify(
 
 def _identify(packed, free, fixed, method, seed, n_trial, n_starts, progress, weights, held_out):
     """:func:`identify`'s work."""
+    # imported where called: SciPy's optimize and stats cost every command ~1 s (tests/test_layout.py)
     from scipy.optimize import differential_evolution
-    from scipy.stats import (
-        qmc,
-    )  # imported here: SciPy's optimize and stats take about a second, which every command paid
+    from scipy.stats import qmc
 
     if method not in ("global", "de"):
         raise ParameterError(f"unknown method {method!r} (allowed: global, de)")

@@ -236,9 +236,8 @@ def optimise_program(
         box-bounded damped Gauss-Newton, :func:`_projected_gauss_newton`: lighter per
         iteration, for a warm-started receding horizon)
     """
-    from scipy.optimize import (
-        least_squares,
-    )  # imported here: SciPy's optimize and stats take about a second, which every command paid
+    # imported where called: SciPy's optimize and stats cost every command ~1 s (tests/test_layout.py)
+    from scipy.optimize import least_squares
 
     t0_clock = time.perf_counter()
     if sensitivities not in ("exact", "fd"):

@@ -367,7 +367,8 @@ def _far_below_C(values) -> float:
     """Below what a log's ET - BT lies far below ``values`` (of other logs) [degC]: 0, or the
     values' median minus three robust standard deviations (the median absolute deviation scaled
     to a normal's standard deviation) where that is lower."""
-    from scipy.stats import median_abs_deviation  # here: scipy.stats takes 0.7 s to import, every command pays it
+    # imported where called: SciPy's optimize and stats cost every command ~1 s (tests/test_layout.py)
+    from scipy.stats import median_abs_deviation
 
     return min(0.0, float(np.median(values)) - 3.0 * float(median_abs_deviation(values, scale="normal")))
 
