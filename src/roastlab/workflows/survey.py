@@ -811,13 +811,14 @@ def survey(paths, batch_kg: float | None = None, units: dict | None = None) -> S
         if et_is_bean or et_below_bt
         else [i.path.name for i, bad in zip(infos, et_not_drum_air([i.et_minus_bt_C for i in infos])) if bad]
     )
+    et_drives = not heater and inlet is None  # map_text then takes ET as the inlet air that drives the model
     if odd:
         notes.append(
             f"ET reads below BT through the roast on {len(odd)} log(s) ({', '.join(odd[:3])}{' ...' if len(odd) > 3 else ''}), "
             "unlike the others: not the drum's air there, so the map drops ET on such logs ([ET] above_BT)"
             + (
                 "; with no heater logged ET is the inlet air that drives the model, so fit-roaster leaves them out"
-                if not heater and inlet is None
+                if et_drives
                 else ""
             )
         )
@@ -831,7 +832,7 @@ def survey(paths, batch_kg: float | None = None, units: dict | None = None) -> S
             "first_crack), so the fit cannot put the beans where coffee does not crack"
         )
     has_et = all(i.has_et for i in infos) and not et_is_bean and not et_below_bt
-    if not heater and inlet is None and has_et:  # map_text: ET then drives the model as the inlet air
+    if et_drives and has_et:
         notes.append(
             "no heater setting in the logs: ET drives the model as the inlet air, but a burner or element also "
             "heats the drum itself, which the air does not show, so the fit is weak or fails (docs/your-roaster.md, "
