@@ -621,7 +621,7 @@ def survey(paths, batch_kg: float | None = None, units: dict | None = None) -> S
     passed_over: dict[str, str] = {}
     paths = log_paths(paths, passed_over)
     if not paths:
-        raise InputError("give the roast logs of one roaster", "init")
+        raise InputError("give the roast logs of one roaster", "command line")
     infos, unreadable = readable_logs(paths, batch_kg)
     first = infos[0]
     kinds = {i.format for i in infos}
@@ -672,14 +672,13 @@ def survey(paths, batch_kg: float | None = None, units: dict | None = None) -> S
         )
     machines = {i.machine for i in infos if i.machine}
     if len(machines) > 1:
-        raise InputError(f"the logs name different roasters ({', '.join(sorted(machines))}): one at a time", "init")
+        raise InputError(f"the logs name different roasters ({', '.join(sorted(machines))}): one at a time")
     unweighed = logs_without_weight(infos)
     if unweighed and len(infos) - len(unweighed) < 2:
         missing = list(unweighed)
         raise InputError(
             f"no green weight in {len(missing)} log(s) ({', '.join(missing[:3])}{' ...' if len(missing) > 3 else ''}) "
-            "and none in the file name: pass --batch-kg",
-            "init",
+            "and none in the file name: pass --batch-kg"
         )
     infos = [i for i in infos if i.path.name not in unweighed]  # the set-up reads the weighed logs
     pooled = {
@@ -702,9 +701,9 @@ def survey(paths, batch_kg: float | None = None, units: dict | None = None) -> S
     unit_of, name_of = {"heater": heater_unit, "fan": fan_unit}, {"heater": heater, "fan": fan}
     for what, unit in given.items():
         if unit not in CONTROL_UNITS[what]:
-            raise InputError(f"--{what}-unit {unit}: one of {', '.join(CONTROL_UNITS[what])}", "init")
+            raise InputError(f"--{what}-unit {unit}: one of {', '.join(CONTROL_UNITS[what])}", "command line")
         if what not in pooled:
-            raise InputError(f"--{what}-unit {unit}: the logs have no {what} setting to read in it", "init")
+            raise InputError(f"--{what}-unit {unit}: the logs have no {what} setting to read in it", "command line")
         if unit != unit_of[what]:
             notes.append(
                 f"the {what} ({name_of[what]}) read in {unit}, as given (its name and values read as {unit_of[what]})"
