@@ -1650,3 +1650,28 @@ def test_a_readouts_offset_about_its_zero_is_off_and_a_step_below_zero_a_wrong_u
     assert readout_zero_offset("W", np.array([-20.0, 900.0])) and not readout_zero_offset(
         "W", np.array([-100.0, 900.0])
     )
+
+
+def test_fit_roaster_leaves_out_an_output_that_no_log_of_its_fit_records(cli, tmp_path):
+    """init's files for all 16 Skywalker logs weigh ET; the first four by name, whose fit half are two
+    logs with an ET the map leaves out (it reads 31-38 °C below BT), are fitted without it and the
+    report says so, where identify with the same files refuses (the spec is the user's there)."""
+    sky = REAL_DATA / "skywalker"
+    if not sky.is_dir():
+        pytest.skip("../shared/data/real is absent")
+    logs = sorted(sky.glob("*.alog"))
+    assert cli("init", *logs, "--out", tmp_path / "cfg")[0] == 0
+    cfg = tmp_path / "cfg"
+    assert 'ET = "residual"' in (cfg / "fit.toml").read_text()  # the premise: init weighs ET
+    code, out, err = cli("fit-roaster", cfg, *logs[:4])
+    assert code == 0, err
+    said = "the fit leaves out ET, which fit.toml weighs: none of the 2 logs it fits records it"
+    assert f"note: {said}" in out and "reads below BT" in out
+    assert f"The {said[4:]}" in (cfg / "report.md").read_text()
+    assert printed_percent(out, "held out: FIT ") > 75.0
+    C = ["--plant", cfg / "plant.toml", "--map", cfg / "map.toml", "--spec", cfg / "fit.toml"]
+    code, _, err = cli("identify", *C, logs[0], logs[2], "--out", tmp_path / "m.json")
+    assert code == 2 and "set ET = 0 under [weights]" in err
+    # a fit half that records ET keeps its weight: the next four logs, no note
+    code, out, _ = cli("fit-roaster", cfg, *logs[4:8])
+    assert code == 0 and "leaves out" not in out

@@ -81,6 +81,8 @@ def cmd_fit_roaster(args) -> int:
         print(f"left out: {why}")
     if r["refit"]:
         print(f"refitted: {r['refit']}")
+    if r["unweighed"]:
+        print(f"note: the fit {r['unweighed']}")
     print(f"fit set:  FIT {f['FIT']:.1f} %, MAE {dT(f['MAE']):.2f} {u}")
     print(
         f"held out: FIT {h['FIT']:.1f} %, MAE {dT(h['MAE']):.2f} {u} (first-order baseline: {b['FIT']:.1f} %, {dT(b['MAE']):.2f} {u})"
@@ -177,7 +179,8 @@ def add_parsers(sub) -> None:
         "DIR/report.md (the same as DIR/report.html, one page any browser opens, its figures inside) and "
         "DIR/heldout.png. A log that cannot be read as a roast, is a copy of another, records no green weight or "
         "no setting the map drives the model with is left out; a fit whose drum runs below the beans with the heater free to heat the air is refitted with the "
-        "heater heating the drum alone; a model worse than the baseline on the held-out logs is called not "
+        "heater heating the drum alone; an output fit.toml weighs (ET, a second bean reading) that none of the fit's logs "
+        "records is left out of that fit; a model worse than the baseline on the held-out logs is called not "
         "usable; each is said. Exit status 1 when the fit failed (states the machine cannot have, "
         "such as drum metal below the beans; the files are written and say so), 2 on bad input.",
         formatter_class=argparse.RawDescriptionHelpFormatter,

@@ -154,6 +154,32 @@ def _as_batch(item, column_map) -> Batch:
     return load_log(item, column_map)
 
 
+#: The second outputs a fit can weigh beside the probe, and the :class:`~roastlab.io.batch.Batch`
+#: column each is read from.
+SECOND_OUTPUTS = {"Tb2": "Tb2_C", "ET": "ET_C"}
+
+
+def weighs(weights: dict, name: str) -> bool:
+    """Whether ``weights`` (an output's name to its weight) fit output ``name``: a positive number, or
+    :data:`~roastlab.model.parameters.RESIDUAL_WEIGHT` (a weight that is no number is refused by
+    identify's ``check_weights``)."""
+    w = weights.get(name, 0)
+    return w == RESIDUAL_WEIGHT or (isinstance(w, (int, float)) and w > 0)
+
+
+def records(batches, name: str) -> bool:
+    """Whether any of ``batches`` records the second output ``name`` (:data:`SECOND_OUTPUTS`): a
+    finite sample of its column."""
+    column = SECOND_OUTPUTS[name]
+    return any(getattr(b, column) is not None and np.isfinite(getattr(b, column)).any() for b in batches)
+
+
+def et_dropped(batches) -> int:
+    """How many of ``batches`` had their ET left out by the map because it reads below BT through the
+    roast (the map's ``[ET] above_BT``, :data:`~roastlab.io.importers.mapping.ET_NOT_DRUM_AIR`)."""
+    return sum(any(ET_NOT_DRUM_AIR in n for n in b.notes) for b in batches)
+
+
 def fit(
     batches: list[Batch],
     plant,
@@ -221,15 +247,10 @@ def fit(
     given = dict(weights or {})
     weights = {**spec_weights, **given}
     from_residuals = [k for k, w in weights.items() if w == RESIDUAL_WEIGHT]  # set below, from a first fit
-
-    def weighed(name: str) -> bool:  # a weight that is no number is refused by identify (check_weights)
-        w = weights.get(name, 0)
-        return name in from_residuals or (isinstance(w, (int, float)) and w > 0)
-
-    if weighed("Tb2") and all(b.Tb2_C is None or not np.isfinite(b.Tb2_C).any() for b in batches):
+    if weighs(weights, "Tb2") and not records(batches, "Tb2"):
         raise InputError(NO_SECOND_READING, "command line" if "Tb2" in given else spec_source)
-    if weighed("ET") and all(b.ET_C is None or not np.isfinite(b.ET_C).any() for b in batches):
-        dropped = sum(any(ET_NOT_DRUM_AIR in n for n in b.notes) for b in batches)
+    if weighs(weights, "ET") and not records(batches, "ET"):
+        dropped = et_dropped(batches)
         message = NO_ET_READING
         if dropped:  # the map's [ET] above_BT dropped it on every log given (io.importers.mapping)
             message = (

@@ -182,7 +182,9 @@ def fit_roaster(
 
     Logs that do not record a setting the map drives the model with, or their green weight, are
     left out (:func:`logs_without_controls`, :func:`logs_without_weight`). A fit that fails on its states with both of the heater's paths
-    free is refitted with the drum's path alone (:func:`drum_path_alone`), said in ``refit``; a model
+    free is refitted with the drum's path alone (:func:`drum_path_alone`), said in ``refit``; an output
+    fit.toml weighs that none of the fit's logs records (an ET the map leaves out) is left out of that fit
+    (:func:`outputs_the_logs_lack`), said in ``unweighed``; a model
     that predicts the held-out logs worse than the first-order baseline is called so
     (:func:`below_baseline`).
 
@@ -271,6 +273,7 @@ def fit_roaster(
     sizes = size_split(batches, fit_size_kg) if (by_size or fit_size_kg is not None) else None
     fit_b, val_b = batches[0::2], batches[1::2]
     spec, depth_held = depth_held_on_one_size(load_fit_spec(d / "fit.toml"), fit_b)
+    spec, unweighed = outputs_the_logs_lack(spec, fit_b)
     stage = progress or (lambda done, total, text="": None)  # a stage of unknown length: total 0
     from ..sim.cache import cold
 
@@ -307,6 +310,7 @@ def fit_roaster(
         *(line for why in left_out.values() for line in (f"Left out: {why}.", "")),
         *([f"Refitted: {refit}.", ""] if refit else []),
         *([f"The fit {depth_held}.", ""] if depth_held else []),
+        *([f"The fit {unweighed}.", ""] if unweighed else []),
         *(
             [
                 "Read from the logs:",
@@ -383,6 +387,7 @@ def fit_roaster(
     if sizes is not None:
         size_b = [batches[k] for k in sizes.fit]
         size_spec, size_depth = depth_held_on_one_size(spec, size_b)
+        size_spec, size_unweighed = outputs_the_logs_lack(size_spec, size_b)
         stage(0, 0, f"fitting {sizes.fit_size} alone ({len(size_b)} logs) for the other sizes")
         size_fit, _, size_refit = fit_checked(size_b, d, size_spec, cmap, seed, progress, units)
         across = across_sizes(size_fit.model, batches, sizes)
@@ -390,6 +395,8 @@ def fit_roaster(
         lines += across_sizes_lines(across, SIZES_FIGURE, units)
         if size_depth:
             lines += ["", f"The fit on {sizes.fit_size} alone {size_depth}."]
+        if size_unweighed:
+            lines += ["", f"The fit on {sizes.fit_size} alone {size_unweighed}."]
         if size_refit:
             lines += ["", f"Refitted (the fit on {sizes.fit_size} alone): {size_refit}."]
         if size_fit.failed:
@@ -422,6 +429,7 @@ def fit_roaster(
         "below_baseline": verdict,
         "left_out": left_out,
         "refit": refit,
+        "unweighed": unweighed,
         "notes": {p.name: list(b.notes) for p, b in zip(paths, batches) if b.notes},
         "band": band,
         "units": units,
@@ -457,6 +465,31 @@ def depth_held_on_one_size(spec, batches):
         spec, free=[f for f in spec.free if f is not depth], fixed={**spec.fixed, "h_probe_m": depth.start}
     )
     return held, f"holds the probe's depth scale at {depth.start:g} m: logs of one batch size cannot determine it"
+
+
+def outputs_the_logs_lack(spec, batches):
+    """``spec`` with the weight of each second output it fits (ET, the second bean reading Tb2) set to 0
+    where none of ``batches`` records it. ``init`` weighs what the logs it read record; the logs one fit
+    is given (the fit half, one batch size) can all lack it: the Skywalker's first four logs' ET reads
+    below BT, and the map leaves it out (:func:`roastlab.workflows.fitting.et_dropped`), where
+    ``identify`` would refuse the spec. Returns ``(spec, sentence or None)``."""
+    import dataclasses
+
+    from .fitting import SECOND_OUTPUTS, et_dropped, records, weighs
+
+    lacking = [name for name in SECOND_OUTPUTS if weighs(spec.weights, name) and not records(batches, name)]
+    if not lacking:
+        return spec, None
+    held = dataclasses.replace(spec, weights={**spec.weights, **dict.fromkeys(lacking, 0.0)})
+    why = (
+        " (the map leaves out an ET that reads below BT through the roast)"
+        if "ET" in lacking and et_dropped(batches)
+        else ""
+    )
+    return held, (
+        f"leaves out {' and '.join(lacking)}, which fit.toml weighs: none of the {len(batches)} logs it fits "
+        f"records {'them' if len(lacking) > 1 else 'it'}{why}"
+    )
 
 
 def fit_checked(batches, config_dir: Path, spec, column_map, seed: int, progress=None, units: str = "C"):
