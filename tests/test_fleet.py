@@ -5,6 +5,7 @@ import os
 import subprocess
 import sys
 import textwrap
+import time
 from pathlib import Path
 
 import numpy as np
@@ -478,9 +479,42 @@ def test_sigterm_during_a_long_command_cleans_up_like_ctrl_c(tmp_path):
         time.sleep(0.05)
     time.sleep(0.5)
     proc.send_signal(signal.SIGTERM)
-    _, err = proc.communicate(timeout=60)
+    try:
+        _, err = proc.communicate(timeout=60)
+    finally:  # a process the signal did not end is ended here, not left to the next test
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
     assert proc.returncode == 128 + signal.SIGTERM and "terminated" in err, err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_sigterm_that_lands_in_a_compilers_callback_is_sent_again(monkeypatch):
+    """Raised inside Python code that C calls back into (llvmlite's, while numba compiles), the
+    exception would be printed and lost, and the command would run on: there the handler sends the
+    signal again shortly instead; anywhere else it raises at once."""
+    import importlib
+    import signal
+
+    cli_main = importlib.import_module("roastlab.cli.main")  # the module (roastlab.cli.main is also the function)
+    sent = []
+    monkeypatch.setattr(cli_main, "RESEND_S", 0.0)
+    monkeypatch.setattr(cli_main.os, "kill", lambda pid, sig: sent.append((pid, sig)))
+
+    def frame_in(filename):  # a real frame whose code comes from ``filename``
+        namespace = {"sys": sys}
+        exec(compile("def here():\n    return sys._getframe()\n", filename, "exec"), namespace)
+        return namespace["here"]()
+
+    callback = frame_in(os.path.join("site-packages", "llvmlite", "binding", "executionengine.py"))
+    assert cli_main._on_sigterm(signal.SIGTERM, callback) is None
+    deadline = time.monotonic() + 5
+    while not sent and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert sent == [(os.getpid(), signal.SIGTERM)]
+    with pytest.raises(cli_main.Terminated):
+        cli_main._on_sigterm(signal.SIGTERM, sys._getframe())
+    assert len(sent) == 1
 
 
 def test_batches_are_fitted_under_the_machine_model_as_validate_applies_it(cli, tmp_path, fleet):

@@ -13,6 +13,7 @@ outputs are written together at the end or not at all.
 from __future__ import annotations
 
 import argparse
+import os
 import signal
 import sys
 import threading
@@ -58,7 +59,32 @@ class Terminated(KeyboardInterrupt):
     cleaned up exactly as on Ctrl-C (a KeyboardInterrupt) instead of the process just ending."""
 
 
+#: Packages whose Python code C calls back into while numba compiles (llvmlite's object-cache and
+#: diagnostic callbacks): an exception raised there is printed by ctypes as "Exception ignored" and
+#: the program runs on. A SIGTERM that lands there on a first run's compile was lost, and a 50,000-batch
+#: `fleet synthetic` ran on past the test's minute (CI on 2026-12-01).
+CALLBACK_PACKAGES = ("llvmlite",)
+#: How soon a SIGTERM that landed in a callback is sent again [s].
+RESEND_S = 0.05
+
+
+def in_callback(frame, depth: int = 4) -> bool:
+    """Whether ``frame`` or one of the ``depth`` frames under it runs code of :data:`CALLBACK_PACKAGES`."""
+    for _ in range(depth):
+        if frame is None:
+            return False
+        if any(f"{os.sep}{name}{os.sep}" in frame.f_code.co_filename for name in CALLBACK_PACKAGES):
+            return True
+        frame = frame.f_back
+    return False
+
+
 def _on_sigterm(signum, frame):
+    if in_callback(frame):  # raised here it would be lost: the same signal again, once out of the callback
+        timer = threading.Timer(RESEND_S, os.kill, (os.getpid(), signum))
+        timer.daemon = True
+        timer.start()
+        return
     raise Terminated()
 
 
