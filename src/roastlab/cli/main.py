@@ -59,9 +59,10 @@ class Terminated(KeyboardInterrupt):
     cleaned up exactly as on Ctrl-C (a KeyboardInterrupt) instead of the process just ending."""
 
 
-#: Packages whose Python code C calls back into while numba compiles (llvmlite's object-cache and
-#: diagnostic callbacks): an exception raised there is printed by ctypes as "Exception ignored" and
-#: the program runs on. A SIGTERM that lands there on a first run's compile was lost, and a 50,000-batch
+#: Packages whose Python code C calls back into while numba compiles (llvmlite's object-cache
+#: callbacks, ``ExecutionEngine._raw_object_cache_notify``): an exception raised there is printed by
+#: ctypes as "Exception ignored" and the program runs on. The rule takes any of the package's frames,
+#: the wrappers around its C calls too: a signal held back there arrives 50 ms later. A SIGTERM that lands there on a first run's compile was lost, and a 50,000-batch
 #: `fleet synthetic` ran on past the test's minute (CI on 2026-12-01).
 CALLBACK_PACKAGES = ("llvmlite",)
 #: How soon a SIGTERM that landed in a callback is sent again [s].
