@@ -489,14 +489,17 @@ def test_sigterm_during_a_long_command_cleans_up_like_ctrl_c(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
-def test_a_sigterm_that_lands_in_a_compilers_callback_is_sent_again(monkeypatch):
+@pytest.mark.parametrize("name, raised", [("SIGTERM", "Terminated"), ("SIGINT", "KeyboardInterrupt")])
+def test_a_signal_that_lands_in_a_compilers_callback_is_sent_again(monkeypatch, name, raised):
     """Raised inside Python code that C calls back into (llvmlite's, while numba compiles), the
     exception would be printed and lost, and the command would run on: there the handler sends the
-    signal again shortly instead; anywhere else it raises at once."""
+    signal again shortly instead; anywhere else it raises at once (SIGTERM as Terminated, Ctrl-C as
+    a KeyboardInterrupt)."""
     import importlib
     import signal
 
     cli_main = importlib.import_module("roastlab.cli.main")  # the module (roastlab.cli.main is also the function)
+    signum = getattr(signal, name)
     sent = []
     monkeypatch.setattr(cli_main, "RESEND_S", 0.0)
     monkeypatch.setattr(cli_main.os, "kill", lambda pid, sig: sent.append((pid, sig)))
@@ -507,14 +510,28 @@ def test_a_sigterm_that_lands_in_a_compilers_callback_is_sent_again(monkeypatch)
         return namespace["here"]()
 
     callback = frame_in(os.path.join("site-packages", "llvmlite", "binding", "executionengine.py"))
-    assert cli_main._on_sigterm(signal.SIGTERM, callback) is None
+    assert cli_main._on_signal(signum, callback) is None
     deadline = time.monotonic() + 5
     while not sent and time.monotonic() < deadline:
         time.sleep(0.01)
-    assert sent == [(os.getpid(), signal.SIGTERM)]
-    with pytest.raises(cli_main.Terminated):
-        cli_main._on_sigterm(signal.SIGTERM, sys._getframe())
+    assert sent == [(os.getpid(), signum)]
+    with pytest.raises(KeyboardInterrupt) as info:
+        cli_main._on_signal(signum, sys._getframe())
+    assert type(info.value).__name__ == raised
     assert len(sent) == 1
+
+
+def test_ctrl_c_is_taken_where_python_takes_it_and_left_ignored_where_the_parent_ignores_it(monkeypatch):
+    """The handler takes SIGINT only from Python's own handler: a command started as a shell's
+    background job (SIGINT ignored) keeps ignoring it, as Python itself would."""
+    import importlib
+    import signal
+
+    cli_main = importlib.import_module("roastlab.cli.main")
+    monkeypatch.setattr(signal, "getsignal", lambda signum: signal.default_int_handler)
+    assert cli_main._handled_signals() == [signal.SIGTERM, signal.SIGINT]
+    monkeypatch.setattr(signal, "getsignal", lambda signum: signal.SIG_IGN)
+    assert cli_main._handled_signals() == [signal.SIGTERM]
 
 
 def test_batches_are_fitted_under_the_machine_model_as_validate_applies_it(cli, tmp_path, fleet):

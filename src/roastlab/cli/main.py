@@ -62,10 +62,11 @@ class Terminated(KeyboardInterrupt):
 #: Packages whose Python code C calls back into while numba compiles (llvmlite's object-cache
 #: callbacks, ``ExecutionEngine._raw_object_cache_notify``): an exception raised there is printed by
 #: ctypes as "Exception ignored" and the program runs on. The rule takes any of the package's frames,
-#: the wrappers around its C calls too: a signal held back there arrives 50 ms later. A SIGTERM that lands there on a first run's compile was lost, and a 50,000-batch
-#: `fleet synthetic` ran on past the test's minute (CI on 2026-12-01).
+#: the wrappers around its C calls too: a signal held back there arrives 50 ms later. A SIGTERM that
+#: lands there on a first run's compile was lost, and a 50,000-batch `fleet synthetic` ran on past the
+#: test's minute (CI on 2026-12-01); Ctrl-C (SIGINT) goes through the same rule.
 CALLBACK_PACKAGES = ("llvmlite",)
-#: How soon a SIGTERM that landed in a callback is sent again [s].
+#: How soon a signal that landed in a callback is sent again [s].
 RESEND_S = 0.05
 
 
@@ -80,13 +81,23 @@ def in_callback(frame, depth: int = 4) -> bool:
     return False
 
 
-def _on_sigterm(signum, frame):
+def _on_signal(signum, frame):
+    """SIGTERM raises :class:`Terminated`, SIGINT a KeyboardInterrupt (Python's own rule), where the
+    program is; inside a callback (:func:`in_callback`) the same signal is sent again instead."""
     if in_callback(frame):  # raised here it would be lost: the same signal again, once out of the callback
         timer = threading.Timer(RESEND_S, os.kill, (os.getpid(), signum))
         timer.daemon = True
         timer.start()
         return
-    raise Terminated()
+    raise Terminated() if signum == signal.SIGTERM else KeyboardInterrupt()
+
+
+def _handled_signals() -> list[int]:
+    """The signals :func:`_on_signal` takes: SIGTERM, and SIGINT where Python's own handler has it (a
+    SIGINT the parent ignores, as a shell's background job does, stays ignored)."""
+    if threading.current_thread() is not threading.main_thread():
+        return []
+    return [signal.SIGTERM] + ([signal.SIGINT] if signal.getsignal(signal.SIGINT) is signal.default_int_handler else [])
 
 
 #: Commands that run no compiled code (and fit-roaster and compile, whose own progress says a first run's compile).
@@ -118,9 +129,7 @@ def main(argv: list[str] | None = None) -> int:
     begin_run()
     if note := first_run_note(args.command):
         print(note, file=sys.stderr)
-    previous = None
-    if threading.current_thread() is threading.main_thread():
-        previous = signal.signal(signal.SIGTERM, _on_sigterm)
+    previous = {signum: signal.signal(signum, _on_signal) for signum in _handled_signals()}
     try:
         return int(args.func(args) or 0)
     except RoastlabError as exc:
@@ -135,8 +144,8 @@ def main(argv: list[str] | None = None) -> int:
     except BrokenPipeError:
         return 0
     finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
 
 
 def _one_line(text: str, limit: int = 400) -> str:
