@@ -299,9 +299,12 @@ function unitName(name) {
 function drawTable() {
   const t = state.table;
   if (!t) return;
-  const kinds = { time: (v) => mmss(v), temp: (v) => (v === null ? "-" : temp(v).toFixed(1)), pct: (v) => (v === null ? "-" : v.toFixed(1)) };
-  const delta = { time: (d) => (d < 0 ? "-" : "+") + mmss(Math.abs(d)), temp: (d) => (dtemp(d) >= 0 ? "+" : "") + dtemp(d).toFixed(1), pct: (d) => (d >= 0 ? "+" : "") + d.toFixed(1) };
-  const unitOf = { time: "m:ss", temp: unit(), pct: "%" };
+  // auc: an area of temperature differences (degC min), whole degree-minutes as Artisan shows it
+  const kinds = { time: (v) => mmss(v), temp: (v) => (v === null ? "-" : temp(v).toFixed(1)), pct: (v) => (v === null ? "-" : v.toFixed(1)),
+    auc: (v) => (v === null ? "-" : dtemp(v).toFixed(0)) };
+  const delta = { time: (d) => (d < 0 ? "-" : "+") + mmss(Math.abs(d)), temp: (d) => (dtemp(d) >= 0 ? "+" : "") + dtemp(d).toFixed(1), pct: (d) => (d >= 0 ? "+" : "") + d.toFixed(1),
+    auc: (d) => (dtemp(d) >= 0 ? "+" : "") + dtemp(d).toFixed(0) };
+  const unitOf = { time: "m:ss", temp: unit(), pct: "%", auc: `${unit()}·min` };
   let html = "<tr><th></th><th>measured</th><th>as run</th><th>changed</th><th>change</th><th>model error</th></tr>";
   let group = null;
   for (const r of t.rows) {

@@ -66,7 +66,8 @@ def add_parsers(sub) -> None:
         "whatif",
         help="predict a logged roast as run and with changed settings, batch or charge state",
         description="Apply MODEL.json to LOG twice, as logged and with the changes, and print the roaster's "
-        "milestones (turning point, DRY END, first crack, temperature at DROP, development time and ratio) as "
+        "milestones (turning point, DRY END, first crack, temperature at DROP, development time and ratio; for BT "
+        "Artisan's AUC, the area above BT at TP from TP to DROP) as "
         "measured, as run by the model and with the changes, with the change and the model's own error on this "
         "log. Judged on the beans (the model's bean temperature; the log's second bean reading as 'measured' "
         "where it has one), the probe BT below: a batch-size change also changes how deep the probe sits in the "

@@ -1,4 +1,4 @@
-"""Roast-profile figures defined once: rate of rise and crossing times.
+"""Roast-profile figures defined once: rate of rise, crossing times and the area under the curve.
 
 Every figure, table, score and optimiser of roastlab reads a curve through these functions: the
 figures' RoR axis, the closed-loop score, the rate-of-rise term of the program optimiser (transfer
@@ -14,6 +14,14 @@ least-squares slope, not the difference of the window's ends, so that every samp
 counts and one noisy reading moves the RoR by a fraction of its error. The RoR is a linear map
 of the curve (:func:`ror_operator`), which is what lets the optimiser put it in its residuals with
 an exact Jacobian. The first samples, whose window holds fewer than two points, have no RoR (NaN).
+
+**Area under the curve** (AUC) [degC min], Artisan's measure of the heat a roast gave its beans:
+the area between BT and a base temperature where BT is above it, from the turning point to DROP
+(:func:`area_under_curve_C_min`). The base is BT at the turning point, Artisan's "from event"
+base with its TP start, as 12 of the 16 Skywalker logs record it; Artisan can also take a set base
+(the other four: 100 degC), which gives larger numbers. A table that compares curves takes one
+base for them all (the measured curve's, :func:`milestone_levels`), so its AUCs differ only by the
+curves.
 
 **Crossing time** [s]: the first time the rising curve reaches a temperature after its turning
 point, linearly interpolated between samples (:func:`crossing_time_s`); for a curve that stops
@@ -186,11 +194,36 @@ def turning_point(t, y) -> tuple[float | None, float | None]:
     return float(t[i]), float(y[i])
 
 
+def area_under_curve_C_min(t, y, from_s: float | None, base_C: float | None) -> float | None:
+    """Artisan's area under the curve [degC min]: the integral of max(y - ``base_C``, 0) [degC] over
+    time from ``from_s`` [s] (the turning point) to the curve's end (DROP), in minutes; trapezoids
+    between samples, the curve interpolated at ``from_s``. None without a start, a base or two
+    samples after the start.
+
+    >>> t = np.arange(0.0, 601.0, 1.0)
+    >>> round(area_under_curve_C_min(t, 100.0 + 0.1 * t, 0.0, 100.0), 3)  # a 60 degC x 10 min triangle
+    300.0
+    """
+    t = np.asarray(t, dtype=float)
+    y = np.asarray(y, dtype=float)
+    ok = np.isfinite(y)
+    t, y = t[ok], y[ok]
+    if from_s is None or base_C is None or t.size < 2 or not t[0] <= from_s < t[-1]:
+        return None
+    after = t > from_s
+    tt = np.concatenate(([from_s], t[after]))
+    yy = np.concatenate(([np.interp(from_s, t, y)], y[after]))
+    above = np.maximum(yy - base_C, 0.0)
+    return float(np.sum(0.5 * (above[1:] + above[:-1]) * np.diff(tt)) / 60.0)
+
+
 def milestone_levels(t, y, events: dict | None = None) -> dict[str, float]:
     """The temperatures [degC] that mark DRY END and first crack on this curve: the curve's own
     reading at the log's DRY / FCs marks where it has them, else :data:`DRY_END_C` and
     :data:`FIRST_CRACK_C`. Other curves (predictions, a changed roast) are then judged by when
-    they reach the same temperatures (:func:`milestones`)."""
+    they reach the same temperatures (:func:`milestones`). ``AUC``: the base of the area under
+    the curve, this curve's temperature at its turning point (the module docstring), which the
+    other curves' areas then take too (absent for a curve without one)."""
     t = np.asarray(t, dtype=float)
     y = np.asarray(y, dtype=float)
     ok = np.isfinite(y)
@@ -199,6 +232,9 @@ def milestone_levels(t, y, events: dict | None = None) -> dict[str, float]:
         at = (events or {}).get(name)
         if at is not None and ok.sum() >= 2 and t[ok][0] <= at <= t[ok][-1]:
             levels[name] = round(float(np.interp(at, t[ok], y[ok])), 1)
+    tp_C = turning_point(t[ok], y[ok])[1] if ok.sum() >= 2 else None
+    if tp_C is not None:
+        levels["AUC"] = round(tp_C, 1)
     return levels
 
 
@@ -206,8 +242,9 @@ def milestones(t, y, levels: dict[str, float]) -> dict[str, float | None]:
     """A roaster's milestones of one curve [s, degC, %]: ``TP_s``, ``TP_C`` (turning point),
     ``DRY_s`` and ``FCs_s`` (when the curve reaches ``levels["DRY"]`` / ``levels["FCs"]``,
     :func:`crossing_time_s`), ``DROP_s`` and ``DROP_C`` (the curve's end), ``development_s``
-    (DROP - FCs) and ``DTR_pct`` (development time ratio, 100 development / DROP). Missing
-    where the curve never gets there (None).
+    (DROP - FCs), ``DTR_pct`` (development time ratio, 100 development / DROP) and ``AUC_C_min``
+    (the area under the curve from its turning point to DROP above ``levels["AUC"]``,
+    :func:`area_under_curve_C_min`). Missing where the curve never gets there (None).
 
     >>> t = np.arange(0.0, 601.0, 5.0)
     >>> y = 100.0 + 0.2 * np.abs(t - 60.0) - 0.1 * 60  # a V: turning point at 1:00
@@ -235,6 +272,7 @@ def milestones(t, y, levels: dict[str, float]) -> dict[str, float | None]:
         "DROP_C": drop_c,
         "development_s": dev,
         "DTR_pct": dtr,
+        "AUC_C_min": area_under_curve_C_min(tt, yy, tp_s, levels.get("AUC")),
     }
 
 

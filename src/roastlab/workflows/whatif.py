@@ -45,7 +45,18 @@ ROWS = (
     ("DROP_C", "temperature at DROP", "temp"),
     ("development_s", "development time (FCs to DROP)", "time"),
     ("DTR_pct", "development time ratio", "pct"),
+    ("AUC_C_min", "AUC (TP to DROP, above BT at TP)", "auc"),
 )
+#: Rows of the probe's curve alone: the beans only warm, so the turning point (the charge drop) and
+#: the area Artisan counts from it are BT's.
+PROBE_ONLY = ("TP_s", "TP_C", "AUC_C_min")
+#: Each kind of row: (unit of its stored value, unit a table shows it in; "T" the temperature's symbol).
+ROW_UNITS = {
+    "time": ("s", "m:ss"),
+    "temp": ("degC", "T"),
+    "pct": ("%", "%"),
+    "auc": ("degC min", "T·min"),
+}
 #: Rows that need first crack within the roast (not when it is projected past DROP).
 DEVELOPMENT = ("development_s", "DTR_pct")
 #: The two readings a what-if compares: the beans (what it judges) and the bean probe (what the
@@ -161,7 +172,14 @@ def _fmt(value, kind: str, units: str) -> str:
         return mmss(value)
     if kind == "pct":
         return f"{value:.1f}"
+    if kind == "auc":  # an area of temperature differences, whole degree-minutes as Artisan shows it
+        return f"{display_temp_delta(value, units):.0f}"
     return f"{display_temp(value, units):.1f}"
+
+
+def _unit(kind: str, units: str) -> str:
+    """The unit a table shows a row of ``kind`` in (:data:`ROW_UNITS`), temperatures in ``units``."""
+    return ROW_UNITS[kind][1].replace("T", temp_symbol(units))
 
 
 def _fmt_delta(a, b, kind: str, units: str) -> str:
@@ -172,6 +190,8 @@ def _fmt_delta(a, b, kind: str, units: str) -> str:
         return ("+" if d >= 0 else "-") + mmss(abs(d))
     if kind == "pct":
         return f"{d:+.1f}"
+    if kind == "auc":
+        return f"{display_temp_delta(d, units):+.0f}"
     return f"{display_temp_delta(d, units):+.1f}"
 
 
@@ -219,8 +239,7 @@ class WhatIf(Result):
             lines += ["", title, head]
             for r in (r for r in self.rows if r["reading"] == reading):
                 kind = r["kind"]
-                unit = {"time": "m:ss", "temp": u, "pct": "%"}[kind]
-                what = f"  {r['what']} [{unit}]"
+                what = f"  {r['what']} [{_unit(kind, units)}]"
                 cells = {k: _fmt(r[k], kind, units) + ("*" if k in r["projected"] else "") for k in COLUMNS}
                 lines.append(
                     f"{what:40s}{cells['measured']:>10s}{cells['as_run']:>10s}{cells['changed']:>10s}"
@@ -274,8 +293,8 @@ class WhatIf(Result):
             if a is None or c is None or m is None or r["key"].startswith("TP"):
                 continue
             if 1e-6 < abs(c - a) < abs(a - m):  # a change there is, smaller than the model's own error
-                unit = {"time": "s", "temp": u, "pct": "points"}[r["kind"]]
-                scale = display_temp_delta(1.0, units) if r["kind"] == "temp" else 1.0
+                unit = {"time": "s", "pct": "points"}.get(r["kind"]) or _unit(r["kind"], units)
+                scale = display_temp_delta(1.0, units) if r["kind"] in ("temp", "auc") else 1.0
                 small.append(
                     f"{r['reading']} {r['what']} {scale * (c - a):+.1f} {unit} against {scale * (a - m):+.1f} {unit}"
                 )
@@ -469,15 +488,15 @@ def whatif(
                 ms["FCs_s"] = crossing_or_projected_s(t, y, lv["FCs"])
                 projected[name] = ms["FCs_s"] is not None
         for key, what, kind in ROWS:
-            if reading == "beans" and key.startswith("TP"):
-                continue  # the beans only warm: the turning point is the probe's (charge drop)
+            if reading == "beans" and key in PROBE_ONLY:
+                continue
             rows.append(
                 {
                     "reading": reading,
                     "key": key,
                     "what": what,
                     "kind": kind,
-                    "unit": {"time": "s", "temp": "degC", "pct": "%"}[kind],
+                    "unit": ROW_UNITS[kind][0],
                     "measured": ms_meas.get(key),
                     "as_run": ms_run[key] if not (key in DEVELOPMENT and projected.get("as_run")) else None,
                     "changed": ms_chg[key] if not (key in DEVELOPMENT and projected.get("changed")) else None,
