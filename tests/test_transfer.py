@@ -77,6 +77,35 @@ def test_scale_up_beats_both_baselines_and_is_deterministic():
     assert better >= 5 * m["rmse_C"]
 
 
+def test_a_transfer_states_the_heat_dose_of_target_and_programs_as_artisans_auc():
+    """SYNTHETIC 120 -> 360 kg scale-up: the summary gives each curve's AUC above the target's BT at its
+    turning point (Artisan's, roastlab.metrics.profile), the program's within 1 % of the target's where it
+    follows the curve to 0.5 degC, and in degF 9/5 as many degree-minutes."""
+    from roastlab.metrics.profile import area_under_curve_C_min, turning_point
+
+    model, ref = random_reference(np.random.default_rng(11), "120kg")
+    r = transfer(model, ref, "120kg", "360kg")
+    m, t = r.metrics, r.time_s
+    tp_s, base = turning_point(t, r.target_C)
+    assert m["AUC_base_C"] == base and m["target_AUC_C_min"] == pytest.approx(
+        area_under_curve_C_min(t, r.target_C, tp_s, base)
+    )
+    assert m["AUC_C_min"] == pytest.approx(m["target_AUC_C_min"], rel=0.01)
+    same = m["baseline_same_inputs"]["AUC_C_min"]
+    assert same == pytest.approx(
+        area_under_curve_C_min(
+            t, r.baselines["A's inputs unchanged"], turning_point(t, r.baselines["A's inputs unchanged"])[0], base
+        )
+    )
+    line = next(x for x in r.summary().splitlines() if x.startswith("target"))
+    assert line.split()[-1] == f"{m['target_AUC_C_min']:.0f}" and "AUC °C·min" in r.summary()
+    r.units = "F"
+    assert (
+        next(x for x in r.summary().splitlines() if x.startswith("target")).split()[-1]
+        == f"{9 / 5 * m['target_AUC_C_min']:.0f}"
+    )
+
+
 def test_unreachable_target_returns_the_best_program_and_says_why():
     model, ref = random_reference(np.random.default_rng(4), "120kg")
     r = transfer(model, ref, "120kg", "360kg", limits=ProgramLimits(150.0, 330.0, 120.0))

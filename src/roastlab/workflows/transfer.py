@@ -31,6 +31,7 @@ from ..io.batch import Batch
 from ..metrics.profile import (
     DRY_END_C,
     FIRST_CRACK_C,
+    area_under_curve_C_min,
     crossing_or_projected_s,
     crossing_time_s,
     display_units,
@@ -50,11 +51,20 @@ from ..sim.population import PARAM_SLOTS
 PHASE_LEVELS_C = (DRY_END_C, FIRST_CRACK_C)
 
 
-def _errors(pred, target) -> dict:
+def _errors(pred, target, t=None) -> dict:
+    """RMSE and max |e| [degC] of ``pred`` against ``target``; with the times ``t`` [s] also the
+    predicted curve's area under the curve (:func:`_auc`) as ``AUC_C_min``."""
     e = np.asarray(pred) - np.asarray(target)
     if not np.all(np.isfinite(e)):
-        return {"rmse_C": None, "max_abs_C": None}
-    return {"rmse_C": float(np.sqrt(np.mean(e**2))), "max_abs_C": float(np.max(np.abs(e)))}
+        return {"rmse_C": None, "max_abs_C": None} | ({"AUC_C_min": None} if t is not None else {})
+    out = {"rmse_C": float(np.sqrt(np.mean(e**2))), "max_abs_C": float(np.max(np.abs(e)))}
+    return out | ({"AUC_C_min": _auc(t, pred, target)} if t is not None else {})
+
+
+def _auc(t, y, target) -> float | None:
+    """Artisan's area under ``y`` [degC min] from its turning point to the end, above the target's BT at
+    its turning point: one base for the target and every program, as the what-if table takes one."""
+    return area_under_curve_C_min(t, y, turning_point(t, y)[0], turning_point(t, target)[1])
 
 
 @dataclasses.dataclass
@@ -106,12 +116,19 @@ class TransferResult(Result):
             f"transfer of {self.reference}: {self.plant_from} -> {self.plant_to} ({self.batch_kg:g} kg), "
             f"{len(self.time_s)} knots every {self.time_s[1] - self.time_s[0]:g} s"
         )
-        rows = [head, "", f"{'program':<24} {'RMSE ' + u:>9} {'max |e| ' + u:>11}"]
+
+        def auc(v):  # Artisan's area under the curve, whole degree-minutes in the summary's unit
+            return f"{d(v):>13.0f}" if v is not None else f"{'-':>13}"
+
+        rows = [head, "", f"{'program':<24} {'RMSE ' + u:>9} {'max |e| ' + u:>11} {'AUC ' + u + '·min':>13}"]
+        rows.append(f"{'target':<24} {'':>9} {'':>11} {auc(m.get('target_AUC_C_min'))}")
         label = "runnable (machine steps)" if "runnable" in m else "optimised"
-        rows.append(f"{label:<24} {d(m['rmse_C']):>9.3f} {d(m['max_abs_C']):>11.3f}")
+        rows.append(f"{label:<24} {d(m['rmse_C']):>9.3f} {d(m['max_abs_C']):>11.3f} {auc(m.get('AUC_C_min'))}")
         if "continuous" in m and m["continuous"]["rmse_C"] is not None:
             c = m["continuous"]
-            rows.append(f"{'continuous (optimiser)':<24} {d(c['rmse_C']):>9.3f} {d(c['max_abs_C']):>11.3f}")
+            rows.append(
+                f"{'continuous (optimiser)':<24} {d(c['rmse_C']):>9.3f} {d(c['max_abs_C']):>11.3f} {auc(c.get('AUC_C_min'))}"
+            )
         for key, label in (
             ("baseline_same_inputs", "A's inputs unchanged"),
             ("baseline_retimed", "A's inputs retimed"),
@@ -120,7 +137,12 @@ class TransferResult(Result):
             if b["rmse_C"] is None:
                 rows.append(f"{label:<24} {'(could not be simulated)':>21}")
             else:
-                rows.append(f"{label:<24} {d(b['rmse_C']):>9.3f} {d(b['max_abs_C']):>11.3f}")
+                rows.append(f"{label:<24} {d(b['rmse_C']):>9.3f} {d(b['max_abs_C']):>11.3f} {auc(b.get('AUC_C_min'))}")
+        if m.get("AUC_base_C") is not None:
+            rows.append(
+                "AUC: from each curve's turning point to DROP, above the target's BT at its turning point "
+                f"({display_temp(m['AUC_base_C'], units):.1f} {u})"
+            )
         rows.append("")
         verdict = "feasible" if m["feasible"] else "NOT feasible"
         rows.append(
@@ -553,7 +575,7 @@ def transfer(
     if limits.actuator is not None and limits.actuator.stepped:
         # the machine's settings, changed a few times a minute: the program a roaster can run
         program = runnable_program(continuous, target, limits.actuator)
-    err = _errors(program.Ta_pred_C, target)
+    err = _errors(program.Ta_pred_C, target, grid.time_s)
 
     # baseline 2: A's inputs retimed by the phase times baseline 1 gives on B
     t = grid.time_s
@@ -571,9 +593,9 @@ def transfer(
         ta_ret = res_ret.Ta_C
     except InputError:
         ta_ret = np.full(grid.n, np.nan)
-    base_same = {**_errors(res_same.Ta_C, target), "what": "plant B run with plant A's inputs unchanged"}
+    base_same = {**_errors(res_same.Ta_C, target, t), "what": "plant B run with plant A's inputs unchanged"}
     base_ret = {
-        **_errors(ta_ret, target),
+        **_errors(ta_ret, target, t),
         "what": "plant A's inputs retimed by the phase times the same-input run gives on B (Transposer-style)",
         "phase_marks_s": [{"reference_s": a, "same_inputs_s": b} for a, b in used],
     }
@@ -596,6 +618,8 @@ def transfer(
         "feasible": bool(feasible),
         "tolerance_C": tolerance_C,
         "turning_point_s": tp_s,
+        "target_AUC_C_min": _auc(t, target, target),
+        "AUC_base_C": turning_point(t, target)[1],
         "max_abs_from_turning_point_C": from_tp["max_abs_C"] if from_tp else None,
         "solve_s": program.solve_s,
         "iterations": program.iterations,
@@ -631,7 +655,7 @@ def transfer(
             "changes": [{"time_s": float(t[k]), "setting": act.label(program.heater[k])} for k in [0, *steps]],
         }
         metrics["continuous"] = {
-            **_errors(continuous.Ta_pred_C, target),
+            **_errors(continuous.Ta_pred_C, target, t),
             "what": "the optimiser's continuous program, before rounding to the machine's settings",
         }
     result = TransferResult(
