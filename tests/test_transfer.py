@@ -86,7 +86,8 @@ def test_a_transfer_states_the_heat_dose_of_target_and_programs_as_artisans_auc(
     model, ref = random_reference(np.random.default_rng(11), "120kg")
     r = transfer(model, ref, "120kg", "360kg")
     m, t = r.metrics, r.time_s
-    tp_s, base = turning_point(t, r.target_C)
+    tp_s, tp_C = turning_point(t, r.target_C)
+    base = round(tp_C, 1)  # the target's BT at its turning point, to 0.1 degC (metrics.profile.auc_base_C)
     assert m["AUC_base_C"] == base and m["target_AUC_C_min"] == pytest.approx(
         area_under_curve_C_min(t, r.target_C, tp_s, base)
     )

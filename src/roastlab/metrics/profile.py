@@ -217,13 +217,24 @@ def area_under_curve_C_min(t, y, from_s: float | None, base_C: float | None) -> 
     return float(np.sum(0.5 * (above[1:] + above[:-1]) * np.diff(tt)) / 60.0)
 
 
+def auc_base_C(t, y) -> float | None:
+    """The base [degC] of the area under the curve for a table that compares curves against ``y`` (the
+    measured BT, a transfer's target): ``y`` at its turning point, to 0.1 degC (the module docstring);
+    None for a curve with fewer than two readings."""
+    t = np.asarray(t, dtype=float)
+    y = np.asarray(y, dtype=float)
+    ok = np.isfinite(y)
+    tp_C = turning_point(t[ok], y[ok])[1] if ok.sum() >= 2 else None
+    return None if tp_C is None else round(tp_C, 1)
+
+
 def milestone_levels(t, y, events: dict | None = None) -> dict[str, float]:
     """The temperatures [degC] that mark DRY END and first crack on this curve: the curve's own
     reading at the log's DRY / FCs marks where it has them, else :data:`DRY_END_C` and
     :data:`FIRST_CRACK_C`. Other curves (predictions, a changed roast) are then judged by when
     they reach the same temperatures (:func:`milestones`). ``AUC``: the base of the area under
-    the curve, this curve's temperature at its turning point (the module docstring), which the
-    other curves' areas then take too (absent for a curve without one)."""
+    the curve (:func:`auc_base_C`), which the other curves' areas then take too (absent for a
+    curve without one)."""
     t = np.asarray(t, dtype=float)
     y = np.asarray(y, dtype=float)
     ok = np.isfinite(y)
@@ -232,9 +243,8 @@ def milestone_levels(t, y, events: dict | None = None) -> dict[str, float]:
         at = (events or {}).get(name)
         if at is not None and ok.sum() >= 2 and t[ok][0] <= at <= t[ok][-1]:
             levels[name] = round(float(np.interp(at, t[ok], y[ok])), 1)
-    tp_C = turning_point(t[ok], y[ok])[1] if ok.sum() >= 2 else None
-    if tp_C is not None:
-        levels["AUC"] = round(tp_C, 1)
+    if (base := auc_base_C(t, y)) is not None:
+        levels["AUC"] = base
     return levels
 
 

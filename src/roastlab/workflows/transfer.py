@@ -32,6 +32,7 @@ from ..metrics.profile import (
     DRY_END_C,
     FIRST_CRACK_C,
     area_under_curve_C_min,
+    auc_base_C,
     crossing_or_projected_s,
     crossing_time_s,
     display_units,
@@ -62,9 +63,10 @@ def _errors(pred, target, t=None) -> dict:
 
 
 def _auc(t, y, target) -> float | None:
-    """Artisan's area under ``y`` [degC min] from its turning point to the end, above the target's BT at
-    its turning point: one base for the target and every program, as the what-if table takes one."""
-    return area_under_curve_C_min(t, y, turning_point(t, y)[0], turning_point(t, target)[1])
+    """Artisan's area under ``y`` [degC min] from its turning point to the end, above the target's base
+    (:func:`~roastlab.metrics.profile.auc_base_C`): one base for the target and every program, as the
+    what-if table takes one."""
+    return area_under_curve_C_min(t, y, turning_point(t, y)[0], auc_base_C(t, target))
 
 
 @dataclasses.dataclass
@@ -619,7 +621,7 @@ def transfer(
         "tolerance_C": tolerance_C,
         "turning_point_s": tp_s,
         "target_AUC_C_min": _auc(t, target, target),
-        "AUC_base_C": turning_point(t, target)[1],
+        "AUC_base_C": auc_base_C(t, target),
         "max_abs_from_turning_point_C": from_tp["max_abs_C"] if from_tp else None,
         "solve_s": program.solve_s,
         "iterations": program.iterations,
