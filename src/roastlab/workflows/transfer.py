@@ -52,21 +52,23 @@ from ..sim.population import PARAM_SLOTS
 PHASE_LEVELS_C = (DRY_END_C, FIRST_CRACK_C)
 
 
-def _errors(pred, target, t=None) -> dict:
-    """RMSE and max |e| [degC] of ``pred`` against ``target``; with the times ``t`` [s] also the
-    predicted curve's area under the curve (:func:`_auc`) as ``AUC_C_min``."""
+def _errors(pred, target) -> dict:
     e = np.asarray(pred) - np.asarray(target)
     if not np.all(np.isfinite(e)):
-        return {"rmse_C": None, "max_abs_C": None} | ({"AUC_C_min": None} if t is not None else {})
-    out = {"rmse_C": float(np.sqrt(np.mean(e**2))), "max_abs_C": float(np.max(np.abs(e)))}
-    return out | ({"AUC_C_min": _auc(t, pred, target)} if t is not None else {})
+        return {"rmse_C": None, "max_abs_C": None}
+    return {"rmse_C": float(np.sqrt(np.mean(e**2))), "max_abs_C": float(np.max(np.abs(e)))}
 
 
-def _auc(t, y, target) -> float | None:
-    """Artisan's area under ``y`` [degC min] from its turning point to the end, above the target's base
-    (:func:`~roastlab.metrics.profile.auc_base_C`): one base for the target and every program, as the
-    what-if table takes one."""
-    return area_under_curve_C_min(t, y, turning_point(t, y)[0], auc_base_C(t, target))
+def _auc(t, y, base_C) -> float | None:
+    """``y``'s area under the curve from its turning point above ``base_C``, the target's
+    (:func:`~roastlab.metrics.profile.auc_base_C`: one base for the target and every program, as the
+    what-if table takes one); None for a curve that could not be simulated."""
+    return area_under_curve_C_min(t, y, turning_point(t, y)[0], base_C)
+
+
+def _scored(pred, target, t, base_C) -> dict:
+    """:func:`_errors` of ``pred`` against ``target`` and its :func:`_auc` as ``AUC_C_min``."""
+    return _errors(pred, target) | {"AUC_C_min": _auc(t, pred, base_C)}
 
 
 @dataclasses.dataclass
@@ -577,10 +579,11 @@ def transfer(
     if limits.actuator is not None and limits.actuator.stepped:
         # the machine's settings, changed a few times a minute: the program a roaster can run
         program = runnable_program(continuous, target, limits.actuator)
-    err = _errors(program.Ta_pred_C, target, grid.time_s)
+    t = grid.time_s
+    auc_base = auc_base_C(t, target)
+    err = _scored(program.Ta_pred_C, target, t, auc_base)
 
     # baseline 2: A's inputs retimed by the phase times baseline 1 gives on B
-    t = grid.time_s
     levels = [lv for lv in PHASE_LEVELS_C if crossing_time_s(t, target, lv) is not None]
     if not levels:  # a light or short roast: the level 80 % of the way from the turning point to DROP
         levels = [float(np.min(target) + 0.8 * (target[-1] - np.min(target)))]
@@ -595,9 +598,9 @@ def transfer(
         ta_ret = res_ret.Ta_C
     except InputError:
         ta_ret = np.full(grid.n, np.nan)
-    base_same = {**_errors(res_same.Ta_C, target, t), "what": "plant B run with plant A's inputs unchanged"}
+    base_same = {**_scored(res_same.Ta_C, target, t, auc_base), "what": "plant B run with plant A's inputs unchanged"}
     base_ret = {
-        **_errors(ta_ret, target, t),
+        **_scored(ta_ret, target, t, auc_base),
         "what": "plant A's inputs retimed by the phase times the same-input run gives on B (Transposer-style)",
         "phase_marks_s": [{"reference_s": a, "same_inputs_s": b} for a, b in used],
     }
@@ -620,8 +623,8 @@ def transfer(
         "feasible": bool(feasible),
         "tolerance_C": tolerance_C,
         "turning_point_s": tp_s,
-        "target_AUC_C_min": _auc(t, target, target),
-        "AUC_base_C": auc_base_C(t, target),
+        "target_AUC_C_min": _auc(t, target, auc_base),
+        "AUC_base_C": auc_base,
         "max_abs_from_turning_point_C": from_tp["max_abs_C"] if from_tp else None,
         "solve_s": program.solve_s,
         "iterations": program.iterations,
@@ -657,7 +660,7 @@ def transfer(
             "changes": [{"time_s": float(t[k]), "setting": act.label(program.heater[k])} for k in [0, *steps]],
         }
         metrics["continuous"] = {
-            **_errors(continuous.Ta_pred_C, target, t),
+            **_scored(continuous.Ta_pred_C, target, t, auc_base),
             "what": "the optimiser's continuous program, before rounding to the machine's settings",
         }
     result = TransferResult(
