@@ -229,11 +229,12 @@ def test_lanes_stop_where_the_scalar_integrator_stops():
 def test_law_key_names_one_set_of_laws_or_none():
     _, _, _, PP = _runs(1, 4)
     linear = 4**4 + 4**5  # the heater's and the fan's drives in proportion to their settings (exponents 1)
-    assert lanes.law_key(PP) == 2 * 4**3 + linear  # the paper's laws, Schwartzberg's exponent 2
+    off = 4**8  # bit j above it: OFF_SLOTS' j-th term (the probe's depth, the radiation, the surface gas) off
+    assert lanes.law_key(PP) == 2 * 4**3 + linear + 7 * off  # the paper's laws, Schwartzberg's exponent 2
     _, _, _, PB = _runs(1, 4, BULLET_LAWS)
-    assert lanes.law_key(PB) == 1 + 4 + 16 + 128 + linear
+    assert lanes.law_key(PB) == 1 + 4 + 16 + 128 + linear + 6 * off  # the probe in the bed: its depth read
     _, _, _, PS = _runs(1, 4, held=(("bean_swell", 1.0),))
-    assert lanes.law_key(PS) == 2 * 4**3 + linear + 4**7  # beans that double their volume: a constant
+    assert lanes.law_key(PS) == 2 * 4**3 + linear + 4**7 + 7 * off  # beans that double their volume: a constant
     PS[:, P["bean_swell"]] = 0.5
     assert lanes.law_key(PS) is None  # a swelling that is not a whole number: the scalar integrator
     assert lanes.law_key(np.vstack([PP, PB])) is None  # mixed laws: the scalar integrator
@@ -247,7 +248,30 @@ def test_law_key_names_one_set_of_laws_or_none():
     draft[:, P["fan_exp"]] = 0.5  # a fan logged as its draft: the square root, the scalar integrator
     assert lanes.law_key(draft) is None
     assert lanes.usable(PP) is None  # too few runs to fill the lanes
-    assert lanes.usable(np.repeat(PP, lanes.MIN_RUNS, axis=0)) == 128 + linear
+    assert lanes.usable(np.repeat(PP, lanes.MIN_RUNS, axis=0)) == 128 + linear + 7 * off
+
+
+def test_terms_off_in_every_run_are_compiled_out_to_the_same_bits():
+    """OFF_SLOTS: where every run holds 0 in a term's slot the key says so and the lanes compile the 0
+    in; the kernel that reads those slots per lane gives the same runs the same values to the bit, and
+    runs that turn the terms on (the probe in the bed, the wall's radiation, the gas at the bed's
+    surface) what the scalar integrator gives them."""
+    inputs, batch_of, X0, PP = _runs(6, lanes.LANES + 5)
+    rng = np.random.default_rng(6)
+    on = PP.copy()
+    on[::2, P["h_probe"]] = rng.uniform(0.01, 0.3, on[::2].shape[0])
+    on[::3, P["eps_rad"]] = rng.uniform(0.1, 1.0, on[::3].shape[0])
+    on[::4, P["k_flight"]] = rng.uniform(1.0, 20.0, on[::4].shape[0])
+    read = lanes.law_key(on)  # some runs hold each term on: every one read per lane
+    assert lanes.law_key(PP) == read + 7 * 4**8
+    nmax = inputs[0].shape[1]
+    cols = np.arange(N_OUT, dtype=np.int64)
+    compiled, per_lane = (np.full((len(batch_of), nmax, N_OUT), np.nan) for _ in range(2))
+    lanes.simulate_runs(*inputs, batch_of, X0, PP, False, 30.0, cols, compiled, 1.0, lanes.law_key(PP))
+    lanes.simulate_runs(*inputs, batch_of, X0, PP, False, 30.0, cols, per_lane, 1.0, read)
+    assert np.array_equal(compiled, per_lane, equal_nan=True)
+    scalar, vector = _both(inputs, batch_of, X0, on, False)
+    _agree(scalar, vector)
 
 
 def test_population_takes_the_lanes_for_many_runs(monkeypatch):

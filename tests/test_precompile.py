@@ -41,7 +41,7 @@ before = {k: set(d.overloads) for k, d in dispatchers().items()}
 batches = roastlab.read_dataset(roastlab.default_dataset_root() / "dataset-I").batches[:1]
 res = roastlab.fit(batches, "120kg", starts=1)
 res.model.validate(batches)
-roastlab.fit(batches, "120kg", starts=1, bed=held.bed, fix=dict(held.held))
+roastlab.fit(batches, "120kg", starts=1, bed=held.bed, fix={**dict(held.held), **{k: 0.1 for k in held.on}})
 simulate_population(pack_batches(batches, "120kg", roastlab.THETA_PAPER), ["hbm"], np.full((16, 1, 1), 0.03))
 roastlab.simulate("120kg", batches[0].time_s, batches[0].Gg_kg_s, batches[0].Tgi_C)
 gained = {k: [str(s) for s in set(d.overloads) - before.get(k, set())] for k, d in dispatchers().items()}
@@ -65,8 +65,8 @@ def test_lanes_once_per_set_of_laws_and_first():
         "job_stepper",
     ]
     assert [args for _, args in todo[:2]] == [
-        ("paper", "schwartzberg"),
-        ("probe=tumbling,probe_gas=mean", "schwartzberg"),
+        ("paper", "schwartzberg", (), ()),
+        ("probe=tumbling,probe_gas=mean", "schwartzberg", (), ("h_probe_m",)),  # its probe's depth held at 0.2 m
     ]
     # the sensitivities once per bed and moisture law (their codes are compiled in), the program's once
     assert [args for _, args in todo[3:5]] == [
@@ -88,7 +88,7 @@ def test_a_model_files_laws_are_its_bed_and_moisture_law(tmp_path):
     laws = precompile.law_set_of(model.save(tmp_path / "model.json"))
     assert laws == precompile.LawSet(BedLaws(probe="tumbling", probe_gas="mean"), "schwartzberg")
     todo = precompile.jobs([precompile.LawSet(), laws])
-    assert todo[1] == (precompile.job_lanes, ("probe=tumbling,probe_gas=mean", "schwartzberg"))
+    assert todo[1] == (precompile.job_lanes, ("probe=tumbling,probe_gas=mean", "schwartzberg", (), ()))
 
 
 def test_a_held_value_the_lanes_compile_in_is_part_of_the_set_of_laws(tmp_path):
@@ -107,14 +107,32 @@ def test_a_held_value_the_lanes_compile_in_is_part_of_the_set_of_laws(tmp_path):
     assert laws.name.endswith("bean_swell 1")
     todo = precompile.jobs([precompile.LawSet(), laws, precompile.LawSet(BedLaws(probe="tumbling"))])
     assert [args for _, args in todo[:3]] == [
-        ("paper", "schwartzberg"),
-        ("probe=tumbling", "schwartzberg", (("bean_swell", 1.0),)),
-        ("probe=tumbling", "schwartzberg"),
+        ("paper", "schwartzberg", (), ()),
+        ("probe=tumbling", "schwartzberg", (("bean_swell", 1.0),), ()),
+        ("probe=tumbling", "schwartzberg", (), ()),
     ]
     gas = precompile.LawSet(held=(("heater_exp", 0.5),))  # a gas burner's square root: the scalar integrator
     assert [job.__name__ for job, _ in precompile.jobs([gas])] == ["job_population", "job_sensitivities", "job_stepper"]
     model = FittedModel.paper().with_values(bean_swell=1.0, heater_exp=1.0)
     assert precompile.law_set_of(model.save(tmp_path / "model.json")).held == (("bean_swell", 1.0),)
+
+
+def test_a_term_a_zero_turns_off_is_on_where_a_spec_frees_or_holds_it_or_a_model_has_it(tmp_path):
+    """The lanes compile a 0 in for a term off in every run (roastlab.sim.lanes.OFF_SLOTS), so a set of
+    laws says which such terms are on: freed by the spec, held at another value, or not 0 in a model
+    file; a term held at its 0 is off. The job runs each one on at the middle of its fit bounds."""
+    from roastlab.workflows.model import FittedModel
+
+    spec = tmp_path / "fit.toml"
+    spec.write_text(
+        "[free]\nhbm = [0.001, 0.1, 0.02]\nh_probe_m = [0.0, 0.5, 0.1]\n[fixed]\neps_rad = 0.8\nk_flight = 0.0\n"
+    )
+    laws = precompile.law_set_of(spec)
+    assert laws == precompile.LawSet(on=("eps_rad", "h_probe_m")) and laws.name.endswith("eps_rad on, h_probe_m on")
+    assert precompile.jobs([laws])[0] == (precompile.job_lanes, ("paper", "schwartzberg", (), ("eps_rad", "h_probe_m")))
+    model = FittedModel.paper().with_values(k_flight=4.0)
+    assert precompile.law_set_of(model.save(tmp_path / "model.json")).on == ("k_flight",)
+    assert precompile.law_set_of(FittedModel.paper().save(tmp_path / "paper.json")) == precompile.LawSet()
 
 
 def test_each_family_of_jobs_keeps_its_processes():

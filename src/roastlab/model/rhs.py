@@ -212,6 +212,8 @@ def bed_areas_m2(p, s):
     else:
         Abm = p[I_PBM] * p[I_AWALL] * s  # the wetted arc widens as the bed deepens
         Agb = fmax(Ab - Abm, 0.01 * Ab)
+    if p[I_KFLIGHT] == 0.0:  # off: the lanes compile the zero in (roastlab.sim.lanes.OFF_SLOTS)
+        return Agb, Abm
     return where(p[I_KFLIGHT] > 0.0, p[I_KFLIGHT] * p[I_ASURF] * s, Agb), Abm
 
 
@@ -372,6 +374,8 @@ def wall_radiation_kW(Tb, Tm, s, p):
     the bed's segment), so a small batch takes more of this heat per kilogram than a large one;
     swollen beans (``s``, :func:`swell_factor`) widen it as s. eps_rad 0 (the default) is the paper's model.
     """
+    if p[I_EPSRAD] == 0.0:  # off: the lanes compile the zero in (roastlab.sim.lanes.OFF_SLOTS)
+        return 0.0
     a = Tm + KELVIN
     b = Tb + KELVIN
     a2 = a * a
@@ -393,6 +397,8 @@ def probe_coverage(p, s):
     (:func:`swell_factor`) deepen the bed to h_bed s^2.
     """
     h_probe = p[I_HPROBE]
+    if h_probe == 0.0:  # the paper's probe: the lanes compile the zero in (roastlab.sim.lanes.OFF_SLOTS)
+        return 1.0
     h_bed = p[I_HBED] * (s * s)  # swollen beans deepen the bed (:func:`swell_factor`)
     if p[I_PROBELAW] == 0.0:
         return where(h_probe > h_bed, h_bed / fmax(h_probe, 1e-12), 1.0)

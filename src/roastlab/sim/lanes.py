@@ -26,7 +26,20 @@ from numba.core import cgutils, types
 from numba.core.errors import NumbaIRAssumptionWarning
 from numba.extending import intrinsic, register_jitable
 
-from ..model.layout import I_CONTACT, I_FEXP, I_HEXP, I_HLEXP, I_PROBEGAS, I_PROBELAW, I_SWELL, I_XEXP, N_PARAMS
+from ..model.layout import (
+    I_CONTACT,
+    I_EPSRAD,
+    I_FEXP,
+    I_HEXP,
+    I_HLEXP,
+    I_HPROBE,
+    I_KFLIGHT,
+    I_PROBEGAS,
+    I_PROBELAW,
+    I_SWELL,
+    I_XEXP,
+    N_PARAMS,
+)
 from ..model.rhs import outlet_gas_C, rebind
 from . import vecmath
 from .cache import compiled, literal_entry
@@ -129,6 +142,16 @@ def _k(stage, i):
 #: ``swell_factor``'s branch).
 LAW_SLOTS = (I_CONTACT, I_PROBELAW, I_PROBEGAS, I_XEXP, I_HEXP, I_FEXP, I_HLEXP, I_SWELL)
 _LAW_BASE = 4  # each law slot's value is a whole number below this
+#: The parameter slots of terms that a 0 turns off (the right-hand side tests ``p[slot] == 0.0``): the
+#: probe's depth scale (0, the paper's probe, always immersed), the wall's radiation and the gas meeting
+#: the bed's surface. Where every run of a call holds 0 in one, the key says so (:func:`law_key`) and the
+#: lanes compile the 0 in, so the term's test is decided when compiling instead of both of its sides
+#: computed in every lane; any other value is read per lane, as every parameter is. The same values
+#: either way, to the bit; the paper's runs are about a tenth faster (docs/performance.md, "Terms that
+#: are off"). The shell loss, the heater's gains and the fan's flow are not among them: a fitted value
+#: often ends on its bound 0, and a model fitted with it free would then run on a second kernel.
+OFF_SLOTS = (I_HPROBE, I_EPSRAD, I_KFLIGHT)
+_OFF_BASE = _LAW_BASE ** len(LAW_SLOTS)  # a key's off bits (law_key) start here
 
 
 def law_key(PP: np.ndarray) -> int | None:
@@ -139,7 +162,9 @@ def law_key(PP: np.ndarray) -> int | None:
     The lanes integrator is compiled once per key with these values as constants, so the laws'
     branches are decided when compiling instead of evaluated, both sides, in every lane
     (a vector instruction computes both sides of a branch). Paper's laws: contact, probe and probe
-    gas 0, moisture exponent 2, heater and fan exponents 1: key 128 + 256 + 1024 = 1408.
+    gas 0, moisture exponent 2, heater and fan exponents 1: 128 + 256 + 1024 = 1408. Above the laws,
+    bit j (times 4^8) says that :data:`OFF_SLOTS`' j-th term is off in every run: with the paper's
+    probe and neither extension, 1408 + 7 4^8 = 460160.
     """
     if PP.shape[0] == 0:
         return None
@@ -148,7 +173,8 @@ def law_key(PP: np.ndarray) -> int | None:
         return None
     if not compiles_in(first):
         return None
-    return int(sum(int(v) * _LAW_BASE**j for j, v in enumerate(first)))
+    off = sum(2**j for j, slot in enumerate(OFF_SLOTS) if np.all(PP[:, slot] == 0.0))
+    return int(sum(int(v) * _LAW_BASE**j for j, v in enumerate(first))) + off * _OFF_BASE
 
 
 def compiles_in(values) -> bool:
@@ -160,12 +186,14 @@ def compiles_in(values) -> bool:
 
 @intrinsic
 def _lane_parameters(typingctx, Z, lane, key):
-    """Lane ``lane``'s parameter vector (Z's rows from _PT) as a tuple of values, the law slots
-    the constants of ``key`` (:func:`law_key`, a compile-time constant). Loads only, no array view,
-    whose reference counting would put a call into the lane loop and stop its vectorisation."""
+    """Lane ``lane``'s parameter vector (Z's rows from _PT) as a tuple of values, the law slots and the
+    slots of the terms off in every run the constants of ``key`` (:func:`law_key`, a compile-time
+    constant). Loads only, no array view, whose reference counting would put a call into the lane loop
+    and stop its vectorisation."""
     if not isinstance(key, types.IntegerLiteral):
         return None
     laws = {slot: float((key.literal_value // _LAW_BASE**j) % _LAW_BASE) for j, slot in enumerate(LAW_SLOTS)}
+    laws.update({slot: 0.0 for j, slot in enumerate(OFF_SLOTS) if (key.literal_value // _OFF_BASE) >> j & 1})
     tup = types.UniTuple(types.float64, N_PARAMS)
 
     def codegen(context, builder, signature, args):

@@ -33,18 +33,22 @@ from ..model.bed import BedLaws
 @dataclass(frozen=True)
 class LawSet:
     """The laws a set of runs shares, which the lanes integrator compiles in (one kernel per set):
-    the bed laws, the moisture law, and ``held``, the held values of the other parameters the lanes
+    the bed laws, the moisture law, ``held``, the held values of the other parameters the lanes
     compile in as constants (:data:`roastlab.sim.lanes.LAW_SLOTS`: the drive exponents, the beans'
-    swelling) where they differ from the quantity table's defaults, as sorted (name, value) pairs."""
+    swelling) where they differ from the quantity table's defaults, as sorted (name, value) pairs, and
+    ``on``, the terms a 0 turns off that are on (:data:`roastlab.sim.lanes.OFF_SLOTS`: held at
+    another value, or free), as sorted names."""
 
     bed: BedLaws = BedLaws()
     moisture: str = "schwartzberg"
     held: tuple[tuple[str, float], ...] = ()
+    on: tuple[str, ...] = ()
 
     @property
     def name(self) -> str:
         held = "".join(f", {k} {v:g}" for k, v in self.held)
-        return f"{self.bed.name}, {self.moisture} moisture{held}"
+        on = "".join(f", {k} on" for k in self.on)
+        return f"{self.bed.name}, {self.moisture} moisture{held}{on}"
 
 
 def held_law_values(values: dict[str, float]) -> tuple[tuple[str, float], ...]:
@@ -64,10 +68,20 @@ def held_law_values(values: dict[str, float]) -> tuple[tuple[str, float], ...]:
     )
 
 
+def terms_on(values: dict[str, float], free=()) -> tuple[str, ...]:
+    """The names among ``values`` (registry names; a value other than 0) and ``free`` (names a fit
+    frees) of the terms that a 0 turns off (:data:`roastlab.sim.lanes.OFF_SLOTS`), sorted: :attr:`LawSet.on`."""
+    from ..sim.lanes import OFF_SLOTS
+    from ..sim.population import PARAM_SLOTS
+
+    named = {name for name, v in values.items() if float(v) != 0.0} | set(free)
+    return tuple(sorted(name for name in named if PARAM_SLOTS.get(name) in OFF_SLOTS))
+
+
 def law_set_of(path) -> LawSet:
     """The laws of a fit spec (``.toml``: its ``[bed]``, the default moisture law, its ``[fixed]``
-    values the lanes compile in) or a model file (``.json``: its bed and moisture law, its values the
-    lanes compile in)."""
+    values the lanes compile in, the terms it holds on or frees) or a model file (``.json``: its bed
+    and moisture law, its values the lanes compile in, the terms its values turn on)."""
     from pathlib import Path
 
     path = Path(path)
@@ -75,11 +89,11 @@ def law_set_of(path) -> LawSet:
         from .model import load_model
 
         model = load_model(path)
-        return LawSet(model.bed or BedLaws(), model.moisture, held_law_values(model.values))
+        return LawSet(model.bed or BedLaws(), model.moisture, held_law_values(model.values), terms_on(model.values))
     from ..io.fitspec import load_fit_spec
 
     spec = load_fit_spec(path)
-    return LawSet(spec.bed, held=held_law_values(spec.fixed))
+    return LawSet(spec.bed, held=held_law_values(spec.fixed), on=terms_on(spec.fixed, (f.name for f in spec.free)))
 
 
 def _batch():
@@ -100,16 +114,18 @@ def _packed(laws: LawSet = LawSet(), n: int = 1):
     return pack_batches([_batch()] * n, "120kg", THETA_PAPER, moisture=laws.moisture, bed=laws.bed)
 
 
-def job_lanes(bed: str, moisture: str, held: tuple[tuple[str, float], ...] = ()) -> str:
-    """The lanes integrator for one set of laws (:func:`roastlab.sim.population.predict_outputs`)."""
+def job_lanes(bed: str, moisture: str, held: tuple[tuple[str, float], ...] = (), on: tuple[str, ...] = ()) -> str:
+    """The lanes integrator for one set of laws (:func:`roastlab.sim.population.predict_outputs`); the
+    terms ``on`` at the middle of their fit bounds (the kernel is the same for any value but 0)."""
+    from ..model.parameters import REGISTRY
     from ..sim import lanes
     from ..sim.population import predict_outputs
 
-    laws = LawSet(BedLaws.parse(bed), moisture, tuple(held))
+    laws = LawSet(BedLaws.parse(bed), moisture, tuple(held), tuple(on))
     packed = _packed(laws)
-    names = ["hbm", *(k for k, _ in laws.held)]
+    names = ["hbm", *(k for k, _ in laws.held), *laws.on]
     values = np.empty((lanes.MIN_RUNS, 1, len(names)))
-    values[:] = [0.0254, *(v for _, v in laws.held)]
+    values[:] = [0.0254, *(v for _, v in laws.held), *(sum(REGISTRY[k].bounds) / 2 for k in laws.on)]
     predict_outputs(packed, names, values, with_tgo=True, use_lanes=True)
     return f"lanes ({laws.name})"
 
@@ -173,7 +189,7 @@ def jobs(law_sets=(LawSet(),)) -> list[tuple]:
         if (laws.bed.name, laws.moisture) not in codes:
             codes.append((laws.bed.name, laws.moisture))
     return [
-        *((job_lanes, (laws.bed.name, laws.moisture, *((laws.held,) if laws.held else ()))) for laws in seen),
+        *((job_lanes, (laws.bed.name, laws.moisture, laws.held, laws.on)) for laws in seen),
         (job_population, ()),
         *((job_sensitivities, (bed, moisture, k == 0)) for k, (bed, moisture) in enumerate(codes)),
         (job_stepper, ()),
@@ -284,4 +300,4 @@ def compile_kernels(law_sets=(LawSet(),), processes: int | None = None, progress
     return done
 
 
-__all__ = ["LawSet", "law_set_of", "held_law_values", "compile_kernels", "chains", "jobs", "process_count"]
+__all__ = ["LawSet", "law_set_of", "held_law_values", "terms_on", "compile_kernels", "chains", "jobs", "process_count"]
