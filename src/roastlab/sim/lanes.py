@@ -85,8 +85,9 @@ from .kernels import (
     step_budget,
 )
 
-#: Runs one core integrates together. The compiler takes 8 lanes (one AVX-512 register, two AVX2
-#: ones) per vector instruction; 32 give each loop four independent iterations to overlap. On the
+#: Runs one core integrates together. The compiler takes 4 lanes per vector instruction (256-bit
+#: registers, also on AVX-512 processors, for which LLVM's tuning prefers them: docs/performance.md,
+#: "What a vector instruction holds"); 32 give each loop eight independent iterations to overlap. On the
 #: project's 2-core VM, one thread, the benchmark's population: 8 lanes 16.2, 16 lanes 14.8, 32 lanes
 #: 13.7 us per run (scalar integrator 29.7); 32 lanes' work array (~29 kB) still fits the L1 cache.
 LANES = 32
