@@ -437,7 +437,13 @@ def _interval(lane, k, b, T, GG, TGI, QQ, FF, zoh, Z, DTI, first, FRESH):
 def _first_stages(Z, FRESH, key):
     """The first stage anew for the lanes marked FRESH (a run's start; every interval under a
     zero-order hold), all of them in one vectorised evaluation at their states and interval starts;
-    the other lanes' results are discarded (their first stage is the last step's seventh)."""
+    the other lanes' results are discarded (their first stage is the last step's seventh). With no
+    lane marked, nothing: under a linear hold most trials, whose first stages are all the last step's."""
+    fresh = False
+    for lane in range(LANES):
+        fresh |= FRESH[lane]
+    if not fresh:
+        return
     for lane in range(LANES):
         for i in range(NS):
             Z[_at(_Y + i, lane)] = Z[_at(_X + i, lane)]
