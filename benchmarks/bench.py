@@ -472,6 +472,22 @@ def _load(where: str, res: dict) -> None:
     res.setdefault("load", {})[where] = {"loadavg_1min": round(one, 2), "loadavg_5min": round(five, 2)}
 
 
+def _processor() -> dict:
+    """The processor as the OS names it and the one numba compiles for (LLVM's name for the host, or
+    ``NUMBA_CPU_NAME``): the compiled figures depend on both, and a VM's type changes between runs
+    (docs/performance.md, "What a vector instruction holds")."""
+    import platform
+
+    import llvmlite.binding as llvm
+    from numba.core import config
+
+    name = platform.processor()
+    with contextlib.suppress(OSError):
+        with open("/proc/cpuinfo") as f:
+            name = next((line.split(":", 1)[1].strip() for line in f if line.startswith("model name")), name)
+    return {"processor": name or "unknown", "compiled_for": config.CPU_NAME or llvm.get_host_cpu_name()}
+
+
 def _log(msg: str, quiet: bool) -> None:
     if not quiet:
         print(msg, file=sys.stderr, flush=True)
@@ -524,6 +540,7 @@ def run(quiet: bool = False, baseline_repeats: int = 5, only: str | None = None)
             "python": sys.version.split()[0],
             # the all-core figures depend on it (roastlab.sim.OMP_WAIT_POLICY)
             "omp_wait_policy": os.environ.get("OMP_WAIT_POLICY"),
+            **_processor(),
         },
         "batch": {"name": f"dataset-I/{batch.name}", "duration_s": float(t[-1]), "samples": int(batch.n)},
     }
@@ -540,6 +557,7 @@ def run(quiet: bool = False, baseline_repeats: int = 5, only: str | None = None)
         _load("start", res)
         res["sensitivity"] = sensitivity_bench(quiet)
         _load("end", res)
+        res["checks"] = check_targets(res)
         return res
     if only == "control":
         _load("start", res)
@@ -966,6 +984,9 @@ def table(res: dict) -> str:
                 f"5 min {load['loadavg_5min']:.2f}; {res['machine']['cpus']} cpus",
             )
         )
+    m = res.get("machine") or {}
+    if "compiled_for" in m:
+        rows.append(("processor, compiled for", m["compiled_for"], f"{m['processor']}; {m['cpus']} cpus"))
     w = max(len(r[0]) for r in rows)
     return "\n".join(f"{a:<{w}}  {b:>16}  {c}" for a, b, c in rows)
 

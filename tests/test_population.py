@@ -124,6 +124,19 @@ def test_the_benchmarks_fresh_process_measurement_runs():
     assert out["peak_MB"] > 0 and out["mean_FIT"] > 50
 
 
+def test_the_benchmarks_sensitivity_section_prints_its_table_with_the_processor():
+    """``roastlab bench --only sensitivity`` prints its table (it failed on its missing target checks)
+    and, as every section, names the processor and the one numba compiles for."""
+    from roastlab.cli.bench import load_benchmark
+
+    bench = load_benchmark()
+    res = bench.run(quiet=True, only="sensitivity")
+    text = bench.table(res)
+    assert res["checks"] == bench.check_targets(res)
+    assert res["machine"]["compiled_for"] and res["machine"]["processor"]
+    assert f"{res['machine']['compiled_for']}  {res['machine']['processor']}; " in text
+
+
 def test_the_benchmarks_busy_core_check_stops_its_busy_process(monkeypatch):
     """``roastlab bench``'s busy-core check (busy_identify) times its call on one thread and on all
     cores, alternated, beside a second process it starts, and stops that process after, also when
