@@ -92,11 +92,12 @@ from .kernels import (
 #: 13.7 us per run (scalar integrator 29.7); 32 lanes' work array (~29 kB) still fits the L1 cache.
 LANES = 32
 #: Groups of lanes per thread: the unit of parallel work is a group, which works through its share of
-#: the runs (a lane whose run ends takes the next). One: numba's OpenMP layer hands each thread an equal
-#: share of the groups, so more groups per thread even nothing out, and each group ends in a tail where
-#: its last runs go on with its other lanes idle, every step a whole 32-lane evaluation. A stiff run in
-#: a fit's screening makes that tail long: the Bullet example's fit took 5.8-6.4 s with one group per
-#: thread against 7.2-7.6 s with four (one thread), the same model file (docs/performance.md).
+#: the runs (a lane whose run ends takes the next). One: numba's default scheduling gives each thread
+#: one equal share of a parallel loop, so more groups per thread even nothing out, and each group ends
+#: in a tail where its last runs go on with its other lanes idle, every step a whole 32-lane
+#: evaluation. A stiff run in a fit's screening makes that tail long: the Bullet example's fit took
+#: 5.8-6.4 s with one group per thread against 7.2-7.6 s with four (one thread), the same model file
+#: (docs/performance.md, "One group per thread").
 GROUPS_PER_THREAD = 1
 
 # the one right-hand side over vectorisable elementary operations, compiled inline into the lanes
