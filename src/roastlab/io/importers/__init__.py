@@ -1,9 +1,10 @@
 """Importers: real roast logs into the canonical batch (time_s, Gg_kg_s, Tgi_C, Ta_C).
 
 * :mod:`.artisan`: Artisan ``.alog`` (Python-literal or JSON dict) and Artisan CSV export;
-* :mod:`.tables`: generic CSV and Parquet;
-* :mod:`.mapping`: a TOML column map saying which channel is time, Ta, Tgi and Gg, in which
-  units, and how to get Gg (a column, a constant to identify, or a Pitot tube, eq. 16).
+* :mod:`.roastime`: Aillio RoasTime JSON;
+* :mod:`.mapping`: generic CSV and Parquet, and a TOML column map saying which channel is time, Ta,
+  Tgi and Gg, in which units, and how to get Gg (a column, a constant to identify, or a Pitot tube,
+  eq. 16).
 
 Untrusted files are parsed as data only (JSON parsers, a token translator for Python literals), never executed.
 """
