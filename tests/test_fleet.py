@@ -534,6 +534,43 @@ def test_ctrl_c_is_taken_where_python_takes_it_and_left_ignored_where_the_parent
     assert cli_main._handled_signals() == [signal.SIGTERM]
 
 
+def test_ctrl_c_while_the_command_line_loads_its_libraries_ends_without_a_traceback(monkeypatch, capsys):
+    """`import roastlab.cli` loads no numerical library (the package's names load on first use), so the
+    command line's signal handling is in place before the half second of NumPy, SciPy and numba that
+    building its parser takes; a Ctrl-C there ends as anywhere else: one line, exit code 130 (SIGTERM's
+    143; tried by hand on `roastlab validate --help`, signalled 0.06-0.3 s after its start). And
+    ``roastlab.fit`` stays the function though the subpackage of that name loads first."""
+    import importlib
+
+    code = (
+        "import sys, roastlab.cli; heavy = [m for m in ('numpy', 'scipy', 'numba') if m in sys.modules]; "
+        "import roastlab.fit.identify, roastlab; print(heavy, callable(roastlab.fit), roastlab.fit.__module__)"
+    )
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert run.stdout.split() == ["[]", "True", "roastlab.workflows.fitting"], run.stdout + run.stderr
+    cli_main = importlib.import_module("roastlab.cli.main")
+
+    def loading(raised):
+        def build():
+            raise raised
+
+        return build
+
+    monkeypatch.setattr(cli_main, "build_parser", loading(KeyboardInterrupt()))
+    assert cli_main.main(["simulate", "--help"]) == 130
+    assert capsys.readouterr().err == "roastlab: interrupted\n"
+    # Python 3.11 wraps a signal that lands in a class's __set_name__ (numba defines classes as it
+    # imports) in a RuntimeError; it ends the same way, and any other RuntimeError goes on up
+    wrapped = RuntimeError("Error calling __set_name__")
+    wrapped.__cause__ = cli_main.Terminated()
+    monkeypatch.setattr(cli_main, "build_parser", loading(wrapped))
+    assert cli_main.main(["simulate", "--help"]) == 128 + 15
+    assert capsys.readouterr().err == "roastlab: terminated\n"
+    monkeypatch.setattr(cli_main, "build_parser", loading(RuntimeError("a bug")))
+    with pytest.raises(RuntimeError, match="a bug"):
+        cli_main.main(["simulate", "--help"])
+
+
 def test_batches_are_fitted_under_the_machine_model_as_validate_applies_it(cli, tmp_path, fleet):
     """With --model, a batch's fleet fit is the model file with the batch's own free values: its
     stored FIT is what `validate` gives that model with those values, bed laws and all."""

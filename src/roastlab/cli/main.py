@@ -122,30 +122,44 @@ def first_run_note(command: str, stream=None) -> str | None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    from ..io.files import begin_run
-
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    begin_run()
-    if note := first_run_note(args.command):
-        print(note, file=sys.stderr)
+    # the signals first: building the parser imports the numerical libraries (about half a second),
+    # and a Ctrl-C there ends like one anywhere else, without a traceback
     previous = {signum: signal.signal(signum, _on_signal) for signum in _handled_signals()}
+    command = ""
     try:
+        from ..io.files import begin_run
+
+        args = build_parser().parse_args(argv)
+        command = f" {args.command}"
+        begin_run()
+        if note := first_run_note(args.command):
+            print(note, file=sys.stderr)
         return int(args.func(args) or 0)
     except RoastlabError as exc:
-        print(f"roastlab {args.command}: error: {_one_line(str(exc))}", file=sys.stderr)
+        print(f"roastlab{command}: error: {_one_line(str(exc))}", file=sys.stderr)
         return 2
-    except Terminated:
-        print("roastlab: terminated", file=sys.stderr)
-        return 128 + signal.SIGTERM
-    except KeyboardInterrupt:
-        print("roastlab: interrupted", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:
+        return _stopped(exc)
+    except RuntimeError as exc:
+        # Python 3.11 wraps what a class's __set_name__ raises in a RuntimeError, so a signal that lands
+        # while an imported module defines a class (numba's, as the parser is built) arrives as its cause
+        if not isinstance(exc.__cause__, KeyboardInterrupt):
+            raise
+        return _stopped(exc.__cause__)
     except BrokenPipeError:
         return 0
     finally:
         for signum, handler in previous.items():
             signal.signal(signum, handler)
+
+
+def _stopped(exc: KeyboardInterrupt) -> int:
+    """The line and exit code of a command stopped by a signal: SIGTERM (:class:`Terminated`) or Ctrl-C."""
+    if isinstance(exc, Terminated):
+        print("roastlab: terminated", file=sys.stderr)
+        return 128 + signal.SIGTERM
+    print("roastlab: interrupted", file=sys.stderr)
+    return 130
 
 
 def _one_line(text: str, limit: int = 400) -> str:
