@@ -345,6 +345,42 @@ def test_whatif_on_the_fan_moves_the_roast_and_a_model_deaf_to_it_says_so(sky_mo
     )
 
 
+def test_a_shift_past_the_knobs_end_says_where_the_log_is_there_already(sky_model):
+    """The heater shifted up where the log runs it at the top of its range changes nothing there; a note
+    says when (a Bullet log runs P9 from 1:00 to 8:00, and "+1 from 4:00" there first acts at 8:00), and
+    of a change that nothing is left for, that it changes nothing, rather than a table of zeros a
+    roaster would read as "the heater does not matter". The page shows the notes (``warnings``)."""
+    import dataclasses
+
+    from roastlab.metrics.profile import mmss
+    from roastlab.workflows.whatif import parse_setting_change, whatif
+
+    model_path, log = sky_model
+    model = roastlab.load_model(model_path)
+    batch = roastlab.load_log(log, model.column_map)
+    t = batch.time_s
+    top = dataclasses.replace(batch, heater=np.where((t >= 180.0) & (t < 360.0), 100.0, 60.0))
+    moved = whatif(model, top, [parse_setting_change("heater", "+10@2:00")])
+    assert moved.changes == ["heater +10 from 2:00 (held within 0 %-100 %)"]
+    last = t[t < 360.0][-1]
+    assert (
+        f"heater +10 from 2:00: the log is at 100 % there 3:00-{mmss(last)}, the end of its range, so the change acts "
+        "only outside those times"
+    ) in moved.warnings()
+    drop = next(r for r in moved.rows if r["reading"] == "probe" and r["key"] == "DROP_C")
+    assert drop["changed"] > drop["as_run"] + 0.5  # it acts outside those minutes
+    full = whatif(
+        model, dataclasses.replace(batch, heater=np.full(t.size, 100.0)), [parse_setting_change("heater", "+10")]
+    )
+    assert (
+        "heater +10: the log is at 100 % wherever it applies, the end of its range, so it changes nothing"
+        in full.warnings()
+    )
+    assert np.array_equal(full.changed.Ta_C, full.as_run.Ta_C)
+    plain = whatif(model, batch, [parse_setting_change("heater", "+5@5:00")])
+    assert plain.held_at_end == [] and not any("end of its range" in w for w in plain.warnings())
+
+
 def test_transfer_deciding_a_heater_the_model_is_deaf_to_says_so(sky_model):
     """A program decided on the heater of a model whose heater gains are all 0 (SETTING_GAINS, the
     one table whatif reads too) is refused with the gains named, not optimised over a flat response."""

@@ -222,6 +222,8 @@ class WhatIf(Result):
     #: the machine's name and the changed roast's green batch [kg], for the background
     roaster: str = ""
     batch_kg: float | None = None
+    #: changed settings that a log at the knob's end leaves unchanged, and when (:func:`_at_the_end`)
+    held_at_end: list = field(default_factory=list)
 
     def band_line(self, units: str = "C") -> str | None:
         """The changed probe BT's band in one line: its level, median width and BT at DROP."""
@@ -268,7 +270,8 @@ class WhatIf(Result):
 
     def warnings(self, units: str = "C") -> list[str]:
         """What the table alone would hide: a changed setting the model does not respond to (its
-        "+0.0" is the model file's, not the roast's), milestones a curve reaches only past DROP, and
+        "+0.0" is the model file's, not the roast's), a shift that the log at the knob's end leaves
+        without effect for a while, milestones a curve reaches only past DROP, and
         rows where the change is smaller than the model's own error on this log (the change may be
         real, but this log cannot confirm the model that close). Temperatures in ``units`` ("C" or "F")."""
         u = temp_symbol(units)
@@ -279,6 +282,7 @@ class WhatIf(Result):
             f"to it shows none; free {' or '.join(gains)} in the fit spec and refit to ask this"
             for setting, gains in self.inert.items()
         ]
+        out += self.held_at_end
         for r in self.rows:
             level = self.levels.get(r["reading"], {}).get("FCs")
             for col in r["projected"]:
@@ -400,6 +404,23 @@ class WhatIf(Result):
         draw_curves(ax, curves, "BT [°C]")
 
 
+def _at_the_end(t, logged, wanted, held, act, most: int = 3) -> str:
+    """Where a change past the knob's end changes nothing, because the log is at that end already: "the
+    log is at P9 there 4:00-8:00, so the change acts only outside those times" (at most ``most`` spans),
+    or "the log is at P9 wherever it applies, so it changes nothing"; "" where it acts wherever it applies."""
+    from ..fit.program import true_runs
+
+    meant = wanted != logged
+    runs = true_runs(meant & (held == logged))
+    if not runs:
+        return ""
+    ends = "/".join(sorted({act.label(logged[a]) for a, _ in runs}))
+    if sum(b - a + 1 for a, b in runs) == int(meant.sum()):
+        return f"the log is at {ends} wherever it applies, the end of its range, so it changes nothing"
+    spans = ", ".join(f"{mmss(t[a])}-{mmss(t[b])}" for a, b in runs[:most]) + (", ..." if len(runs) > most else "")
+    return f"the log is at {ends} there {spans}, the end of its range, so the change acts only outside those times"
+
+
 def whatif(
     model: FittedModel,
     batch: Batch,
@@ -431,6 +452,7 @@ def whatif(
         actuators = {k: cmap.actuator(k) for k in ("heater", "fan") if cmap is not None and getattr(cmap, k)}
     changed_batch = batch
     labels = [str(c) for c in setting_changes]
+    at_end = []
     for c in setting_changes:
         series = getattr(changed_batch, c.setting)
         if series is None:
@@ -451,8 +473,11 @@ def whatif(
                 raise ParameterError(
                     f"{c}: outside the machine's {c.setting} range {act.label(act.low)}-{act.label(act.high)}"
                 )
-            new = np.clip(new, act.low, act.high)  # a shift past the knob's end stays at the end
+            held = np.clip(new, act.low, act.high)  # a shift past the knob's end stays at the end
             labels[labels.index(str(c))] += f" (held within {act.label(act.low)}-{act.label(act.high)})"
+            if idle := _at_the_end(batch.time_s, series, new, held, act):
+                at_end.append(f"{c}: {idle}")
+            new = held
         changed_batch = dataclasses.replace(changed_batch, **{c.setting: new})
     # four digits: a drum given as 400F is "drum at charge 204.4 °C", not 204.444
     names = {
@@ -526,4 +551,5 @@ def whatif(
         et_source=et_source(cmap),
         roaster=model.plant.name if model.plant is not None else "",
         batch_kg=changes.get("batch_kg") or batch.Mb_kg or (model.plant.Mb_kg if model.plant is not None else None),
+        held_at_end=at_end,
     )
