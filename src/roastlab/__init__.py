@@ -30,7 +30,7 @@ import sys
 import types
 from typing import TYPE_CHECKING
 
-from . import sim  # noqa: E402, F401  (light: it sets numba's OpenMP wait policy before anything loads OpenMP)
+from . import sim  # noqa: F401  (light: it sets numba's OpenMP wait policy before anything loads OpenMP)
 
 # The package's names load on first use (PEP 562), so that `import roastlab.cli` costs no numerical
 # library: the command line sets up its handling of Ctrl-C before it imports them (roastlab.cli).
