@@ -34,6 +34,23 @@ def sky_model(tmp_path_factory):
     return path, logs[1]
 
 
+def test_the_packages_names_are_one_list_three_ways():
+    """``roastlab``'s public names load on first use: the table that loads them (``_LAZY``), ``__all__``
+    and the imports static tools read (under TYPE_CHECKING) name the same objects, and each loads."""
+    import ast
+    import inspect
+
+    tree = ast.parse(inspect.getsource(roastlab))
+    block = next(n for n in tree.body if isinstance(n, ast.If) and getattr(n.test, "id", "") == "TYPE_CHECKING")
+    static = {
+        a.asname or a.name: f"{n.module}" + (f":{a.name}" if a.asname else "") for n in block.body for a in n.names
+    }
+    assert static == roastlab._LAZY
+    assert sorted(roastlab.__all__) == sorted(roastlab._LAZY)
+    for name in roastlab.__all__:
+        assert getattr(roastlab, name) is not None
+
+
 def test_whatif_is_the_same_through_every_path(cli, sky_model, tmp_path):
     """simulate --model, validate --model --predictions and model.predict agree to 1e-6 degC."""
     model_path, log = sky_model

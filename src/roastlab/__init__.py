@@ -66,7 +66,7 @@ _LAZY = {
     "default_dataset_root": "workflows.reproduce",
 }
 
-if TYPE_CHECKING:
+if TYPE_CHECKING:  # the same names for static tools (editors, type checkers); tests/test_api.py holds them alike
     from .errors import InputError, ParameterError, RoastlabError
     from .io.batch import Batch, read_batch_csv, read_dataset
     from .io.plants import load_plant

@@ -406,8 +406,9 @@ class WhatIf(Result):
 
 def _at_the_end(t, logged, wanted, held, act, most: int = 3) -> str:
     """Where a change past the knob's end changes nothing, because the log is at that end already: "the
-    log is at P9 there 4:00-8:00, so the change acts only outside those times" (at most ``most`` spans),
-    or "the log is at P9 wherever it applies, so it changes nothing"; "" where it acts wherever it applies."""
+    log is at P9 there 4:00-8:00, the end of its range, so the change acts only outside those times" (at
+    most ``most`` spans), or "... wherever it applies, the end of its range, so it changes nothing"; ""
+    where it acts wherever it applies."""
     from ..fit.program import true_runs
 
     meant = wanted != logged
