@@ -423,6 +423,17 @@ def test_init_reads_a_plain_csv_whose_time_is_a_clock(cli, tmp_path):
         import_log(logs[0], load_map(tmp_path / "seconds.toml"))
 
 
+def test_fit_roaster_with_a_log_where_the_folder_goes_says_what_the_first_argument_is(cli, tmp_path):
+    """SYNTHETIC: the folder forgotten (``roastlab fit-roaster a.alog b.alog``): one line naming the
+    log and what the first argument is, exit 2, rather than a missing map.toml inside a file."""
+    logs = [tmp_path / f"r{i}.alog" for i in range(2)]
+    for log in logs:
+        log.write_text(fake_alog(extra=_BURNER_AIR))
+    code, _, err = cli("fit-roaster", *logs)
+    assert code == 2 and err.count("\n") == 1
+    assert str(logs[0]) in err and "a file, not a folder" in err and "--out DIR" in err
+
+
 def test_fit_roaster_on_one_log_says_how_to_fit_it_without_a_check(cli, tmp_path):
     """SYNTHETIC: one log leaves nothing to hold out; the refusal gives the identify command that
     fits it anyway from init's files, and that command runs."""

@@ -216,6 +216,11 @@ def fit_roaster(
     from .sizes import across_sizes, across_sizes_figure, across_sizes_lines, size_split
 
     d = Path(config_dir)
+    if d.is_file():  # the folder forgotten, a log in its place
+        raise InputError(
+            "a file, not a folder: the first argument is the folder 'roastlab init LOG... --out DIR' wrote, then the logs",
+            d,
+        )
     for name in ("map.toml", "plant.toml", "fit.toml"):
         if not (d / name).is_file():
             raise InputError(f"no {name} here: run 'roastlab init LOG... --out {d}' first", d)
