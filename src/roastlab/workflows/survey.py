@@ -94,8 +94,6 @@ from ..model.parameters import FIRST_CRACK_WEIGHT, RESIDUAL_WEIGHT
 from ..model.quantities import default, quantity
 
 #: Names of a heater/burner and a fan/air channel in Artisan's languages (lower case, substrings).
-
-#: Names of a heater/burner and a fan/air channel in Artisan's languages (lower case, substrings).
 HEATER_NAMES = ("burner", "heater", "power", "heat", "gas", "brûleur", "bruleur", "brenner", "quemador",
                 "queimador", "bruciatore", "potencia", "leistung", "puissance", "火力", "火")  # fmt: skip
 #: The words of a control's name that say it is logged as a gas pressure (lower case, whole words
