@@ -574,7 +574,6 @@ def test_an_artisan_logs_et_is_kept_beside_the_model_and_survives_the_batch_csv(
 
 
 def test_a_map_names_et_where_the_log_calls_it_something_else(tmp_path):
-    from roastlab.errors import InputError
 
     p = tmp_path / "et.alog"
     extra = {
@@ -585,8 +584,11 @@ def test_a_map_names_et_where_the_log_calls_it_something_else(tmp_path):
     p.write_text(fake_alog(n=80, extra=extra))
     b = import_log(p, load_map(write_map(tmp_path, ROOM_AIR_MAP + '[ET]\ncolumn = "Exhaust"\n')))
     assert b.ET_C[0] == pytest.approx(205.0)
-    with pytest.raises(InputError, match="ET: no channel 'Nope'"):
-        import_log(p, load_map(write_map(tmp_path, ROOM_AIR_MAP + '[ET]\ncolumn = "Nope"\n')))
+    # a name this log does not record: the log is read without ET, and the note names what it has
+    b = import_log(p, load_map(write_map(tmp_path, ROOM_AIR_MAP + '[ET]\ncolumn = "Nope"\n')))
+    assert b.ET_C is None
+    (note,) = [n for n in b.notes if n.startswith("ET: no channel 'Nope' in the log (has: ")]
+    assert "Exhaust" in note and note.endswith("so it is neither fitted nor scored")
 
 
 def test_a_list_of_control_names_is_checked_and_serves_logs_not_csv(tmp_path):
@@ -902,6 +904,34 @@ def test_a_roastime_log_without_a_map_is_read_as_a_bullet(tmp_path):
     assert b.fan is None and b.Tb2_C is None and "Tm0_C" not in b.initial and b.heater[-1] == 4
     (note,) = [n for n in b.notes if n.startswith("no map")]
     assert "the heater levels over room air" in note and "the IR" not in note and "drum at charge" not in note
+
+
+def test_a_log_without_the_maps_second_bean_reading_is_read_without_it(tmp_path):
+    """SYNTHETIC RoasTime log with no IR channel, read with the Bullet example's map, whose [Tb2] names
+    it: the log is read with its probe alone and a note, as a log whose ET is not the drum's air is,
+    rather than refused (a prediction, a what-if and a fit that has other logs with the IR go on)."""
+    from conftest import REPO
+
+    n = 200
+    d = {
+        "sampleRate": 1,
+        "weightGreen": 480,
+        "preheatTemperature": 235,
+        "beanTemperature": [150.0 - 2 * i if i < 30 else 90 + i for i in range(n)],
+        "actions": {"actionTimeList": [{"index": 0, "value": 6, "ctrlType": 0}, {"index": 0, "value": 2, "ctrlType": 1}]},
+    }  # fmt: skip
+    p = tmp_path / "rt.json"
+    p.write_text(json.dumps(d))
+    cmap = load_map(REPO / "examples" / "bullet" / "map.toml")
+    assert cmap.Tb2["column"] == "drumTemperature"
+    b = import_log(p, cmap)
+    assert b.Tb2_C is None and b.Ta_C[0] == 150.0 and b.initial["Tm0_C"] == 235.0
+    (note,) = [n for n in b.notes if n.startswith("Tb2: no channel 'drumTemperature' in the log (has: ")]
+    assert "beanTemperature" in note and note.endswith("so it is neither fitted nor scored")
+    d["drumTemperature"] = [300.0 - i for i in range(n)]  # with it, it is read as before
+    p.write_text(json.dumps(d))
+    b = import_log(p, cmap)
+    assert np.isfinite(b.Tb2_C).sum() > 0 and not any(note.startswith("Tb2:") for note in b.notes)
 
 
 def test_a_roastworld_export_steps_its_settings_at_their_seconds(tmp_path):

@@ -840,9 +840,27 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
         elif "pitot" in gg:
             extra["dp"] = channel({"column": gg["pitot"]["dp_column"]}, "Gg.pitot.dp_column")
             extra["Tp"] = channel({"column": gg["pitot"]["T_column"]}, "Gg.pitot.T_column")
+        # a second reading (the beans' IR, the drum's air) that this log does not record is left out of
+        # it with a note, as an ET that is not the drum's air is: the probe alone is fitted and scored
+        for k, spec in (("Tb2", settings.get("Tb2")), ("ET", et_spec)):
+            if spec is not None and not any(n in available for n in names_of(spec["column"])):
+                wanted = " or ".join(map(repr, names_of(spec["column"])))
+                has = ", ".join(sorted(available))
+                default_notes.append(
+                    f"{k}: no channel {wanted} in the log (has: {has}), so it is neither fitted nor scored"
+                )
+                settings.pop(k, None)
+                if k == "ET":
+                    et_spec = None
         series = {k: channel(spec, k) + (spec.get("offset_C") or 0.0) for k, spec in settings.items()}
         # Artisan's ET (temp1): drawn beside the model, never an input; unless the map reads it as the beans
-        if et_spec is None and fmt != "roastime" and "ET" in available and not cmap.et_is_bean_reading:
+        if (
+            et_spec is None
+            and cmap.ET is None
+            and fmt != "roastime"
+            and "ET" in available
+            and not cmap.et_is_bean_reading
+        ):
             et_spec = {"column": "ET"}
         rejected = set()  # channels that do not read what the map says (no initial state from them)
         if et_spec is not None:
