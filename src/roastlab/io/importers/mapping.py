@@ -814,12 +814,19 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
         available = log.channels
         default_notes.extend(log.notes)
 
+        def missing(spec: dict) -> str | None:
+            """Why the log has no channel the map's ``spec`` names, or None where it has one."""
+            names = names_of(spec["column"])
+            if any(n in available for n in names):
+                return None
+            return f"no channel {' or '.join(map(repr, names))} in the log (has: {', '.join(sorted(available))})"
+
         def channel(spec: dict, what: str) -> np.ndarray:
-            names = names_of(spec["column"])  # a control the logs name differently: the first this log has
-            col = next((n for n in names if n in available), None)
-            if col is None:
-                wanted = " or ".join(map(repr, names))
-                raise InputError(f"{what}: no channel {wanted} in the log (has: {', '.join(sorted(available))})", path)
+            why = missing(spec)
+            if why is not None:
+                raise InputError(f"{what}: {why}", path)
+            # a control the logs name differently: the first this log has
+            col = next(n for n in names_of(spec["column"]) if n in available)
             return np.array(available[col], dtype=float)  # log temperatures already in degC
 
         Ta = channel(cmap.Ta, "Ta") + (cmap.Ta.get("offset_C") or 0.0)
@@ -843,12 +850,9 @@ def import_log(path: str | Path, cmap: ColumnMap | None, name: str | None = None
         # a second reading (the beans' IR, the drum's air) that this log does not record is left out of
         # it with a note, as an ET that is not the drum's air is: the probe alone is fitted and scored
         for k, spec in (("Tb2", settings.get("Tb2")), ("ET", et_spec)):
-            if spec is not None and not any(n in available for n in names_of(spec["column"])):
-                wanted = " or ".join(map(repr, names_of(spec["column"])))
-                has = ", ".join(sorted(available))
-                default_notes.append(
-                    f"{k}: no channel {wanted} in the log (has: {has}), so it is neither fitted nor scored"
-                )
+            why = None if spec is None else missing(spec)
+            if why is not None:
+                default_notes.append(f"{k}: {why}, so it is neither fitted nor scored")
                 settings.pop(k, None)
                 if k == "ET":
                     et_spec = None
