@@ -574,7 +574,6 @@ def test_an_artisan_logs_et_is_kept_beside_the_model_and_survives_the_batch_csv(
 
 
 def test_a_map_names_et_where_the_log_calls_it_something_else(tmp_path):
-
     p = tmp_path / "et.alog"
     extra = {
         "extratimex": [[1.5 * i for i in range(80)]],
