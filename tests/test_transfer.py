@@ -136,6 +136,35 @@ def test_a_miss_is_also_said_from_the_targets_turning_point_on():
     assert f"from the target's turning point (0:{tp:02.0f}) on: max |e| {after:.1f} °C" in r.summary()
 
 
+def test_a_miss_no_setting_can_move_is_said_to_be_the_charges_not_a_limits():
+    """SYNTHETIC charge dip of the test above (the probe 40 degC above the model's run at CHARGE, fading
+    in 10 s): in its first seconds the inlet over its whole range barely moves the probe, so the miss is
+    said to be the charge's, with that reach, and not blamed on a limit. The reach is recomputed here
+    through the model's own predict on the program's batch, the inlet held at its floor and at its
+    ceiling, not through the optimiser's simulator call."""
+    import dataclasses
+
+    model, ref = random_reference(np.random.default_rng(1), "120kg")
+    ref = dataclasses.replace(ref, Ta_C=ref.Ta_C + 40.0 * np.exp(-ref.time_s / 10.0))
+    r = transfer(model, ref, "120kg", "120kg")
+    t, e, lim = r.time_s, r.program.Ta_pred_C - r.target_C, r.limits
+    batch = r.program_batch()
+    ends = [model.predict(dataclasses.replace(batch, Tgi_C=np.full(len(t), level)), plant="120kg").Ta_C
+            for level in (lim.low, lim.high)]  # fmt: skip
+    reach = ends[1] - ends[0]
+    assert reach[0] == pytest.approx(0.0, abs=1e-9) and np.all(reach[1:] > 0)  # more inlet heat, a hotter probe
+    first = r.metrics["explanation"][0]
+    end = next(k for k in range(1, len(t)) if abs(e[k]) <= 2.0 < abs(e[k - 1]))  # after the first miss
+    worst = int(np.argmax(np.abs(e[:end])))
+    assert 0 < t[worst] <= r.metrics["turning_point_s"] and abs(reach[worst]) < abs(e[worst])
+    assert (
+        f"no program closes it: the Tgi over its whole range (150 degC against 550 degC from CHARGE on) moves the "
+        f"predicted BT at 0:{t[worst]:02.0f} by at most {abs(reach[worst]):.1f} °C; before the turning point the "
+        "charge sets it (the drum's heat at CHARGE, the probe's fall onto the beans)"
+    ) in first
+    assert "ceiling" not in first and "floor" not in first
+
+
 def test_limit_spans_name_levels_and_rates():
     t = np.arange(0.0, 60.0, 5.0)
     u = np.array([150, 150, 160, 170, 180, 180, 180, 550, 550, 550, 540, 540], dtype=float)

@@ -22,6 +22,8 @@ from ..errors import InputError
 from ..fit.program import (
     ProgramLimits,
     ProgramResult,
+    input_reach_C,
+    level_labels,
     limit_spans,
     optimise_program,
     runnable_program,
@@ -611,7 +613,10 @@ def transfer(
     tp_s = turning_point(t, target)[0]
     from_tp = _errors(program.Ta_pred_C[t >= tp_s], target[t >= tp_s]) if tp_s is not None else None
     units = display_units(units or reference.temp_unit)
-    explanation = _explain(t, program.Ta_pred_C - target, spans, tolerance_C, pb.name, mass_b, feasible, units)
+    explanation = _explain(
+        t, program.Ta_pred_C - target, spans, tolerance_C, pb.name, mass_b, feasible, units,
+        limits=limits, reach=input_reach_C(program, limits), tp_s=tp_s,
+    )  # fmt: skip
     baselines_best = min((b["rmse_C"] for b in (base_same, base_ret) if b["rmse_C"] is not None), default=None)
     metrics = {
         "reference": src,
@@ -712,11 +717,16 @@ def _spans_in_words(spans, listed: int = 3) -> str:
     return "; ".join(words)
 
 
-def _explain(t, e, spans, tol, plant, mass, feasible, units: str = "C") -> list[str]:
-    """Where the program misses the target by more than ``tol`` and the limits that hold it back
-    in the direction of the miss (below the target: a ceiling or a rising rate; above it: a
-    floor or a falling rate), so an explanation never contradicts the error it explains; the
-    misses in ``units`` ("C" or "F")."""
+def _explain(
+    t, e, spans, tol, plant, mass, feasible, units: str = "C", *, limits=None, reach=None, tp_s=None
+) -> list[str]:
+    """Where the program misses the target by more than ``tol`` and why, the misses in ``units``
+    ("C" or "F"). A miss larger at its worst knot than the decided input of ``limits`` can move the
+    probe there at all (``reach`` [degC per knot], :func:`roastlab.fit.program.input_reach_C`) is no
+    program's to close, and one at or before the target's turning point ``tp_s`` [s] is the charge's.
+    Any other is explained by the limits that hold the program back in the direction of the miss
+    (below the target: a ceiling or a rising rate; above it: a floor or a falling rate), so an
+    explanation never contradicts the error it explains."""
     from ..metrics.profile import display_temp_delta, temp_symbol
 
     out = []
@@ -731,7 +741,17 @@ def _explain(t, e, spans, tol, plant, mass, feasible, units: str = "C") -> list[
         need = "up" if below else "down"
         active = [s for s in spans if s["holds_back"] == need and s["from_s"] <= t[j] and s["to_s"] >= t[i] - 60.0]
         side = "below" if below else "above"
-        if active:
+        moved = None if reach is None else abs(float(reach[worst]))
+        if moved is not None and moved < abs(e[worst]):  # at its worst, more than any program moves the probe
+            low, high = level_labels(limits)
+            why = (
+                f"no program closes it: the {limits.decide} over its whole range ({low} against {high} from CHARGE "
+                f"on) moves the predicted BT at {mmss(t[worst])} by at most "
+                f"{display_temp_delta(moved, units):.1f} {temp_symbol(units)}"
+            )
+            if tp_s is not None and t[worst] <= tp_s:
+                why += "; before the turning point the charge sets it (the drum's heat at CHARGE, the probe's fall onto the beans)"
+        elif active:
             why = "; ".join(f"{s['limit']} from {mmss(s['from_s'])} to {mmss(s['to_s'])}" for s in active)
             verb = "cannot heat that fast" if below else "cannot cool that fast"
             why += f": the {mass:g} kg batch on {plant} {verb}"
