@@ -33,7 +33,9 @@ def test_spread_is_stored_and_is_the_rms_by_time():
     assert s["rms_C"][0] == pytest.approx(
         np.sqrt((1 + 1 + 9) / 3), abs=1e-4
     )  # stored to 4 decimals  # three logs reach t = 0
-    assert s["rms_C"][-1] == pytest.approx(1.0)  # past 100 s only two logs, errors +-1
+    # past 100 s the third log has ended: it counts with its error at DROP, +3, not as a log that never was
+    assert s["rms_C"][-1] == pytest.approx(np.sqrt((1 + 1 + 9) / 3), abs=1e-4)
+    assert s["time_s"][-1] == t[-1] and len(s["rms_C"]) == len(s["time_s"])  # to the longest log
     assert roast_spread([t], [t]) is None  # one log says nothing about the spread between roasts
 
 
