@@ -152,6 +152,8 @@ def test_a_miss_no_setting_can_move_is_said_to_be_the_charges_not_a_limits():
     ends = [model.predict(dataclasses.replace(batch, Tgi_C=np.full(len(t), level)), plant="120kg").Ta_C
             for level in (lim.low, lim.high)]  # fmt: skip
     reach = ends[1] - ends[0]
+    # every program's probe lies between the input held at its floor and at its ceiling: the reach bounds it
+    assert np.all(ends[0] <= r.program.Ta_pred_C + 1e-6) and np.all(r.program.Ta_pred_C <= ends[1] + 1e-6)
     assert reach[0] == pytest.approx(0.0, abs=1e-9) and np.all(reach[1:] > 0)  # more inlet heat, a hotter probe
     first = r.metrics["explanation"][0]
     end = next(k for k in range(1, len(t)) if abs(e[k]) <= 2.0 < abs(e[k - 1]))  # after the first miss

@@ -586,7 +586,11 @@ def input_reach_C(program: ProgramResult, limits: ProgramLimits) -> np.ndarray:
     probe with the input at its ceiling from CHARGE on, minus with it at its floor, everything else
     (the charge state, the other inputs, the plant) as the program has it.
 
-    A miss larger than this at a knot is not the program's to close, whatever the limits: in the first
+    More heat into the drum or the gas at any time leaves the later probe higher (the heat paths run
+    from hot to cold; the drying a hotter bean speeds is not proven never to outweigh it, so this is
+    checked: on a 0.8 kg Bullet and a 0.25 kg Skywalker transfer of the shared logs, and in
+    tests/test_transfer.py), so a program's probe lies between these two runs, and a miss larger than
+    their difference at a knot is not the program's to close, whatever the limits: in the first
     seconds after CHARGE a heater's lag and the drum's heat capacity leave the probe's fall onto the
     beans to the charge state alone (0.8 kg in the Bullet, a model fitted on its 490-500 g logs: P0
     against P9 moves the probe by under 0.1 degC in the first 15 s and 2.5 degC by the first minute).

@@ -615,7 +615,7 @@ def transfer(
     units = display_units(units or reference.temp_unit)
     explanation = _explain(
         t, program.Ta_pred_C - target, spans, tolerance_C, pb.name, mass_b, feasible, units,
-        limits=limits, reach=input_reach_C(program, limits), tp_s=tp_s,
+        limits=limits, reach=None if feasible else input_reach_C(program, limits), tp_s=tp_s,
     )  # fmt: skip
     baselines_best = min((b["rmse_C"] for b in (base_same, base_ret) if b["rmse_C"] is not None), default=None)
     metrics = {
