@@ -66,7 +66,7 @@ def roast_spread(time_s, errors_C, held_out: bool = True, batch_kg=None, units=N
         return None
     end = max(float(t[-1]) for t in time_s)
     grid = np.arange(0.0, end + SPREAD_GRID_S, SPREAD_GRID_S)
-    sq, count = np.zeros(grid.size), np.zeros(grid.size)
+    sq, count = np.zeros(grid.size), 0  # every log counts at every grid time
     for t, e in zip(time_s, errors_C):
         t, e = np.asarray(t, float), np.asarray(e, float)
         ok = np.isfinite(e)
@@ -75,12 +75,11 @@ def roast_spread(time_s, errors_C, held_out: bool = True, batch_kg=None, units=N
         # past its DROP a log counts with its error at DROP (np.interp holds the last value)
         sq += np.interp(grid, t[ok], e[ok]) ** 2
         count += 1
-    keep = count >= 2
-    if not keep.any():
+    if count < 2:
         return None
-    rms = np.sqrt(sq[keep] / count[keep])
+    rms = np.sqrt(sq / count)
     out = {
-        "time_s": grid[keep].tolist(),
+        "time_s": grid.tolist(),
         "rms_C": [round(float(v), 4) for v in rms],
         "logs": int(len(time_s)),
         "held_out": bool(held_out),
