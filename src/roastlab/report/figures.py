@@ -443,6 +443,10 @@ def plot_whatif(w, path=None, outputs=None, units: str = "C"):
         handles += ax2.plot(t_min, w.changed.Tgi_C, color="tab:red", ls="--", label="inlet gas Tgi changed")
         temperature_axis(ax2, "Tgi [{u}]", units)
     time_axis(ax2)
+    # the legend's rows above the curves, not over them (a fan at its top step ran under it)
+    for on in {id(a): a for a in (ax2, *axes.values())}.values():
+        lo, hi = on.get_ylim()
+        on.set_ylim(lo, hi + 0.45 * (hi - lo))
     ax2.legend(handles=handles, loc="upper right", fontsize=7, ncol=2, framealpha=0.9)
     ax2.grid(alpha=0.3)
     return finish_figure(fig, path, f"what if: {b.name}", outputs)
