@@ -413,7 +413,12 @@ def fit_roaster(
     stage(0, 0, "writing the report and its figures")
     # held-out logs of several sizes (an alternate split of every size): a panel of each size in turn
     held_kg = [b.Mb_kg for b in val_b]
-    figures = {d / HELD_OUT_FIGURE: plot_fit(v_val, bands=bands, units=units, **panels_by_size(v_val.names, held_kg))}
+    held_title = f"{roaster_name}: held-out logs, measured and predicted BT"
+    figures = {
+        d / HELD_OUT_FIGURE: plot_fit(
+            v_val, title=held_title, bands=bands, units=units, **panels_by_size(v_val.names, held_kg)
+        )
+    }
     if across is not None:
         figures[d / SIZES_FIGURE] = across_sizes_figure(across)
     pngs = {path: figure_bytes(fig, path) for path, fig in figures.items()}
