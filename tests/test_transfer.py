@@ -66,6 +66,27 @@ def test_same_plant_same_batch_matches_as_well_as_the_references_own_inputs(seed
     assert np.all(np.abs(np.diff(r.program.Tgi_C)) <= lim.rate_per_min / 60 * 5.0 + 1e-9)
 
 
+def test_the_models_own_miss_of_the_reference_is_scored_and_said():
+    """A reference whose BT the model misses (its own run plus a ramp that grows to 6 degC at DROP, a late
+    rise the model cannot follow): "A's inputs on A" scores the model's own run against it, in the JSON and
+    in the summary, and that is the ramp's own size, independent of the transfer's program."""
+    import dataclasses
+
+    model, ref = random_reference(np.random.default_rng(5), "120kg")
+    t = np.asarray(ref.time_s, float)
+    ramp = 6.0 * (t / t[-1]) ** 2
+    missed = dataclasses.replace(ref, Ta_C=np.asarray(ref.Ta_C, float) + ramp)
+    r = transfer(model, missed, "120kg", "120kg", batch_kg=100.0)
+    own = r.metrics["reference_own_inputs_on_A"]
+    grid = np.arange(0.0, t[-1] + 1e-9, 5.0)  # the program's knots
+    want = np.interp(grid, t, ramp)
+    assert own["rmse_C"] == pytest.approx(np.sqrt(np.mean(want**2)), rel=1e-3)
+    assert own["max_abs_C"] == pytest.approx(6.0, abs=1e-3)
+    row = next(line for line in r.summary().splitlines() if line.startswith("A's inputs on A "))
+    assert f"{own['rmse_C']:.3f}" in row and f"{own['max_abs_C']:.3f}" in row
+    assert "misses the target by this much" in r.summary()
+
+
 def test_scale_up_beats_both_baselines_and_is_deterministic():
     model, ref = random_reference(np.random.default_rng(11), "120kg")
     a = transfer(model, ref, "120kg", "360kg")

@@ -138,6 +138,7 @@ class TransferResult(Result):
         for key, label in (
             ("baseline_same_inputs", "A's inputs unchanged"),
             ("baseline_retimed", "A's inputs retimed"),
+            ("reference_own_inputs_on_A", "A's inputs on A"),
         ):
             b = m[key]
             if b["rmse_C"] is None:
@@ -149,6 +150,11 @@ class TransferResult(Result):
                 "AUC: from each curve's turning point to DROP, above the target's BT at its turning point "
                 f"({display_temp(m['AUC_base_C'], units):.1f} {u})"
             )
+        rows.append(
+            f"A's inputs on A: the model on {self.plant_from} as the reference was run; the program is judged by "
+            "the model, which misses the target by this much before any change (a roast's own miss does not "
+            "carry over to the next: docs/profile-transfer.md)"
+        )
         rows.append("")
         verdict = "feasible" if m["feasible"] else "NOT feasible"
         rows.append(
@@ -537,7 +543,6 @@ def transfer(
     changes = dict(initial or {})
     changes["Ta0_C"] = ta0
     res_a = model.predict(grid, plant=pa, **changes)
-    own = _errors(res_a.Ta_C, grid.Ta_C)
 
     # B with A's inputs, unchanged (baseline 1); it also gives B's parameters and charge state.
     # On another plant a flow the model fitted for A is dropped, so B gets A's flow as applied.
@@ -584,6 +589,8 @@ def transfer(
     t = grid.time_s
     auc_base = auc_base_C(t, target)
     err = _scored(program.Ta_pred_C, target, t, auc_base)
+    # the model's own run of the reference on A: how far the model is from the target before any program
+    own = {**_scored(res_a.Ta_C, target, t, auc_base), "what": "plant A run with its own inputs (the model as logged)"}
 
     # baseline 2: A's inputs retimed by the phase times baseline 1 gives on B
     levels = [lv for lv in PHASE_LEVELS_C if crossing_time_s(t, target, lv) is not None]
