@@ -55,6 +55,14 @@ def save_figure(fig, path, outputs: Outputs | None = None) -> None:
             out.write_bytes(path, data)
 
 
+def room_for_legend(*axes, share: float = 0.45) -> None:
+    """Raise each of ``axes``' top by ``share`` of its height, so that a legend in the upper corner sits
+    above the curves, not over them (settings panels whose steps run the panel's whole width)."""
+    for ax in {id(a): a for a in axes}.values():
+        lo, hi = ax.get_ylim()
+        ax.set_ylim(lo, hi + share * (hi - lo))
+
+
 def finish_figure(fig, path, title, outputs=None):
     if title:
         fig.suptitle(title)
@@ -443,10 +451,7 @@ def plot_whatif(w, path=None, outputs=None, units: str = "C"):
         handles += ax2.plot(t_min, w.changed.Tgi_C, color="tab:red", ls="--", label="inlet gas Tgi changed")
         temperature_axis(ax2, "Tgi [{u}]", units)
     time_axis(ax2)
-    # the legend's rows above the curves, not over them (a fan at its top step ran under it)
-    for on in {id(a): a for a in (ax2, *axes.values())}.values():
-        lo, hi = on.get_ylim()
-        on.set_ylim(lo, hi + 0.45 * (hi - lo))
+    room_for_legend(ax2, *axes.values())  # a fan at its top step ran under the legend
     ax2.legend(handles=handles, loc="upper right", fontsize=7, ncol=2, framealpha=0.9)
     ax2.grid(alpha=0.3)
     return finish_figure(fig, path, f"what if: {b.name}", outputs)
@@ -519,7 +524,8 @@ def plot_transfer(r, path=None, outputs=None):
         ax2.plot(t_min, u, color="tab:blue", lw=1.6, label="optimised program")
     ax2.set_ylim(lim.low - 0.08 * span, lim.high + 0.08 * span)
     ax2.set_ylabel("Tgi [°C]" if lim.decide == "Tgi" else setting_axis_label("heater", lim.unit))
-    ax2.legend(loc="lower left", fontsize=7, ncol=2, framealpha=0.9)
+    room_for_legend(ax2, share=0.35)  # a program at its floor ran under the legend in the lower corner
+    ax2.legend(loc="upper right", fontsize=7, ncol=3, framealpha=0.9)
     ax2.grid(alpha=0.3)
 
     ax3.axhspan(-m["tolerance_C"], m["tolerance_C"], color="tab:blue", alpha=0.1, lw=0, label="tolerance")
@@ -575,7 +581,8 @@ def plot_closed_loop(r, path=None, title=None, outputs=None):
     ax_u.step(t_min, r.u_applied, where="post", color="tab:blue", lw=1.4, label="applied")
     ax_u.set_ylim(lim.low - 0.08 * span, lim.high + 0.08 * span)
     ax_u.set_ylabel("Tgi [°C]" if lim.decide == "Tgi" else "heater setting")
-    ax_u.legend(loc="upper right", fontsize=7, ncol=2)
+    room_for_legend(ax_u, share=0.3)  # an input at its ceiling ran under the legend
+    ax_u.legend(loc="upper right", fontsize=7, ncol=4)
     ax_u.grid(alpha=0.3)
     ax_m.plot(t_min, r.states[:, S_TM], color="tab:red", lw=1.4, label="drum metal Tm (true)")
     if "Tm_C_est" in r.estimates:
