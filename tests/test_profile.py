@@ -295,3 +295,98 @@ def test_whatif_counts_the_area_under_the_probe_curve_on_one_base():
     line_F = next(x for x in w.table("F").splitlines() if "AUC" in x)
     assert "[°C·min]" in line_C and line_C.split()[-3] == f"{r['changed']:.0f}"
     assert "[°F·min]" in line_F and line_F.split()[-3] == f"{9 / 5 * r['changed']:.0f}"
+
+
+def _heated_batch(offset_C: float = 0.0):
+    """SYNTHETIC 10-minute batch on the paper's 120 kg plant with a heater series, its BT the paper
+    model's own prediction plus ``offset_C`` (so the model misses it by exactly that), FCs and DROP
+    marked, and a COOL mark after DROP."""
+    from roastlab import FittedModel
+    from roastlab.io.batch import Batch
+
+    t = np.arange(0.0, 601.0, 5.0)
+    heater = np.where(t < 300.0, 8.0, 6.0)
+    model = FittedModel.paper()
+    b = Batch("synthetic", t, np.full(t.size, 0.4), np.full(t.size, 450.0), heater=heater, initial={"Ta0_C": 30.0})
+    bt = model.predict(b).Ta_C + offset_C
+    fcs = float(crossing_time_s(t, bt, float(bt[-1]) - 15.0))
+    events = {"CHARGE": 0.0, "FCs": fcs, "DROP": 600.0, "COOL": 700.0}
+    import dataclasses
+
+    return model, dataclasses.replace(b, Ta_C=bt, events=events)
+
+
+def test_whatif_dropped_later_carries_the_roast_on_and_earlier_cuts_it():
+    """--drop-at: later, the changed roast runs on to its new DROP with the last inputs held and is the
+    logged prediction up to the logged DROP (holding later inputs cannot change the past); earlier, it is
+    that prediction cut there. Development time moves by exactly the shift, a row DROP says where the
+    changed roast ends, the marks after its DROP go, and a note says the settings were held."""
+    from roastlab.workflows.whatif import whatif
+
+    model, b = _heated_batch()
+    t = b.time_s
+    for shift in (60.0, -60.0):
+        w = whatif(model, b, drop_s=600.0 + shift)
+        tc, ch = w.changed.time_s, w.changed.Ta_C
+        assert tc[-1] == pytest.approx(600.0 + shift)
+        common = tc <= 600.0
+        np.testing.assert_allclose(ch[common], np.interp(tc[common], t, w.as_run.Ta_C), atol=2e-3)
+        rows = {(r["reading"], r["key"]): r for r in w.rows}
+        assert rows["probe", "DROP_s"]["changed"] == pytest.approx(600.0 + shift)
+        assert rows["probe", "DROP_s"]["as_run"] == pytest.approx(600.0) == rows["probe", "DROP_s"]["measured"]
+        for reading in ("probe", "beans"):
+            dev = rows[reading, "development_s"]
+            assert dev["changed"] - dev["as_run"] == pytest.approx(shift, abs=1e-6)
+        drop_c = rows["probe", "DROP_C"]
+        assert (drop_c["changed"] - drop_c["as_run"]) * shift > 0  # a rising roast: hotter later, cooler sooner
+        held = [n for n in w.warnings() if "held at their last values" in n]
+        assert (len(held) == 1) == (shift > 0)
+        assert not any("DROP" in n and "within the model's own error" in n for n in w.warnings())
+    assert w.changes == ["DROP at 9:00 (-1:00)"]
+    later = whatif(model, b, drop_s=660.0)
+    assert np.all(later.changed.heater[later.changed.time_s > 600.0] == 6.0)
+
+
+def test_whatif_dropped_at_a_bt_reads_the_model_as_the_logs_probe():
+    """--drop-bt: the model misses this SYNTHETIC log by exactly +4 degC (its BT is the model's plus 4),
+    so dropping at the BT the log read at 7:30 drops the changed roast (here unchanged) at 7:30, where the
+    model reads 4 degC less; a BT it never reaches within DROP_LATER_MAX_S is refused naming how far it
+    gets, and a DROP at a time and at a BT at once is refused."""
+    from roastlab.errors import ParameterError
+    from roastlab.workflows.whatif import DROP_LATER_MAX_S, whatif
+
+    model, b = _heated_batch(offset_C=4.0)
+    target = float(np.interp(450.0, b.time_s, b.Ta_C))
+    w = whatif(model, b, drop_bt_C=target)
+    assert w.drop_s == pytest.approx(450.0, abs=0.5)
+    assert w.drop_offset_C == pytest.approx(4.0, abs=1e-6)
+    assert w.changed.Ta_C[-1] + 4.0 == pytest.approx(target, abs=0.05)
+    assert any("the model read 4.0 °C below it" in n for n in w.warnings())
+    with pytest.raises(ParameterError, match=rf"reaches .* at most by .*{int(DROP_LATER_MAX_S // 60)}:00 past"):
+        whatif(model, b, drop_bt_C=400.0)
+    with pytest.raises(ParameterError, match="either at a time or at a BT"):
+        whatif(model, b, drop_s=500.0, drop_bt_C=target)
+    with pytest.raises(ParameterError, match="more than 5:00 after the logged DROP"):
+        whatif(model, b, drop_s=600.0 + DROP_LATER_MAX_S + 30.0)
+
+
+def test_whatif_drop_on_the_command_line(cli, tmp_path):
+    """roastlab whatif --drop-at (+m:ss relative to the logged DROP) and --drop-bt (in degF as written):
+    the table's DROP row; --drop-at and --drop-bt together are refused in one line, exit 2."""
+    from roastlab.io.batch import write_batch_csv
+
+    model, b = _heated_batch()
+    model.save(tmp_path / "m.json")
+    write_batch_csv(tmp_path / "b.csv", b)
+    code, out, err = cli("whatif", tmp_path / "b.csv", "--model", tmp_path / "m.json", "--drop-at", "+0:30")
+    assert code == 0, err
+    drop_row = next(line for line in out.splitlines() if line.strip().startswith("DROP [m:ss]"))
+    assert drop_row.split()[-3:-1] == ["10:30", "+0:30"]
+    bt_F = float(np.interp(450.0, b.time_s, b.Ta_C)) * 9 / 5 + 32
+    code, out, err = cli("whatif", tmp_path / "b.csv", "--model", tmp_path / "m.json", "--drop-bt", f"{bt_F:.2f}F")
+    assert code == 0, err
+    assert "(7:30)" in out.splitlines()[0]
+    code, out, err = cli(
+        "whatif", tmp_path / "b.csv", "--model", tmp_path / "m.json", "--drop-at", "9:00", "--drop-bt", "200"
+    )
+    assert code == 2 and "not allowed with argument" in err and len(err.strip().splitlines()) == 1

@@ -25,7 +25,7 @@ def cmd_whatif(args) -> int:
     from ..io.files import Outputs
     from ..io.importers.mapping import load_map
     from ..workflows.model import load_model
-    from ..workflows.whatif import parse_set, parse_setting_change, whatif
+    from ..workflows.whatif import drop_time_s, parse_set, parse_setting_change, whatif
 
     outputs = Outputs([args.log, args.model, args.map])
     check_targets(outputs, args.json, args.alog, args.alarms, plot=args.plot)
@@ -51,7 +51,12 @@ def cmd_whatif(args) -> int:
     batch = read_inputs(args.log, args.map, model)
     say(batch.notes)
     actuators = {k: cmap.actuator(k) for k in ("heater", "fan") if cmap is not None and getattr(cmap, k)}
-    result = whatif(model, batch, setting_changes, actuators=actuators, band_level=args.band, **changes)
+    drop = {}
+    if args.drop_at is not None:
+        drop["drop_s"] = drop_time_s(args.drop_at, float(batch.time_s[-1]))
+    if args.drop_bt is not None:
+        drop["drop_bt_C"] = args.drop_bt
+    result = whatif(model, batch, setting_changes, actuators=actuators, band_level=args.band, **drop, **changes)
     units = args.units or batch.temp_unit  # the log's own unit unless asked otherwise
     print(result.table(units=units))
     with outputs as out:
@@ -62,6 +67,9 @@ def cmd_whatif(args) -> int:
 
 def add_parsers(sub) -> None:
     """Register this module's command(s) on the ``roastlab`` subparsers ``sub``."""
+    from ..metrics.profile import mmss
+    from ..model.actuators import DROP_LATER_MAX_S
+
     p = sub.add_parser(
         "whatif",
         help="predict a logged roast as run and with changed settings, batch or charge state",
@@ -74,7 +82,8 @@ def add_parsers(sub) -> None:
         "bed. DRY END and first crack are when a curve reaches the temperature the log marks them at. A note "
         "says where a change is within the model's own error. Settings (heater, fan) exist when the model's map "
         "reads them, in the map's units (percent, level; W, rpm, Hz; a gas pressure such as kPa; a reading as logged); a model that does "
-        "not respond to a changed setting says so; --tgi works on any model.",
+        "not respond to a changed setting says so; --tgi works on any model. --drop-at or --drop-bt end the changed "
+        "roast elsewhere than the log, its milestones read at that DROP.",
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog="examples:\n"
         "  roastlab whatif roast.alog --model model.json --heater +5 --plot whatif.png\n"
@@ -82,6 +91,8 @@ def add_parsers(sub) -> None:
         "  roastlab whatif roast.json --model bullet.json --set heater=6@2:00 --fan -2\n"
         "  roastlab whatif roast.json --model bullet.json --batch-kg 0.8 --tm0 260 --units F\n"
         "  roastlab whatif roast.json --model bullet.json --heater -1@5:00 --band    # with the 90 % band\n"
+        "  roastlab whatif roast.alog --model model.json --drop-at +0:20     # development time, 20 s longer\n"
+        "  roastlab whatif roast.alog --model model.json --heater -5@6:00 --drop-bt 205   # lower heat, same drop BT\n"
         "  roastlab whatif roast.json --model bullet.json --heater -1@5:00 --alog next.alog   # to roast against\n"
         "  roastlab whatif roast.alog --model model.json --heater -10@4:00 --alarms next.alrm  # for Artisan to run",
     )
@@ -110,6 +121,21 @@ def add_parsers(sub) -> None:
         help="add this to the inlet gas temperature [degC; 36F for degF]",
     )
     p.add_argument("--batch-kg", type=float_arg("--batch-kg"), help="green batch mass [kg] (default: the log's)")
+    drop = p.add_mutually_exclusive_group()
+    drop.add_argument(
+        "--drop-at",
+        metavar="T|+D|-D",
+        help="drop the changed roast at T after CHARGE (m:ss or s), or D later (+0:20) or earlier (-0:15) than the "
+        "log: its development time, temperature at DROP and the rest read at that DROP; past the logged DROP "
+        f"the settings are held at their last values (at most {mmss(DROP_LATER_MAX_S)} more)",
+    )
+    drop.add_argument(
+        "--drop-bt",
+        type=temperature_arg("--drop-bt"),
+        metavar="TEMP",
+        help="drop the changed roast when its BT reaches TEMP [degC; 400F for degF], as the log's probe would read "
+        "it: the model's BT plus its own miss at the logged DROP",
+    )
     add_initial_options(p)
     add_band_option(p, "the changed probe BT's prediction band", "its median width and BT at DROP in the table, "
                     "shaded in --plot, in --json")  # fmt: skip

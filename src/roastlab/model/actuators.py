@@ -103,6 +103,9 @@ TGI_LIMITS = (150.0, 550.0, 120.0)
 #: Shortest time a runnable program holds a setting before the next change [s]: a person at
 #: the machine (or Artisan's playback) acts a few times a minute at most.
 MIN_HOLD_S = 30.0
+#: How far past a log's DROP a what-if may carry the roast on [s] (``roastlab whatif --drop-at/--drop-bt``):
+#: its settings held at their last values, a few minutes of a roast that was not run, not a second roast.
+DROP_LATER_MAX_S = 300.0
 
 
 @dataclass(frozen=True)

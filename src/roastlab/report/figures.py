@@ -110,10 +110,13 @@ def time_axis(ax, label: str = "time after CHARGE [m:ss]") -> None:
 
 def ror_limits(ax, time_s, *curves) -> None:
     """Clip a rate-of-rise axis [degC/min] to the roast's range after the turning point, so the
-    charge drop (-100 degC/min and below) does not flatten the curves that matter."""
-    t = np.asarray(time_s, dtype=float)
+    charge drop (-100 degC/min and below) does not flatten the curves that matter. A curve on times of
+    its own (a what-if dropped elsewhere) is given as ``(times, curve)``."""
     vals = []
     for bt in curves:
+        t = np.asarray(time_s, dtype=float)
+        if isinstance(bt, tuple):
+            t, bt = np.asarray(bt[0], dtype=float), bt[1]
         if bt is None:
             continue
         tp_s, _ = turning_point(t, bt)
@@ -394,6 +397,8 @@ def plot_whatif(w, path=None, outputs=None, units: str = "C"):
     b = w.batch
     t = b.time_s
     t_min = t / 60.0
+    tc = w.changed.time_s  # the changed roast's own times: it may drop elsewhere (--drop-at, --drop-bt)
+    tc_min = tc / 60.0
     fig = new_figure(figsize=(9, 8.5), layout="constrained")
     ax, ax_r, ax2 = fig.subplots(3, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1.3, 1.1]})
     if b.Ta_C is not None:
@@ -409,24 +414,27 @@ def plot_whatif(w, path=None, outputs=None, units: str = "C"):
         ax.plot(t_min, b.ET_C, ".", ms=2, color="tab:purple", alpha=0.6, label="ET measured (log)")
     change = "; ".join(w.changes) or "no change"
     ax.plot(t_min, w.as_run.Ta_C, color="tab:blue", lw=1.8, label="BT model, as run")
-    ax.plot(t_min, w.changed.Ta_C, color="tab:orange", lw=1.8, label=f"BT model, {change}")
+    ax.plot(tc_min, w.changed.Ta_C, color="tab:orange", lw=1.8, label=f"BT model, {change}")
     if w.band is not None:
         _shade_band(ax, w.band, "tab:orange", "band, changed")
     ax.plot(t_min, w.as_run.Tb_C, color="tab:blue", lw=1.0, ls="--", label="beans model (Tb), as run")
-    ax.plot(t_min, w.changed.Tb_C, color="tab:orange", lw=1.0, ls="--", label="beans model (Tb), changed")
+    ax.plot(tc_min, w.changed.Tb_C, color="tab:orange", lw=1.0, ls="--", label="beans model (Tb), changed")
     temperature_axis(ax, "temperature [{u}]", units)
     ax.legend(loc="lower right", fontsize=7)
     ax.grid(alpha=0.3)
-    ax.set_xlim(t_min[0], t_min[-1])
-    _events(ax, b.events)
-    for bt, color, label in (
-        (b.Ta_C, "0.3", "measured"),
-        (w.as_run.Ta_C, "tab:blue", "as run"),
-        (w.changed.Ta_C, "tab:orange", "changed"),
+    ax.set_xlim(min(t_min[0], tc_min[0]), max(t_min[-1], tc_min[-1]))
+    marks = dict(b.events)
+    if w.drop_s is not None:  # the changed roast's own DROP; the log's marks after its DROP (COOL) are no roast's
+        marks = {k: v for k, v in marks.items() if v is not None and v <= t[-1] + 5.0} | {"DROP changed": w.drop_s}
+    _events(ax, marks)
+    for tt, bt, color, label in (
+        (t, b.Ta_C, "0.3", "measured"),
+        (t, w.as_run.Ta_C, "tab:blue", "as run"),
+        (tc, w.changed.Ta_C, "tab:orange", "changed"),
     ):
         if bt is not None:
-            ax_r.plot(t_min, rate_of_rise_C_per_min(t, bt), color=color, lw=1.0, label=f"BT RoR {label}")
-    ror_limits(ax_r, t, b.Ta_C, w.as_run.Ta_C, w.changed.Ta_C)
+            ax_r.plot(tt / 60.0, rate_of_rise_C_per_min(tt, bt), color=color, lw=1.0, label=f"BT RoR {label}")
+    ror_limits(ax_r, t, b.Ta_C, w.as_run.Ta_C, (tc, w.changed.Ta_C))
     temperature_axis(ax_r, f"RoR [{{u}}/min]\n({ROR_SPAN_S:g} s)", units, delta=True)
     ax_r.legend(loc="upper right", fontsize=7, ncol=3)
     ax_r.grid(alpha=0.3)
@@ -439,8 +447,8 @@ def plot_whatif(w, path=None, outputs=None, units: str = "C"):
     for name, color in logged:
         before, after, on = getattr(b, name), getattr(w.changed, name), axes[name]
         handles += on.step(t_min, before, where="post", color=color, lw=1.2, label=f"{name} as run")
-        if after is not None and not np.array_equal(after, before):
-            handles += on.step(t_min, after, where="post", color=color, lw=1.2, ls="--", label=f"{name} changed")
+        if after is not None and not (len(after) == len(before) and np.array_equal(after, before)):
+            handles += on.step(tc_min, after, where="post", color=color, lw=1.2, ls="--", label=f"{name} changed")
     if two:
         ax2.set_ylabel(setting_axis_label("heater", units["heater"]), color="tab:red")
         axes["fan"].set_ylabel(setting_axis_label("fan", units["fan"]), color="tab:green")
@@ -448,7 +456,7 @@ def plot_whatif(w, path=None, outputs=None, units: str = "C"):
         ax2.set_ylabel(setting_axis_label("setting", next(iter(units.values()))))
     if not logged:
         handles += ax2.plot(t_min, w.as_run.Tgi_C, color="tab:red", label="inlet gas Tgi as run")
-        handles += ax2.plot(t_min, w.changed.Tgi_C, color="tab:red", ls="--", label="inlet gas Tgi changed")
+        handles += ax2.plot(tc_min, w.changed.Tgi_C, color="tab:red", ls="--", label="inlet gas Tgi changed")
         temperature_axis(ax2, "Tgi [{u}]", units)
     time_axis(ax2)
     room_for_legend(ax2, *axes.values())  # a fan at its top step ran under the legend

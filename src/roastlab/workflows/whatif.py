@@ -31,7 +31,7 @@ from ..metrics.profile import (  # noqa: F401  (re-exported)
     mmss,
     temp_symbol,
 )
-from ..model.actuators import SETTING_GAINS, inert_settings
+from ..model.actuators import DROP_LATER_MAX_S, SETTING_GAINS, inert_settings  # noqa: F401 (re-exported)
 from ..report.result import Result, draw_curves
 from ..sim.simulate import SimulationResult
 from .model import FittedModel
@@ -47,6 +47,8 @@ ROWS = (
     ("DTR_pct", "development time ratio", "pct"),
     ("AUC_C_min", "AUC (TP to DROP, above BT at TP)", "auc"),
 )
+#: The rows when the changed roast drops elsewhere: DROP's time beside first crack.
+ROWS_WITH_DROP = ROWS[:4] + (("DROP_s", "DROP", "time"),) + ROWS[4:]
 #: Rows of the probe's curve alone: the beans only warm, so the turning point (the charge drop) and
 #: the area Artisan counts from it are BT's.
 PROBE_ONLY = ("TP_s", "TP_C", "AUC_C_min")
@@ -63,6 +65,87 @@ DEVELOPMENT = ("development_s", "DTR_pct")
 #: roaster's BT shows); the probe's immersion in the bed changes with the batch mass, so across
 #: batch sizes it can move against the beans.
 READINGS = {"beans": "beans (model Tb; measured: a second bean reading where logged)", "probe": "probe BT (model Ta)"}
+
+
+def drop_time_s(text: str, logged_drop_s: float) -> float:
+    """The changed roast's DROP [s after CHARGE] from ``--drop-at``: ``"9:30"`` or ``"570"`` after CHARGE,
+    or with a sign relative to the logged DROP (``"+0:20"`` later, ``"-15"`` earlier)."""
+    text = text.strip()
+    when = parse_time_s(text)
+    return float(logged_drop_s + when) if text[:1] in "+-" else when
+
+
+def roast_until(batch: Batch, drop_s: float) -> Batch:
+    """``batch`` dropped at ``drop_s`` [s after CHARGE] instead of at its logged DROP: cut there (each input
+    interpolated at the cut, as the simulator holds it between samples), or carried on past its DROP, on its
+    own median sampling step, with every input held at its last logged value, up to :data:`DROP_LATER_MAX_S`.
+    A roast that was not run has no readings: the probe, second bean reading and ET are dropped, the probe
+    starting where the log's did (``initial["Ta0_C"]``). Marks after the new DROP go; DROP moves."""
+    src = batch.source or batch.name
+    t = np.asarray(batch.time_s, dtype=float)
+    end = float(t[-1])
+    if not np.isfinite(drop_s) or drop_s <= t[0] + 2 * float(np.min(np.diff(t))):
+        raise ParameterError(f"DROP at {mmss(drop_s)}: give a time after CHARGE and after the log's first samples", src)
+    if drop_s > end + DROP_LATER_MAX_S + 1e-9:
+        raise ParameterError(
+            f"DROP at {mmss(drop_s)} is more than {mmss(DROP_LATER_MAX_S)} after the logged DROP ({mmss(end)}): past "
+            "it the settings are held at their last values, a few minutes of a roast, not a longer one",
+            src,
+        )
+    if drop_s <= end:
+        keep = t < drop_s - 1e-9
+        new_t = np.append(t[keep], drop_s)
+
+        def series(a):
+            return None if a is None else np.append(np.asarray(a, float)[keep], np.interp(drop_s, t, a))
+
+    else:
+        step = float(np.median(np.diff(t)))
+        extra = np.arange(end + step, drop_s - 1e-9, step)
+        extra = np.append(extra, drop_s) if not extra.size or extra[-1] < drop_s - 1e-9 else extra
+        new_t = np.concatenate([t, extra])
+
+        def series(a):
+            return None if a is None else np.concatenate([np.asarray(a, float), np.full(extra.size, a[-1])])
+
+    initial = dict(batch.initial)
+    if batch.Ta_C is not None:
+        initial.setdefault("Ta0_C", float(batch.Ta_C[0]))
+    events = {k: v for k, v in batch.events.items() if v is not None and v < drop_s - 1e-9} | {"DROP": float(drop_s)}
+    return dataclasses.replace(
+        batch,
+        time_s=new_t,
+        Gg_kg_s=series(batch.Gg_kg_s),
+        Tgi_C=series(batch.Tgi_C),
+        heater=series(batch.heater),
+        fan=series(batch.fan),
+        Ta_C=None,
+        Tb2_C=None,
+        ET_C=None,
+        initial=initial,
+        events=events,
+    )
+
+
+def drop_at_bt_s(model: FittedModel, batch: Batch, bt_C: float, offset_C: float = 0.0, **changes) -> float:
+    """When the changed roast (``batch`` with ``changes``, carried on up to :data:`DROP_LATER_MAX_S` past
+    its DROP) reads ``bt_C`` on the roaster's BT after its turning point [s after CHARGE]: when the model's
+    probe BT plus ``offset_C`` reaches it. ``offset_C``, the log's BT less the model's at the logged DROP
+    (:func:`whatif`), reads the model as the roaster's probe would, the model's own miss at the end of this
+    roast carried a few minutes on (as the band's spread carries a log's error past its DROP,
+    :func:`roastlab.evaluate.bands.roast_spread`). A ParameterError naming how far it gets where it never
+    does."""
+    longest = roast_until(batch, float(batch.time_s[-1]) + DROP_LATER_MAX_S)
+    res = model.predict(longest, **changes)
+    hit = crossing_time_s(res.time_s, res.Ta_C + offset_C, bt_C)
+    if hit is None:
+        raise ParameterError(
+            f"DROP at BT {bt_C:.1f} °C: the changed roast's BT reaches {float(np.max(res.Ta_C)) + offset_C:.1f} °C at "
+            f"most by {mmss(res.time_s[-1])}, {mmss(DROP_LATER_MAX_S)} past the logged DROP with the last settings "
+            "held",
+            batch.source or batch.name,
+        )
+    return hit
 
 
 @dataclass
@@ -224,6 +307,11 @@ class WhatIf(Result):
     batch_kg: float | None = None
     #: changed settings that a log at the knob's end leaves unchanged, and when (:func:`_at_the_end`)
     held_at_end: list = field(default_factory=list)
+    #: the changed roast's DROP [s after CHARGE] where it drops elsewhere than the log (:func:`roast_until`)
+    drop_s: float | None = None
+    #: with DROP at a BT: the log's BT less the model's at the logged DROP, by which the model was read as the
+    #: roaster's probe (:func:`drop_at_bt_s`)
+    drop_offset_C: float | None = None
 
     def band_line(self, units: str = "C") -> str | None:
         """The changed probe BT's band in one line: its level, median width and BT at DROP."""
@@ -283,19 +371,41 @@ class WhatIf(Result):
             for setting, gains in self.inert.items()
         ]
         out += self.held_at_end
+        logged_drop = float(self.batch.time_s[-1])
+        if self.drop_offset_C:
+            d = display_temp_delta(self.drop_offset_C, units)
+            out.append(
+                f"DROP at a BT reads the model's BT as this log's probe: at the logged DROP the model read "
+                f"{abs(d):.1f} {u} {'below' if d > 0 else 'above'} it, a miss carried on to the new DROP"
+            )
+        if self.drop_s is not None and self.drop_s > logged_drop:
+            held = [
+                f"{k} {self.actuators[k].label(getattr(self.changed, k)[-1])}"
+                if k in self.actuators
+                else f"{k} as logged"
+                for k in ("heater", "fan")
+                if getattr(self.changed, k) is not None
+            ]
+            out.append(
+                f"from the logged DROP ({mmss(logged_drop)}) to {mmss(self.drop_s)} the roast is the model's alone, "
+                f"its inputs held at their last values{' (' + ', '.join(held) + ')' if held else ''}"
+            )
         for r in self.rows:
             level = self.levels.get(r["reading"], {}).get("FCs")
             for col in r["projected"]:
                 who = "the model as run" if col == "as_run" else "the changed roast"
+                drop = "its DROP" if col == "changed" and self.drop_s is not None else "the logged DROP"
                 out.append(
-                    f"{r['reading']}: {who} reaches the first-crack temperature ({display_temp(level, units):.1f} {u}) only after the "
-                    f"logged DROP (at {mmss(r[col])}, projected){': it runs cooler than this log late in the roast' if col == 'as_run' else ''}"
+                    f"{r['reading']}: {who} reaches the first-crack temperature ({display_temp(level, units):.1f} {u}) only after "
+                    f"{drop} (at {mmss(r[col])}, projected){': it runs cooler than this log late in the roast' if col == 'as_run' else ''}"
                 )
         small = []
         for r in self.rows:
             a, c, m = r["as_run"], r["changed"], r["measured"]
             if a is None or c is None or m is None or r["key"].startswith("TP"):
                 continue
+            if self.drop_s is not None and r["key"] in ("DROP_s", *DEVELOPMENT):
+                continue  # set by the DROP asked for, not predicted
             if 1e-6 < abs(c - a) < abs(a - m):  # a change there is, smaller than the model's own error
                 unit = {"time": "s", "pct": "points"}.get(r["kind"]) or _unit(r["kind"], units)
                 scale = display_temp_delta(1.0, units) if r["kind"] in ("temp", "auc") else 1.0
@@ -400,7 +510,7 @@ class WhatIf(Result):
     def _draw(self, ax) -> None:
         t = self.as_run.time_s
         curves = {"BT measured": (t, self.batch.Ta_C), "BT as run (model)": (t, self.as_run.Ta_C)}
-        curves["BT changed (model)"] = (t, self.changed.Ta_C)
+        curves["BT changed (model)"] = (self.changed.time_s, self.changed.Ta_C)
         draw_curves(ax, curves, "BT [°C]")
 
 
@@ -429,6 +539,8 @@ def whatif(
     *,
     actuators: dict | None = None,
     band_level: float | None = None,
+    drop_s: float | None = None,
+    drop_bt_C: float | None = None,
     **changes,
 ) -> WhatIf:
     """Predict ``batch`` as logged and with the changes; compare the roaster's milestones
@@ -441,7 +553,10 @@ def whatif(
     milestones are judged at the temperatures the log marks (its DRY and FCs); the beans' at
     the model's bean temperature at those marks as run. ``band_level`` (e.g. 0.9): also the
     changed probe BT's prediction band (:func:`roastlab.evaluate.bands.prediction_bands`); a
-    model file that cannot carry one is a ParameterError saying why.
+    model file that cannot carry one is a ParameterError saying why. ``drop_s`` [s after CHARGE] or
+    ``drop_bt_C`` (when the changed probe BT reaches it) drop the changed roast there instead of at the
+    logged DROP (:func:`roast_until`: cut, or carried on with the last settings held); its milestones
+    (development time, temperature at DROP, ...) are then those of its own DROP, a row DROP added.
     """
     if band_level is not None:
         from ..evaluate.bands import check_level, require_band
@@ -488,12 +603,30 @@ def whatif(
         "Tb0_C": "beans at charge {:.4g} °C",
     }
     labels += [names.get(k, k + " = {:g}").format(float(v)) for k, v in changes.items()]
+    if drop_s is not None and drop_bt_C is not None:
+        raise ParameterError("DROP is either at a time or at a BT, not both", batch.source or batch.name)
+    logged_drop_s = float(batch.time_s[-1])
     as_run = model.predict(batch)
+    drop_offset_C = None
+    if drop_bt_C is not None:
+        # the BT the roaster reads: the model's, as far off as it was from the log at the logged DROP
+        drop_offset_C = float(batch.Ta_C[-1] - as_run.Ta_C[-1]) if batch.Ta_C is not None else 0.0
+        drop_s = drop_at_bt_s(model, changed_batch, drop_bt_C, drop_offset_C, **changes)
+        labels.append(f"DROP at BT {drop_bt_C:.1f} °C ({mmss(drop_s)})")
+    elif drop_s is not None:
+        sign = "-" if drop_s < logged_drop_s else "+"
+        labels.append(f"DROP at {mmss(drop_s)} ({sign}{mmss(abs(drop_s - logged_drop_s))})")
+    if drop_s is not None:
+        changed_batch = roast_until(changed_batch, drop_s)
     changed = model.predict(changed_batch, **changes)
-    t = batch.time_s
+    t, tc = batch.time_s, changed.time_s
     events = batch.events
     measured = {"probe": batch.Ta_C, "beans": batch.Tb2_C}
-    model_curves = {"probe": (as_run.Ta_C, changed.Ta_C), "beans": (as_run.Tb_C, changed.Tb_C)}
+    # each model curve on its own times: a changed DROP ends the changed roast elsewhere
+    model_curves = {
+        "probe": ((t, as_run.Ta_C), (tc, changed.Ta_C)),
+        "beans": ((t, as_run.Tb_C), (tc, changed.Tb_C)),
+    }
     levels = {
         "probe": milestone_levels(t, batch.Ta_C, events) if batch.Ta_C is not None else {},
         "beans": milestone_levels(t, as_run.Tb_C, events),
@@ -504,16 +637,16 @@ def whatif(
     for reading in READINGS:
         lv = levels[reading]
         ms_meas = milestones(t, measured[reading], lv) if measured[reading] is not None else {}
-        ms_run, ms_chg = (milestones(t, y, lv) for y in model_curves[reading])
+        ms_run, ms_chg = (milestones(tt, y, lv) for tt, y in model_curves[reading])
         projected = {}
-        for name, ms, y in (
+        for name, ms, (tt, y) in (
             ("as_run", ms_run, model_curves[reading][0]),
             ("changed", ms_chg, model_curves[reading][1]),
         ):
             if ms["FCs_s"] is None:  # a model curve that stops short: where it would get there
-                ms["FCs_s"] = crossing_or_projected_s(t, y, lv["FCs"])
+                ms["FCs_s"] = crossing_or_projected_s(tt, y, lv["FCs"])
                 projected[name] = ms["FCs_s"] is not None
-        for key, what, kind in ROWS:
+        for key, what, kind in ROWS if drop_s is None else ROWS_WITH_DROP:
             if reading == "beans" and key in PROBE_ONLY:
                 continue
             rows.append(
@@ -553,4 +686,6 @@ def whatif(
         roaster=model.plant.name if model.plant is not None else "",
         batch_kg=changes.get("batch_kg") or batch.Mb_kg or (model.plant.Mb_kg if model.plant is not None else None),
         held_at_end=at_end,
+        drop_s=drop_s,
+        drop_offset_C=drop_offset_C,
     )
