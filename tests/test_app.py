@@ -83,6 +83,27 @@ def test_open_whatif_and_table_through_the_api(client):
     assert w["server_ms"] < 1000
 
 
+def test_a_what_if_dropped_elsewhere_through_the_api(client):
+    """The page's DROP field (roastlab whatif --drop-at / --drop-bt): a later DROP carries the changed curves
+    on to it, the table gains its DROP row and says where; a BT to drop at ends them where the changed
+    BT, read as the log's probe, reaches it; a DROP that is no time is one error, not a traceback."""
+    r = client.post("/api/open", json={"log": "batch1.csv", "model": "paper-model.json"}, headers=H).json()
+    end = r["curves"]["time_s"][-1]
+    w = client.post("/api/whatif", json={"drop_at": "+1:00"}, headers=H).json()
+    assert "error" not in w, w
+    assert w["curves"]["time_s"][-1] == pytest.approx(end + 60.0) and w["table"]["drop_s"] == pytest.approx(end + 60.0)
+    rows = {(x["reading"], x["key"]): x for x in w["table"]["rows"]}
+    assert rows["probe", "DROP_s"]["changed"] - rows["probe", "DROP_s"]["as_run"] == pytest.approx(60.0)
+    bt = np.array(r["curves"]["BT_measured"], dtype=float)
+    t = np.array(r["curves"]["time_s"], dtype=float)
+    at = float(np.interp(0.8 * end, t, bt))  # the BT the log read at 80 % of the roast
+    w = client.post("/api/whatif", json={"drop_bt": at}, headers=H).json()
+    assert "error" not in w, w
+    assert w["table"]["drop_s"] < end and w["curves"]["time_s"][-1] == pytest.approx(w["table"]["drop_s"])
+    bad = client.post("/api/whatif", json={"drop_at": "soon"}, headers=H)
+    assert bad.status_code == 400 and "not a time" in bad.json()["error"]
+
+
 def test_open_gives_phases_band_fit_figures_and_the_machines_controls(client, data_dir):
     if not (data_dir / "bullet-model.json").exists():
         pytest.skip("../shared/data/real is absent")
@@ -390,6 +411,25 @@ def test_the_page_draws_a_real_log_and_follows_a_what_if(page, data_dir, tmp_pat
         "heater [kPa] (drag a step)",
         "fan [steps]",
     ]
+
+
+def test_the_page_drops_the_changed_roast_later(page, tmp_path):
+    """Type +1:00 in the DROP field: the changed curves run a minute past the logged DROP, a "DROP changed"
+    mark stands there, and the table's DROP row says +1:00."""
+    _open(page, "batch1.csv", "paper-model.json")
+    updates = page.evaluate("Number(document.body.dataset.updates || 0)")
+    page.fill("#drop", "+1:00")
+    page.dispatch_event("#drop", "change")
+    page.wait_for_function(f"Number(document.body.dataset.updates || 0) > {updates}")
+    ends = page.evaluate(
+        "Object.fromEntries(document.getElementById('plot').data.map(t => [t.name, t.x[t.x.length - 1]]))"
+    )
+    assert ends["BT model, changed"] == pytest.approx(ends["BT model, as run"] + 1.0, abs=1e-6)
+    notes = page.evaluate("document.getElementById('plot')._fullLayout.annotations.map(a => a.text)")
+    assert any(n.startswith("DROP changed") for n in notes)
+    row = page.inner_text("tr[data-key='probe-DROP_s']")
+    assert "+1:00" in row
+    page.screenshot(path=str(tmp_path / "drop.png"), full_page=True)
 
 
 @pytest.mark.slow

@@ -230,6 +230,8 @@ function draw() {
   if (!o) return;
   const c = o.curves, ch = state.changed || o.curves;
   const x = minutes(c.time_s);
+  const xc = minutes(ch.time_s || c.time_s);  // the changed roast's own times: it may drop elsewhere
+  const xAll = xc.length && xc[xc.length - 1] > x[x.length - 1] ? xc : x;  // the axis spans the longer
   const T = (a) => (a ? a.map(temp) : null);
   const traces = [];
   if (c.BT_measured) traces.push({ x, y: T(c.BT_measured), name: "BT measured", mode: "markers", marker: { size: 3, color: "#333" } });
@@ -247,28 +249,31 @@ function draw() {
   }
   const cb = state.changed && state.changedBand;
   if (cb && cb.lower) {  // the changed curve's band, asked for once a change has settled (bandSoon)
-    traces.push({ x, y: T(cb.lower), name: "band changed", line: { width: 0 }, hoverinfo: "skip", showlegend: false });
-    traces.push({ x, y: T(cb.upper), name: `${Math.round(cb.level * 100)} % band, changed`, fill: "tonexty",
+    traces.push({ x: xc, y: T(cb.lower), name: "band changed", line: { width: 0 }, hoverinfo: "skip", showlegend: false });
+    traces.push({ x: xc, y: T(cb.upper), name: `${Math.round(cb.level * 100)} % band, changed`, fill: "tonexty",
                   fillcolor: "rgba(255, 127, 14, 0.15)", line: { width: 0 }, hoverinfo: "skip" });
   }
   traces.push({ x, y: T(c.BT_model), name: "BT model, as run", line: { color: "#1f77b4", width: 2 } });
-  traces.push({ x, y: T(ch.BT_model), name: "BT model, changed", line: { color: "#ff7f0e", width: 2 }, uid: "bt-changed" });
+  traces.push({ x: xc, y: T(ch.BT_model), name: "BT model, changed", line: { color: "#ff7f0e", width: 2 }, uid: "bt-changed" });
   traces.push({ x, y: T(c.beans_model), name: "beans model, as run", line: { color: "#1f77b4", width: 1, dash: "dash" } });
-  traces.push({ x, y: T(ch.beans_model), name: "beans model, changed", line: { color: "#ff7f0e", width: 1, dash: "dash" } });
-  traces.push({ x, y: T(ch.ET_model), name: `ET model: ${o.ET_model_is}, changed`, line: { color: "#9467bd", width: 1 } });
+  traces.push({ x: xc, y: T(ch.beans_model), name: "beans model, changed", line: { color: "#ff7f0e", width: 1, dash: "dash" } });
+  traces.push({ x: xc, y: T(ch.ET_model), name: `ET model: ${o.ET_model_is}, changed`, line: { color: "#9467bd", width: 1 } });
   if (c.RoR_measured) traces.push({ x, y: c.RoR_measured.map(dtemp), name: "RoR measured", yaxis: "y2", line: { color: "#555", width: 1 } });
-  traces.push({ x, y: ch.RoR_model.map(dtemp), name: "RoR model, changed", yaxis: "y2", line: { color: "#ff7f0e", width: 1 } });
-  if (ch.heater) traces.push({ x, y: ch.heater, name: `heater [${unitName("heater")}]`, yaxis: "y3", line: { shape: "hv", color: "#d62728" } });
-  if (ch.fan) traces.push({ x, y: ch.fan, name: `fan [${unitName("fan")}]`, yaxis: settingAxis("fan"), line: { shape: "hv", color: "#2ca02c" } });
-  const pxMin = pxPerMinute("plot", x);
-  const ev = eventShapes(o.events), ph = phaseShapes(o.phases, pxMin);
-  const rorAfter = (ch.RoR_model || []).filter((v, i) => v !== null && c.time_s[i] > 90).map(dtemp);
+  traces.push({ x: xc, y: ch.RoR_model.map(dtemp), name: "RoR model, changed", yaxis: "y2", line: { color: "#ff7f0e", width: 1 } });
+  if (ch.heater) traces.push({ x: xc, y: ch.heater, name: `heater [${unitName("heater")}]`, yaxis: "y3", line: { shape: "hv", color: "#d62728" } });
+  if (ch.fan) traces.push({ x: xc, y: ch.fan, name: `fan [${unitName("fan")}]`, yaxis: settingAxis("fan"), line: { shape: "hv", color: "#2ca02c" } });
+  const pxMin = pxPerMinute("plot", xAll);
+  const dropS = state.changed && state.table && state.table.drop_s;  // the changed roast's own DROP
+  const marks = dropS == null ? o.events : Object.fromEntries(
+    Object.entries(o.events || {}).filter(([, t]) => t <= c.time_s[c.time_s.length - 1] + 5).concat([["DROP changed", dropS]]));
+  const ev = eventShapes(marks), ph = phaseShapes(o.phases, pxMin);
+  const rorAfter = (ch.RoR_model || []).filter((v, i) => v !== null && (ch.time_s || c.time_s)[i] > 90).map(dtemp);
   const rorTop = rorAfter.length ? Math.max(...rorAfter) * 1.2 + 2 : 30;
   const t0 = performance.now();
   Plotly.react("plot", traces, {
     // a narrow screen (a tablet beside the roaster) wraps the legend into more rows: below the time axis's title
     margin: { t: 30, r: SIDE_PX, l: SIDE_PX, b: 40 }, legend: { orientation: "h", y: narrow() ? -0.2 : -0.12, font: { size: 10 } },
-    xaxis: { title: { text: "time after CHARGE [m:ss]" }, domain: [0, 1], anchor: "y3", ...mmssTicks(x, pxMin) },
+    xaxis: { title: { text: "time after CHARGE [m:ss]" }, domain: [0, 1], anchor: "y3", ...mmssTicks(xAll, pxMin) },
     yaxis: { title: { text: `temperature [${unit()}]` }, domain: [0.42, 1] },
     yaxis2: { title: { text: `RoR [${unit()}/min]` }, overlaying: "y", side: "right", range: [dtemp(-2), rorTop], showgrid: false,
               tickmode: "auto", nticks: 6, tickformat: ".0f" },
@@ -333,6 +338,11 @@ function drawTable() {
 function changes() {
   const v = (id) => $(id).value.trim();
   const body = { heater: v("heater"), fan: v("fan"), tgi: v("tgi") === "" ? "" : String(fieldC("tgi")) };
+  // DROP elsewhere: a clock (9:30) or a shift (+0:20, -15) is a time, a plain number the BT to drop at
+  if (v("drop") !== "") {
+    if (/[:+-]/.test(v("drop"))) body.drop_at = v("drop");
+    else body.drop_bt = celsius(Number(v("drop")), "level", F());
+  }
   const o = state.open;
   // a field shown in degF and read back differs from the log's degC value by its rounding to 0.1 degF
   const moved = (c, was) => c !== "" && Math.abs(c - was) > (F() ? 0.05 : 1e-9);
@@ -454,7 +464,7 @@ async function openLog() {
     $("batch_kg_range").max = (r.batch_kg || 1) * 1.6;
     $("batch_kg_range").value = r.batch_kg || 1;
     $("tr_batch_kg").value = r.batch_kg ?? "";
-    for (const id of ["heater", "fan"]) $(id).value = "";
+    for (const id of ["heater", "fan", "drop"]) $(id).value = "";
     $("notes").textContent = (r.notes || []).join("\n");
     showReport(r.report_html);
     draw();
@@ -612,7 +622,7 @@ window.addEventListener("DOMContentLoaded", async () => {
   link("Tm0_C", "Tm0_C_range");
   link("batch_kg", "batch_kg_range");
   const changed = () => { if (state.tInput === null) state.tInput = performance.now(); whatif(); };
-  for (const id of ["X0", "Tb0_C", "heater", "fan", "tgi"]) $(id).addEventListener("change", changed);
+  for (const id of ["X0", "Tb0_C", "heater", "fan", "tgi", "drop"]) $(id).addEventListener("change", changed);
   try {
     await refreshFiles();
     if ($("log").value && $("model").value) await openLog();

@@ -264,8 +264,9 @@ def _program_sets(body: dict, units: dict) -> list:
 
 def _changes(body: dict, session: Session):
     """The what-if's changes from the page's fields (the CLI's parsers, the same units)."""
+    from ..io.files import finite_number
     from ..model.limits import check_value
-    from ..workflows.whatif import parse_setting_change
+    from ..workflows.whatif import drop_time_s, parse_setting_change
 
     setting_changes, changes = [], {}
     cmap = session.model.column_map
@@ -280,6 +281,11 @@ def _changes(body: dict, session: Session):
             changes[name] = check_value(name, body[key], key)
     if body.get("tgi") not in (None, "", 0, "0"):
         changes["Tgi_offset_C"] = check_value("Tgi_offset_C", body["tgi"], "tgi")
+    # the changed roast's DROP (roastlab whatif --drop-at / --drop-bt): a time, or the BT [degC] to drop at
+    if str(body.get("drop_at") or "").strip():
+        changes["drop_s"] = drop_time_s(str(body["drop_at"]), float(session.batch.time_s[-1]))
+    if body.get("drop_bt") not in (None, ""):
+        changes["drop_bt_C"] = finite_number(body["drop_bt"], "request", "drop_bt")
     return setting_changes, changes
 
 

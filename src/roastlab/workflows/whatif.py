@@ -433,6 +433,8 @@ class WhatIf(Result):
             "rows": self.rows,
             "warnings": self.warnings(units),
             **({"band": bands.band_summary(self.band, self.band_note)} if self.band is not None else {}),
+            **({"drop_s": self.drop_s} if self.drop_s is not None else {}),
+            **({"drop_offset_C": self.drop_offset_C} if self.drop_offset_C is not None else {}),
         }
 
     def alog_text(self) -> str:
