@@ -297,10 +297,10 @@ def test_whatif_counts_the_area_under_the_probe_curve_on_one_base():
     assert "[°F·min]" in line_F and line_F.split()[-3] == f"{9 / 5 * r['changed']:.0f}"
 
 
-def _heated_batch(offset_C: float = 0.0):
+def _heated_batch(offset_C=0.0):
     """SYNTHETIC 10-minute batch on the paper's 120 kg plant with a heater series, its BT the paper
-    model's own prediction plus ``offset_C`` (so the model misses it by exactly that), FCs and DROP
-    marked, and a COOL mark after DROP."""
+    model's own prediction plus ``offset_C`` (a number, or a function of time [s]: so the model misses it
+    by exactly that), FCs and DROP marked, and a COOL mark after DROP."""
     from roastlab import FittedModel
     from roastlab.io.batch import Batch
 
@@ -308,7 +308,7 @@ def _heated_batch(offset_C: float = 0.0):
     heater = np.where(t < 300.0, 8.0, 6.0)
     model = FittedModel.paper()
     b = Batch("synthetic", t, np.full(t.size, 0.4), np.full(t.size, 450.0), heater=heater, initial={"Ta0_C": 30.0})
-    bt = model.predict(b).Ta_C + offset_C
+    bt = model.predict(b).Ta_C + (offset_C(t) if callable(offset_C) else offset_C)
     fcs = float(crossing_time_s(t, bt, float(bt[-1]) - 15.0))
     events = {"CHARGE": 0.0, "FCs": fcs, "DROP": 600.0, "COOL": 700.0}
     import dataclasses
@@ -348,20 +348,24 @@ def test_whatif_dropped_later_carries_the_roast_on_and_earlier_cuts_it():
 
 
 def test_whatif_dropped_at_a_bt_reads_the_model_as_the_logs_probe():
-    """--drop-bt: the model misses this SYNTHETIC log by exactly +4 degC (its BT is the model's plus 4),
-    so dropping at the BT the log read at 7:30 drops the changed roast (here unchanged) at 7:30, where the
-    model reads 4 degC less; a BT it never reaches within DROP_LATER_MAX_S is refused naming how far it
-    gets, and a DROP at a time and at a BT at once is refused."""
+    """--drop-bt: the model misses this SYNTHETIC log by 2 degC at CHARGE growing to 6 degC at DROP (its
+    BT is the model's plus that), so dropping at the BT the log read at 7:30 drops the changed roast (here
+    unchanged) at 7:30, where the model reads 5 degC less; past the logged DROP the miss at DROP is carried
+    on. A BT it never reaches within DROP_LATER_MAX_S is refused naming how far it gets, and a DROP at a
+    time and at a BT at once is refused."""
     from roastlab.errors import ParameterError
     from roastlab.workflows.whatif import DROP_LATER_MAX_S, whatif
 
-    model, b = _heated_batch(offset_C=4.0)
+    model, b = _heated_batch(offset_C=lambda t: 2.0 + 4.0 * t / 600.0)
     target = float(np.interp(450.0, b.time_s, b.Ta_C))
     w = whatif(model, b, drop_bt_C=target)
     assert w.drop_s == pytest.approx(450.0, abs=0.5)
-    assert w.drop_offset_C == pytest.approx(4.0, abs=1e-6)
-    assert w.changed.Ta_C[-1] + 4.0 == pytest.approx(target, abs=0.05)
-    assert any("the model read 4.0 °C below it" in n for n in w.warnings())
+    assert w.drop_offset_C == pytest.approx(5.0, abs=0.01)
+    assert w.changed.Ta_C[-1] + 5.0 == pytest.approx(target, abs=0.05)
+    assert any("the model read 5.0 °C below the log at 7:30" in n for n in w.warnings())
+    later = whatif(model, b, drop_bt_C=float(b.Ta_C[-1]) + 0.5)  # past the logged DROP: the miss at DROP
+    assert later.drop_s > 600.0 and later.drop_offset_C == pytest.approx(6.0, abs=1e-6)
+    assert later.changed.Ta_C[-1] + 6.0 == pytest.approx(float(b.Ta_C[-1]) + 0.5, abs=0.05)
     with pytest.raises(ParameterError, match=rf"reaches .* at most by .*{int(DROP_LATER_MAX_S // 60)}:00 past"):
         whatif(model, b, drop_bt_C=400.0)
     with pytest.raises(ParameterError, match="either at a time or at a BT"):

@@ -134,7 +134,7 @@ def add_parsers(sub) -> None:
         type=temperature_arg("--drop-bt"),
         metavar="TEMP",
         help="drop the changed roast when its BT reaches TEMP [degC; 400F for degF], as the log's probe would read "
-        "it: the model's BT plus its own miss at the logged DROP",
+        "it: the model's BT plus its own miss on the log then (past the logged DROP, its miss at DROP)",
     )
     add_initial_options(p)
     add_band_option(p, "the changed probe BT's prediction band", "its median width and BT at DROP in the table, "

@@ -127,25 +127,26 @@ def roast_until(batch: Batch, drop_s: float) -> Batch:
     )
 
 
-def drop_at_bt_s(model: FittedModel, batch: Batch, bt_C: float, offset_C: float = 0.0, **changes) -> float:
+def drop_at_bt_s(model: FittedModel, batch: Batch, bt_C: float, miss=None, **changes) -> tuple[float, float]:
     """When the changed roast (``batch`` with ``changes``, carried on up to :data:`DROP_LATER_MAX_S` past
-    its DROP) reads ``bt_C`` on the roaster's BT after its turning point [s after CHARGE]: when the model's
-    probe BT plus ``offset_C`` reaches it. ``offset_C``, the log's BT less the model's at the logged DROP
-    (:func:`whatif`), reads the model as the roaster's probe would, the model's own miss at the end of this
-    roast carried a few minutes on (as the band's spread carries a log's error past its DROP,
-    :func:`roastlab.evaluate.bands.roast_spread`). A ParameterError naming how far it gets where it never
-    does."""
+    its DROP) reads ``bt_C`` on the roaster's BT after its turning point [s after CHARGE], and the model's
+    miss added there [degC]: ``miss``, ``(time_s, miss_C)``, the log's BT less the model's as run
+    (:func:`whatif`), reads the model as the roaster's probe would, the model's own miss at each time of this
+    roast and past its DROP the miss at DROP carried a few minutes on (as the band's spread carries a log's
+    error past its DROP, :func:`roastlab.evaluate.bands.roast_spread`). Unchanged, the roast then drops
+    where the log read ``bt_C``. A ParameterError naming how far it gets where it never does."""
     longest = roast_until(batch, float(batch.time_s[-1]) + DROP_LATER_MAX_S)
     res = model.predict(longest, **changes)
-    hit = crossing_time_s(res.time_s, res.Ta_C + offset_C, bt_C)
+    added = np.zeros_like(res.Ta_C) if miss is None else np.interp(res.time_s, *miss)  # held past its end
+    reads = res.Ta_C + added
+    hit = crossing_time_s(res.time_s, reads, bt_C)
     if hit is None:
         raise ParameterError(
-            f"DROP at BT {bt_C:.1f} °C: the changed roast's BT reaches {float(np.max(res.Ta_C)) + offset_C:.1f} °C at "
-            f"most by {mmss(res.time_s[-1])}, {mmss(DROP_LATER_MAX_S)} past the logged DROP with the last settings "
-            "held",
+            f"DROP at BT {bt_C:.1f} °C: the changed roast's BT reaches {float(np.max(reads)):.1f} °C at most by "
+            f"{mmss(res.time_s[-1])}, {mmss(DROP_LATER_MAX_S)} past the logged DROP with the last settings held",
             batch.source or batch.name,
         )
-    return hit
+    return hit, float(np.interp(hit, res.time_s, added))
 
 
 @dataclass
@@ -309,8 +310,8 @@ class WhatIf(Result):
     held_at_end: list = field(default_factory=list)
     #: the changed roast's DROP [s after CHARGE] where it drops elsewhere than the log (:func:`roast_until`)
     drop_s: float | None = None
-    #: with DROP at a BT: the log's BT less the model's at the logged DROP, by which the model was read as the
-    #: roaster's probe (:func:`drop_at_bt_s`)
+    #: with DROP at a BT: the log's BT less the model's at the new DROP (past the logged DROP, at it), by which
+    #: the model was read as the roaster's probe (:func:`drop_at_bt_s`)
     drop_offset_C: float | None = None
 
     def band_line(self, units: str = "C") -> str | None:
@@ -374,9 +375,10 @@ class WhatIf(Result):
         logged_drop = float(self.batch.time_s[-1])
         if self.drop_offset_C:
             d = display_temp_delta(self.drop_offset_C, units)
+            when = "at the logged DROP, a miss carried on" if self.drop_s > logged_drop else f"at {mmss(self.drop_s)}"
             out.append(
-                f"DROP at a BT reads the model's BT as this log's probe: at the logged DROP the model read "
-                f"{abs(d):.1f} {u} {'below' if d > 0 else 'above'} it, a miss carried on to the new DROP"
+                f"DROP at a BT reads the model's BT as this log's probe: the model read {abs(d):.1f} {u} "
+                f"{'below' if d > 0 else 'above'} the log {when}"
             )
         if self.drop_s is not None and self.drop_s > logged_drop:
             held = [
@@ -611,9 +613,9 @@ def whatif(
     as_run = model.predict(batch)
     drop_offset_C = None
     if drop_bt_C is not None:
-        # the BT the roaster reads: the model's, as far off as it was from the log at the logged DROP
-        drop_offset_C = float(batch.Ta_C[-1] - as_run.Ta_C[-1]) if batch.Ta_C is not None else 0.0
-        drop_s = drop_at_bt_s(model, changed_batch, drop_bt_C, drop_offset_C, **changes)
+        # the BT the roaster reads: the model's, as far off as it was from the log then (past DROP, at DROP)
+        miss = (batch.time_s, batch.Ta_C - as_run.Ta_C) if batch.Ta_C is not None else None
+        drop_s, drop_offset_C = drop_at_bt_s(model, changed_batch, drop_bt_C, miss, **changes)
         labels.append(f"DROP at BT {drop_bt_C:.1f} °C ({mmss(drop_s)})")
     elif drop_s is not None:
         sign = "-" if drop_s < logged_drop_s else "+"
