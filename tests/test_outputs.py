@@ -81,6 +81,8 @@ VALUES = {
     "--fan",
     "--set",
     "--tgi",
+    "--drop-at",
+    "--drop-bt",
     "--batch-kg",
     "--tm0-range",
     "--decide",
